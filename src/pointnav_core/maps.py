@@ -28,6 +28,7 @@ from collections import OrderedDict
 from typing import Any, Callable, Hashable, TypeVar
 
 import numpy as np
+import shapely
 from numpy.typing import ArrayLike, NDArray
 from scipy import ndimage
 
@@ -101,6 +102,11 @@ class TraversableMap:
         World (x, y) of the outer corner of cell (0, 0), in metres.
     height : float
         World z of the floor, in metres.
+    geometry : FloorPlan, optional
+        The polygons the grid was rasterised from (anything with ``outline`` and
+        ``obstacles``). When given, erosion measures clearance from the polygons themselves
+        rather than from their staircase raster, which keeps geodesics unbiased along
+        rotated walls and furniture.
 
     Examples
     --------
@@ -121,6 +127,7 @@ class TraversableMap:
         resolution: float,
         origin: tuple[float, float] = (0.0, 0.0),
         height: float = 0.0,
+        geometry: Any = None,
     ) -> None:
         codes = np.asarray(grid)
         if codes.ndim != 2 or codes.shape[0] < 1 or codes.shape[1] < 1:
@@ -151,6 +158,7 @@ class TraversableMap:
         self.resolution = resolution
         self.origin = (float(origin_arr[0]), float(origin_arr[1]))
         self.height = height
+        self.geometry = geometry
         self._usable = BoundedCache(8)
         self._labels = BoundedCache(8)
         # Owned by ``geodesic``; kept here so that planners live exactly as long as the map.
@@ -249,6 +257,8 @@ class TraversableMap:
 
     def _erode(self, r: float) -> NDArray[np.bool_]:
         free = self.codes == FREE
+        if self.geometry is not None:
+            return self._erode_polygons(free, r * self.resolution)
         if r <= 0.5:
             # The disc stays inside its own cell, or touches a side neighbour exactly.
             mask = free.copy()
@@ -275,6 +285,24 @@ class TraversableMap:
                         touched |= blocked[rows + dr, cols + dc]
             usable[rows[~touched], cols[~touched]] = True
         mask = usable[pad:-pad, pad:-pad] & free
+        mask.flags.writeable = False
+        return mask
+
+    def _erode_polygons(self, free: NDArray[np.bool_], radius: float) -> NDArray[np.bool_]:
+        """Exact erosion against the source polygons: centre clearance >= radius."""
+        h, w = self.shape
+        ys, xs = np.mgrid[0:h, 0:w]
+        x = self.origin[0] + (xs + 0.5) * self.resolution
+        y = self.origin[1] + (ys + 0.5) * self.resolution
+        outline = self.geometry.outline
+        inner = outline.buffer(-radius, quad_segs=16, join_style="mitre") if radius > 0 else outline
+        mask = free & shapely.contains_xy(inner, x, y)
+        obstacles = list(self.geometry.obstacles)
+        if obstacles and radius > 0:
+            grown = shapely.union_all(obstacles).buffer(radius, quad_segs=16)
+            shapely.prepare(grown)
+            rows, cols = np.nonzero(mask)
+            mask[rows, cols] = ~shapely.intersects_xy(grown, x[rows, cols], y[rows, cols])
         mask.flags.writeable = False
         return mask
 

@@ -1,0 +1,591 @@
+"""Exact any-angle geodesic distances and paths on a robot-eroded grid.
+
+The robot's centre may move through the union of the *usable* cells of a floor
+(:meth:`TraversableMap.usable`), touching a blocked cell nowhere: a straight segment is
+free when every cell its closed extent meets is usable, so it cannot squeeze between two
+blocked cells that share a corner nor clip a blocked corner. Shortest paths in that space
+are polylines that bend only at *corner cells*: usable cells diagonal to a blocked cell
+whose two side neighbours towards it are usable. So the geodesic is exact on the
+visibility graph of those corners (computed once per floor and radius), not a count of grid
+steps, and paths are any-angle (string-pulled) from the true source to the true target.
+
+A :class:`GoalField` holds, for one goal, the geodesic distance of every corner (one
+Dijkstra run on the corner graph) and assigns every cell its best visible corner lazily, a
+tile of cells at a time, so that any later query to the same goal is a table lookup:
+
+====================  =====================================================  ===========
+stage                 work                                                   cached per
+====================  =====================================================  ===========
+:class:`Planner`      usable cells, components, corners, corner graph        floor, radius
+:class:`GoalField`    goal visibility, Dijkstra over corners                 floor, radius, goal
+tile of 16x16 cells   nearest visible corner of each cell (vectorised)       goal field
+query                 ``|p - corner| + D(corner)``                           --
+====================  =====================================================  ===========
+
+Internally everything is in *grid units* (cells) and grid coordinates ``(row, col)`` whose
+floor is the cell index; the public functions speak metres and world ``(x, y)``.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import TYPE_CHECKING
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+from scipy import sparse
+from scipy.sparse import csgraph
+
+from pointnav_core.maps import BoundedCache
+
+if TYPE_CHECKING:
+    from pointnav_core.maps import TraversableMap
+
+__all__ = ["Planner", "GoalField", "planner_for", "resample_path", "path_length"]
+
+_EPS = 1e-9
+_CORNER_INSET = 1e-6
+# How many segments' worth of band checks to vectorise at once (bounds peak memory).
+_CHUNK_BANDS = 1 << 21
+# Parent codes in a goal field's cell table (corner ids are >= 0).
+_TO_GOAL = -1
+_UNREACHABLE = -2
+
+
+def planner_for(tmap: TraversableMap, radius: float) -> Planner:
+    """Return the cached :class:`Planner` of ``tmap`` for a robot of ``radius`` metres."""
+    key = round(float(radius) / tmap.resolution, 9)
+    return tmap.planner_cache.get_or_create(key, lambda: Planner(tmap, radius))
+
+
+class Planner:
+    """Corner visibility graph of one floor for one robot radius.
+
+    Parameters
+    ----------
+    tmap : TraversableMap
+        The floor.
+    radius : float
+        Robot radius in metres (0 for a point robot).
+    field_cache_size : int
+        How many goal fields to keep (least recently used are dropped).
+    """
+
+    def __init__(self, tmap: TraversableMap, radius: float, field_cache_size: int = 32) -> None:
+        self.tmap = tmap
+        self.radius = float(radius)
+        self.usable = tmap.usable(radius)
+        self.labels = tmap.components(radius)
+        self.shape = self.usable.shape
+        blocked = (~self.usable).astype(np.int32)
+        h, w = self.shape
+        # Prefix sums of blocked cells along rows and along columns: a run of cells in one
+        # row (or column) is free iff its count is zero, which makes a segment test cost
+        # one lookup per row (or column) it crosses.
+        self._row_cum = np.zeros((h, w + 1), dtype=np.int32)
+        np.cumsum(blocked, axis=1, out=self._row_cum[:, 1:])
+        self._col_cum = np.zeros((w, h + 1), dtype=np.int32)
+        np.cumsum(blocked.T, axis=1, out=self._col_cum[:, 1:])
+        self.corners, self.corner_diag = self._find_corners()
+        rows = self.corners[:, 0].astype(np.int64)
+        cols = self.corners[:, 1].astype(np.int64)
+        self.corner_cells = rows * w + cols
+        self.corner_labels = self.labels[rows, cols]
+        self._cell_graph: sparse.csr_matrix | None = None
+        self._component_graphs: dict[int, tuple[NDArray[np.int64], sparse.csr_matrix]] = {}
+        self._fields = BoundedCache(field_cache_size)
+
+    # --------------------------------------------------------------- visibility
+    def visible(self, p: ArrayLike, q: ArrayLike) -> NDArray[np.bool_]:
+        """Whether straight segments between grid points are free (vectorised).
+
+        Parameters
+        ----------
+        p, q : array_like, shape (..., 2)
+            Segment ends in grid coordinates ``(row, col)``; they broadcast.
+
+        Returns
+        -------
+        ndarray of bool
+            True where every cell the closed segment meets is usable.
+        """
+        p, q = np.broadcast_arrays(np.asarray(p, dtype=np.float64), np.asarray(q, dtype=np.float64))
+        shape = p.shape[:-1]
+        p = p.reshape(-1, 2)
+        q = q.reshape(-1, 2)
+        out = np.empty(len(p), dtype=bool)
+        # Walk the axis the segment crosses fewer cells of: rows, or columns (transposed).
+        by_rows = np.abs(q[:, 0] - p[:, 0]) <= np.abs(q[:, 1] - p[:, 1])
+        if by_rows.any():
+            out[by_rows] = self._visible_banded(p[by_rows], q[by_rows], self._row_cum)
+        by_cols = ~by_rows
+        if by_cols.any():
+            out[by_cols] = self._visible_banded(
+                p[by_cols][:, ::-1], q[by_cols][:, ::-1], self._col_cum
+            )
+        return out.reshape(shape)
+
+    @staticmethod
+    def _visible_banded(
+        p: NDArray[np.float64], q: NDArray[np.float64], cum: NDArray[np.int32]
+    ) -> NDArray[np.bool_]:
+        """Segment test over bands (rows of ``cum``); column 0 of p, q is the band axis.
+
+        Each band the closed segment meets is checked in O(1): the run of cells it covers
+        in that band must hold no blocked cell (a difference of two prefix sums).
+        """
+        n_bands, n_cells = cum.shape[0], cum.shape[1] - 1
+        p0, p1, q0, q1 = p[:, 0], p[:, 1], q[:, 0], q[:, 1]
+        a0 = np.minimum(p0, q0)
+        a1 = np.maximum(p0, q0)
+        k_lo = np.ceil(a0 - _EPS).astype(np.int64) - 1
+        counts = np.floor(a1 + _EPS).astype(np.int64) - k_lo + 1
+        d0 = q0 - p0
+        flat = np.abs(d0) < _EPS
+        slope = np.divide(q1 - p1, d0, out=np.zeros_like(d0), where=~flat)
+        free = np.empty(len(p), dtype=bool)
+        ends = np.cumsum(counts)
+        start = 0
+        while start < len(p):
+            # Chunk segments so that the flattened band arrays stay bounded in memory.
+            stop = int(np.searchsorted(ends, ends[start] - counts[start] + _CHUNK_BANDS, "right"))
+            stop = max(stop, start + 1)
+            n = counts[start:stop]
+            seg = np.repeat(np.arange(start, stop), n)
+            first = ends[start:stop] - n
+            k = np.arange(first[0], first[0] + len(seg)) - np.repeat(first - k_lo[start:stop], n)
+            sp0, sp1, sl = p0[seg], p1[seg], slope[seg]
+            o_a = sp1 + (np.maximum(k, a0[seg]) - sp0) * sl
+            o_b = sp1 + (np.minimum(k + 1, a1[seg]) - sp0) * sl
+            lo = np.minimum(o_a, o_b)
+            hi = np.maximum(o_a, o_b)
+            flat_band = flat[seg]
+            if flat_band.any():
+                # A segment along the band covers its whole extent inside its band(s).
+                lo[flat_band] = np.minimum(p1, q1)[seg[flat_band]]
+                hi[flat_band] = np.maximum(p1, q1)[seg[flat_band]]
+            j_lo = np.ceil(lo - _EPS).astype(np.int64) - 1
+            j_hi = np.floor(hi + _EPS).astype(np.int64) + 1
+            off_map = (k < 0) | (k >= n_bands) | (j_lo < 0) | (j_hi > n_cells)
+            kc = np.minimum(np.maximum(k, 0), n_bands - 1)
+            j_lo = np.minimum(np.maximum(j_lo, 0), n_cells)
+            j_hi = np.minimum(np.maximum(j_hi, 0), n_cells)
+            blocked = off_map | (cum[kc, j_hi] != cum[kc, j_lo])
+            free[start:stop] = ~np.logical_or.reduceat(blocked, first - first[0])
+            start = stop
+        return free
+
+    # ------------------------------------------------------------------ corners
+    def _find_corners(self) -> tuple[NDArray[np.float64], NDArray[np.int8]]:
+        """Corner points (V, 2) in grid coordinates and the blocked diagonal (V, 2) of each."""
+        u = self.usable
+        h, w = u.shape
+        pad = np.pad(u, 1, constant_values=False)
+
+        def shifted(dr: int, dc: int) -> NDArray[np.bool_]:
+            return pad[1 + dr : 1 + dr + h, 1 + dc : 1 + dc + w]
+
+        points, diags = [], []
+        inset = 0.5 - _CORNER_INSET
+        for dr in (-1, 1):
+            for dc in (-1, 1):
+                rows, cols = np.nonzero(u & shifted(dr, 0) & shifted(0, dc) & ~shifted(dr, dc))
+                # The corner of the usable cell that touches the blocked one, pulled in by a
+                # hair so that segments leaving it tangentially do not touch the blocked cell.
+                # Bending there (not at the cell centre) keeps the path on the usable region's
+                # boundary, which is what keeps the geodesic unbiased.
+                points.append(np.stack([rows + 0.5 + dr * inset, cols + 0.5 + dc * inset], axis=1))
+                diags.append(np.tile(np.array([dr, dc], dtype=np.int8), (len(rows), 1)))
+        return np.concatenate(points), np.concatenate(diags)
+
+    def tangent(self, ids: ArrayLike, direction: ArrayLike) -> NDArray[np.bool_]:
+        """Whether lines through corners ``ids`` along ``direction`` stay clear of their cell.
+
+        A shortest path can only bend at a corner, or arrive at it, along such a line: one
+        that does not enter the open quadrant of the blocked diagonal cell.
+        """
+        d = self.corner_diag[np.asarray(ids, dtype=np.int64)]
+        e = np.asarray(direction, dtype=np.float64)
+        return (e[..., 0] * d[..., 0]) * (e[..., 1] * d[..., 1]) <= 0.0
+
+    def component_graph(self, label: int) -> tuple[NDArray[np.int64], sparse.csr_matrix]:
+        """Corner ids of one component and their visibility graph (edge weights in cells).
+
+        Only bitangent edges are kept (tangent at both ends): no shortest path uses others.
+        """
+        try:
+            return self._component_graphs[label]
+        except KeyError:
+            pass
+        ids = np.flatnonzero(self.corner_labels == label)
+        n = len(ids)
+        edges_i, edges_j = [np.zeros(0, np.int64)], [np.zeros(0, np.int64)]
+        pts = self.corners[ids]
+        i, j = np.triu_indices(n, k=1)
+        e = pts[j] - pts[i]
+        keep = self.tangent(ids[i], e) & self.tangent(ids[j], e)
+        i, j = i[keep], j[keep]
+        ok = self.visible(pts[i], pts[j])
+        i, j = i[ok], j[ok]
+        weight = np.maximum(np.hypot(*(pts[i] - pts[j]).T), _EPS)
+        graph = sparse.csr_matrix((weight, (i, j)), shape=(n, n))
+        self._component_graphs[label] = (ids, graph)
+        return ids, graph
+
+    def cell_graph(self) -> sparse.csr_matrix:
+        """16-connected graph of usable cells, plus an empty last row for a super source.
+
+        Nodes are flat cell indices. A step (one of the 8 king moves and 8 knight moves) is
+        an edge when the segment between the two cell centres is free, the same rule as
+        :meth:`visible`, so no step cuts a blocked corner. Knight moves bring the grid
+        metric within 3 % of Euclidean in every direction, which is what lets one Dijkstra
+        run pick each cell's root corner well.
+        """
+        if self._cell_graph is not None:
+            return self._cell_graph
+        u = self.usable
+        h, w = u.shape
+        index = np.arange(h * w).reshape(h, w)
+        pad = 2
+        padded = np.pad(u, pad, constant_values=False)
+        src, dst, wts = [], [], []
+        for dr, dc in ((0, 1), (1, 0), (1, 1), (1, -1), (1, 2), (2, 1), (1, -2), (2, -1)):
+            ok = u.copy()
+            for tr, tc in _touched_cells(dr, dc):
+                ok &= padded[pad + tr : pad + tr + h, pad + tc : pad + tc + w]
+            rows, cols = np.nonzero(ok)
+            a = index[rows, cols]
+            b = (rows + dr) * w + (cols + dc)
+            length = math.hypot(dr, dc)
+            src += [a, b]
+            dst += [b, a]
+            wts += [np.full(len(a), length)] * 2
+        n = h * w + 1
+        graph = sparse.csr_matrix(
+            (np.concatenate(wts), (np.concatenate(src), np.concatenate(dst))), shape=(n, n)
+        )
+        graph.sort_indices()
+        self._cell_graph = graph
+        return graph
+
+    # -------------------------------------------------------------------- goals
+    def goal_field(self, goal: ArrayLike) -> GoalField:
+        """Return the cached :class:`GoalField` rooted at ``goal`` (grid coordinates)."""
+        g = np.asarray(goal, dtype=np.float64)
+        key = (float(g[0]), float(g[1]))
+        return self._fields.get_or_create(key, lambda: GoalField(self, g))
+
+    def label_at(self, g: ArrayLike) -> int:
+        """Component id at a grid point (0 when off the map or not usable)."""
+        r, c = (int(math.floor(v)) for v in np.asarray(g, dtype=np.float64))
+        h, w = self.shape
+        if 0 <= r < h and 0 <= c < w:
+            return int(self.labels[r, c])
+        return 0
+
+
+class GoalField:
+    """Geodesic distances to one goal, for every point of the goal's component.
+
+    Build it through :meth:`Planner.goal_field` (cached). Distances are in grid units
+    (cells) here; ``Scene`` converts to metres.
+
+    Two tables make queries cheap. ``corner_dist`` is the exact geodesic distance of every
+    corner (Dijkstra on the corner visibility graph). ``root`` names, for every cell, the
+    corner (or the goal) through which the cell's shortest path leaves it; it comes from one
+    multi-source Dijkstra on the cell grid seeded with the corners' exact distances, so the
+    per-step query ``|p - root| + D(root)`` is a lookup. Path queries check that the root is
+    visible from the exact source point and search the corners exactly when it is not.
+
+    Parameters
+    ----------
+    planner : Planner
+        The floor and radius.
+    goal : array_like, shape (2,)
+        Goal in grid coordinates ``(row, col)``.
+    """
+
+    def __init__(self, planner: Planner, goal: ArrayLike) -> None:
+        self.planner = planner
+        self.goal = np.asarray(goal, dtype=np.float64).copy()
+        self.label = planner.label_at(self.goal)
+        h, w = planner.shape
+        self.root = np.full((h, w), _UNREACHABLE, dtype=np.int32)
+        if self.label == 0:
+            self.corner_ids = np.zeros(0, dtype=np.int64)
+            self.corner_pos = np.zeros((0, 2))
+            self.corner_dist = np.zeros(0)
+            self.corner_pred = np.zeros(0, dtype=np.int64)
+        else:
+            self._solve_corners()
+            self._solve_cells()
+        # Plain Python copies for the per-step scalar lookup (faster than numpy scalars).
+        self._pos_r = self.corner_pos[:, 0].tolist()
+        self._pos_c = self.corner_pos[:, 1].tolist()
+        self._dist = self.corner_dist.tolist()
+        self._root_rows = self.root.tolist()
+
+    @property
+    def reachable_from_anywhere(self) -> bool:
+        """False when the goal itself is not usable (every query is unreachable)."""
+        return self.label != 0
+
+    def _solve_corners(self) -> None:
+        planner = self.planner
+        ids, graph = planner.component_graph(self.label)
+        n = len(ids)
+        pos = planner.corners[ids]
+        sees_goal = planner.visible(pos, self.goal[None, :]) & planner.tangent(ids, self.goal - pos)
+        to_goal = np.maximum(np.hypot(*(pos - self.goal).T), _EPS) if n else np.zeros(0)
+        rows = np.flatnonzero(sees_goal)
+        goal_edges = sparse.csr_matrix(
+            (to_goal[rows], (rows, np.full(len(rows), n))), shape=(n + 1, n + 1)
+        )
+        full = sparse.bmat([[graph, None], [None, sparse.csr_matrix((1, 1))]], format="csr")
+        full = (full + goal_edges).tocsr()
+        dist, pred = csgraph.dijkstra(full, directed=False, indices=n, return_predecessors=True)
+        self.corner_ids = ids
+        self.corner_pos = pos
+        self.corner_dist = dist[:n]
+        # Predecessor of each corner on its way to the goal: a corner index, or n (the goal).
+        self.corner_pred = pred[:n].astype(np.int64)
+        self.corner_pred[self.corner_pred < 0] = n
+
+    def _solve_cells(self) -> None:
+        planner = self.planner
+        h, w = planner.shape
+        n_cells = h * w
+        reached = np.isfinite(self.corner_dist)
+        local = np.flatnonzero(reached)
+        cells = planner.corner_cells[self.corner_ids[local]]
+        # One seed per cell: the corner with the smallest distance (written last wins).
+        order = np.argsort(-self.corner_dist[local], kind="stable")
+        source_of = np.full(n_cells + 1, _UNREACHABLE, dtype=np.int64)
+        source_of[cells[order]] = local[order]
+        goal_cell = int(math.floor(self.goal[0])) * w + int(math.floor(self.goal[1]))
+        source_of[goal_cell] = _TO_GOAL
+        seeds = np.flatnonzero(source_of[:n_cells] != _UNREACHABLE)
+        seed_ids = source_of[seeds]
+        weight = np.where(seed_ids == _TO_GOAL, 0.0, self.corner_dist[np.maximum(seed_ids, 0)])
+        base = planner.cell_graph()
+        super_source = n_cells
+        graph = sparse.csr_matrix(
+            (
+                np.concatenate([base.data, np.maximum(weight, _EPS)]),
+                np.concatenate([base.indices, seeds]),
+                np.concatenate([base.indptr[:-1], [base.nnz + len(seeds)]]),
+            ),
+            shape=(n_cells + 1, n_cells + 1),
+        )
+        _, pred = csgraph.dijkstra(
+            graph, directed=True, indices=super_source, return_predecessors=True
+        )
+        # Follow predecessors up to the seed each cell hangs from (pointer jumping).
+        anc = pred.astype(np.int64)
+        anc[super_source] = super_source
+        seeded = anc == super_source
+        anc[seeded] = np.flatnonzero(seeded)
+        unreached = anc < 0
+        anc[unreached] = super_source
+        while True:
+            nxt = anc[anc]
+            if np.array_equal(nxt, anc):
+                break
+            anc = nxt
+        root = np.where(unreached[:n_cells] | (anc[:n_cells] == super_source), _UNREACHABLE,
+                        source_of[np.minimum(anc[:n_cells], n_cells)])
+        self.root = self._pull_taut(root).reshape(h, w).astype(np.int32)
+
+    def _pull_taut(self, root: NDArray[np.int64]) -> NDArray[np.int64]:
+        """Re-root cells whose path does not wrap their root corner tautly.
+
+        The grid metric sometimes routes a cell through a corner it could pass by. A path
+        c -> v -> next only bends at v if both legs are tangent there and it turns towards
+        v's blocked cell; otherwise the cell hangs from ``next`` instead (repeat).
+        """
+        planner = self.planner
+        w = planner.shape[1]
+        n = len(self.corner_ids)
+        diag = planner.corner_diag[self.corner_ids].astype(np.float64)
+        next_pos = np.vstack([self.corner_pos, self.goal[None, :]])[self.corner_pred]
+        cells = np.flatnonzero(root >= 0)
+        centre = np.stack([cells // w + 0.5, cells % w + 0.5], axis=1)
+        v = root[cells]
+        for _ in range(n + 1):
+            a = self.corner_pos[v] - centre
+            b = next_pos[v] - self.corner_pos[v]
+            d = diag[v]
+            turn = a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0]
+            side = a[:, 0] * d[:, 1] - a[:, 1] * d[:, 0]
+            taut = (turn * side > 0) & ((a[:, 0] * d[:, 0]) * (a[:, 1] * d[:, 1]) <= 0)
+            slack = np.flatnonzero(~taut)
+            if len(slack) == 0:
+                break
+            nxt = self.corner_pred[v[slack]]
+            done = nxt == n
+            root[cells[slack[done]]] = _TO_GOAL
+            v[slack] = nxt
+            keep = np.ones(len(v), dtype=bool)
+            keep[slack[done]] = False
+            cells, centre, v = cells[keep], centre[keep], v[keep]
+            root[cells] = v
+        return root
+
+    # ------------------------------------------------------------------ lookups
+    def distance(self, gr: float, gc: float) -> float:
+        """Geodesic distance from grid point (gr, gc) to the goal, in cells (inf if none).
+
+        This is the per-step hot path: plain Python on cached tables, no search.
+        """
+        r = math.floor(gr)
+        c = math.floor(gc)
+        h, w = self.planner.shape
+        if not (0 <= r < h and 0 <= c < w):
+            return math.inf
+        root = self._root_rows[r][c]
+        if root >= 0:
+            return math.hypot(gr - self._pos_r[root], gc - self._pos_c[root]) + self._dist[root]
+        if root == _TO_GOAL:
+            return math.hypot(gr - self.goal[0], gc - self.goal[1])
+        return math.inf
+
+    def best_parent(self, g: NDArray[np.float64]) -> int:
+        """First corner (or -1: the goal) on the shortest path from an exact grid point.
+
+        The cell's root is used when the exact point sees it (the common case: one segment
+        test); otherwise the corners are searched exactly.
+        """
+        r, c = math.floor(g[0]), math.floor(g[1])
+        h, w = self.planner.shape
+        if self.label == 0 or not (0 <= r < h and 0 <= c < w) or self.planner.labels[r, c] != self.label:
+            return _UNREACHABLE
+        root = int(self.root[r, c])
+        if root == _TO_GOAL:
+            ok = bool(self.planner.visible(g, self.goal))
+        else:
+            target = self.corner_pos[root]
+            ok = bool(self.planner.visible(g, target)) and bool(
+                self.planner.tangent(self.corner_ids[root], target - g)
+            )
+        return root if ok else int(self._search(g[None, :])[0])
+
+    def path(self, g: NDArray[np.float64]) -> tuple[NDArray[np.float64], float] | tuple[None, None]:
+        """Any-angle path from grid point ``g`` to the goal and its length (cells)."""
+        g = np.asarray(g, dtype=np.float64)
+        parent = self.best_parent(g)
+        if parent == _UNREACHABLE:
+            return None, None
+        points = [g]
+        if parent == _TO_GOAL:
+            length = float(np.hypot(*(g - self.goal)))
+        else:
+            length = float(np.hypot(*(g - self.corner_pos[parent]))) + float(self.corner_dist[parent])
+            n = len(self.corner_ids)
+            node = parent
+            while node != n:
+                points.append(self.corner_pos[node])
+                node = int(self.corner_pred[node])
+        points.append(self.goal)
+        return np.array(points), length
+
+    def _search(self, points: NDArray[np.float64]) -> NDArray[np.int32]:
+        """Best visible candidate (goal or corner) for each point, exactly.
+
+        Candidates are tried in increasing order of ``|p - corner| + D(corner)`` (``|p - goal|``
+        for the goal, which is the smallest key of all); the first visible one is optimal.
+        """
+        n = len(self.corner_ids)
+        cand_pos = np.vstack([self.corner_pos, self.goal[None, :]])
+        cand_dist = np.append(self.corner_dist, 0.0)
+        keys = np.hypot(
+            points[:, None, 0] - cand_pos[None, :, 0], points[:, None, 1] - cand_pos[None, :, 1]
+        ) + cand_dist[None, :]
+        for i, p in enumerate(points):
+            # A path can only bend at a corner it meets tangentially.
+            keys[i, :n][~self.planner.tangent(self.corner_ids, self.corner_pos - p)] = np.inf
+        best = np.full(len(points), _UNREACHABLE, dtype=np.int32)
+        todo = np.arange(len(points))
+        batch = 4
+        while len(todo):
+            k = min(batch, n + 1)
+            sub = keys[todo]
+            if k < n + 1:
+                order = np.argpartition(sub, k - 1, axis=1)[:, :k]
+            else:
+                order = np.broadcast_to(np.arange(n + 1), (len(todo), n + 1)).copy()
+            cand_keys = np.take_along_axis(sub, order, axis=1)
+            seen = self.planner.visible(
+                np.repeat(points[todo], k, axis=0), cand_pos[order.ravel()]
+            ).reshape(len(todo), k)
+            seen &= np.isfinite(cand_keys)
+            masked = np.where(seen, cand_keys, np.inf)
+            pick = np.argmin(masked, axis=1)
+            found = np.isfinite(masked[np.arange(len(todo)), pick])
+            chosen = order[np.arange(len(todo)), pick]
+            best[todo[found]] = np.where(chosen[found] == n, _TO_GOAL, chosen[found])
+            # Everything tested and not chosen is either invisible or worse: rule it out.
+            rest = todo[~found]
+            keys[rest[:, None], order[~found]] = np.inf
+            exhausted = ~np.isfinite(keys[rest]).any(axis=1)
+            todo = rest[~exhausted]
+            batch = min(batch * 4, n + 1)
+        return best
+
+
+def _touched_cells(dr: int, dc: int) -> list[tuple[int, int]]:
+    """Cell offsets met by the closed segment from cell (0, 0)'s centre to (dr, dc)'s."""
+    touched = []
+    for r in range(min(0, dr) - 1, max(0, dr) + 2):
+        for c in range(min(0, dc) - 1, max(0, dc) + 2):
+            # Clip the segment p(t) = (0.5 + t*dr, 0.5 + t*dc) to the closed square.
+            t0, t1 = 0.0, 1.0
+            for start, delta, low in ((0.5, dr, r), (0.5, dc, c)):
+                if delta == 0:
+                    if not low <= start <= low + 1:
+                        t0, t1 = 1.0, 0.0
+                    continue
+                a, b = (low - start) / delta, (low + 1 - start) / delta
+                t0, t1 = max(t0, min(a, b)), min(t1, max(a, b))
+            if t0 <= t1 + 1e-12:
+                touched.append((r, c))
+    return touched
+
+
+def path_length(points: ArrayLike) -> float:
+    """Length of a polyline, shape (N, 2), in its own units."""
+    pts = np.asarray(points, dtype=np.float64)
+    if len(pts) < 2:
+        return 0.0
+    return float(np.hypot(*np.diff(pts, axis=0).T).sum())
+
+
+def resample_path(points: ArrayLike, spacing: float, count: int) -> NDArray[np.float64]:
+    """First ``count`` points spaced ``spacing`` apart along a polyline, padded with its end.
+
+    Parameters
+    ----------
+    points : array_like, shape (N, 2)
+        The polyline, N >= 1.
+    spacing : float
+        Arc-length spacing (same units as ``points``), > 0.
+    count : int
+        Number of points returned, >= 1.
+
+    Returns
+    -------
+    ndarray, shape (count, 2)
+        Points at arc lengths 0, spacing, 2*spacing, ...; past the end of the polyline the
+        last point repeats (as OmniGibson pads its waypoints with the target).
+
+    Examples
+    --------
+    >>> resample_path([[0.0, 0.0], [1.0, 0.0]], 0.4, 4).tolist()
+    [[0.0, 0.0], [0.4, 0.0], [0.8, 0.0], [1.0, 0.0]]
+    """
+    pts = np.asarray(points, dtype=np.float64)
+    seg = np.hypot(*np.diff(pts, axis=0).T) if len(pts) > 1 else np.zeros(0)
+    arc = np.concatenate([[0.0], np.cumsum(seg)])
+    s = np.minimum(np.arange(count) * float(spacing), arc[-1])
+    x = np.interp(s, arc, pts[:, 0])
+    y = np.interp(s, arc, pts[:, 1])
+    return np.stack([x, y], axis=1)
