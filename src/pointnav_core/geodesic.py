@@ -45,6 +45,7 @@ __all__ = ["Planner", "GoalField", "planner_for", "resample_path", "path_length"
 
 _EPS = 1e-9
 _CORNER_INSET = 1e-6
+_STEPS = ((0, 1), (1, 0), (1, 1), (1, -1))
 # How many segments' worth of band checks to vectorise at once (bounds peak memory).
 _CHUNK_BANDS = 1 << 21
 # Parent codes in a goal field's cell table (corner ids are >= 0).
@@ -249,7 +250,7 @@ class Planner:
         pad = 2
         padded = np.pad(u, pad, constant_values=False)
         src, dst, wts = [], [], []
-        for dr, dc in ((0, 1), (1, 0), (1, 1), (1, -1), (1, 2), (2, 1), (1, -2), (2, -1)):
+        for dr, dc in _STEPS:
             ok = u.copy()
             for tr, tc in _touched_cells(dr, dc):
                 ok &= padded[pad + tr : pad + tr + h, pad + tc : pad + tc + w]
@@ -290,12 +291,16 @@ class GoalField:
     Build it through :meth:`Planner.goal_field` (cached). Distances are in grid units
     (cells) here; ``Scene`` converts to metres.
 
-    Two tables make queries cheap. ``corner_dist`` is the exact geodesic distance of every
-    corner (Dijkstra on the corner visibility graph). ``root`` names, for every cell, the
-    corner (or the goal) through which the cell's shortest path leaves it; it comes from one
-    multi-source Dijkstra on the cell grid seeded with the corners' exact distances, so the
-    per-step query ``|p - root| + D(root)`` is a lookup. Path queries check that the root is
-    visible from the exact source point and search the corners exactly when it is not.
+    ``corner_dist`` is the exact geodesic distance of every corner (Dijkstra on the corner
+    visibility graph), solved when the field is made. That alone answers exact point
+    queries (:meth:`path`, :meth:`point_distance`) by searching the corners a point sees.
+
+    For the per-step hot path, :meth:`distance` reads a *root table*, built on its first
+    call: for every cell, the corner (or the goal) through which its shortest path leaves
+    it. One multi-source Dijkstra on the 8-connected cell grid, seeded with the corners'
+    exact distances, proposes each cell's root; the grid metric can pick a corner the cell
+    could pass by, so on first use a cell's root is pulled up its corner chain until the
+    path wraps it tautly. Then a query is ``|p - root| + D(root)``: a lookup and a hypot.
 
     Parameters
     ----------
@@ -309,8 +314,7 @@ class GoalField:
         self.planner = planner
         self.goal = np.asarray(goal, dtype=np.float64).copy()
         self.label = planner.label_at(self.goal)
-        h, w = planner.shape
-        self.root = np.full((h, w), _UNREACHABLE, dtype=np.int32)
+        self._root_rows: list[list[int]] | None = None
         if self.label == 0:
             self.corner_ids = np.zeros(0, dtype=np.int64)
             self.corner_pos = np.zeros((0, 2))
@@ -318,12 +322,16 @@ class GoalField:
             self.corner_pred = np.zeros(0, dtype=np.int64)
         else:
             self._solve_corners()
-            self._solve_cells()
-        # Plain Python copies for the per-step scalar lookup (faster than numpy scalars).
-        self._pos_r = self.corner_pos[:, 0].tolist()
-        self._pos_c = self.corner_pos[:, 1].tolist()
-        self._dist = self.corner_dist.tolist()
-        self._root_rows = self.root.tolist()
+        # Plain Python copies for the per-step scalar work (faster than numpy scalars).
+        n = len(self.corner_ids)
+        self._n = n
+        self._pos_r = self.corner_pos[:, 0].tolist() + [float(self.goal[0])]
+        self._pos_c = self.corner_pos[:, 1].tolist() + [float(self.goal[1])]
+        self._dist = self.corner_dist.tolist() + [0.0]
+        self._pred = self.corner_pred.tolist()
+        diag = planner.corner_diag[self.corner_ids]
+        self._diag_r = diag[:, 0].tolist()
+        self._diag_c = diag[:, 1].tolist()
 
     @property
     def reachable_from_anywhere(self) -> bool:
@@ -336,13 +344,17 @@ class GoalField:
         n = len(ids)
         pos = planner.corners[ids]
         sees_goal = planner.visible(pos, self.goal[None, :]) & planner.tangent(ids, self.goal - pos)
-        to_goal = np.maximum(np.hypot(*(pos - self.goal).T), _EPS) if n else np.zeros(0)
         rows = np.flatnonzero(sees_goal)
-        goal_edges = sparse.csr_matrix(
-            (to_goal[rows], (rows, np.full(len(rows), n))), shape=(n + 1, n + 1)
+        to_goal = np.maximum(np.hypot(*(pos[rows] - self.goal).T), _EPS)
+        # The corner graph plus one last node, the goal, linked to the corners that see it.
+        full = sparse.csr_matrix(
+            (
+                np.concatenate([graph.data, to_goal]),
+                np.concatenate([graph.indices, rows]),
+                np.concatenate([graph.indptr, [graph.nnz + len(rows)]]),
+            ),
+            shape=(n + 1, n + 1),
         )
-        full = sparse.bmat([[graph, None], [None, sparse.csr_matrix((1, 1))]], format="csr")
-        full = (full + goal_edges).tocsr()
         dist, pred = csgraph.dijkstra(full, directed=False, indices=n, return_predecessors=True)
         self.corner_ids = ids
         self.corner_pos = pos
@@ -351,10 +363,22 @@ class GoalField:
         self.corner_pred = pred[:n].astype(np.int64)
         self.corner_pred[self.corner_pred < 0] = n
 
-    def _solve_cells(self) -> None:
+    def _solve_cells(self) -> list[list[int]]:
+        """Build the root table (raw grid-Dijkstra roots; pulled taut lazily per cell)."""
         planner = self.planner
         h, w = planner.shape
         n_cells = h * w
+        root = np.full(n_cells, _UNREACHABLE, dtype=np.int64)
+        if self.label != 0:
+            root = self._grid_roots()
+        self._root_rows = root.reshape(h, w).tolist()
+        return self._root_rows
+
+    def _grid_roots(self) -> NDArray[np.int64]:
+        planner = self.planner
+        h, w = planner.shape
+        n_cells = h * w
+        n = self._n
         reached = np.isfinite(self.corner_dist)
         local = np.flatnonzero(reached)
         cells = planner.corner_cells[self.corner_ids[local]]
@@ -363,10 +387,9 @@ class GoalField:
         source_of = np.full(n_cells + 1, _UNREACHABLE, dtype=np.int64)
         source_of[cells[order]] = local[order]
         goal_cell = int(math.floor(self.goal[0])) * w + int(math.floor(self.goal[1]))
-        source_of[goal_cell] = _TO_GOAL
+        source_of[goal_cell] = n
         seeds = np.flatnonzero(source_of[:n_cells] != _UNREACHABLE)
-        seed_ids = source_of[seeds]
-        weight = np.where(seed_ids == _TO_GOAL, 0.0, self.corner_dist[np.maximum(seed_ids, 0)])
+        weight = np.append(self.corner_dist, 0.0)[source_of[seeds]]
         base = planner.cell_graph()
         super_source = n_cells
         graph = sparse.csr_matrix(
@@ -385,51 +408,49 @@ class GoalField:
         anc[super_source] = super_source
         seeded = anc == super_source
         anc[seeded] = np.flatnonzero(seeded)
-        unreached = anc < 0
-        anc[unreached] = super_source
+        anc[anc < 0] = super_source
         while True:
             nxt = anc[anc]
             if np.array_equal(nxt, anc):
                 break
             anc = nxt
-        root = np.where(unreached[:n_cells] | (anc[:n_cells] == super_source), _UNREACHABLE,
-                        source_of[np.minimum(anc[:n_cells], n_cells)])
-        self.root = self._pull_taut(root).reshape(h, w).astype(np.int32)
-
-    def _pull_taut(self, root: NDArray[np.int64]) -> NDArray[np.int64]:
-        """Re-root cells whose path does not wrap their root corner tautly.
-
-        The grid metric sometimes routes a cell through a corner it could pass by. A path
-        c -> v -> next only bends at v if both legs are tangent there and it turns towards
-        v's blocked cell; otherwise the cell hangs from ``next`` instead (repeat).
-        """
-        planner = self.planner
-        w = planner.shape[1]
-        n = len(self.corner_ids)
-        diag = planner.corner_diag[self.corner_ids].astype(np.float64)
-        next_pos = np.vstack([self.corner_pos, self.goal[None, :]])[self.corner_pred]
-        cells = np.flatnonzero(root >= 0)
-        centre = np.stack([cells // w + 0.5, cells % w + 0.5], axis=1)
-        v = root[cells]
-        for _ in range(n + 1):
-            a = self.corner_pos[v] - centre
-            b = next_pos[v] - self.corner_pos[v]
-            d = diag[v]
-            turn = a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0]
-            side = a[:, 0] * d[:, 1] - a[:, 1] * d[:, 0]
-            taut = (turn * side > 0) & ((a[:, 0] * d[:, 0]) * (a[:, 1] * d[:, 1]) <= 0)
-            slack = np.flatnonzero(~taut)
-            if len(slack) == 0:
-                break
-            nxt = self.corner_pred[v[slack]]
-            done = nxt == n
-            root[cells[slack[done]]] = _TO_GOAL
-            v[slack] = nxt
-            keep = np.ones(len(v), dtype=bool)
-            keep[slack[done]] = False
-            cells, centre, v = cells[keep], centre[keep], v[keep]
-            root[cells] = v
+        root = source_of[anc[:n_cells]]
+        # The goal's own code; corners keep their index and are pulled taut on first use.
+        root[root == n] = _TO_GOAL
         return root
+
+    def _taut_root(self, r: int, c: int, v: int) -> int:
+        """Pull corner ``v`` (the raw root of cell (r, c)) up its chain until it is taut.
+
+        A path c -> v -> next only bends at v if the leg to v is tangent there and the turn
+        is towards v's blocked cell; otherwise the cell hangs from ``next``. Returns a corner
+        index or -1 (the goal), encoded for the table as described in :meth:`_lookup`.
+        """
+        cr, cc = r + 0.5, c + 0.5
+        n = self._n
+        while v != n:
+            vr, vc = self._pos_r[v], self._pos_c[v]
+            ar, ac = vr - cr, vc - cc
+            nxt = self._pred[v]
+            br, bc = self._pos_r[nxt] - vr, self._pos_c[nxt] - vc
+            dr, dc = self._diag_r[v], self._diag_c[v]
+            if (ar * bc - ac * br) * (ar * dc - ac * dr) > 0 and (ar * dr) * (ac * dc) <= 0:
+                return v
+            v = nxt
+        return _TO_GOAL
+
+    def _lookup(self, r: int, c: int) -> int:
+        """Root of cell (r, c): a corner index, -1 (the goal) or -2 (unreachable).
+
+        Table codes: >= 0 a raw corner root not yet pulled taut; -1 goal; -2 unreachable;
+        <= -3 the taut corner ``-code - 3``.
+        """
+        rows = self._root_rows if self._root_rows is not None else self._solve_cells()
+        code = rows[r][c]
+        if code >= 0:
+            root = self._taut_root(r, c, code)
+            rows[r][c] = code = root if root < 0 else -root - 3
+        return -code - 3 if code <= -3 else code
 
     # ------------------------------------------------------------------ lookups
     def distance(self, gr: float, gc: float) -> float:
@@ -442,32 +463,37 @@ class GoalField:
         h, w = self.planner.shape
         if not (0 <= r < h and 0 <= c < w):
             return math.inf
-        root = self._root_rows[r][c]
-        if root >= 0:
-            return math.hypot(gr - self._pos_r[root], gc - self._pos_c[root]) + self._dist[root]
-        if root == _TO_GOAL:
-            return math.hypot(gr - self.goal[0], gc - self.goal[1])
-        return math.inf
+        root = self._lookup(r, c)
+        if root == _UNREACHABLE:
+            return math.inf
+        return math.hypot(gr - self._pos_r[root], gc - self._pos_c[root]) + self._dist[root]
+
+    def point_distance(self, g: NDArray[np.float64]) -> float:
+        """Exact geodesic distance from grid point ``g`` (cells; inf if unreachable)."""
+        parent = self.best_parent(np.asarray(g, dtype=np.float64))
+        if parent == _UNREACHABLE:
+            return math.inf
+        return math.hypot(g[0] - self._pos_r[parent], g[1] - self._pos_c[parent]) + self._dist[parent]
 
     def best_parent(self, g: NDArray[np.float64]) -> int:
         """First corner (or -1: the goal) on the shortest path from an exact grid point.
 
-        The cell's root is used when the exact point sees it (the common case: one segment
-        test); otherwise the corners are searched exactly.
+        With the root table built, the cell's root is used when the exact point sees it (one
+        segment test); otherwise the corners are searched exactly.
         """
         r, c = math.floor(g[0]), math.floor(g[1])
         h, w = self.planner.shape
         if self.label == 0 or not (0 <= r < h and 0 <= c < w) or self.planner.labels[r, c] != self.label:
             return _UNREACHABLE
-        root = int(self.root[r, c])
-        if root == _TO_GOAL:
-            ok = bool(self.planner.visible(g, self.goal))
-        else:
-            target = self.corner_pos[root]
-            ok = bool(self.planner.visible(g, target)) and bool(
-                self.planner.tangent(self.corner_ids[root], target - g)
-            )
-        return root if ok else int(self._search(g[None, :])[0])
+        if self._root_rows is not None:
+            root = self._lookup(r, c)
+            if root != _UNREACHABLE:
+                target = np.array([self._pos_r[root], self._pos_c[root]])
+                if self.planner.visible(g, target) and (
+                    root == _TO_GOAL or self.planner.tangent(self.corner_ids[root], target - g)
+                ):
+                    return root
+        return int(self._search(g[None, :])[0])
 
     def path(self, g: NDArray[np.float64]) -> tuple[NDArray[np.float64], float] | tuple[None, None]:
         """Any-angle path from grid point ``g`` to the goal and its length (cells)."""
@@ -476,15 +502,11 @@ class GoalField:
         if parent == _UNREACHABLE:
             return None, None
         points = [g]
-        if parent == _TO_GOAL:
-            length = float(np.hypot(*(g - self.goal)))
-        else:
-            length = float(np.hypot(*(g - self.corner_pos[parent]))) + float(self.corner_dist[parent])
-            n = len(self.corner_ids)
-            node = parent
-            while node != n:
-                points.append(self.corner_pos[node])
-                node = int(self.corner_pred[node])
+        node = self._n if parent == _TO_GOAL else parent
+        length = math.hypot(g[0] - self._pos_r[node], g[1] - self._pos_c[node]) + self._dist[node]
+        while node != self._n:
+            points.append(self.corner_pos[node])
+            node = self._pred[node]
         points.append(self.goal)
         return np.array(points), length
 

@@ -153,7 +153,7 @@ class TraversableMap:
         height = float(height)
         if not math.isfinite(height):
             raise ValueError(f"height must be finite, got {height!r}")
-        self.codes: NDArray[np.uint8] = np.ascontiguousarray(codes, dtype=np.uint8)
+        self.codes: NDArray[np.uint8] = np.array(codes, dtype=np.uint8, order="C", copy=True)
         self.codes.flags.writeable = False
         self.resolution = resolution
         self.origin = (float(origin_arr[0]), float(origin_arr[1]))

@@ -14,8 +14,12 @@ from hypothesis import strategies as st
 
 from pointnav_core import floorplans
 from pointnav_core.floorplans import FloorPlan
+from pointnav_core.maps import FREE, OBSTACLE, VOID, TraversableMap
 
 __all__: list[str] = [
+    "code_grids",
+    "traversable_maps",
+    "maps_with_points",
     "floor_plans",
     "unit_quaternions",
     "yaws",
@@ -207,3 +211,56 @@ def robot_actions(spec: object, overshoot: float = 0.0) -> st.SearchStrategy[np.
 
 
 __all__ += ["robot_specs", "robot_actions"]
+
+
+# ----------------------------------------------------------------------- maps
+
+
+@st.composite
+def code_grids(draw: st.DrawFn, min_side: int = 2, max_side: int = 24) -> np.ndarray:
+    """Cell-code grids (uint8, FREE/OBSTACLE/VOID) made of a free floor and a few rectangles.
+
+    At least one cell is FREE. Shrinks towards a small, all-free grid.
+    """
+    h = draw(st.integers(min_side, max_side))
+    w = draw(st.integers(min_side, max_side))
+    grid = np.full((h, w), FREE, dtype=np.uint8)
+    for _ in range(draw(st.integers(0, 6))):
+        r0, c0 = draw(st.integers(0, h - 1)), draw(st.integers(0, w - 1))
+        r1, c1 = draw(st.integers(r0, h - 1)), draw(st.integers(c0, w - 1))
+        grid[r0 : r1 + 1, c0 : c1 + 1] = draw(st.sampled_from((OBSTACLE, VOID)))
+    if not (grid == FREE).any():
+        grid[draw(st.integers(0, h - 1)), draw(st.integers(0, w - 1))] = FREE
+    return grid
+
+
+@st.composite
+def traversable_maps(draw: st.DrawFn, max_side: int = 24) -> TraversableMap:
+    """Small :class:`~pointnav_core.maps.TraversableMap` values with a random origin."""
+    grid = draw(code_grids(max_side=max_side))
+    resolution = draw(st.sampled_from((0.1, 0.05, 0.25, 1.0)))
+    origin = (draw(st.floats(-50.0, 50.0)), draw(st.floats(-50.0, 50.0)))
+    height = draw(st.floats(-5.0, 5.0))
+    return TraversableMap(grid, resolution, origin, height)
+
+
+@st.composite
+def maps_with_points(
+    draw: st.DrawFn, n_points: int = 2, max_side: int = 24, max_radius_cells: float = 2.5
+) -> tuple[TraversableMap, float, np.ndarray]:
+    """A map, a robot radius (m) and ``n_points`` usable world points (n, 2) on it.
+
+    The radius is chosen so that some cell is usable; points lie anywhere inside usable
+    cells (not only at centres).
+    """
+    tmap = draw(traversable_maps(max_side=max_side))
+    radius = draw(st.floats(0.0, max_radius_cells)) * tmap.resolution
+    if not tmap.usable(radius).any():
+        radius = 0.0
+    cells = np.argwhere(tmap.usable(radius))
+    points = []
+    for _ in range(n_points):
+        r, c = cells[draw(st.integers(0, len(cells) - 1))]
+        fr, fc = draw(st.floats(0.05, 0.95)), draw(st.floats(0.05, 0.95))
+        points.append(tmap.grid_to_world(np.array([r + fr, c + fc])))
+    return tmap, radius, np.array(points)

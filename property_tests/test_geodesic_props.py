@@ -1,0 +1,128 @@
+"""Properties of maps, erosion, sampling and geodesic paths on random grids."""
+
+import math
+
+import numpy as np
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from pointnav_core.geodesic import path_length, planner_for
+from pointnav_core.maps import FREE
+from pointnav_core.scenes import Scene
+from pointnav_core.testing.strategies import maps_with_points, traversable_maps
+
+
+def scene_of(tmap):
+    return Scene([tmap])
+
+
+def segment_is_free(tmap, radius, a, b, step=0.05):
+    """Dense independent check: every sample along a-b lies in a usable cell."""
+    n = max(2, int(math.ceil(np.hypot(*(np.subtract(b, a))) / (step * tmap.resolution))) + 1)
+    t = np.linspace(0.0, 1.0, n)[:, None]
+    pts = np.asarray(a) * (1 - t) + np.asarray(b) * t
+    return bool(tmap.is_usable(pts, radius).all())
+
+
+@given(traversable_maps(), st.data())
+def test_world_cell_round_trip_and_bounds(tmap, data):
+    h, w = tmap.shape
+    r = data.draw(st.integers(-3, h + 3))
+    c = data.draw(st.integers(-3, w + 3))
+    cell = np.array([r, c])
+    assert np.array_equal(tmap.world_to_cell(tmap.cell_to_world(cell)), cell)
+    inside = 0 <= r < h and 0 <= c < w
+    assert bool(tmap.in_bounds(cell)) == inside
+    expected = tmap.codes[r, c] if inside else 2
+    assert int(tmap.cell_class_at(tmap.cell_to_world(cell))) == expected
+
+
+@given(traversable_maps(), st.floats(0.0, 3.0), st.floats(0.0, 3.0))
+def test_erosion_shrinks_monotonically_and_keeps_the_radius(tmap, a, b):
+    small, large = sorted((a * tmap.resolution, b * tmap.resolution))
+    u_small, u_large = tmap.usable(small), tmap.usable(large)
+    assert not (u_large & ~u_small).any()
+    blocked = np.argwhere(tmap.codes != FREE)
+    h, w = tmap.shape
+    for r, c in np.argwhere(u_large):
+        # At least `large` from every blocked cell square and from the map's outside.
+        if len(blocked):
+            gap = np.maximum(np.abs(blocked - [r, c]) - 0.5, 0.0)
+            assert np.hypot(gap[:, 0], gap[:, 1]).min() * tmap.resolution >= large - 1e-9
+        assert (min(r, c, h - 1 - r, w - 1 - c) + 0.5) * tmap.resolution >= large - 1e-9
+
+
+@given(maps_with_points(n_points=2))
+def test_paths_are_usable_free_and_as_long_as_reported(case):
+    tmap, radius, (a, b) = case
+    scene = scene_of(tmap)
+    path, dist = scene.get_shortest_path(0, a, b, entire_path=True, robot=radius)
+    same_component = tmap.component_at(a, radius) == tmap.component_at(b, radius)
+    assert (path is not None) == bool(same_component)
+    if path is None:
+        return
+    assert np.allclose(path[0], a) and np.allclose(path[-1], b)
+    assert tmap.is_usable(path, radius).all()
+    for p, q in zip(path[:-1], path[1:]):
+        assert segment_is_free(tmap, radius, p, q)
+    assert math.isclose(path_length(path), dist, rel_tol=1e-9, abs_tol=1e-12)
+    assert dist >= math.dist(a, b) - 1e-9
+
+
+@given(maps_with_points(n_points=3))
+@settings(max_examples=40)
+def test_geodesic_is_symmetric_and_obeys_the_triangle_inequality(case):
+    tmap, radius, (a, b, c) = case
+    scene = scene_of(tmap)
+    d = lambda p, q: scene.get_shortest_path(0, p, q, entire_path=True, robot=radius)[1]  # noqa: E731
+    ab, ba = d(a, b), d(b, a)
+    if ab is None:
+        assert ba is None
+        return
+    cell = tmap.resolution
+    assert abs(ab - ba) <= cell
+    bc, ac = d(b, c), d(a, c)
+    if bc is not None:
+        assert ac <= ab + bc + cell
+
+
+@given(maps_with_points(n_points=2))
+@settings(max_examples=40)
+def test_field_lookup_agrees_with_the_path_query(case):
+    tmap, radius, (a, b) = case
+    scene = scene_of(tmap)
+    _, dist = scene.get_shortest_path(0, a, b, entire_path=True, robot=radius)
+    lookup = scene.goal_field(0, b, robot=radius).distance(*a)
+    if dist is None:
+        assert lookup == math.inf
+    else:
+        # The lookup uses the root of a's cell; the path query checks the exact point.
+        assert lookup >= math.dist(a, b) - 1e-9
+        assert abs(lookup - dist) <= 2 * tmap.resolution + 0.02 * dist
+
+
+@given(maps_with_points(n_points=1), st.integers(0, 2**32 - 1))
+def test_random_points_are_usable_and_stay_in_the_reference_component(case, seed):
+    tmap, radius, (ref,) = case
+    scene = scene_of(tmap)
+    rng = np.random.default_rng(seed)
+    floor, p = scene.get_random_point(robot=radius, rng=rng)
+    assert floor == 0 and p[2] == tmap.height
+    assert tmap.is_usable(p[:2], radius)
+    _, q = scene.get_random_point(0, reference_point=ref, robot=radius, rng=rng)
+    assert tmap.component_at(q[:2], radius) == tmap.component_at(ref, radius)
+    assert scene.get_shortest_path(0, ref, q[:2], robot=radius)[1] is not None
+
+
+@given(maps_with_points(n_points=1))
+@settings(max_examples=30)
+def test_corner_graph_edges_are_free_segments(case):
+    tmap, radius, _ = case
+    planner = planner_for(tmap, radius)
+    for label in np.unique(planner.corner_labels):
+        ids, graph = planner.component_graph(int(label))
+        coo = graph.tocoo()
+        for i, j in zip(coo.row, coo.col):
+            a = tmap.grid_to_world(planner.corners[ids[i]])
+            b = tmap.grid_to_world(planner.corners[ids[j]])
+            assert segment_is_free(tmap, radius, a, b)

@@ -1,0 +1,411 @@
+"""Scenes: one or more floors, with sampling and geodesic shortest paths.
+
+A :class:`Scene` is a list of floors (:class:`~pointnav_core.maps.TraversableMap`, each
+with its own height) and the API of OmniGibson's ``TraversableScene``, so that ported code
+reads the same:
+
+=============================================  ==========================================
+member                                         meaning
+=============================================  ==========================================
+``n_floors``, ``get_floor_height(floor)``      floors and their z (m)
+``get_random_point(floor, reference_point,     uniform usable point (a cell centre), in
+robot, rng) -> (floor, xyz)``                  the reference point's component if given
+``get_shortest_path(floor, source_xy,          any-angle path (N, 2) from the true source
+target_xy, entire_path, robot)``               to the true target and its length (m)
+``geodesic_distance(floor, source, target)``   the length alone (``inf`` when unreachable)
+``goal_field(floor, goal_xy, robot)``          cached per-goal distance field (hot path)
+=============================================  ==========================================
+
+``robot`` is anything with a ``radius`` attribute (a ``RobotSpec``), a radius in metres, or
+None for a point robot. Scenes are built from arrays, shapely polygons, OmniGibson
+traversability PNGs or MovingAI maps, or generated (:func:`rooms`, :func:`maze`,
+:func:`clutter`).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from os import PathLike
+from typing import Any
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from pointnav_core import floorplans, loaders
+from pointnav_core.errors import SamplingError
+from pointnav_core.floorplans import FloorPlan
+from pointnav_core.geodesic import GoalField, Planner, planner_for, resample_path
+from pointnav_core.maps import TraversableMap
+
+__all__ = ["Scene", "FloorGoalField", "robot_radius", "rooms", "maze", "clutter"]
+
+
+def robot_radius(robot: Any) -> float:
+    """Radius in metres of a robot spec (``.radius``), a number, or None (a point: 0.0)."""
+    if robot is None:
+        return 0.0
+    radius = getattr(robot, "radius", robot)
+    try:
+        radius = float(radius)
+    except (TypeError, ValueError):
+        raise ValueError(
+            f"robot must be a robot spec with a radius, a radius in metres, or None; got {robot!r}"
+        ) from None
+    if not math.isfinite(radius) or radius < 0.0:
+        raise ValueError(f"robot radius must be a finite number >= 0 (m), got {radius!r}")
+    return radius
+
+
+def _as_xy(value: ArrayLike, name: str) -> NDArray[np.float64]:
+    arr = np.asarray(value, dtype=np.float64).reshape(-1)
+    if arr.shape not in ((2,), (3,)) or not np.isfinite(arr).all():
+        raise ValueError(f"{name} must be a finite (x, y) or (x, y, z) point in metres, got {value!r}")
+    return arr[:2]
+
+
+def _as_rng(rng: np.random.Generator | int | None) -> np.random.Generator:
+    if isinstance(rng, np.random.Generator):
+        return rng
+    return np.random.default_rng(rng)
+
+
+class FloorGoalField:
+    """Geodesic distance to one goal on one floor, in metres (a cached view of a GoalField).
+
+    ``distance(x, y)`` is the per-step query: a table lookup plus one ``hypot`` (the table is
+    built on the first call). ``exact_distance`` and ``path`` check the exact point.
+    """
+
+    def __init__(self, tmap: TraversableMap, field: GoalField) -> None:
+        self.tmap = tmap
+        self.field = field
+        self._ox, self._oy = tmap.origin
+        self._inv_res = 1.0 / tmap.resolution
+        self._res = tmap.resolution
+
+    @property
+    def goal_usable(self) -> bool:
+        """Whether the goal lies in a usable cell (if not, nothing reaches it)."""
+        return self.field.reachable_from_anywhere
+
+    def distance(self, x: float, y: float) -> float:
+        """Geodesic distance (m) from world point (x, y) to the goal; ``inf`` if unreachable."""
+        d = self.field.distance((y - self._oy) * self._inv_res, (x - self._ox) * self._inv_res)
+        return d * self._res
+
+    def exact_distance(self, source_xy: ArrayLike) -> float:
+        """Geodesic distance (m) from the exact point ``source_xy``, checked, not looked up."""
+        g = self.tmap.world_to_grid(_as_xy(source_xy, "source_xy"))
+        return self.field.point_distance(g) * self._res
+
+    def path(self, source_xy: ArrayLike) -> tuple[NDArray[np.float64], float] | tuple[None, None]:
+        """Any-angle path (N, 2) in world metres from ``source_xy`` to the goal, and its length."""
+        g = self.tmap.world_to_grid(_as_xy(source_xy, "source_xy"))
+        points, length = self.field.path(g)
+        if points is None:
+            return None, None
+        return self.tmap.grid_to_world(points), float(length) * self._res
+
+
+class Scene:
+    """A navigable scene: floors with heights, sampling and geodesic paths.
+
+    Parameters
+    ----------
+    floors : sequence of TraversableMap
+        One map per floor, floor 0 first; each map carries its floor height.
+    num_waypoints : int
+        Waypoints returned by :meth:`get_shortest_path` when ``entire_path=False``.
+    waypoint_spacing : float
+        Spacing (m) of those waypoints along the path.
+    floor_plans : sequence of FloorPlan or None, optional
+        The polygons each floor was rasterised from, when known (backends may use them).
+
+    Examples
+    --------
+    >>> scene = Scene.from_array(np.ones((40, 40), bool), resolution=0.1)
+    >>> scene.n_floors, scene.get_floor_height(0)
+    (1, 0.0)
+    >>> path, dist = scene.get_shortest_path(0, (0.5, 0.5), (3.5, 0.5), entire_path=True)
+    >>> round(dist, 6), path.shape
+    (3.0, (2, 2))
+    """
+
+    def __init__(
+        self,
+        floors: Sequence[TraversableMap],
+        *,
+        num_waypoints: int = 10,
+        waypoint_spacing: float = 0.2,
+        floor_plans: Sequence[FloorPlan | None] | None = None,
+    ) -> None:
+        floors = list(floors)
+        if not floors or not all(isinstance(f, TraversableMap) for f in floors):
+            raise ValueError("floors must be a non-empty sequence of TraversableMap")
+        if int(num_waypoints) != num_waypoints or num_waypoints < 1:
+            raise ValueError(f"num_waypoints must be an integer >= 1, got {num_waypoints!r}")
+        if not math.isfinite(waypoint_spacing) or waypoint_spacing <= 0:
+            raise ValueError(f"waypoint_spacing must be > 0 (m), got {waypoint_spacing!r}")
+        plans = list(floor_plans) if floor_plans is not None else [None] * len(floors)
+        if len(plans) != len(floors):
+            raise ValueError(
+                f"floor_plans must have one entry per floor ({len(floors)}), got {len(plans)}"
+            )
+        self.floors = floors
+        self.num_waypoints = int(num_waypoints)
+        self.waypoint_spacing = float(waypoint_spacing)
+        self.floor_plans = plans
+
+    # ------------------------------------------------------------- constructors
+    @classmethod
+    def from_array(
+        cls,
+        grid: ArrayLike | Sequence[ArrayLike],
+        resolution: float,
+        origin: tuple[float, float] = (0.0, 0.0),
+        heights: Sequence[float] | None = None,
+        **kwargs: Any,
+    ) -> Scene:
+        """Scene from one 2D array per floor: booleans (True = free) or cell codes.
+
+        Parameters
+        ----------
+        grid : array_like (H, W), (F, H, W), or a sequence of 2D arrays
+            The floors' grids.
+        resolution : float
+            Metres per cell.
+        origin : (float, float)
+            World (x, y) of the outer corner of cell (0, 0), shared by all floors.
+        heights : sequence of float, optional
+            Floor heights (m); default ``0, 3, 6, ...``.
+        """
+        if isinstance(grid, np.ndarray) and grid.ndim == 2:
+            grids = [grid]
+        elif isinstance(grid, np.ndarray) and grid.ndim == 3:
+            grids = list(grid)
+        elif isinstance(grid, (list, tuple)) and grid and np.ndim(grid[0]) == 2:
+            grids = list(grid)
+        else:
+            grids = [np.asarray(grid)]
+        heights = cls._heights(heights, len(grids))
+        floors = [TraversableMap(g, resolution, origin, h) for g, h in zip(grids, heights)]
+        return cls(floors, **kwargs)
+
+    @classmethod
+    def from_polygons(
+        cls,
+        floor: Any,
+        obstacles: Sequence[Any] = (),
+        resolution: float = 0.05,
+        height: float = 0.0,
+        **kwargs: Any,
+    ) -> Scene:
+        """Scene of one floor from a shapely outline (outside = VOID) and obstacle polygons.
+
+        Cells are classified by their centres with shapely's vectorised predicates; the
+        robot's clearance is measured from the polygons themselves (see TraversableMap).
+        """
+        plan = FloorPlan(outline=floor, obstacles=tuple(obstacles))
+        codes, origin = floorplans.rasterize(plan.outline, plan.obstacles, resolution)
+        tmap = TraversableMap(codes, resolution, origin, height, geometry=plan)
+        return cls([tmap], floor_plans=[plan], **kwargs)
+
+    @classmethod
+    def from_png(
+        cls,
+        paths: str | PathLike[str] | Sequence[str | PathLike[str]],
+        resolution: float = 0.1,
+        source_resolution: float = 0.01,
+        heights: Sequence[float] | None = None,
+        **kwargs: Any,
+    ) -> Scene:
+        """Scene from OmniGibson ``floor_trav_<n>.png`` images, one per floor (see loaders)."""
+        if isinstance(paths, (str, PathLike)):
+            paths = [paths]
+        paths = list(paths)
+        heights = cls._heights(heights, len(paths))
+        floors = []
+        for path, h in zip(paths, heights):
+            codes, origin = loaders.read_trav_png(path, resolution, source_resolution)
+            floors.append(TraversableMap(codes, resolution, origin, h))
+        return cls(floors, **kwargs)
+
+    @classmethod
+    def from_movingai(
+        cls, path: str | PathLike[str], resolution: float = 0.5, **kwargs: Any
+    ) -> Scene:
+        """Scene from a MovingAI ``.map`` grid benchmark file.
+
+        ``resolution`` is metres per map character; the default 0.5 m makes a corridor one
+        character wide passable for the default robot (radius 0.18 m).
+        """
+        return cls([TraversableMap(loaders.read_movingai(path), resolution)], **kwargs)
+
+    @staticmethod
+    def _heights(heights: Sequence[float] | None, n: int) -> list[float]:
+        if heights is None:
+            return [3.0 * i for i in range(n)]
+        heights = [float(h) for h in heights]
+        if len(heights) != n:
+            raise ValueError(f"heights must have one value per floor ({n}), got {len(heights)}")
+        return heights
+
+    # ------------------------------------------------------------------ floors
+    @property
+    def n_floors(self) -> int:
+        """Number of floors."""
+        return len(self.floors)
+
+    def _floor(self, floor: int) -> TraversableMap:
+        if isinstance(floor, bool) or not isinstance(floor, (int, np.integer)):
+            raise ValueError(f"floor must be an integer in [0, {self.n_floors}), got {floor!r}")
+        if not 0 <= floor < self.n_floors:
+            raise ValueError(f"floor must be in [0, {self.n_floors}), got {floor}")
+        return self.floors[int(floor)]
+
+    def get_floor_height(self, floor: int = 0) -> float:
+        """Height (world z, m) of ``floor``."""
+        return self._floor(floor).height
+
+    def planner(self, floor: int, robot: Any = None) -> Planner:
+        """The cached corner-graph planner of ``floor`` for ``robot``'s radius."""
+        return planner_for(self._floor(floor), robot_radius(robot))
+
+    def is_usable(self, floor: int, xy: ArrayLike, robot: Any = None) -> bool:
+        """Whether the robot's centre can stand at world point ``xy`` on ``floor``."""
+        return bool(self._floor(floor).is_usable(_as_xy(xy, "xy"), robot_radius(robot)))
+
+    # ---------------------------------------------------------------- sampling
+    def get_random_point(
+        self,
+        floor: int | None = None,
+        reference_point: ArrayLike | None = None,
+        robot: Any = None,
+        rng: np.random.Generator | int | None = None,
+    ) -> tuple[int, NDArray[np.float64]]:
+        """Sample a usable point uniformly over the robot-eroded free space.
+
+        Parameters
+        ----------
+        floor : int, optional
+            Floor to sample on; None picks one of the floors with usable space at random.
+        reference_point : array_like, optional
+            (x, y[, z]); the point is then drawn from the component that contains it. A
+            reference point that is not usable raises ``ValueError``.
+        robot : RobotSpec, float or None
+            Whose radius erodes the free space.
+        rng : numpy Generator, int seed, or None
+
+        Returns
+        -------
+        floor : int
+        point : ndarray, shape (3,)
+            A usable cell centre ``(x, y, z)`` with z the floor height (m).
+
+        Raises
+        ------
+        SamplingError
+            When the floor (or the component) has no usable cell for this radius.
+        """
+        rng = _as_rng(rng)
+        radius = robot_radius(robot)
+        if floor is None:
+            candidates = [i for i, f in enumerate(self.floors) if f.usable(radius).any()]
+            if not candidates:
+                raise SamplingError(f"no floor has a usable cell for a robot of radius {radius} m")
+            floor = candidates[int(rng.integers(len(candidates)))]
+        tmap = self._floor(floor)
+        if reference_point is None:
+            cells = np.flatnonzero(tmap.usable(radius))
+        else:
+            ref = _as_xy(reference_point, "reference_point")
+            label = int(tmap.component_at(ref, radius))
+            if label == 0:
+                raise ValueError(
+                    f"reference_point {ref.tolist()} is not usable on floor {floor} for a robot "
+                    f"of radius {radius} m (blocked, too close to an obstacle, or off the map)"
+                )
+            cells = np.flatnonzero(tmap.components(radius) == label)
+        if len(cells) == 0:
+            raise SamplingError(
+                f"floor {floor} has no usable cell for a robot of radius {radius} m"
+            )
+        cell = np.unravel_index(cells[int(rng.integers(len(cells)))], tmap.shape)
+        x, y = tmap.cell_to_world(np.array(cell))
+        return int(floor), np.array([x, y, tmap.height])
+
+    # ---------------------------------------------------------------- geodesic
+    def goal_field(self, floor: int, goal_xy: ArrayLike, robot: Any = None) -> FloorGoalField:
+        """Cached geodesic distance field to ``goal_xy`` on ``floor`` (see FloorGoalField)."""
+        tmap = self._floor(floor)
+        goal = tmap.world_to_grid(_as_xy(goal_xy, "goal_xy"))
+        field = planner_for(tmap, robot_radius(robot)).goal_field(goal)
+        return FloorGoalField(tmap, field)
+
+    def geodesic_distance(
+        self, floor: int, source_xy: ArrayLike, target_xy: ArrayLike, robot: Any = None
+    ) -> float:
+        """Geodesic distance (m) between two points; ``math.inf`` when there is no path.
+
+        Exact for the given source point, and cheap for a new target (it does not build the
+        target's per-cell table, only its corner distances), which makes it the right call
+        for sampling start/goal pairs. Use :meth:`goal_field` for repeated queries.
+        """
+        return self.goal_field(floor, target_xy, robot).exact_distance(source_xy)
+
+    def get_shortest_path(
+        self,
+        floor: int,
+        source_xy: ArrayLike,
+        target_xy: ArrayLike,
+        entire_path: bool = False,
+        robot: Any = None,
+    ) -> tuple[NDArray[np.float64], float] | tuple[None, None]:
+        """Shortest collision-free path of the robot's centre and its geodesic length.
+
+        Parameters
+        ----------
+        floor : int
+        source_xy, target_xy : array_like
+            (x, y) or (x, y, z) in metres; z is ignored.
+        entire_path : bool
+            True: the whole any-angle polyline, source, corners, target. False: the first
+            ``num_waypoints`` points spaced ``waypoint_spacing`` apart along it, padded
+            with the target (OmniGibson's convention).
+        robot : RobotSpec, float or None
+
+        Returns
+        -------
+        waypoints : ndarray (N, 2) or None
+        geodesic_distance : float or None
+            Path length in metres. ``(None, None)`` when the target is unreachable from the
+            source, off the map, or not usable by the robot (nor is the source).
+        """
+        points, length = self.goal_field(floor, target_xy, robot).path(source_xy)
+        if points is None:
+            return None, None
+        if not entire_path:
+            points = resample_path(points, self.waypoint_spacing, self.num_waypoints)
+        return points, length
+
+    def __repr__(self) -> str:
+        return f"Scene(n_floors={self.n_floors}, floors={self.floors!r})"
+
+
+def rooms(seed: int | None = None, resolution: float = 0.1, **kwargs: Any) -> Scene:
+    """A generated house: rooms with walls, doors and furniture (see ``floorplans.rooms``)."""
+    plan = floorplans.rooms(seed, **kwargs)
+    return Scene.from_polygons(plan.outline, plan.obstacles, resolution=resolution)
+
+
+def maze(seed: int | None = None, resolution: float = 0.1, **kwargs: Any) -> Scene:
+    """A generated maze of corridors (see ``floorplans.maze``)."""
+    plan = floorplans.maze(seed, **kwargs)
+    return Scene.from_polygons(plan.outline, plan.obstacles, resolution=resolution)
+
+
+def clutter(seed: int | None = None, resolution: float = 0.1, **kwargs: Any) -> Scene:
+    """A generated open space cluttered with obstacles (see ``floorplans.clutter``)."""
+    plan = floorplans.clutter(seed, **kwargs)
+    return Scene.from_polygons(plan.outline, plan.obstacles, resolution=resolution)

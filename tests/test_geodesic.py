@@ -1,0 +1,125 @@
+"""Geodesic distances and paths: exact values on hand-made maps, caching, bad input."""
+
+import math
+
+import numpy as np
+import pytest
+
+from pointnav_core.geodesic import path_length, planner_for, resample_path
+from pointnav_core.maps import OBSTACLE, VOID, TraversableMap
+from pointnav_core.scenes import Scene
+
+
+def wall_scene():
+    """20 x 30 m, 1 m cells: a vertical wall (col 10, rows 5..14) and a horizontal one."""
+    grid = np.ones((20, 30), bool)
+    grid[5:15, 10] = False
+    grid[10, 10:25] = False
+    return Scene.from_array(grid, resolution=1.0)
+
+
+def test_open_floor_distance_is_the_straight_line_from_the_true_points():
+    scene = Scene.from_array(np.ones((50, 50), bool), resolution=0.1)
+    path, dist = scene.get_shortest_path(0, (0.33, 0.41), (4.02, 3.17), entire_path=True)
+    assert dist == pytest.approx(math.hypot(4.02 - 0.33, 3.17 - 0.41), abs=1e-9)
+    assert np.allclose(path, [[0.33, 0.41], [4.02, 3.17]])
+
+
+def test_path_bends_at_the_wall_corner_and_its_length_is_exact():
+    scene = wall_scene()
+    path, dist = scene.get_shortest_path(0, (2.5, 12.5), (28.5, 2.5), entire_path=True)
+    # Around the top of the vertical wall: the corner of cell (4, 9) touching cell (5, 10).
+    corner = (10.0, 5.0)
+    expected = math.dist((2.5, 12.5), corner) + math.dist(corner, (28.5, 2.5))
+    assert dist == pytest.approx(expected, abs=1e-5)
+    assert len(path) == 3
+    assert path[1] == pytest.approx(corner, abs=1e-5)
+    assert path_length(path) == pytest.approx(dist)
+
+
+def test_short_path_keeps_num_waypoints_spaced_and_padded_with_target():
+    scene = Scene.from_array(np.ones((20, 20), bool), resolution=0.1, num_waypoints=10)
+    path, dist = scene.get_shortest_path(0, (0.15, 0.15), (0.95, 0.15))
+    assert path.shape == (10, 2)
+    assert np.allclose(np.diff(path[:5, 0]), 0.2)
+    assert np.allclose(path[-1], (0.95, 0.15))
+    assert dist == pytest.approx(0.8)
+
+
+def test_unreachable_blocked_and_off_map_targets_give_none():
+    grid = np.ones((10, 10), bool)
+    grid[:, 5] = False
+    scene = Scene.from_array(grid, resolution=1.0)
+    assert scene.get_shortest_path(0, (1.5, 1.5), (8.5, 1.5)) == (None, None)  # other side
+    assert scene.get_shortest_path(0, (1.5, 1.5), (5.5, 1.5)) == (None, None)  # on the wall
+    assert scene.get_shortest_path(0, (1.5, 1.5), (50.0, 1.5)) == (None, None)  # off map
+    assert scene.get_shortest_path(0, (-3.0, 1.5), (2.5, 1.5)) == (None, None)  # source off
+    assert scene.geodesic_distance(0, (1.5, 1.5), (8.5, 1.5)) == math.inf
+
+
+def test_robot_radius_closes_a_narrow_door():
+    grid = np.ones((30, 30), bool)
+    grid[15, :] = False
+    grid[15, 14:17] = True  # a 0.3 m door at 0.1 m cells
+    scene = Scene.from_array(grid, resolution=0.1)
+    assert scene.get_shortest_path(0, (1.5, 0.5), (1.5, 2.5), robot=0.1)[1] is not None
+    assert scene.get_shortest_path(0, (1.5, 0.5), (1.5, 2.5), robot=0.2) == (None, None)
+
+
+def test_diagonal_squeeze_between_blocked_corners_is_not_a_path():
+    grid = np.array([[1, 0], [0, 1]], bool)
+    scene = Scene.from_array(grid, resolution=1.0)
+    assert scene.get_shortest_path(0, (0.5, 0.5), (1.5, 1.5)) == (None, None)
+
+
+def test_goal_field_is_cached_and_queries_are_lookups():
+    scene = wall_scene()
+    a = scene.goal_field(0, (28.5, 2.5))
+    b = scene.goal_field(0, (28.5, 2.5))
+    assert a.field is b.field
+    assert a.distance(2.5, 12.5) == pytest.approx(scene.get_shortest_path(0, (2.5, 12.5), (28.5, 2.5))[1])
+
+
+def test_goal_field_cache_is_bounded():
+    scene = Scene.from_array(np.ones((10, 10), bool), resolution=1.0)
+    planner = scene.planner(0)
+    for i in range(planner._fields.maxsize + 5):
+        scene.goal_field(0, (0.5 + 0.01 * i, 0.5))
+    assert len(planner._fields) == planner._fields.maxsize
+
+
+def test_floors_are_planned_separately():
+    ground = np.ones((10, 10), bool)
+    upper = np.ones((10, 10), bool)
+    upper[:, 5] = False
+    scene = Scene.from_array([ground, upper], resolution=1.0, heights=[0.0, 3.0])
+    assert scene.get_shortest_path(1, (1.5, 1.5), (8.5, 1.5)) == (None, None)
+    assert scene.get_shortest_path(0, (1.5, 1.5), (8.5, 1.5))[1] == pytest.approx(7.0)
+    assert scene.get_floor_height(1) == 3.0
+
+
+def test_visibility_rejects_segments_touching_a_blocked_corner():
+    grid = np.ones((3, 3), bool)
+    grid[1, 1] = False
+    planner = planner_for(TraversableMap(grid, 1.0), 0.0)
+    # Through the blocked cell's corner point (1, 1): touching counts as blocked.
+    assert not planner.visible([0.5, 0.5], [2.5, 2.5])
+    # Grazing the blocked cell's corner point (1, 2) also counts as touching it.
+    assert not planner.visible([0.5, 1.5], [1.5, 2.5])
+    assert planner.visible([0.5, 0.5], [0.5, 2.5])
+    assert not planner.visible([0.5, 0.5], [1.0, 1.0])
+
+
+def test_resample_path_pads_with_the_end_point():
+    out = resample_path([[0.0, 0.0], [0.0, 0.5]], 0.2, 5)
+    assert out[:, 1].tolist() == pytest.approx([0.0, 0.2, 0.4, 0.5, 0.5])
+
+
+def test_void_cells_are_not_paths():
+    grid = np.zeros((5, 5), np.uint8)
+    grid[:, 2] = VOID
+    scene = Scene.from_array(grid, resolution=1.0)
+    assert scene.get_shortest_path(0, (0.5, 0.5), (4.5, 0.5)) == (None, None)
+    grid[:, 2] = OBSTACLE
+    grid[2, 2] = 0
+    assert Scene.from_array(grid, 1.0).get_shortest_path(0, (0.5, 0.5), (4.5, 0.5))[1] is not None
