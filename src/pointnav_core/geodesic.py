@@ -48,6 +48,7 @@ _CORNER_INSET = 1e-6
 _STEPS = ((0, 1), (1, 0), (1, 1), (1, -1))
 # How many segments' worth of band checks to vectorise at once (bounds peak memory).
 _CHUNK_BANDS = 1 << 21
+_COARSE = 4
 # Parent codes in a goal field's cell table (corner ids are >= 0).
 _TO_GOAL = -1
 _UNREACHABLE = -2
@@ -78,15 +79,14 @@ class Planner:
         self.usable = tmap.usable(radius)
         self.labels = tmap.components(radius)
         self.shape = self.usable.shape
-        blocked = (~self.usable).astype(np.int32)
         h, w = self.shape
-        # Prefix sums of blocked cells along rows and along columns: a run of cells in one
-        # row (or column) is free iff its count is zero, which makes a segment test cost
-        # one lookup per row (or column) it crosses.
-        self._row_cum = np.zeros((h, w + 1), dtype=np.int32)
-        np.cumsum(blocked, axis=1, out=self._row_cum[:, 1:])
-        self._col_cum = np.zeros((w, h + 1), dtype=np.int32)
-        np.cumsum(blocked.T, axis=1, out=self._col_cum[:, 1:])
+        self._sight = _Sightlines(~self.usable)
+        # Blocks of _COARSE x _COARSE cells that are entirely blocked: a segment touching one
+        # is blocked, which rejects most corner pairs at a fraction of the cost.
+        hb, wb = -(-h // _COARSE), -(-w // _COARSE)
+        padded = np.ones((hb * _COARSE, wb * _COARSE), dtype=bool)
+        padded[:h, :w] = ~self.usable
+        self._coarse = _Sightlines(padded.reshape(hb, _COARSE, wb, _COARSE).all(axis=(1, 3)))
         self.corners, self.corner_diag = self._find_corners()
         rows = self.corners[:, 0].astype(np.int64)
         cols = self.corners[:, 1].astype(np.int64)
@@ -110,71 +110,7 @@ class Planner:
         ndarray of bool
             True where every cell the closed segment meets is usable.
         """
-        p, q = np.broadcast_arrays(np.asarray(p, dtype=np.float64), np.asarray(q, dtype=np.float64))
-        shape = p.shape[:-1]
-        p = p.reshape(-1, 2)
-        q = q.reshape(-1, 2)
-        out = np.empty(len(p), dtype=bool)
-        # Walk the axis the segment crosses fewer cells of: rows, or columns (transposed).
-        by_rows = np.abs(q[:, 0] - p[:, 0]) <= np.abs(q[:, 1] - p[:, 1])
-        if by_rows.any():
-            out[by_rows] = self._visible_banded(p[by_rows], q[by_rows], self._row_cum)
-        by_cols = ~by_rows
-        if by_cols.any():
-            out[by_cols] = self._visible_banded(
-                p[by_cols][:, ::-1], q[by_cols][:, ::-1], self._col_cum
-            )
-        return out.reshape(shape)
-
-    @staticmethod
-    def _visible_banded(
-        p: NDArray[np.float64], q: NDArray[np.float64], cum: NDArray[np.int32]
-    ) -> NDArray[np.bool_]:
-        """Segment test over bands (rows of ``cum``); column 0 of p, q is the band axis.
-
-        Each band the closed segment meets is checked in O(1): the run of cells it covers
-        in that band must hold no blocked cell (a difference of two prefix sums).
-        """
-        n_bands, n_cells = cum.shape[0], cum.shape[1] - 1
-        p0, p1, q0, q1 = p[:, 0], p[:, 1], q[:, 0], q[:, 1]
-        a0 = np.minimum(p0, q0)
-        a1 = np.maximum(p0, q0)
-        k_lo = np.ceil(a0 - _EPS).astype(np.int64) - 1
-        counts = np.floor(a1 + _EPS).astype(np.int64) - k_lo + 1
-        d0 = q0 - p0
-        flat = np.abs(d0) < _EPS
-        slope = np.divide(q1 - p1, d0, out=np.zeros_like(d0), where=~flat)
-        free = np.empty(len(p), dtype=bool)
-        ends = np.cumsum(counts)
-        start = 0
-        while start < len(p):
-            # Chunk segments so that the flattened band arrays stay bounded in memory.
-            stop = int(np.searchsorted(ends, ends[start] - counts[start] + _CHUNK_BANDS, "right"))
-            stop = max(stop, start + 1)
-            n = counts[start:stop]
-            seg = np.repeat(np.arange(start, stop), n)
-            first = ends[start:stop] - n
-            k = np.arange(first[0], first[0] + len(seg)) - np.repeat(first - k_lo[start:stop], n)
-            sp0, sp1, sl = p0[seg], p1[seg], slope[seg]
-            o_a = sp1 + (np.maximum(k, a0[seg]) - sp0) * sl
-            o_b = sp1 + (np.minimum(k + 1, a1[seg]) - sp0) * sl
-            lo = np.minimum(o_a, o_b)
-            hi = np.maximum(o_a, o_b)
-            flat_band = flat[seg]
-            if flat_band.any():
-                # A segment along the band covers its whole extent inside its band(s).
-                lo[flat_band] = np.minimum(p1, q1)[seg[flat_band]]
-                hi[flat_band] = np.maximum(p1, q1)[seg[flat_band]]
-            j_lo = np.ceil(lo - _EPS).astype(np.int64) - 1
-            j_hi = np.floor(hi + _EPS).astype(np.int64) + 1
-            off_map = (k < 0) | (k >= n_bands) | (j_lo < 0) | (j_hi > n_cells)
-            kc = np.minimum(np.maximum(k, 0), n_bands - 1)
-            j_lo = np.minimum(np.maximum(j_lo, 0), n_cells)
-            j_hi = np.minimum(np.maximum(j_hi, 0), n_cells)
-            blocked = off_map | (cum[kc, j_hi] != cum[kc, j_lo])
-            free[start:stop] = ~np.logical_or.reduceat(blocked, first - first[0])
-            start = stop
-        return free
+        return self._sight.visible(p, q)
 
     # ------------------------------------------------------------------ corners
     def _find_corners(self) -> tuple[NDArray[np.float64], NDArray[np.int8]]:
@@ -220,14 +156,25 @@ class Planner:
             pass
         ids = np.flatnonzero(self.corner_labels == label)
         n = len(ids)
-        edges_i, edges_j = [np.zeros(0, np.int64)], [np.zeros(0, np.int64)]
         pts = self.corners[ids]
-        i, j = np.triu_indices(n, k=1)
-        e = pts[j] - pts[i]
-        keep = self.tangent(ids[i], e) & self.tangent(ids[j], e)
-        i, j = i[keep], j[keep]
-        ok = self.visible(pts[i], pts[j])
-        i, j = i[ok], j[ok]
+        edges_i, edges_j = [np.zeros(0, np.int64)], [np.zeros(0, np.int64)]
+        # Rows of the pair triangle in blocks, to bound memory on large maps.
+        step = max(1, (1 << 22) // max(n, 1))
+        for start in range(0, max(n - 1, 0), step):
+            rows = np.arange(start, min(start + step, n - 1))
+            counts = n - 1 - rows
+            i = np.repeat(rows, counts)
+            j = np.arange(len(i)) - np.repeat(np.cumsum(counts) - counts, counts) + i + 1
+            e = pts[j] - pts[i]
+            keep = self.tangent(ids[i], e) & self.tangent(ids[j], e)
+            i, j = i[keep], j[keep]
+            keep = ~self._coarse.touches_blocked(pts[i] / _COARSE, pts[j] / _COARSE)
+            i, j = i[keep], j[keep]
+            keep = self.visible(pts[i], pts[j])
+            edges_i.append(i[keep])
+            edges_j.append(j[keep])
+        i = np.concatenate(edges_i)
+        j = np.concatenate(edges_j)
         weight = np.maximum(np.hypot(*(pts[i] - pts[j]).T), _EPS)
         graph = sparse.csr_matrix((weight, (i, j)), shape=(n, n))
         self._component_graphs[label] = (ids, graph)
@@ -552,6 +499,96 @@ class GoalField:
             todo = rest[~exhausted]
             batch = min(batch * 4, n + 1)
         return best
+
+
+class _Sightlines:
+    """Segment tests against a boolean grid of blocked cells, via row/column prefix sums."""
+
+    def __init__(self, blocked: NDArray[np.bool_]) -> None:
+        h, w = blocked.shape
+        counts = blocked.astype(np.int32)
+        # A run of cells in one row (or column) is free iff its blocked count is zero, so a
+        # segment test costs one lookup per row (or column) it crosses.
+        self._row_cum = np.zeros((h, w + 1), dtype=np.int32)
+        np.cumsum(counts, axis=1, out=self._row_cum[:, 1:])
+        self._col_cum = np.zeros((w, h + 1), dtype=np.int32)
+        np.cumsum(counts.T, axis=1, out=self._col_cum[:, 1:])
+
+    def visible(self, p: ArrayLike, q: ArrayLike) -> NDArray[np.bool_]:
+        """True where the closed segment p-q meets no blocked cell and stays on the grid."""
+        p, q = np.broadcast_arrays(np.asarray(p, dtype=np.float64), np.asarray(q, dtype=np.float64))
+        shape = p.shape[:-1]
+        p = p.reshape(-1, 2)
+        q = q.reshape(-1, 2)
+        out = np.empty(len(p), dtype=bool)
+        # Walk the axis the segment crosses fewer cells of: rows, or columns (transposed).
+        by_rows = np.abs(q[:, 0] - p[:, 0]) <= np.abs(q[:, 1] - p[:, 1])
+        if by_rows.any():
+            out[by_rows] = self._banded(p[by_rows], q[by_rows], self._row_cum)
+        by_cols = ~by_rows
+        if by_cols.any():
+            out[by_cols] = self._banded(p[by_cols][:, ::-1], q[by_cols][:, ::-1], self._col_cum)
+        return out.reshape(shape)
+
+    def touches_blocked(self, p: ArrayLike, q: ArrayLike) -> NDArray[np.bool_]:
+        """True where the closed segment meets a blocked cell (leaving the grid aside)."""
+        h, w = self._row_cum.shape[0], self._col_cum.shape[0]
+        # Clamp into the grid: off-grid parts are for the exact test to judge, not this one.
+        lim = np.array([h, w], dtype=np.float64) - 1e-6
+        p = np.clip(np.asarray(p, dtype=np.float64), 1e-6, lim)
+        q = np.clip(np.asarray(q, dtype=np.float64), 1e-6, lim)
+        return ~self.visible(p, q)
+
+    @staticmethod
+    def _banded(
+        p: NDArray[np.float64], q: NDArray[np.float64], cum: NDArray[np.int32]
+    ) -> NDArray[np.bool_]:
+        """Segment test over bands (rows of ``cum``); column 0 of p, q is the band axis.
+
+        Each band the closed segment meets is checked in O(1): the run of cells it covers
+        in that band must hold no blocked cell (a difference of two prefix sums).
+        """
+        n_bands, n_cells = cum.shape[0], cum.shape[1] - 1
+        p0, p1, q0, q1 = p[:, 0], p[:, 1], q[:, 0], q[:, 1]
+        a0 = np.minimum(p0, q0)
+        a1 = np.maximum(p0, q0)
+        k_lo = np.ceil(a0 - _EPS).astype(np.int64) - 1
+        counts = np.floor(a1 + _EPS).astype(np.int64) - k_lo + 1
+        d0 = q0 - p0
+        flat = np.abs(d0) < _EPS
+        slope = np.divide(q1 - p1, d0, out=np.zeros_like(d0), where=~flat)
+        free = np.empty(len(p), dtype=bool)
+        ends = np.cumsum(counts)
+        start = 0
+        while start < len(p):
+            # Chunk segments so that the flattened band arrays stay bounded in memory.
+            stop = int(np.searchsorted(ends, ends[start] - counts[start] + _CHUNK_BANDS, "right"))
+            stop = max(stop, start + 1)
+            n = counts[start:stop]
+            seg = np.repeat(np.arange(start, stop), n)
+            first = ends[start:stop] - n
+            k = np.arange(first[0], first[0] + len(seg)) - np.repeat(first - k_lo[start:stop], n)
+            sp0, sp1, sl = p0[seg], p1[seg], slope[seg]
+            o_a = sp1 + (np.maximum(k, a0[seg]) - sp0) * sl
+            o_b = sp1 + (np.minimum(k + 1, a1[seg]) - sp0) * sl
+            lo = np.minimum(o_a, o_b)
+            hi = np.maximum(o_a, o_b)
+            flat_band = flat[seg]
+            if flat_band.any():
+                # A segment along the band covers its whole extent inside its band(s).
+                lo[flat_band] = np.minimum(p1, q1)[seg[flat_band]]
+                hi[flat_band] = np.maximum(p1, q1)[seg[flat_band]]
+            j_lo = np.ceil(lo - _EPS).astype(np.int64) - 1
+            j_hi = np.floor(hi + _EPS).astype(np.int64) + 1
+            off_map = (k < 0) | (k >= n_bands) | (j_lo < 0) | (j_hi > n_cells)
+            kc = np.minimum(np.maximum(k, 0), n_bands - 1)
+            j_lo = np.minimum(np.maximum(j_lo, 0), n_cells)
+            j_hi = np.minimum(np.maximum(j_hi, 0), n_cells)
+            blocked = off_map | (cum[kc, j_hi] != cum[kc, j_lo])
+            free[start:stop] = ~np.logical_or.reduceat(blocked, first - first[0])
+            start = stop
+        return free
+
 
 
 def _touched_cells(dr: int, dc: int) -> list[tuple[int, int]]:
