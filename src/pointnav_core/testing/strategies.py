@@ -204,7 +204,7 @@ def robot_actions(spec: object, overshoot: float = 0.0) -> st.SearchStrategy[np.
     if not (math.isfinite(overshoot) and overshoot >= 0.0):
         raise ValueError(f"overshoot must be a finite number >= 0, got {overshoot!r}")
     bound = 1.0 + overshoot
-    n = int(getattr(spec, "action_dim"))
+    n = int(spec.action_dim)  # type: ignore[attr-defined]
     return st.lists(st.floats(-bound, bound), min_size=n, max_size=n).map(
         lambda values: np.array(values, dtype=np.float64)
     )

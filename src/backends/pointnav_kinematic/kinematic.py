@@ -1,0 +1,675 @@
+"""The kinematic backend: exact drive integration and swept-disc collisions, no physics."""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping, Sequence
+from typing import Any
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from pointnav_core.backend import RobotSpec
+from pointnav_core.maps import FREE, OBSTACLE
+from pointnav_kinematic.geometry import (
+    FloorGeometry,
+    enter_disc,
+    enter_rounded_square,
+    square_distance,
+)
+
+__all__ = ["COLLISION_MODES", "KinematicBackend"]
+
+#: Valid values of ``collision_mode``.
+COLLISION_MODES = ("slide", "stop")
+
+# Contact tolerances, in metres. A blocked robot is placed _PLACE beyond contact and a
+# motion only counts as hitting something when it comes within _HIT of it, so a robot
+# that rests against a flat wall can slide along the wall's other cells without
+# "hitting" them through rounding. Constraints within _ACTIVE are treated as touching.
+_HIT = 0.5e-9
+_PLACE = 1.0e-9
+_ACTIVE = 2.0e-9
+# Accepted overlap in is_valid_pose (touching is allowed).
+_TOUCH = 1.0e-9
+_GRAVITY = 9.81  # m/s^2
+_MIN_FIRST_DROP = 0.05  # m: a fall must be visible on the step it starts, at any rate
+_MAX_TURN = 0.25  # rad per sub-step: the chord stays close to the arc
+_MAX_SUBSTEPS = 1024  # beyond this, segments grow; collisions stay exact regardless
+_MAX_SLIDES = 4  # contacts resolved per segment (two walls and a corner, plus one)
+
+
+class _Robot:
+    """Mutable state of one robot, as plain floats for the per-step hot path."""
+
+    __slots__ = (
+        "spec",
+        "radius",
+        "holonomic",
+        "x",
+        "y",
+        "z",
+        "yaw",
+        "floor",
+        "geom",
+        "fast",
+        "present",
+        "placed",
+        "falling",
+        "fall_speed",
+        "contact",
+        "vel",
+        "cmd",
+        "travel",
+        "stopped",
+    )
+
+    def __init__(self, spec: RobotSpec, geom: FloorGeometry) -> None:
+        self.spec = spec
+        self.radius = spec.radius
+        self.holonomic = spec.drive == "holonomic"
+        self.x = self.y = self.yaw = 0.0
+        self.z = geom.height
+        self.floor = 0
+        self.geom = geom
+        self.fast = geom.fast_clearance(spec.radius)
+        self.present = True
+        self.placed = False
+        self.falling = False
+        self.fall_speed = 0.0
+        self.contact = False
+        # World velocity of the last step: (vx, vy, vz) in m/s and yaw rate in rad/s.
+        self.vel = (0.0, 0.0, 0.0, 0.0)
+        # Commanded body-frame velocity (vx, vy, w) for the current step.
+        self.cmd = (0.0, 0.0, 0.0)
+        self.travel = 0.0
+        self.stopped = False
+
+    def solid(self) -> bool:
+        """Whether other robots can collide with this one."""
+        return self.present and self.placed and not self.falling
+
+
+def _arc(
+    yaw: float, vx: float, vy: float, w: float, h: float
+) -> tuple[float, float]:
+    """World displacement over ``h`` s of body velocity (vx, vy) turning at ``w`` rad/s.
+
+    Exact for a constant command: the integral of R(yaw + w t) (vx, vy) over [0, h].
+    Written with sin(a)/a, a = w h / 2, so it stays accurate as w -> 0 (straight line).
+    """
+    a = 0.5 * w * h
+    s = h * (math.sin(a) / a if a != 0.0 else 1.0)
+    mid = yaw + a
+    c = math.cos(mid)
+    sn = math.sin(mid)
+    return s * (vx * c - vy * sn), s * (vx * sn + vy * c)
+
+
+def _planar_quat(yaw: float) -> NDArray[np.float64]:
+    half = 0.5 * math.remainder(yaw, 2.0 * math.pi)
+    return np.array((0.0, 0.0, math.sin(half), math.cos(half)))
+
+
+def _yaw_of(orientation: ArrayLike) -> float:
+    q = np.asarray(orientation, dtype=np.float64)
+    if q.shape != (4,) or not np.isfinite(q).all():
+        raise ValueError(
+            "orientation must be a finite (x, y, z, w) quaternion of shape (4,), "
+            f"got {orientation!r}"
+        )
+    x, y, z, w = q.tolist()
+    if x * x + y * y + z * z + w * w < 1e-12:
+        raise ValueError(f"orientation must be a non-zero quaternion, got {orientation!r}")
+    # Heading of the rotated +x axis; scale-free, so a non-unit quaternion is fine.
+    return math.atan2(2.0 * (w * z + x * y), w * w + x * x - y * y - z * z)
+
+
+def _xy(position: ArrayLike, *, allow_2d: bool) -> tuple[float, ...]:
+    p = np.asarray(position, dtype=np.float64)
+    shapes = ((2,), (3,)) if allow_2d else ((3,),)
+    if p.shape not in shapes or not np.isfinite(p).all():
+        want = "(x, y) or (x, y, z)" if allow_2d else "(x, y, z)"
+        raise ValueError(f"position must be finite {want} in metres, got {position!r}")
+    return tuple(p.tolist())
+
+
+class KinematicBackend:
+    """Physics-free backend: robots are discs that follow their commands exactly.
+
+    Each :meth:`step` integrates every robot's drive in closed form over one control
+    step of ``1 / action_frequency`` seconds (an exact arc for differential drive; exact
+    rotation of the body-frame velocity for holonomic drive). A motion that would make a
+    robot's disc overlap an OBSTACLE cell square or another robot on the same floor is
+    cut at the first contact, found exactly by sweeping the disc (no tunnelling at any
+    speed); then the robot slides along the contact (``"slide"``) or stops there for
+    the rest of the step (``"stop"``), and both parties' contact flags are set. No robot
+    ever ends a step overlapping an obstacle or another robot. A robot whose centre
+    moves over VOID (or off the map) stops moving in x, y and falls: its z drops by at
+    least 0.05 m on that step, then under gravity.
+
+    Parameters
+    ----------
+    collision_mode : {"slide", "stop"}
+        What a blocked robot does with the rest of its motion: ``"slide"`` keeps the part
+        tangent to the contact, ``"stop"`` stays at the contact point. Rotation is never
+        blocked (a disc can always turn in place).
+    fall_speed : float
+        Downward speed in m/s with which a fall starts, > 0; gravity (9.81 m/s^2) then
+        accelerates it.
+
+    Notes
+    -----
+    Open space is the fast path: a per-floor, per-radius clearance grid says in one
+    lookup that nothing is within reach of the step, and the robot just moves. Contact
+    resolution runs only near obstacles, VOID or other robots.
+
+    Examples
+    --------
+    >>> import types
+    >>> from pointnav_core.maps import TraversableMap
+    >>> floor = TraversableMap([[0, 0, 0, 0, 1]], resolution=1.0)
+    >>> scene = types.SimpleNamespace(floors=[floor], n_floors=1, get_floor_height=lambda f=0: 0.0)
+    >>> backend = KinematicBackend()
+    >>> backend.load(scene, [RobotSpec(radius=0.25)], action_frequency=1.0)
+    >>> backend.land(0, 0, (1.5, 0.5, 0.0), (0.0, 0.0, 0.0, 1.0))
+    >>> backend.step({0: np.array([1.0, 0.0])})  # 0.5 m/s for 1 s
+    >>> backend.get_pose(0)[0].tolist(), backend.in_contact(0)
+    ([2.0, 0.5, 0.0], False)
+    >>> for _ in range(6):
+    ...     backend.step({0: np.array([1.0, 0.0])})
+    >>> round(float(backend.get_pose(0)[0][0]), 6), backend.in_contact(0)  # at the wall
+    (3.75, True)
+    """
+
+    def __init__(self, collision_mode: str = "slide", fall_speed: float = 1.0) -> None:
+        if collision_mode not in COLLISION_MODES:
+            raise ValueError(
+                f"collision_mode must be one of {list(COLLISION_MODES)}, got {collision_mode!r}"
+            )
+        fall_speed_f = float(fall_speed)
+        if not math.isfinite(fall_speed_f) or fall_speed_f <= 0.0:
+            raise ValueError(f"fall_speed must be a finite number > 0 (m/s), got {fall_speed!r}")
+        self.collision_mode = collision_mode
+        self.fall_speed = fall_speed_f
+        self._stop = collision_mode == "stop"
+        self._floors: list[FloorGeometry] = []
+        self._robots: list[_Robot] = []
+        self._dt = 0.1
+
+    # ------------------------------------------------------------------ lifecycle
+    @property
+    def n_robots(self) -> int:
+        """Number of robots loaded (0 before :meth:`load`)."""
+        return len(self._robots)
+
+    @property
+    def action_frequency(self) -> float:
+        """Control steps per second (Hz)."""
+        return 1.0 / self._dt
+
+    def load(
+        self, scene: Any, robots: Sequence[RobotSpec], action_frequency: float = 10.0
+    ) -> None:
+        """Build the world from ``scene.floors`` and one robot per spec.
+
+        Parameters
+        ----------
+        scene : Scene
+            Uses only ``floors`` (list of TraversableMap), ``n_floors`` and
+            ``get_floor_height(floor)``.
+        robots : sequence of RobotSpec
+            Robot ``idn`` is ``robots[idn]``.
+        action_frequency : float
+            Control steps per second (Hz), > 0.
+
+        Notes
+        -----
+        Robots start present, unplaced, at rest at x = y = 0 on floor 0.
+        """
+        freq = float(action_frequency)
+        if not math.isfinite(freq) or freq <= 0.0:
+            raise ValueError(
+                f"action_frequency must be a finite number > 0 (Hz), got {action_frequency!r}"
+            )
+        specs = list(robots)
+        for i, spec in enumerate(specs):
+            if not isinstance(spec, RobotSpec):
+                raise TypeError(f"robots[{i}] must be a RobotSpec, got {type(spec).__name__}")
+        n_floors = int(scene.n_floors)
+        if n_floors < 1 or len(scene.floors) != n_floors:
+            raise ValueError(
+                f"scene must have n_floors >= 1 floors, got n_floors={n_floors} "
+                f"and {len(scene.floors)} maps"
+            )
+        self._floors = [
+            FloorGeometry(scene.floors[f], float(scene.get_floor_height(f)))
+            for f in range(n_floors)
+        ]
+        self._robots = [_Robot(spec, self._floors[0]) for spec in specs]
+        self._dt = 1.0 / freq
+
+    def reset(self) -> None:
+        """Return every robot to its state after :meth:`load`, keeping its pose.
+
+        Velocities and contact flags become zero, falls end, and every robot is present
+        again but unplaced: it takes part in no collision until :meth:`land` or
+        :meth:`set_pose` places it, so that the task can place robots one by one.
+        """
+        for rb in self._robots:
+            rb.present = True
+            rb.placed = False
+            self._at_rest(rb)
+
+    @staticmethod
+    def _at_rest(rb: _Robot) -> None:
+        rb.falling = False
+        rb.fall_speed = 0.0
+        rb.contact = False
+        rb.stopped = False
+        rb.vel = (0.0, 0.0, 0.0, 0.0)
+        rb.cmd = (0.0, 0.0, 0.0)
+
+    def _robot(self, idn: int) -> _Robot:
+        if isinstance(idn, (bool, np.bool_)) or not isinstance(idn, (int, np.integer)):
+            raise TypeError(f"idn must be an int robot index, got {idn!r}")
+        if not 0 <= idn < len(self._robots):
+            if not self._robots:
+                raise RuntimeError("no robots: call load(scene, robots) first")
+            raise ValueError(f"idn must be in [0, {len(self._robots)}), got {idn}")
+        return self._robots[idn]
+
+    def _floor_geom(self, floor: int) -> FloorGeometry:
+        if isinstance(floor, (bool, np.bool_)) or not isinstance(floor, (int, np.integer)):
+            raise TypeError(f"floor must be an int floor index, got {floor!r}")
+        if not 0 <= floor < len(self._floors):
+            raise ValueError(f"floor must be in [0, {len(self._floors)}), got {floor}")
+        return self._floors[floor]
+
+    # ------------------------------------------------------------------ poses
+    def land(self, idn: int, floor: int, position: ArrayLike, orientation: ArrayLike) -> None:
+        """Place robot ``idn`` at rest on ``floor``: x, y from ``position``, z = floor height.
+
+        Parameters
+        ----------
+        idn : int
+            Robot index.
+        floor : int
+            Floor index.
+        position : array_like, shape (2,) or (3,)
+            World x, y in metres; a z is ignored.
+        orientation : array_like, shape (4,)
+            ``(x, y, z, w)`` quaternion; only its yaw matters.
+        """
+        rb = self._robot(idn)
+        geom = self._floor_geom(floor)
+        xy = _xy(position, allow_2d=True)
+        yaw = _yaw_of(orientation)
+        rb.floor = int(floor)
+        rb.geom = geom
+        rb.fast = geom.fast_clearance(rb.radius)
+        rb.x, rb.y, rb.z, rb.yaw = xy[0], xy[1], geom.height, yaw
+        rb.placed = True
+        self._at_rest(rb)
+
+    def set_pose(self, idn: int, position: ArrayLike, orientation: ArrayLike) -> None:
+        """Teleport robot ``idn`` (at rest) to world ``position`` and ``orientation``.
+
+        Parameters
+        ----------
+        idn : int
+            Robot index.
+        position : array_like, shape (3,)
+            World x, y, z in metres. The robot stays on its floor (use :meth:`land` to
+            change floors).
+        orientation : array_like, shape (4,)
+            ``(x, y, z, w)`` quaternion; the backend is planar, so only its yaw is kept.
+        """
+        rb = self._robot(idn)
+        x, y, z = _xy(position, allow_2d=False)
+        yaw = _yaw_of(orientation)
+        rb.x, rb.y, rb.z, rb.yaw = x, y, z, yaw
+        rb.placed = True
+        self._at_rest(rb)
+
+    def get_pose(self, idn: int) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+        """Return robot ``idn``'s world position (3,) in metres and orientation (4,).
+
+        The orientation is the planar quaternion ``(0, 0, sin(yaw/2), cos(yaw/2))`` with
+        yaw in [-pi, pi], so its w is >= 0.
+        """
+        rb = self._robot(idn)
+        return np.array((rb.x, rb.y, rb.z)), _planar_quat(rb.yaw)
+
+    def get_velocity(self, idn: int) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+        """Return robot ``idn``'s world linear (3,) m/s and angular (3,) rad/s velocity.
+
+        These are the effective velocities of the last step: displacement and yaw change
+        divided by the step's duration (zero after load, reset, land and set_pose).
+        """
+        rb = self._robot(idn)
+        vx, vy, vz, wz = rb.vel
+        return np.array((vx, vy, vz)), np.array((0.0, 0.0, wz))
+
+    def get_robot_floor(self, idn: int) -> int:
+        """The floor robot ``idn`` was last landed on (0 until then)."""
+        return self._robot(idn).floor
+
+    def in_contact(self, idn: int) -> bool:
+        """Whether robot ``idn`` hit or pushed against an obstacle or robot in the last step."""
+        return self._robot(idn).contact
+
+    def set_present(self, idn: int, present: bool) -> None:
+        """Take robot ``idn`` out of the world (``False``) or bring it back (``True``).
+
+        An absent robot keeps its pose (and a fall in progress) but is not moved by
+        :meth:`step`, has no velocity and collides with nothing; bringing it back does not
+        check whether its pose is still free.
+        """
+        rb = self._robot(idn)
+        rb.present = bool(present)
+        if not rb.present:
+            rb.contact = False
+            rb.vel = (0.0, 0.0, 0.0, 0.0)
+
+    def is_present(self, idn: int) -> bool:
+        """Whether robot ``idn`` is in the world."""
+        return self._robot(idn).present
+
+    def is_valid_pose(
+        self,
+        idn: int,
+        position: ArrayLike,
+        orientation: ArrayLike | None = None,
+        *,
+        floor: int | None = None,
+    ) -> bool:
+        """Whether robot ``idn`` could stand at ``position``.
+
+        Parameters
+        ----------
+        idn : int
+            Robot index.
+        position : array_like, shape (2,) or (3,)
+            World x, y (and an ignored z) in metres.
+        orientation : array_like, shape (4,), optional
+            Ignored (a disc looks the same in every heading); validated when given.
+        floor : int, optional
+            Floor to test on; default: the robot's floor (:meth:`get_robot_floor`).
+
+        Returns
+        -------
+        bool
+            True when the centre is on the map and not over VOID or an OBSTACLE cell, the
+            disc overlaps no OBSTACLE square by more than 1e-9 m (touching is fine), and it
+            overlaps no other present, placed, non-falling robot on that floor.
+        """
+        rb = self._robot(idn)
+        geom = rb.geom if floor is None else self._floor_geom(floor)
+        fl = rb.floor if floor is None else int(floor)
+        xy = _xy(position, allow_2d=True)
+        if orientation is not None:
+            _yaw_of(orientation)
+        x, y = xy[0], xy[1]
+        cell = geom.cell_index(x, y)
+        if cell < 0 or geom.codes[cell] != FREE:  # VOID, OBSTACLE or off the map
+            return False
+        r = rb.radius
+        limit = r - _TOUCH
+        for x0, y0, x1, y1 in geom.edge_squares(x - r, y - r, x + r, y + r):
+            if square_distance(x, y, x0, y0, x1, y1)[0] < limit:
+                return False
+        for other in self._robots:
+            if other is rb or other.floor != fl or not other.solid():
+                continue
+            reach = r + other.radius - _TOUCH
+            if (x - other.x) ** 2 + (y - other.y) ** 2 < reach * reach and reach > 0.0:
+                return False
+        return True
+
+    # ------------------------------------------------------------------ stepping
+    def step(self, actions: Mapping[int, ArrayLike]) -> None:
+        """Apply each given robot's action and advance one control step for all robots.
+
+        Parameters
+        ----------
+        actions : mapping of int to array_like
+            Robot index -> action in ``[-1, 1]`` (see :meth:`RobotSpec.scale_action`).
+            Robots without an entry get a zero command.
+        """
+        robots = self._robots
+        zero = (0.0, 0.0, 0.0)
+        for rb in robots:
+            rb.cmd = zero
+        for idn, action in actions.items():
+            rb = self._robot(idn)
+            cmd = rb.spec._scaled(action)
+            rb.cmd = cmd if rb.holonomic else (cmd[0], 0.0, cmd[1])
+        dt = self._dt
+        moving = []
+        for rb in robots:
+            rb.contact = False
+            if not (rb.present and rb.placed):
+                rb.vel = (0.0, 0.0, 0.0, 0.0)
+            elif rb.falling:
+                self._fall(rb, first=False)
+            else:
+                vx, vy, _ = rb.cmd
+                rb.travel = (math.hypot(vx, vy) if vy else abs(vx)) * dt
+                moving.append(rb)
+        if not moving:
+            return
+        slow = []
+        for rb in moving:
+            # Fast path: the clearance grid vouches for everything within reach.
+            geom = rb.geom
+            col = math.floor((rb.x - geom.ox) * geom.inv_res)
+            row = math.floor((rb.y - geom.oy) * geom.inv_res)
+            if not (0 <= col < geom.width and 0 <= row < geom.rows) or not (
+                rb.fast[row * geom.width + col] > rb.travel
+            ):
+                slow.append(rb)
+                continue
+            if len(moving) > 1:
+                reach = rb.radius + rb.travel
+                for other in moving:
+                    if other is not rb and other.floor == rb.floor:
+                        gap = reach + other.radius + other.travel
+                        if (rb.x - other.x) ** 2 + (rb.y - other.y) ** 2 <= gap * gap:
+                            slow.append(rb)
+                            break
+        if slow and len(slow) < len(moving):
+            fast = [rb for rb in moving if rb not in slow]
+        elif slow:
+            fast = []
+        else:
+            fast = moving
+        for rb in fast:
+            vx, vy, w = rb.cmd
+            dx, dy = _arc(rb.yaw, vx, vy, w, dt)
+            rb.x += dx
+            rb.y += dy
+            rb.yaw += w * dt
+            rb.vel = (dx / dt, dy / dt, 0.0, w)
+        if slow:
+            self._slow_step(slow, moving, dt)
+
+    def _fall(self, rb: _Robot, *, first: bool) -> None:
+        dt = self._dt
+        if first:
+            rb.falling = True
+            rb.fall_speed = self.fall_speed
+        v0 = rb.fall_speed
+        drop = v0 * dt + 0.5 * _GRAVITY * dt * dt
+        if first and drop < _MIN_FIRST_DROP:
+            drop = _MIN_FIRST_DROP
+        rb.fall_speed = v0 + _GRAVITY * dt
+        rb.z -= drop
+        rb.vel = (0.0, 0.0, -drop / dt, 0.0)
+
+    def _slow_step(self, slow: list[_Robot], solid: list[_Robot], dt: float) -> None:
+        # All slow robots advance together in sub-steps, in index order within each, so
+        # that robots meeting head-on share the gap. Collisions are exact for any segment
+        # length; sub-steps keep the swept chord near the arc and the search boxes small.
+        n_sub = 1
+        for rb in slow:
+            res = rb.geom.res
+            need = max(rb.travel / (0.5 * res), abs(rb.cmd[2]) * dt / _MAX_TURN)
+            if need > n_sub:
+                n_sub = min(math.ceil(need), _MAX_SUBSTEPS)
+        h = dt / n_sub
+        start = []
+        for rb in slow:
+            start.append((rb.x, rb.y, rb.yaw))
+            rb.stopped = False
+            if rb.geom.is_void(rb.x, rb.y):
+                rb.falling = True  # standing over nothing: falls without moving
+        for _ in range(n_sub):
+            for rb in slow:
+                if rb.falling:
+                    continue
+                vx, vy, w = rb.cmd
+                if not rb.stopped and (vx != 0.0 or vy != 0.0):
+                    dx, dy = _arc(rb.yaw, vx, vy, w, h)
+                    self._advance(rb, dx, dy, solid)
+                    if rb.geom.is_void(rb.x, rb.y):
+                        rb.falling = True
+                rb.yaw += w * h
+        for rb, (x0, y0, yaw0) in zip(slow, start):
+            if rb.falling:
+                vel_x, vel_y, wz = (rb.x - x0) / dt, (rb.y - y0) / dt, (rb.yaw - yaw0) / dt
+                self._fall(rb, first=True)
+                rb.vel = (vel_x, vel_y, rb.vel[2], wz)
+            else:
+                rb.vel = ((rb.x - x0) / dt, (rb.y - y0) / dt, 0.0, (rb.yaw - yaw0) / dt)
+
+    def _advance(self, rb: _Robot, dx: float, dy: float, solid: list[_Robot]) -> None:
+        """Move robot ``rb`` by (dx, dy), resolving contacts; sets contact flags."""
+        r = rb.radius
+        geom = rb.geom
+        px, py = rb.x, rb.y
+        x_start, y_start = px, py
+        hit_any = False
+        for _ in range(_MAX_SLIDES):
+            length = math.hypot(dx, dy)
+            if length <= 1e-15:
+                break
+            reach = r + length + 2.0 * _ACTIVE
+            squares = geom.edge_squares(px - reach, py - reach, px + reach, py + reach)
+            others = [
+                o
+                for o in solid
+                if o is not rb
+                and o.floor == rb.floor
+                and not o.falling
+                and (o.x - px) ** 2 + (o.y - py) ** 2 < (reach + o.radius) ** 2
+            ]
+            # Constraints already touching: do not move into them.
+            active: list[tuple[float, float, _Robot | None]] = []
+            far_squares = []
+            for sq in squares:
+                dist, nx, ny = square_distance(px, py, *sq)
+                if dist <= r + _ACTIVE:
+                    active.append((nx, ny, None))
+                elif dist < reach:
+                    far_squares.append(sq)
+            far_others = []
+            for o in others:
+                ex, ey = px - o.x, py - o.y
+                d = math.hypot(ex, ey)
+                if d - r - o.radius <= _ACTIVE:
+                    active.append((ex / d, ey / d, o) if d > 0.0 else (1.0, 0.0, o))
+                else:
+                    far_others.append(o)
+            blocked = [c for c in active if dx * c[0] + dy * c[1] < 0.0]
+            if blocked:
+                hit_any = True
+                for _, _, o in blocked:
+                    if o is not None:
+                        o.contact = True
+                if self._stop:
+                    rb.stopped = True
+                    break
+                dx, dy = _slide(dx, dy, blocked, active)
+                if dx == 0.0 and dy == 0.0:
+                    break
+            # First contact along the (possibly projected) motion.
+            t_hit = 1.0
+            first: Any = None
+            for sq in far_squares:
+                t = enter_rounded_square(px, py, dx, dy, *sq, r + _HIT)
+                if t < t_hit:
+                    t_hit, first = t, sq
+            for o in far_others:
+                t = enter_disc(px, py, dx, dy, o.x, o.y, r + o.radius + _HIT)
+                if t < t_hit:
+                    t_hit, first = t, o
+            if first is None:
+                px += dx
+                py += dy
+                dx = dy = 0.0
+                break
+            hit_any = True
+            if isinstance(first, _Robot):
+                first.contact = True
+                t_stop = enter_disc(px, py, dx, dy, first.x, first.y, r + first.radius + _PLACE)
+            else:
+                t_stop = enter_rounded_square(px, py, dx, dy, *first, r + _PLACE)
+            t_stop = min(max(t_stop, 0.0), t_hit)
+            px += t_stop * dx
+            py += t_stop * dy
+            dx *= 1.0 - t_stop
+            dy *= 1.0 - t_stop
+            if self._stop:
+                rb.stopped = True
+                break
+        if hit_any:
+            rb.contact = True
+            # Safety net against rounding: never accept an overlap deeper than before.
+            if (px != x_start or py != y_start) and (
+                (depth := self._penetration(rb, px, py, solid)) > 0.0
+                and depth > self._penetration(rb, x_start, y_start, solid)
+            ):
+                px, py = x_start, y_start
+        rb.x, rb.y = px, py
+
+    def _penetration(self, rb: _Robot, x: float, y: float, solid: list[_Robot]) -> float:
+        """Deepest overlap (m) of robot ``rb``'s disc at (x, y) with obstacles and robots."""
+        r = rb.radius
+        deepest = -math.inf
+        for sq in rb.geom.edge_squares(x - r, y - r, x + r, y + r):
+            deepest = max(deepest, r - square_distance(x, y, *sq)[0])
+        geom = rb.geom
+        cell = geom.cell_index(x, y)
+        if cell >= 0 and geom.codes[cell] == OBSTACLE:  # centre inside, maybe an inner cell
+            row, col = divmod(cell, geom.width)
+            x0, y0 = geom.ox + col * geom.res, geom.oy + row * geom.res
+            sd = square_distance(x, y, x0, y0, x0 + geom.res, y0 + geom.res)[0]
+            deepest = max(deepest, r - sd)
+        for o in solid:
+            if o is not rb and o.floor == rb.floor and not o.falling:
+                deepest = max(deepest, r + o.radius - math.hypot(x - o.x, y - o.y))
+        return deepest
+
+
+def _slide(
+    dx: float,
+    dy: float,
+    blocked: list[tuple[float, float, Any]],
+    active: list[tuple[float, float, Any]],
+) -> tuple[float, float]:
+    """Project motion (dx, dy) onto the tangent of a blocking contact that keeps clear of all.
+
+    In 2D the best feasible motion lies on one constraint's tangent or is zero (a corner).
+    """
+    best = (0.0, 0.0)
+    best_len = 0.0
+    tol = 1e-12 * math.hypot(dx, dy)
+    for nx, ny, _ in blocked:
+        dot = dx * nx + dy * ny
+        tx, ty = dx - dot * nx, dy - dot * ny
+        if all(tx * mx + ty * my >= -tol for mx, my, _ in active):
+            length = tx * tx + ty * ty
+            if length > best_len:
+                best, best_len = (tx, ty), length
+    return best

@@ -1,0 +1,466 @@
+"""The Backend protocol: the only door between the core and the world it drives.
+
+The core (task, envs, metrics) never touches a simulator. It asks a *backend* to build the
+world from a scene and some robot specs, to place robots, to advance one control step, and
+to report poses, velocities and contacts. Backends register under a name in the entry-point
+group ``pointnav_core.backends`` (``"kinematic"`` ships with the library), so a third party
+can add one without touching the core. This module imports no backend package.
+
+==============================================  ==========================================
+Method                                          What it does
+==============================================  ==========================================
+``load(scene, robots, action_frequency)``       build the world; robots present, unplaced
+``reset()``                                     zero velocities and contact flags
+``n_robots``                                    number of robots (property)
+``land(idn, floor, position, orientation)``     place a robot on a floor, z = floor height
+``set_pose(idn, position, orientation)``        teleport a robot (world xyz, xyzw quat)
+``get_pose(idn)``                               world position (3,) and xyzw quaternion (4,)
+``get_velocity(idn)``                           world linear (3,) and angular (3,) velocity
+``step(actions)``                               apply actions, advance one control step
+``in_contact(idn)``                             touched an obstacle or robot last step?
+``is_valid_pose(idn, position, orientation)``   could the robot stand there?
+``set_present(idn, present)``                   take a robot out of (or back into) the world
+``is_present(idn)``                             whether the robot is in the world
+``get_robot_floor(idn)``                        the floor the robot was landed on
+==============================================  ==========================================
+
+Units are metres, seconds and radians; the world frame has x, y on the floor and z up;
+quaternions are ``(x, y, z, w)``. Actions are in ``[-1, 1]`` and are turned into velocities
+by :meth:`RobotSpec.scale_action`.
+"""
+
+from __future__ import annotations
+
+import inspect
+import math
+import types
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+from importlib.metadata import entry_points
+from typing import TYPE_CHECKING, Any, Protocol, runtime_checkable
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from pointnav_core.errors import BackendError
+
+__all__ = [
+    "DRIVES",
+    "ENTRY_POINT_GROUP",
+    "Backend",
+    "RobotSpec",
+    "UnknownBackendError",
+    "available_backends",
+    "check_backend",
+    "get_backend",
+    "make_backend",
+]
+
+#: Drive types and the meaning of their action vector (robot frame: +x ahead, +y left).
+DRIVES = types.MappingProxyType({"differential": ("v", "w"), "holonomic": ("vx", "vy", "w")})
+
+#: Entry-point group under which backends register ``name = "module:Class"``.
+ENTRY_POINT_GROUP = "pointnav_core.backends"
+
+
+class UnknownBackendError(BackendError, ValueError):
+    """No backend is installed under the requested name.
+
+    It is both a :class:`~pointnav_core.errors.BackendError` (what went wrong) and a
+    :class:`ValueError` (a bad argument value), so either ``except`` clause catches it.
+    """
+
+
+def _positive(name: str, value: Any, *, strict: bool, unit: str) -> float:
+    try:
+        number = float(value)
+    except (TypeError, ValueError):
+        raise ValueError(f"{name} must be a number ({unit}), got {value!r}") from None
+    bound_ok = number > 0.0 if strict else number >= 0.0
+    if not math.isfinite(number) or not bound_ok:
+        relation = "> 0" if strict else ">= 0"
+        raise ValueError(f"{name} must be a finite number {relation} ({unit}), got {value!r}")
+    return number
+
+
+@dataclass(frozen=True, kw_only=True)
+class RobotSpec:
+    """What a backend needs to know about one robot: its size, speed limits and drive.
+
+    Parameters
+    ----------
+    radius : float
+        Radius of the robot's footprint disc in metres, >= 0 (0 is a point robot).
+    max_linear_velocity : float
+        Speed in m/s that an action component of 1 maps to, > 0.
+    max_angular_velocity : float
+        Yaw rate in rad/s that an action component of 1 maps to, > 0.
+    drive : {"differential", "holonomic"}
+        ``"differential"``: action ``(v, w)``, forward speed and yaw rate.
+        ``"holonomic"``: action ``(vx, vy, w)``, velocities in the robot frame (+x ahead,
+        +y to the left) and yaw rate.
+
+    Examples
+    --------
+    >>> spec = RobotSpec(radius=0.2, drive="holonomic")
+    >>> spec.action_dim
+    3
+    >>> spec.scale_action([1.0, -2.0, 0.5]).tolist()  # -2 is clipped to -1
+    [0.5, -0.5, 0.75]
+    >>> RobotSpec(drive="tank")
+    Traceback (most recent call last):
+    ...
+    ValueError: drive must be one of ['differential', 'holonomic'], got 'tank'
+    """
+
+    radius: float = 0.18
+    max_linear_velocity: float = 0.5
+    max_angular_velocity: float = 1.5
+    drive: str = "differential"
+
+    if TYPE_CHECKING:
+        # Set in __post_init__; declared here for type checkers only, so not a field.
+        _maxima: tuple[float, ...]
+
+    def __post_init__(self) -> None:
+        # Store floats, so that a spec built from numpy scalars or ints compares and hashes
+        # like one built from Python floats.
+        set_ = object.__setattr__
+        set_(self, "radius", _positive("radius", self.radius, strict=False, unit="metres"))
+        set_(
+            self,
+            "max_linear_velocity",
+            _positive("max_linear_velocity", self.max_linear_velocity, strict=True, unit="m/s"),
+        )
+        set_(
+            self,
+            "max_angular_velocity",
+            _positive(
+                "max_angular_velocity", self.max_angular_velocity, strict=True, unit="rad/s"
+            ),
+        )
+        if not isinstance(self.drive, str) or self.drive not in DRIVES:
+            raise ValueError(f"drive must be one of {sorted(DRIVES)}, got {self.drive!r}")
+        lin, ang = self.max_linear_velocity, self.max_angular_velocity
+        # Velocity each action component maps to: derived, so not a field (asdict, eq).
+        set_(self, "_maxima", (lin, ang) if self.drive == "differential" else (lin, lin, ang))
+
+    @property
+    def action_dim(self) -> int:
+        """Length of an action vector: 2 for differential drive, 3 for holonomic."""
+        return len(self._maxima)
+
+    def scale_action(self, action: ArrayLike) -> NDArray[np.float64]:
+        """Turn an action in ``[-1, 1]`` into velocities.
+
+        Parameters
+        ----------
+        action : array_like, shape (action_dim,)
+            ``(v, w)`` for differential drive or ``(vx, vy, w)`` for holonomic drive, each
+            in ``[-1, 1]``; values outside are clipped.
+
+        Returns
+        -------
+        ndarray of float64, shape (action_dim,)
+            Velocities: linear components in m/s (robot frame), the yaw rate in rad/s.
+
+        Raises
+        ------
+        ValueError
+            If ``action`` has the wrong shape or holds NaN or infinity.
+
+        Examples
+        --------
+        >>> RobotSpec().scale_action([0.5, -1.0]).tolist()
+        [0.25, -1.5]
+        >>> RobotSpec().scale_action([float("nan"), 0.0])
+        Traceback (most recent call last):
+        ...
+        ValueError: action must be finite, got [nan, 0.0]
+        """
+        return np.array(self._scaled(action))
+
+    def _scaled(self, action: ArrayLike) -> tuple[float, ...]:
+        # Hot path (once per robot per step): plain floats beat numpy for 2-3 numbers.
+        maxima = self._maxima
+        try:
+            values = np.asarray(action, dtype=np.float64).tolist()
+        except (TypeError, ValueError):
+            values = None
+        if not isinstance(values, list) or len(values) != len(maxima) or any(
+            isinstance(v, list) for v in values
+        ):
+            shape = getattr(np.asarray(action, dtype=object), "shape", None)
+            raise ValueError(
+                f"action must have shape ({len(maxima)},) for a {self.drive} drive "
+                f"({', '.join(DRIVES[self.drive])}), got shape {shape}"
+            )
+        out = []
+        for v, m in zip(values, maxima):
+            if not -math.inf < v < math.inf:  # also False for NaN
+                raise ValueError(f"action must be finite, got {values}")
+            out.append(m if v >= 1.0 else -m if v <= -1.0 else v * m)
+        return tuple(out)
+
+
+@runtime_checkable
+class Backend(Protocol):
+    """The world as the core sees it: robots on the floors of a scene.
+
+    Robots are numbered ``idn = 0 .. n_robots - 1`` in the order their specs were given to
+    :meth:`load`. Positions are world ``(x, y, z)`` in metres, orientations ``(x, y, z, w)``
+    quaternions, velocities world-frame m/s and rad/s. Every returned array is a fresh
+    object. A robot that is not *present* is out of the world: ``step`` does not move it and
+    nothing collides with it.
+    """
+
+    @property
+    def n_robots(self) -> int:
+        """Number of robots loaded (0 before :meth:`load`)."""
+        ...
+
+    def load(
+        self, scene: Any, robots: Sequence[RobotSpec], action_frequency: float = 10.0
+    ) -> None:
+        """Build the world: the scene's floors and one robot per spec.
+
+        Parameters
+        ----------
+        scene : Scene
+            Anything with ``floors`` (list of TraversableMap), ``n_floors`` and
+            ``get_floor_height(floor)``.
+        robots : sequence of RobotSpec
+            One spec per robot; robot ``idn`` is ``robots[idn]``.
+        action_frequency : float
+            Control steps per second (Hz), > 0; one :meth:`step` lasts
+            ``1 / action_frequency`` seconds.
+
+        Notes
+        -----
+        All robots start present but unplaced: they take part in no collision until
+        :meth:`land` or :meth:`set_pose` places them.
+        """
+        ...
+
+    def reset(self) -> None:
+        """Zero every robot's velocity and contact flag; poses are then set by the task."""
+        ...
+
+    def land(self, idn: int, floor: int, position: ArrayLike, orientation: ArrayLike) -> None:
+        """Place robot ``idn`` standing on ``floor``, at rest.
+
+        Parameters
+        ----------
+        idn : int
+            Robot index.
+        floor : int
+            Floor index in ``[0, scene.n_floors)``.
+        position : array_like, shape (2,) or (3,)
+            World x, y in metres; any z is replaced by the floor's height.
+        orientation : array_like, shape (4,)
+            ``(x, y, z, w)`` quaternion.
+        """
+        ...
+
+    def set_pose(self, idn: int, position: ArrayLike, orientation: ArrayLike) -> None:
+        """Teleport robot ``idn`` to world ``position`` (x, y, z in m) and xyzw ``orientation``."""
+        ...
+
+    def get_pose(self, idn: int) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+        """Return robot ``idn``'s world position (3,) in metres and xyzw quaternion (4,)."""
+        ...
+
+    def get_velocity(self, idn: int) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+        """Return robot ``idn``'s world velocity: linear (3,) in m/s, angular (3,) in rad/s.
+
+        These are the effective velocities of the last step (displacement over its
+        duration), about the world axes.
+        """
+        ...
+
+    def step(self, actions: Mapping[int, ArrayLike]) -> None:
+        """Apply each given robot's action and advance one control step for all robots.
+
+        Parameters
+        ----------
+        actions : mapping of int to array_like
+            Robot index -> action in ``[-1, 1]`` units, scaled by that robot's
+            :meth:`RobotSpec.scale_action`. Robots without an entry get a zero command.
+            The step lasts ``1 / action_frequency`` seconds.
+        """
+        ...
+
+    def in_contact(self, idn: int) -> bool:
+        """Whether robot ``idn`` touched an obstacle or another robot during the last step.
+
+        The floor never counts, and VOID (a hole) is not an obstacle.
+        """
+        ...
+
+    def is_valid_pose(
+        self,
+        idn: int,
+        position: ArrayLike,
+        orientation: ArrayLike | None = None,
+        *,
+        floor: int | None = None,
+    ) -> bool:
+        """Whether robot ``idn`` could stand at ``position``.
+
+        Valid means: the robot's disc overlaps no OBSTACLE cell and no other present,
+        placed robot on the same floor (touching is allowed), and its centre is on the
+        map and not over VOID. ``position`` is world (x, y) or (x, y, z) in metres;
+        ``floor`` defaults to the robot's floor (:meth:`get_robot_floor`).
+        """
+        ...
+
+    def set_present(self, idn: int, present: bool) -> None:
+        """Take robot ``idn`` out of the world (``False``) or bring it back (``True``)."""
+        ...
+
+    def is_present(self, idn: int) -> bool:
+        """Whether robot ``idn`` is in the world."""
+        ...
+
+    def get_robot_floor(self, idn: int) -> int:
+        """The floor index robot ``idn`` was last landed on (0 until then)."""
+        ...
+
+
+def _protocol_members() -> tuple[str, ...]:
+    return tuple(
+        name
+        for name, value in vars(Backend).items()
+        if not name.startswith("_") and (callable(value) or isinstance(value, property))
+    )
+
+
+def check_backend(obj: Any) -> Any:
+    """Raise :class:`BackendError` unless ``obj`` (a class or an instance) is a Backend.
+
+    Parameters
+    ----------
+    obj : object
+        A backend class or instance.
+
+    Returns
+    -------
+    object
+        ``obj`` itself, unchanged.
+
+    Raises
+    ------
+    BackendError
+        Listing every protocol member that ``obj`` lacks or has in a non-callable form.
+
+    Examples
+    --------
+    >>> class Half:
+    ...     def load(self, scene, robots, action_frequency=10.0): ...
+    >>> check_backend(Half)  # doctest: +ELLIPSIS
+    Traceback (most recent call last):
+    ...
+    pointnav_core.errors.BackendError: Half does not implement the Backend protocol; missing: ...
+    """
+    cls = obj if isinstance(obj, type) else type(obj)
+    missing = []
+    for name in _protocol_members():
+        # Look on the class, so that checking never runs a property or __getattr__.
+        attr = inspect.getattr_static(cls, name, None)
+        if attr is None:
+            missing.append(name)
+        elif name == "n_robots":
+            continue
+        elif not callable(attr) and not isinstance(attr, (staticmethod, classmethod)):
+            missing.append(name)
+    if missing:
+        raise BackendError(
+            f"{cls.__name__} does not implement the Backend protocol; missing: "
+            f"{', '.join(missing)}"
+        )
+    return obj
+
+
+def available_backends() -> list[str]:
+    """Names of the installed backends (entry-point group ``pointnav_core.backends``).
+
+    Examples
+    --------
+    >>> "kinematic" in available_backends()
+    True
+    """
+    return sorted({ep.name for ep in entry_points(group=ENTRY_POINT_GROUP)})
+
+
+def get_backend(name: str) -> type:
+    """Return the backend class registered under ``name``.
+
+    Parameters
+    ----------
+    name : str
+        An entry-point name in the group ``pointnav_core.backends``, e.g. ``"kinematic"``.
+
+    Raises
+    ------
+    UnknownBackendError
+        (a BackendError and a ValueError) if no backend has that name; the message lists
+        the installed ones.
+
+    Examples
+    --------
+    >>> get_backend("kinematic").__name__
+    'KinematicBackend'
+    """
+    matches = [ep for ep in entry_points(group=ENTRY_POINT_GROUP) if ep.name == name]
+    if not matches:
+        raise UnknownBackendError(
+            f"backend must be one of {available_backends()}, got {name!r}"
+        )
+    cls = matches[0].load()
+    if not isinstance(cls, type):
+        raise BackendError(
+            f"backend entry point {name!r} ({matches[0].value}) must name a class, got {cls!r}"
+        )
+    return cls
+
+
+def make_backend(backend: str | type | Backend = "kinematic", **kwargs: Any) -> Backend:
+    """Return a backend instance from a name, a class, or an instance.
+
+    Parameters
+    ----------
+    backend : str or type or Backend
+        A registered name (see :func:`available_backends`), a backend class (instantiated
+        with ``kwargs``), or an instance (returned as is).
+    **kwargs
+        Constructor arguments, for a name or a class only.
+
+    Raises
+    ------
+    UnknownBackendError
+        If ``backend`` is a name that is not registered.
+    BackendError
+        If the result does not implement the Backend protocol, or ``backend`` is of
+        another type.
+    ValueError
+        If ``kwargs`` are given along with an instance.
+
+    Examples
+    --------
+    >>> make_backend("kinematic", collision_mode="stop").collision_mode
+    'stop'
+    """
+    if isinstance(backend, str):
+        cls = get_backend(backend)
+        check_backend(cls)
+        return cls(**kwargs)
+    if isinstance(backend, type):
+        check_backend(backend)
+        return backend(**kwargs)
+    check_backend(backend)
+    if kwargs:
+        raise ValueError(
+            f"backend arguments {sorted(kwargs)} only apply when backend is a name or a "
+            f"class, got an instance of {type(backend).__name__}"
+        )
+    return backend
