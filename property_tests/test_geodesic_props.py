@@ -88,17 +88,19 @@ def test_geodesic_is_symmetric_and_obeys_the_triangle_inequality(case):
 
 @given(maps_with_points(n_points=2))
 @settings(max_examples=40)
-def test_field_lookup_agrees_with_the_path_query(case):
+def test_field_lookup_is_the_length_of_a_real_path(case):
     tmap, radius, (a, b) = case
     scene = scene_of(tmap)
     _, dist = scene.get_shortest_path(0, a, b, entire_path=True, robot=radius)
     lookup = scene.goal_field(0, b, robot=radius).distance(*a)
     if dist is None:
         assert lookup == math.inf
-    else:
-        # The lookup uses the root of a's cell; the path query checks the exact point.
-        assert lookup >= math.dist(a, b) - 1e-9
-        assert abs(lookup - dist) <= 2 * tmap.resolution + 0.02 * dist
+        return
+    # The lookup follows the checked root of a's cell: a real path from the cell centre,
+    # so never shorter than the geodesic (less twice the offset from the centre).
+    assert math.isfinite(lookup)
+    assert lookup >= dist - 2 * math.sqrt(0.5) * tmap.resolution - 1e-9
+    assert lookup >= math.dist(a, b) - 1e-9
 
 
 @given(maps_with_points(n_points=1), st.integers(0, 2**32 - 1))

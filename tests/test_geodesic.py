@@ -123,3 +123,17 @@ def test_void_cells_are_not_paths():
     grid[:, 2] = OBSTACLE
     grid[2, 2] = 0
     assert Scene.from_array(grid, 1.0).get_shortest_path(0, (0.5, 0.5), (4.5, 0.5))[1] is not None
+
+
+def test_field_lookup_matches_exact_queries_in_a_generated_house():
+    from pointnav_core import scenes
+
+    scene = scenes.rooms(seed=0)
+    rng = np.random.default_rng(0)
+    worst = 0.0
+    for _ in range(150):
+        _, a = scene.get_random_point(0, robot=0.18, rng=rng)
+        _, b = scene.get_random_point(0, reference_point=a, robot=0.18, rng=rng)
+        field = scene.goal_field(0, b, robot=0.18)
+        worst = max(worst, abs(field.distance(*a[:2]) - field.exact_distance(a[:2])))
+    assert worst < 0.05

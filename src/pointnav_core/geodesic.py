@@ -36,7 +36,7 @@ from numpy.typing import ArrayLike, NDArray
 from scipy import sparse
 from scipy.sparse import csgraph
 
-from pointnav_core.maps import BoundedCache
+from pointnav_core.maps import FREE, BoundedCache
 
 if TYPE_CHECKING:
     from pointnav_core.maps import TraversableMap
@@ -111,6 +111,10 @@ class Planner:
             True where every cell the closed segment meets is usable.
         """
         return self._sight.visible(p, q)
+
+    def visible_one(self, pr: float, pc: float, qr: float, qc: float) -> bool:
+        """:meth:`visible` for one segment, in plain Python (cheaper for a single query)."""
+        return self._sight.visible_one(pr, pc, qr, qc)
 
     # ------------------------------------------------------------------ corners
     def _find_corners(self) -> tuple[NDArray[np.float64], NDArray[np.int8]]:
@@ -317,7 +321,22 @@ class GoalField:
         n_cells = h * w
         root = np.full(n_cells, _UNREACHABLE, dtype=np.int64)
         if self.label != 0:
-            root = self._grid_roots()
+            root = self._grid_roots().reshape(h, w)
+            # A robot can stand in a FREE cell whose *centre* is too close to an obstacle
+            # (the erosion is decided at cell centres). Such margin cells take the root of
+            # a neighbouring cell of the component, so the distance never jumps to infinity.
+            # The roots spread through FREE cells only (never across a wall), a few cells deep.
+            margin = (planner.tmap.codes == FREE) & (planner.labels == 0)
+            for _ in range(int(math.ceil(planner.radius / planner.tmap.resolution)) + 2):
+                todo = margin & (root == _UNREACHABLE)
+                if not todo.any():
+                    break
+                padded = np.pad(root, 1, constant_values=_UNREACHABLE)
+                for dr, dc in ((-1, 0), (1, 0), (0, -1), (0, 1)):
+                    nb = padded[1 + dr : 1 + dr + h, 1 + dc : 1 + dc + w]
+                    take = todo & (nb != _UNREACHABLE)
+                    root[take] = nb[take]
+                    todo &= ~take
         self._root_rows = root.reshape(h, w).tolist()
         return self._root_rows
 
@@ -352,16 +371,17 @@ class GoalField:
         )
         # Follow predecessors up to the seed each cell hangs from (pointer jumping).
         anc = pred.astype(np.int64)
-        anc[super_source] = super_source
-        seeded = anc == super_source
-        anc[seeded] = np.flatnonzero(seeded)
         anc[anc < 0] = super_source
+        anc[super_source] = super_source
+        anc[seeds] = seeds
         while True:
             nxt = anc[anc]
             if np.array_equal(nxt, anc):
                 break
             anc = nxt
         root = source_of[anc[:n_cells]]
+        root[pred[:n_cells] < 0] = _UNREACHABLE
+        root[seeds] = source_of[seeds]
         # The goal's own code; corners keep their index and are pulled taut on first use.
         root[root == n] = _TO_GOAL
         return root
@@ -369,9 +389,10 @@ class GoalField:
     def _taut_root(self, r: int, c: int, v: int) -> int:
         """Pull corner ``v`` (the raw root of cell (r, c)) up its chain until it is taut.
 
-        A path c -> v -> next only bends at v if the leg to v is tangent there and the turn
-        is towards v's blocked cell; otherwise the cell hangs from ``next``. Returns a corner
-        index or -1 (the goal), encoded for the table as described in :meth:`_lookup`.
+        A path c -> v -> next only bends at v if the leg to v is tangent there, the turn is
+        towards v's blocked cell and it bends by at most 90 degrees; otherwise the cell hangs
+        from ``next``. Returns a corner
+        index or -1 (the goal).
         """
         cr, cc = r + 0.5, c + 0.5
         n = self._n
@@ -381,7 +402,13 @@ class GoalField:
             nxt = self._pred[v]
             br, bc = self._pos_r[nxt] - vr, self._pos_c[nxt] - vc
             dr, dc = self._diag_r[v], self._diag_c[v]
-            if (ar * bc - ac * br) * (ar * dc - ac * dr) > 0 and (ar * dr) * (ac * dc) <= 0:
+            # Turn towards the blocked cell, arrive tangentially, and bend by at most 90
+            # degrees: the blocked region at a corner is locally a quadrant.
+            if (
+                (ar * bc - ac * br) * (ar * dc - ac * dr) > 0
+                and (ar * dr) * (ac * dc) <= 0
+                and ar * br + ac * bc >= 0
+            ):
                 return v
             v = nxt
         return _TO_GOAL
@@ -389,15 +416,40 @@ class GoalField:
     def _lookup(self, r: int, c: int) -> int:
         """Root of cell (r, c): a corner index, -1 (the goal) or -2 (unreachable).
 
-        Table codes: >= 0 a raw corner root not yet pulled taut; -1 goal; -2 unreachable;
-        <= -3 the taut corner ``-code - 3``.
+        The table holds raw roots (a corner index >= 0, -1 for the goal, -2 unreachable)
+        until a cell is first looked up; then the root is pulled taut, checked visible from
+        the cell centre (else the corners are searched exactly), and stored as final:
+        -3 for the goal, ``-k - 4`` for corner k. So each cell is settled once, the same way
+        whatever the order of queries.
         """
         rows = self._root_rows if self._root_rows is not None else self._solve_cells()
         code = rows[r][c]
-        if code >= 0:
-            root = self._taut_root(r, c, code)
-            rows[r][c] = code = root if root < 0 else -root - 3
-        return -code - 3 if code <= -3 else code
+        if code <= -3:
+            return _TO_GOAL if code == -3 else -code - 4
+        if code == _UNREACHABLE:
+            return code
+        labels = self.planner.labels
+        if labels[r, c] == 0:
+            # A margin cell: leave the way its nearest usable neighbour does.
+            root = self._margin_root(r, c, code)
+        else:
+            root = self._taut_root(r, c, code) if code >= 0 else _TO_GOAL
+            if not self.planner.visible_one(r + 0.5, c + 0.5, self._pos_r[root], self._pos_c[root]):
+                root = int(self._search(np.array([[r + 0.5, c + 0.5]]))[0])
+        rows[r][c] = -3 if root == _TO_GOAL else -root - 4
+        return root
+
+    def _margin_root(self, r: int, c: int, code: int) -> int:
+        labels = self.planner.labels
+        h, w = self.planner.shape
+        for ring in range(1, 3):
+            for dr in range(-ring, ring + 1):
+                for dc in range(-ring, ring + 1):
+                    rr, cc = r + dr, c + dc
+                    if max(abs(dr), abs(dc)) == ring and 0 <= rr < h and 0 <= cc < w:
+                        if labels[rr, cc] == self.label:
+                            return self._lookup(rr, cc)
+        return self._taut_root(r, c, code) if code >= 0 else _TO_GOAL
 
     # ------------------------------------------------------------------ lookups
     def distance(self, gr: float, gc: float) -> float:
@@ -430,7 +482,13 @@ class GoalField:
         """
         r, c = math.floor(g[0]), math.floor(g[1])
         h, w = self.planner.shape
-        if self.label == 0 or not (0 <= r < h and 0 <= c < w) or self.planner.labels[r, c] != self.label:
+        if self.label == 0 or not (0 <= r < h and 0 <= c < w):
+            return _UNREACHABLE
+        label = self.planner.labels[r, c]
+        if label == 0:
+            # A margin cell (see _solve_cells): leave along the nearest usable cell's root.
+            return self._lookup(r, c)
+        if label != self.label:
             return _UNREACHABLE
         if self._root_rows is not None:
             root = self._lookup(r, c)
@@ -513,6 +571,9 @@ class _Sightlines:
         np.cumsum(counts, axis=1, out=self._row_cum[:, 1:])
         self._col_cum = np.zeros((w, h + 1), dtype=np.int32)
         np.cumsum(counts.T, axis=1, out=self._col_cum[:, 1:])
+        # Python copies for visible_one, made on first use.
+        self._rows: list[list[int]] | None = None
+        self._cols: list[list[int]] | None = None
 
     def visible(self, p: ArrayLike, q: ArrayLike) -> NDArray[np.bool_]:
         """True where the closed segment p-q meets no blocked cell and stays on the grid."""
@@ -529,6 +590,39 @@ class _Sightlines:
         if by_cols.any():
             out[by_cols] = self._banded(p[by_cols][:, ::-1], q[by_cols][:, ::-1], self._col_cum)
         return out.reshape(shape)
+
+    def visible_one(self, pr: float, pc: float, qr: float, qc: float) -> bool:
+        """The same test for one segment, band by band in plain Python (no array overhead)."""
+        if abs(qr - pr) <= abs(qc - pc):
+            if self._rows is None:
+                self._rows = self._row_cum.tolist()
+            cum, p0, p1, q0, q1 = self._rows, pr, pc, qr, qc
+        else:
+            if self._cols is None:
+                self._cols = self._col_cum.tolist()
+            cum, p0, p1, q0, q1 = self._cols, pc, pr, qc, qr
+        n_bands, n_cells = len(cum), len(cum[0]) - 1
+        a0, a1 = min(p0, q0), max(p0, q0)
+        d0 = q0 - p0
+        flat = abs(d0) < _EPS
+        slope = 0.0 if flat else (q1 - p1) / d0
+        for k in range(math.ceil(a0 - _EPS) - 1, math.floor(a1 + _EPS) + 1):
+            if k < 0 or k >= n_bands:
+                return False
+            if flat:
+                lo, hi = min(p1, q1), max(p1, q1)
+            else:
+                o_a = p1 + (max(k, a0) - p0) * slope
+                o_b = p1 + (min(k + 1, a1) - p0) * slope
+                lo, hi = min(o_a, o_b), max(o_a, o_b)
+            j_lo = math.ceil(lo - _EPS) - 1
+            j_hi = math.floor(hi + _EPS) + 1
+            if j_lo < 0 or j_hi > n_cells:
+                return False
+            row = cum[k]
+            if row[j_hi] != row[j_lo]:
+                return False
+        return True
 
     def touches_blocked(self, p: ArrayLike, q: ArrayLike) -> NDArray[np.bool_]:
         """True where the closed segment meets a blocked cell (leaving the grid aside)."""
