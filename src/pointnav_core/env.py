@@ -1,0 +1,310 @@
+"""The single-robot Gymnasium environment ``pointnav_core/PointNav-v0``."""
+
+from __future__ import annotations
+
+import dataclasses
+import inspect
+import math
+from collections import OrderedDict
+from collections.abc import Mapping
+from typing import Any
+
+import gymnasium as gym
+import numpy as np
+from gymnasium import spaces
+from numpy.typing import NDArray
+
+from pointnav_core import scenes
+from pointnav_core.backend import Backend, RobotSpec, make_backend
+from pointnav_core.task import PointNavigationTask
+
+__all__ = ["PointNavEnv"]
+
+_TASK_KEYS = tuple(inspect.signature(PointNavigationTask).parameters)
+_ROBOT_KEYS = tuple(f.name for f in dataclasses.fields(RobotSpec))
+
+
+class PointNavEnv(gym.Env[Any, np.ndarray]):
+    """
+    ## Description
+
+    Point-goal navigation on a 2D floor map, without a physics engine: a disc-shaped robot
+    must drive to a goal position, OmniGibson's `PointNavigationTask` re-implemented on
+    traversability maps. The scene's floors have free floor, obstacles and void (holes the
+    robot falls into); a kinematic backend integrates the robot's drive exactly and resolves
+    contacts by sliding. The goal is given relative to the robot, so the agent must learn to
+    steer towards it and around obstacles. By default the scene is a generated house
+    (`scenes.rooms(seed=0)`: rooms, doors and furniture).
+
+    ## Action Space
+
+    The action is a `ndarray` of `float32` in `[-1, 1]`, scaled by the robot's maxima
+    (`RobotSpec.max_linear_velocity`, 0.5 m/s, and `max_angular_velocity`, 1.5 rad/s) and
+    held for one control step of `1 / action_frequency` s:
+
+    | Num | Action (differential drive, shape `(2,)`) | Unit at 1 |
+    |-----|-------------------------------------------|-----------|
+    | 0   | forward speed                             | m/s       |
+    | 1   | yaw rate (positive turns left)            | rad/s     |
+
+    A holonomic robot (`RobotSpec(drive="holonomic")`) takes `(vx, vy, w)`, shape `(3,)`.
+    Values outside `[-1, 1]` are clipped; NaN, infinity or a wrong shape raise `ValueError`.
+
+    ## Observation Space
+
+    A `Dict` of three `float32` arrays, in the robot's frame (+x ahead, +y to the left).
+    `D` is the diagonal of the task's floor plus 1 m, `v` is `sqrt(2)` times the robot's
+    `max_linear_velocity` and `w` its `max_angular_velocity`:
+
+    | Num | Key              | Observation                                   | Min  | Max |
+    |-----|------------------|-----------------------------------------------|------|-----|
+    | 0   | `xy_pos_to_goal` | goal x relative to the robot (m)              | -D   | D   |
+    | 1   | `xy_pos_to_goal` | goal y relative to the robot (m)              | -D   | D   |
+    | 2   | `robot_lin_vel`  | linear velocity x (m/s)                       | -v   | v   |
+    | 3   | `robot_lin_vel`  | linear velocity y (m/s)                       | -v   | v   |
+    | 4   | `robot_lin_vel`  | linear velocity z (m/s, negative when falling)| -v   | v   |
+    | 5   | `robot_ang_vel`  | angular velocity x (rad/s)                    | -w   | w   |
+    | 6   | `robot_ang_vel`  | angular velocity y (rad/s)                    | -w   | w   |
+    | 7   | `robot_ang_vel`  | angular velocity z, the yaw rate (rad/s)      | -w   | w   |
+
+    With `goal_in_polar=True` in the task, indices 0 and 1 are the distance `rho` in
+    `[0, D]` m and the bearing `phi` in `[-pi, pi]` rad (0 dead ahead, positive to the
+    left). Values are clipped to these bounds (only a fall's vertical speed reaches them).
+    With `flatten_obs=True` the observation is OmniGibson's flat `low_dim` vector: a `Box`
+    of shape `(8,)` holding the numbers in the order of the table.
+
+    ## Rewards
+
+    The sum of three terms, reported in `info["reward_breakdown"]`:
+
+    - `potential`: `r_potential * (previous potential - current potential)` (default 1.0
+      per metre), the potential being the xy distance to the goal (`reward_type="l2"`) or
+      the geodesic distance (`"geodesic"`);
+    - `collision`: `-r_collision` (default 0.1) on every step the robot touches an obstacle;
+    - `pointgoal`: `r_pointgoal` (default 10.0) on the step the goal is reached.
+
+    ## Starting State
+
+    The robot starts at rest at a point drawn uniformly from the free space its disc fits
+    in, with a heading uniform in `[0, 2 pi)`; the goal is drawn uniformly from the part of
+    the floor connected to the start, at least `goal_tolerance` away (within `path_range`
+    of geodesic distance, if given). Both can be fixed instead (`initial_pos`,
+    `initial_quat`, `goal_pos` in the task). All of it comes from the seed passed to
+    `reset`.
+
+    ## Episode End
+
+    The episode ends if any one of the following occurs:
+
+    1. Termination (success): the robot's centre is closer than `goal_tolerance` (0.5 m)
+       to the goal (xy).
+    2. Termination: the robot has touched something on more than `max_collisions` (500)
+       steps.
+    3. Termination: the robot fell: its height dropped more than `fall_height` (0.03 m)
+       below its floor (it drove over void).
+    4. Truncation: the episode reached `max_steps` (500) steps.
+
+    When the step limit coincides with another end, both `terminated` and `truncated` are
+    True. Stepping after the end raises `TaskStateError`: call `reset`.
+
+    `info` holds `success`, `done`, `spl`, `soft_spl`, `path_length`, `geodesic_dist`,
+    `distance_to_goal`, `collisions`, `reward_breakdown`, `termination_conditions`,
+    `episode_length` and `potential_metric` after every step (and at reset).
+
+    ## Arguments
+
+    ```python
+    >>> import gymnasium as gym
+    >>> from pointnav_core.env import PointNavEnv
+    >>> env = PointNavEnv(task={"reward_type": "geodesic", "goal_tolerance": 0.3})
+    >>> obs, info = env.reset(seed=0)
+    >>> sorted(obs), obs["xy_pos_to_goal"].dtype
+    (['robot_ang_vel', 'robot_lin_vel', 'xy_pos_to_goal'], dtype('float32'))
+    >>> obs, reward, terminated, truncated, info = env.step(np.zeros(2, dtype=np.float32))
+    >>> type(reward), terminated, truncated, info["episode_length"]
+    (<class 'float'>, False, False, 1)
+
+    ```
+
+    | Parameter          | Type                         | Default           | Description          |
+    |--------------------|------------------------------|-------------------|----------------------|
+    | `scene`            | **Scene**                    | `scenes.rooms(0)` | floors to navigate   |
+    | `robot`            | **RobotSpec** or **dict**    | `RobotSpec()`     | radius, speeds, drive|
+    | `task`             | **PointNavigationTask**/dict | `{}`              | task or its arguments|
+    | `backend`          | **str**, class or instance   | `"kinematic"`     | the world simulator  |
+    | `backend_kwargs`   | **dict** or `None`           | `None`            | backend's arguments  |
+    | `render_mode`      | **str** or `None`            | `None`            | `"rgb_array"` or None|
+    | `flatten_obs`      | **bool**                     | `False`           | flat `(8,)` `low_dim`|
+    | `action_frequency` | **float**                    | `10.0`            | control rate (Hz)    |
+
+    ## Version History
+
+    * v0: Initial version.
+    """
+
+    metadata = {"render_modes": ["rgb_array"], "render_fps": 10}
+
+    def __init__(
+        self,
+        scene: scenes.Scene | None = None,
+        robot: RobotSpec | Mapping[str, Any] | None = None,
+        task: PointNavigationTask | Mapping[str, Any] | None = None,
+        backend: str | type | Backend = "kinematic",
+        backend_kwargs: Mapping[str, Any] | None = None,
+        render_mode: str | None = None,
+        flatten_obs: bool = False,
+        action_frequency: float = 10.0,
+    ) -> None:
+        if render_mode is not None and render_mode not in self.metadata["render_modes"]:
+            raise ValueError(
+                f"render_mode must be None or one of {self.metadata['render_modes']}, "
+                f"got {render_mode!r}"
+            )
+        if not isinstance(flatten_obs, (bool, np.bool_)):
+            raise ValueError(f"flatten_obs must be True or False, got {flatten_obs!r}")
+        try:
+            frequency = float(action_frequency)
+        except (TypeError, ValueError):
+            frequency = math.nan
+        if isinstance(action_frequency, bool) or not (math.isfinite(frequency) and frequency > 0):
+            raise ValueError(
+                f"action_frequency must be a finite number > 0 (Hz), got {action_frequency!r}"
+            )
+        if scene is None:
+            scene = scenes.rooms(seed=0)
+        elif not isinstance(scene, scenes.Scene):
+            raise ValueError(f"scene must be a pointnav_core Scene or None, got {scene!r}")
+        self.robot = _make_robot(robot)
+        self.task = _make_task(task)
+        if backend_kwargs is not None and not isinstance(backend_kwargs, Mapping):
+            raise ValueError(f"backend_kwargs must be None or a dict, got {backend_kwargs!r}")
+        self.scene = scene
+        self.robots = (self.robot,)
+        self.render_mode = render_mode
+        self.flatten_obs = bool(flatten_obs)
+        self.action_frequency = frequency
+        self.backend = make_backend(backend, **dict(backend_kwargs or {}))
+        self.backend.load(scene, self.robots, frequency)
+        # Fails here, naming the parameter, if the task does not fit this scene and robot.
+        self.task.load(self)
+        self._idn = self.task.robot_idn
+
+        self._action_shape = (self.robot.action_dim,)
+        self.action_space = spaces.Box(-1.0, 1.0, self._action_shape, dtype=np.float32)
+        low, high = self.task.observation_bounds
+        if self.flatten_obs:
+            self.observation_space = spaces.Box(low, high, dtype=np.float32)
+        else:
+            # An OrderedDict keeps this order (a plain dict would be sorted by key), so that
+            # FlattenObservation gives OmniGibson's low_dim order too.
+            self.observation_space = spaces.Dict(
+                OrderedDict(
+                    xy_pos_to_goal=spaces.Box(low[0:2], high[0:2], dtype=np.float32),
+                    robot_lin_vel=spaces.Box(low[2:5], high[2:5], dtype=np.float32),
+                    robot_ang_vel=spaces.Box(low[5:8], high[5:8], dtype=np.float32),
+                )
+            )
+
+    # ------------------------------------------------------------------ Gymnasium API
+    def reset(
+        self, *, seed: int | None = None, options: dict[str, Any] | None = None
+    ) -> tuple[Any, dict[str, Any]]:
+        """Start a new episode; the same ``seed`` gives the same episode.
+
+        ``options`` is accepted for API compatibility and not used.
+        """
+        super().reset(seed=seed)
+        if options is not None and not isinstance(options, Mapping):
+            raise ValueError(f"options must be None or a dict, got {options!r}")
+        self.backend.reset()
+        info = self.task.reset(self)
+        return self._get_obs(), info
+
+    def step(self, action: Any) -> tuple[Any, float, bool, bool, dict[str, Any]]:
+        """Apply ``action`` for one control step; see the class docstring for the rest."""
+        self.task.check_step()  # before anything moves: an illegal step changes nothing
+        action = self._check_action(action)
+        self.backend.step({self._idn: action})
+        reward, terminated, truncated, info = self.task.step(self, action)
+        return self._get_obs(), reward, terminated, truncated, info
+
+    def render(self) -> NDArray[np.uint8] | None:
+        """Return a top-down RGB image (H, W, 3) uint8 when ``render_mode="rgb_array"``."""
+        if self.render_mode is None:
+            gym.logger.warn(
+                "You are calling render method without specifying any render mode. "
+                'You can specify the render_mode at initialization, e.g. '
+                'gymnasium.make("pointnav_core/PointNav-v0", render_mode="rgb_array")'
+            )
+            return None
+        # Imported here: drawing is only needed when rendering.
+        from pointnav_core.render import render_env
+
+        return render_env(self)
+
+    def close(self) -> None:
+        """Release the backend's resources (if it holds any)."""
+        close = getattr(self.backend, "close", None)
+        if callable(close):
+            close()
+
+    # ------------------------------------------------------------------ helpers
+    def _check_action(self, action: Any) -> Any:
+        if not (
+            type(action) is np.ndarray
+            and action.shape == self._action_shape
+            and action.dtype.kind == "f"
+        ):
+            try:
+                action = np.asarray(action, dtype=np.float64)
+            except (TypeError, ValueError):
+                raise ValueError(
+                    f"action must be an array of {self._action_shape[0]} numbers in [-1, 1], "
+                    f"got {action!r}"
+                ) from None
+            if action.shape != self._action_shape:
+                raise ValueError(
+                    f"action must have shape {self._action_shape} for a {self.robot.drive} "
+                    f"drive, got shape {action.shape}"
+                )
+        for value in action.tolist():
+            if not -math.inf < value < math.inf:  # also False for NaN
+                raise ValueError(f"action must be finite, got {action.tolist()}")
+        return action
+
+    def _get_obs(self) -> Any:
+        if self.flatten_obs:
+            return self.task.get_low_dim_obs(self)
+        return self.task.get_obs(self)
+
+
+def _make_robot(robot: RobotSpec | Mapping[str, Any] | None) -> RobotSpec:
+    if robot is None:
+        return RobotSpec()
+    if isinstance(robot, RobotSpec):
+        return robot
+    if isinstance(robot, Mapping):
+        unknown = [key for key in robot if key not in _ROBOT_KEYS]
+        if unknown:
+            raise ValueError(
+                f"robot has an unknown key {unknown[0]!r}; valid keys are {list(_ROBOT_KEYS)}"
+            )
+        return RobotSpec(**robot)
+    raise ValueError(f"robot must be a RobotSpec, a dict of its fields, or None, got {robot!r}")
+
+
+def _make_task(task: PointNavigationTask | Mapping[str, Any] | None) -> PointNavigationTask:
+    if task is None:
+        return PointNavigationTask()
+    if isinstance(task, PointNavigationTask):
+        return task
+    if isinstance(task, Mapping):
+        unknown = [key for key in task if key not in _TASK_KEYS]
+        if unknown:
+            raise ValueError(
+                f"task has an unknown key {unknown[0]!r}; valid keys are {list(_TASK_KEYS)}"
+            )
+        return PointNavigationTask(**task)
+    raise ValueError(
+        f"task must be a PointNavigationTask, a dict of its arguments, or None, got {task!r}"
+    )

@@ -1,0 +1,1114 @@
+"""The point-goal navigation task: OmniGibson's ``PointNavigationTask`` as a state machine.
+
+:class:`PointNavigationTask` owns one robot's episode: it samples a start and a goal,
+lands the robot, and after every control step measures progress, decides whether the
+episode is over (:mod:`~pointnav_core.terminations`), pays rewards
+(:mod:`~pointnav_core.rewards`) and reports metrics (:mod:`~pointnav_core.metrics`). It
+never moves anything itself: the environment steps the backend, then calls
+:meth:`PointNavigationTask.step`.
+
+Lifecycle
+---------
+The task is a small state machine (h11 style). Its states are :class:`TaskState`; the legal
+moves are the table ``_TRANSITIONS`` below, and the diagram is drawn from that table::
+
+    IDLE --reset--> RUNNING --step--> RUNNING --step (a condition fires)--> DONE
+      any state --reset--> RUNNING        any state --reset or step raises--> ERROR
+
+``step`` is legal only while RUNNING. Calling it in any other state raises
+:class:`TaskStateError` and changes nothing. ``reset`` is legal in every state.
+
+The environment
+---------------
+The ``env`` handed to :meth:`~PointNavigationTask.reset`, :meth:`~PointNavigationTask.step`
+and :meth:`~PointNavigationTask.get_obs` is the environment object (a ``PointNavEnv``, or a
+multi-robot env). The task reads only the four members of :class:`TaskEnv`.
+"""
+
+from __future__ import annotations
+
+import enum
+import math
+from collections.abc import Mapping, Sequence
+from types import MappingProxyType
+from typing import TYPE_CHECKING, Any, ClassVar, Protocol
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from pointnav_core.errors import PointNavError, SamplingError
+from pointnav_core.metrics import _soft_spl, _spl
+from pointnav_core.rewards import CollisionReward, PointGoalReward, PotentialReward, RewardFunction
+from pointnav_core.terminations import (
+    Falling,
+    MaxCollision,
+    PointGoal,
+    TerminationCondition,
+    Timeout,
+    _check_count,
+    _check_length,
+)
+
+if TYPE_CHECKING:
+    from pointnav_core.backend import Backend, RobotSpec
+    from pointnav_core.scenes import FloorGoalField, Scene
+
+__all__ = [
+    "REWARD_TYPES",
+    "PointNavigationTask",
+    "TaskEnv",
+    "TaskState",
+    "TaskStateError",
+]
+
+#: Valid values of ``reward_type``: the distance the potential reward is measured in.
+REWARD_TYPES = ("l2", "geodesic")
+
+_TWO_PI = 2.0 * math.pi
+# How far from 1 the norm of a fixed initial_quat may be (it is then normalised).
+_QUAT_NORM_TOL = 1e-3
+
+
+class TaskStateError(PointNavError, RuntimeError):
+    """A task method was called in a state that does not allow it (e.g. step before reset).
+
+    The task's state is unchanged when this is raised.
+    """
+
+
+class TaskState(enum.Enum):
+    """States of a task's episode lifecycle."""
+
+    #: Built, no episode yet: call ``reset(env)``.
+    IDLE = "idle"
+    #: An episode is in progress: ``step`` is legal.
+    RUNNING = "running"
+    #: The episode ended (terminated or truncated): call ``reset(env)`` to start another.
+    DONE = "done"
+    #: A reset or a step raised half-way; no valid episode: call ``reset(env)``.
+    ERROR = "error"
+
+    # Members are singletons compared by identity: hash them so too (Enum's default hash
+    # is a Python-level function, and the transition table is consulted on every step).
+    __hash__ = object.__hash__
+
+
+class _Event(enum.Enum):
+    RESET = "reset"  # a reset succeeded
+    STEP = "step"  # a step ended with no condition done
+    END = "end"  # a step ended with some condition done
+    FAIL = "fail"  # a reset or a step raised
+
+    __hash__ = object.__hash__
+
+
+IDLE, RUNNING, DONE, ERROR = TaskState.IDLE, TaskState.RUNNING, TaskState.DONE, TaskState.ERROR
+
+# The lifecycle, (state, event) -> next state. Rules: a reset may start an episode from any
+# state, and a reset or step that raises leaves the task in ERROR from any state; a step
+# happens only in RUNNING and stays there, or moves to DONE when a termination condition
+# fires. A pair missing from the table is an illegal move: it raises TaskStateError and
+# leaves the state unchanged.
+_TRANSITIONS: Mapping[tuple[TaskState, _Event], TaskState] = MappingProxyType(
+    {
+        **{(state, _Event.RESET): RUNNING for state in TaskState},
+        **{(state, _Event.FAIL): ERROR for state in TaskState},
+        (RUNNING, _Event.STEP): RUNNING,
+        (RUNNING, _Event.END): DONE,
+    }
+)
+
+_ILLEGAL_HINT: Mapping[TaskState, str] = MappingProxyType(
+    {
+        IDLE: "no episode has started: call reset(env) first",
+        DONE: "the episode has ended (terminated or truncated): call reset(env) to start another",
+        ERROR: "the last reset or step failed, so there is no valid episode: call reset(env)",
+    }
+)
+
+
+class TaskEnv(Protocol):
+    """What the task needs from the environment it runs in.
+
+    A ``PointNavEnv`` provides these, and so must any multi-robot environment.
+    """
+
+    @property
+    def scene(self) -> Scene:
+        """The floors, their sampling and geodesic queries."""
+        ...
+
+    @property
+    def backend(self) -> Backend:
+        """The world: poses, velocities, contacts of every robot."""
+        ...
+
+    @property
+    def robots(self) -> Sequence[RobotSpec]:
+        """One spec per robot; the index is ``robot_idn``."""
+        ...
+
+    @property
+    def np_random(self) -> np.random.Generator:
+        """The only source of randomness the task uses (seeded by the env's reset)."""
+        ...
+
+
+# ------------------------------------------------------------------------------ validation
+
+
+def _check_bool(name: str, value: Any) -> bool:
+    if not isinstance(value, (bool, np.bool_)):
+        raise ValueError(f"{name} must be True or False, got {value!r}")
+    return bool(value)
+
+
+def _check_position(name: str, value: Any) -> tuple[float, float] | None:
+    if value is None:
+        return None
+    try:
+        arr = np.asarray(value, dtype=np.float64)
+    except (TypeError, ValueError):
+        arr = None
+    if arr is None or arr.shape not in ((2,), (3,)) or not np.isfinite(arr).all():
+        raise ValueError(
+            f"{name} must be None or a finite position (x, y, z) in metres (z is replaced by "
+            f"the floor height), got {value!r}"
+        )
+    return float(arr[0]), float(arr[1])
+
+
+def _check_quat(name: str, value: Any) -> tuple[float, float, float, float] | None:
+    if value is None:
+        return None
+    try:
+        arr = np.asarray(value, dtype=np.float64)
+    except (TypeError, ValueError):
+        arr = None
+    if arr is None or arr.shape != (4,) or not np.isfinite(arr).all():
+        raise ValueError(
+            f"{name} must be None or a finite unit quaternion (x, y, z, w), got {value!r}"
+        )
+    norm = math.sqrt(float(arr @ arr))
+    if abs(norm - 1.0) > _QUAT_NORM_TOL:
+        raise ValueError(
+            f"{name} must be a unit quaternion (x, y, z, w), got {value!r} of norm {norm:.6g}"
+        )
+    x, y, z, w = (float(c) / norm for c in arr)
+    return x, y, z, w
+
+
+def _check_path_range(value: Any) -> tuple[float, float] | None:
+    if value is None:
+        return None
+    try:
+        lo, hi = (float(v) for v in value)
+    except (TypeError, ValueError):
+        raise ValueError(
+            f"path_range must be None or (min, max) geodesic distances in metres, got {value!r}"
+        ) from None
+    if not (math.isfinite(lo) and lo >= 0.0 and hi > lo):  # hi may be inf; NaN fails
+        raise ValueError(
+            f"path_range must be (min, max) with 0 <= min < max (m), min finite, got {value!r}"
+        )
+    return lo, hi
+
+
+def _check_index(name: str, value: Any) -> int:
+    if isinstance(value, (bool, np.bool_)) or not isinstance(value, (int, np.integer)):
+        raise ValueError(f"{name} must be an integer >= 0, got {value!r}")
+    if value < 0:
+        raise ValueError(f"{name} must be an integer >= 0, got {value!r}")
+    return int(value)
+
+
+def _merge_config(
+    name: str, defaults: Mapping[str, Any], overrides: Mapping[str, Any] | None
+) -> Mapping[str, Any]:
+    merged = dict(defaults)
+    if overrides is None:
+        return MappingProxyType(merged)
+    if not isinstance(overrides, Mapping):
+        raise ValueError(f"{name} must be None or a dict, got {overrides!r}")
+    for key in overrides:
+        if key not in defaults:
+            raise ValueError(
+                f"{name} has an unknown key {key!r}; valid keys are {list(defaults)}"
+            )
+    merged.update(overrides)
+    return MappingProxyType(merged)
+
+
+# ------------------------------------------------------------------------------ the task
+
+
+class PointNavigationTask:
+    """Drive robot ``robot_idn`` to a goal position on floor ``floor``.
+
+    A faithful, bug-fixed port of OmniGibson's ``PointNavigationTask`` (same parameters,
+    rewards, terminations, observations and metrics) that runs on any
+    :class:`~pointnav_core.backend.Backend`.
+
+    Parameters
+    ----------
+    robot_idn : int
+        Index of the robot this task drives (in ``env.robots``), >= 0.
+    floor : int
+        Floor to navigate on, >= 0.
+    initial_pos : array_like, shape (3,) or (2,), optional
+        Fixed start (x, y, z) in metres; z is replaced by the floor height. None: sample a
+        usable start uniformly at every reset.
+    initial_quat : array_like, shape (4,), optional
+        Fixed start orientation, a unit quaternion (x, y, z, w). None: a heading drawn
+        uniformly from [0, 2 pi) at every reset.
+    goal_pos : array_like, shape (3,) or (2,), optional
+        Fixed goal (x, y, z) in metres. None: sample a goal reachable from the start.
+    goal_tolerance : float
+        Success when the xy distance to the goal is strictly below this (m), >= 0.
+    goal_in_polar : bool
+        Goal observation as (rho, phi) instead of (x, y) in the robot frame.
+    path_range : (float, float), optional
+        (min, max) in metres: a sampled start/goal pair must have min < geodesic < max.
+        Ignored when both the start and the goal are fixed.
+    visualize_goal : bool
+        Show start and goal markers (discs of radius ``goal_tolerance``) when rendering.
+    visualize_path : bool
+        Show the current shortest path as ``n_vis_waypoints`` markers when rendering.
+    goal_height : float
+        Goal marker height (m), >= 0.
+    waypoint_height : float
+        Waypoint marker height (m), >= 0.
+    waypoint_width : float
+        Waypoint marker radius (m), > 0.
+    n_vis_waypoints : int
+        Number of waypoint markers, >= 1.
+    reward_type : {"l2", "geodesic"}
+        Distance the potential reward is measured in.
+    termination_config : dict, optional
+        Overrides of :attr:`default_termination_config`.
+    reward_config : dict, optional
+        Overrides of :attr:`default_reward_config`.
+
+    Raises
+    ------
+    ValueError
+        For any invalid argument, naming it. ``robot_idn``, ``floor``, ``initial_pos``
+        and ``goal_pos`` are checked against the environment when the task first meets
+        it (:meth:`load`).
+
+    Notes
+    -----
+    Decisions where OmniGibson is silent or faulty:
+
+    - A sampled goal is at least ``goal_tolerance`` (xy) from the start, so that no
+      episode is won before it starts. Fixed positions are taken as given.
+    - If the goal is not reachable from the start, ``geodesic_dist`` is ``inf`` and the
+      geodesic potential uses L2 for the whole episode (``info["potential_metric"]``).
+    - Where the robot stands legally but no geodesic is defined (its centre off the usable
+      grid, e.g. while falling), the potential keeps its last value, so the potential
+      reward is 0 there and the episode's potential rewards still telescope.
+    - When the timeout fires on the same step as another condition, the step is both
+      ``terminated`` and ``truncated`` (Gymnasium allows both; ``terminated`` tells a
+      learner not to bootstrap).
+
+    Examples
+    --------
+    >>> task = PointNavigationTask(goal_tolerance=0.3, termination_config={"max_steps": 200})
+    >>> dict(task.termination_config)
+    {'max_collisions': 500, 'max_steps': 200, 'fall_height': 0.03}
+    >>> list(task.termination_conditions), list(task.reward_functions)
+    (['max_collision', 'timeout', 'falling', 'pointgoal'], ['potential', 'collision', 'pointgoal'])
+    >>> task.state
+    <TaskState.IDLE: 'idle'>
+    >>> PointNavigationTask(reward_type="manhattan")
+    Traceback (most recent call last):
+    ...
+    ValueError: reward_type must be one of ['l2', 'geodesic'], got 'manhattan'
+    """
+
+    #: Attempts at sampling a valid start and goal before :class:`SamplingError`.
+    max_trials: ClassVar[int] = 100
+
+    #: Termination defaults (read-only; pass ``termination_config`` to override).
+    default_termination_config: ClassVar[Mapping[str, Any]] = MappingProxyType(
+        {"max_collisions": 500, "max_steps": 500, "fall_height": 0.03}
+    )
+    #: Reward defaults (read-only; pass ``reward_config`` to override).
+    default_reward_config: ClassVar[Mapping[str, Any]] = MappingProxyType(
+        {"r_potential": 1.0, "r_collision": 0.1, "r_pointgoal": 10.0}
+    )
+
+    def __init__(
+        self,
+        robot_idn: int = 0,
+        floor: int = 0,
+        initial_pos: ArrayLike | None = None,
+        initial_quat: ArrayLike | None = None,
+        goal_pos: ArrayLike | None = None,
+        goal_tolerance: float = 0.5,
+        goal_in_polar: bool = False,
+        path_range: tuple[float, float] | None = None,
+        visualize_goal: bool = False,
+        visualize_path: bool = False,
+        goal_height: float = 0.06,
+        waypoint_height: float = 0.05,
+        waypoint_width: float = 0.1,
+        n_vis_waypoints: int = 10,
+        reward_type: str = "l2",
+        termination_config: Mapping[str, Any] | None = None,
+        reward_config: Mapping[str, Any] | None = None,
+    ) -> None:
+        self._robot_idn = _check_index("robot_idn", robot_idn)
+        self._floor = _check_index("floor", floor)
+        self._initial_pos = _check_position("initial_pos", initial_pos)
+        self._initial_quat = _check_quat("initial_quat", initial_quat)
+        self._goal_pos = _check_position("goal_pos", goal_pos)
+        self._goal_tolerance = _check_length("goal_tolerance", goal_tolerance)
+        self._goal_in_polar = _check_bool("goal_in_polar", goal_in_polar)
+        self._path_range = _check_path_range(path_range)
+        self._visualize_goal = _check_bool("visualize_goal", visualize_goal)
+        self._visualize_path = _check_bool("visualize_path", visualize_path)
+        self._goal_height = _check_length("goal_height", goal_height)
+        self._waypoint_height = _check_length("waypoint_height", waypoint_height)
+        self._waypoint_width = _check_length("waypoint_width", waypoint_width)
+        if self._waypoint_width == 0.0:
+            raise ValueError(
+                f"waypoint_width must be a finite number > 0 (m), got {waypoint_width!r}"
+            )
+        self._n_vis_waypoints = _check_count("n_vis_waypoints", n_vis_waypoints, minimum=1)
+        if not isinstance(reward_type, str) or reward_type not in REWARD_TYPES:
+            raise ValueError(
+                f"reward_type must be one of {list(REWARD_TYPES)}, got {reward_type!r}"
+            )
+        self._reward_type = reward_type
+        self._termination_config = _merge_config(
+            "termination_config", self.default_termination_config, termination_config
+        )
+        self._reward_config = _merge_config(
+            "reward_config", self.default_reward_config, reward_config
+        )
+        try:
+            terminations = dict(self._create_termination_conditions())
+        except ValueError as err:
+            raise ValueError(f"termination_config: {err}") from None
+        try:
+            rewards = dict(self._create_reward_functions())
+        except ValueError as err:
+            raise ValueError(f"reward_config: {err}") from None
+        self._terminations: Mapping[str, TerminationCondition] = MappingProxyType(terminations)
+        self._rewards: Mapping[str, RewardFunction] = MappingProxyType(rewards)
+
+        self._state = IDLE
+        # Bound at the first meeting with an env (load): caches for the per-step path.
+        self._env: Any = None
+        self._spec: Any = None
+        self._floor_height = 0.0
+        self._obs_low: tuple[float, ...] = ()
+        self._obs_high: tuple[float, ...] = ()
+        # The episode (valid from the first successful reset).
+        self._start_xy: tuple[float, float] | None = None
+        self._start_quat: tuple[float, float, float, float] | None = None
+        self._goal_xy: tuple[float, float] | None = self._goal_pos
+        self._goal_field: FloorGoalField | None = None
+        self._field_distance: Any = None
+        self._geodesic_dist = math.inf
+        self._metric = "l2"
+        self._robot_xyz = (0.0, 0.0, 0.0)
+        self._robot_quat: list[float] = [0.0, 0.0, 0.0, 1.0]
+        self._potential = 0.0
+        self._distance_to_goal = math.inf
+        self._path_length = 0.0
+        self._collisions = 0
+        self._in_contact = False
+        self._steps = 0
+        self._success = False
+        self._results: dict[str, tuple[bool, bool]] = {}
+
+    # ------------------------------------------------------------------ composition
+    def _create_termination_conditions(self) -> dict[str, TerminationCondition]:
+        """Build the termination conditions, in evaluation order (override to change them)."""
+        cfg = self._termination_config
+        conditions: list[TerminationCondition] = [
+            MaxCollision(max_collisions=cfg["max_collisions"]),
+            Timeout(max_steps=cfg["max_steps"]),
+            Falling(fall_height=cfg["fall_height"]),
+            PointGoal(goal_tolerance=self._goal_tolerance),
+        ]
+        return {c.name: c for c in conditions}
+
+    def _create_reward_functions(self) -> dict[str, RewardFunction]:
+        """Build the reward functions, in evaluation order (override to change them)."""
+        cfg = self._reward_config
+        rewards: list[RewardFunction] = [
+            PotentialReward(r_potential=cfg["r_potential"]),
+            CollisionReward(r_collision=cfg["r_collision"]),
+            PointGoalReward(r_pointgoal=cfg["r_pointgoal"]),
+        ]
+        return {r.name: r for r in rewards}
+
+    # ------------------------------------------------------------------ parameters
+    @property
+    def robot_idn(self) -> int:
+        """Index of the robot this task drives."""
+        return self._robot_idn
+
+    @property
+    def floor(self) -> int:
+        """Floor the task navigates on."""
+        return self._floor
+
+    @property
+    def initial_pos(self) -> NDArray[np.float64] | None:
+        """The fixed start (x, y, z) in metres with z = 0 until loaded, or None (sampled)."""
+        if self._initial_pos is None:
+            return None
+        return np.array((*self._initial_pos, self._floor_height))
+
+    @property
+    def initial_quat(self) -> NDArray[np.float64] | None:
+        """The fixed start orientation (x, y, z, w), or None (random heading)."""
+        return None if self._initial_quat is None else np.array(self._initial_quat)
+
+    @property
+    def goal_pos(self) -> NDArray[np.float64] | None:
+        """The fixed goal (x, y, z) in metres, or None (sampled); see :meth:`get_goal_pos`."""
+        return None if self._goal_pos is None else np.array((*self._goal_pos, self._floor_height))
+
+    @property
+    def goal_tolerance(self) -> float:
+        """Success radius (m)."""
+        return self._goal_tolerance
+
+    @property
+    def goal_in_polar(self) -> bool:
+        """Whether the goal observation is (rho, phi)."""
+        return self._goal_in_polar
+
+    @property
+    def path_range(self) -> tuple[float, float] | None:
+        """(min, max) geodesic of sampled start/goal pairs (m), or None."""
+        return self._path_range
+
+    @property
+    def visualize_goal(self) -> bool:
+        """Whether renderers draw the start and goal markers."""
+        return self._visualize_goal
+
+    @property
+    def visualize_path(self) -> bool:
+        """Whether renderers draw the shortest path's waypoint markers."""
+        return self._visualize_path
+
+    @property
+    def goal_height(self) -> float:
+        """Goal marker height (m)."""
+        return self._goal_height
+
+    @property
+    def waypoint_height(self) -> float:
+        """Waypoint marker height (m)."""
+        return self._waypoint_height
+
+    @property
+    def waypoint_width(self) -> float:
+        """Waypoint marker radius (m)."""
+        return self._waypoint_width
+
+    @property
+    def n_vis_waypoints(self) -> int:
+        """Number of waypoint markers."""
+        return self._n_vis_waypoints
+
+    @property
+    def reward_type(self) -> str:
+        """``"l2"`` or ``"geodesic"``."""
+        return self._reward_type
+
+    @property
+    def termination_config(self) -> Mapping[str, Any]:
+        """The merged termination configuration (read-only)."""
+        return self._termination_config
+
+    @property
+    def reward_config(self) -> Mapping[str, Any]:
+        """The merged reward configuration (read-only)."""
+        return self._reward_config
+
+    @property
+    def termination_conditions(self) -> Mapping[str, TerminationCondition]:
+        """Name -> termination condition, in evaluation order (read-only mapping)."""
+        return self._terminations
+
+    @property
+    def reward_functions(self) -> Mapping[str, RewardFunction]:
+        """Name -> reward function, in evaluation order (read-only mapping)."""
+        return self._rewards
+
+    # ------------------------------------------------------------------ episode state
+    @property
+    def state(self) -> TaskState:
+        """Where the task is in its lifecycle."""
+        return self._state
+
+    @property
+    def robot_xyz(self) -> tuple[float, float, float]:
+        """Robot position (m) at the last reset or step, refreshed before the conditions run."""
+        return self._robot_xyz
+
+    @property
+    def in_contact(self) -> bool:
+        """Whether the robot touched an obstacle or another robot in this step (backend's word)."""
+        return self._in_contact
+
+    @property
+    def floor_height(self) -> float:
+        """Height (m) of the task's floor (0.0 until the task has met an env)."""
+        return self._floor_height
+
+    @property
+    def goal_xy(self) -> tuple[float, float] | None:
+        """This episode's goal (x, y) in metres (None before the first reset of a sampled goal)."""
+        return self._goal_xy
+
+    @property
+    def potential(self) -> float:
+        """Potential (m) at the last reset or step: the distance the potential reward uses."""
+        return self._potential
+
+    @property
+    def potential_metric(self) -> str:
+        """``"l2"`` or ``"geodesic"``: the potential's metric this episode (fixed at reset)."""
+        return self._metric
+
+    @property
+    def termination_results(self) -> Mapping[str, tuple[bool, bool]]:
+        """Name -> ``(done, success)`` of every condition at this step (read it, don't write)."""
+        return self._results
+
+    @property
+    def geodesic_dist(self) -> float:
+        """Geodesic distance (m) from this episode's start to the goal; ``inf`` if unreachable."""
+        return self._geodesic_dist
+
+    @property
+    def path_length(self) -> float:
+        """Planar distance (m) driven in this episode, including the last step."""
+        return self._path_length
+
+    @property
+    def collisions(self) -> int:
+        """Steps with a contact in this episode."""
+        return self._collisions
+
+    @property
+    def episode_length(self) -> int:
+        """Steps taken in this episode."""
+        return self._steps
+
+    @property
+    def success(self) -> bool:
+        """Whether the episode has ended in success."""
+        return self._success
+
+    # ------------------------------------------------------------------ lifecycle
+    def _move(self, event: _Event) -> None:
+        self._state = _TRANSITIONS[(self._state, event)]
+
+    def check_step(self) -> None:
+        """Raise :class:`TaskStateError` unless :meth:`step` is legal now (nothing changes).
+
+        Environments call this before stepping the backend, so that an illegal step moves
+        nothing in the world either.
+        """
+        if (self._state, _Event.STEP) not in _TRANSITIONS:
+            raise TaskStateError(
+                f"step() is not allowed while the task is {self._state.name}: "
+                f"{_ILLEGAL_HINT[self._state]}"
+            )
+
+    def load(self, env: TaskEnv) -> None:
+        """Meet an environment: check this task fits it, and cache what steps need.
+
+        Checks that ``robot_idn`` names one of ``env.robots``, that ``floor`` is one of the
+        scene's floors, and that a fixed ``initial_pos`` / ``goal_pos`` is usable by the
+        robot there (on the map, on a FREE cell, and at least the robot's radius from any
+        obstacle or void). :meth:`reset` calls this when it meets a new env; environments
+        call it at construction so that a bad task fails early.
+
+        Raises
+        ------
+        ValueError
+            Naming ``robot_idn``, ``floor``, ``initial_pos`` or ``goal_pos``.
+        """
+        robots = env.robots
+        if self._robot_idn >= len(robots):
+            raise ValueError(
+                f"robot_idn must be in [0, {len(robots)}) for an environment with "
+                f"{len(robots)} robot(s), got {self._robot_idn}"
+            )
+        scene = env.scene
+        if self._floor >= scene.n_floors:
+            raise ValueError(
+                f"floor must be in [0, {scene.n_floors}) for a scene with {scene.n_floors} "
+                f"floor(s), got {self._floor}"
+            )
+        spec = robots[self._robot_idn]
+        for name, xy in (("initial_pos", self._initial_pos), ("goal_pos", self._goal_pos)):
+            if xy is not None and not scene.is_usable(self._floor, xy, spec):
+                raise ValueError(
+                    f"{name} {list(xy)} is not usable on floor {self._floor} by robot "
+                    f"{self._robot_idn} (radius {spec.radius} m): it is off the map, on an "
+                    f"obstacle or void, or closer than the radius to one"
+                )
+        self._spec = spec
+        self._floor_height = float(scene.get_floor_height(self._floor))
+        # Observation bounds (finite, so that Gymnasium's checker accepts the spaces): the
+        # goal is on the floor, so within its diagonal (+1 m for a robot falling off an
+        # edge); velocities within the robot's limits (sqrt(2) for a holonomic diagonal).
+        xmin, xmax, ymin, ymax = scene.floors[self._floor].extent
+        reach = math.hypot(xmax - xmin, ymax - ymin) + 1.0
+        v = math.sqrt(2.0) * spec.max_linear_velocity
+        w = spec.max_angular_velocity
+        if self._goal_in_polar:
+            goal_low, goal_high = (0.0, -math.pi), (reach, math.pi)
+        else:
+            goal_low, goal_high = (-reach, -reach), (reach, reach)
+        self._obs_low = (*goal_low, -v, -v, -v, -w, -w, -w)
+        self._obs_high = (*goal_high, v, v, v, w, w, w)
+        self._env = env
+
+    def reset(self, env: TaskEnv) -> dict[str, Any]:
+        """Start a new episode: sample (or take) a start and a goal, land the robot.
+
+        Parameters
+        ----------
+        env : TaskEnv
+            The environment (its backend already reset). Randomness comes from
+            ``env.np_random`` only, so a seeded env gives the same episode.
+
+        Returns
+        -------
+        dict
+            The episode's initial ``info`` (the keys of :meth:`step`'s info, at step 0).
+
+        Raises
+        ------
+        SamplingError
+            If no valid start/goal pair was found in :attr:`max_trials` attempts; the
+            message names the constraint that failed. The task is then in ERROR.
+        ValueError
+            If a fixed ``initial_pos`` or ``goal_pos`` does not suit the env (see
+            :meth:`load`), or the fixed start is occupied by another robot.
+        """
+        try:
+            if env is not self._env:
+                self.load(env)
+            self._sample_episode(env)
+            pos, quat = env.backend.get_pose(self._robot_idn)
+            x, y, z = pos.tolist()
+            self._robot_xyz = (x, y, z)
+            self._robot_quat = quat.tolist()
+            self._path_length = 0.0
+            self._collisions = 0
+            self._in_contact = False
+            self._steps = 0
+            self._success = False
+            self._distance_to_goal = self._geodesic_at(x, y)
+            self._potential = self._potential_at(x, y, self._distance_to_goal, self._geodesic_dist)
+            self._results = {name: (False, False) for name in self._terminations}
+            for condition in self._terminations.values():
+                condition.reset(self, env)
+            for reward in self._rewards.values():
+                reward.reset(self, env)
+        except BaseException:
+            self._move(_Event.FAIL)
+            raise
+        self._move(_Event.RESET)
+        return self._info(
+            False,
+            False,
+            {name: 0.0 for name in self._rewards},
+            self._results,
+        )
+
+    def _sample_episode(self, env: TaskEnv) -> None:
+        scene, backend, rng = env.scene, env.backend, env.np_random
+        spec, idn, floor, h = self._spec, self._robot_idn, self._floor, self._floor_height
+        fixed_start, fixed_goal = self._initial_pos, self._goal_pos
+        both_fixed = fixed_start is not None and fixed_goal is not None
+        path_range = None if both_fixed else self._path_range
+        goal_field = None if fixed_goal is None else scene.goal_field(floor, fixed_goal, robot=spec)
+        failures: dict[str, int] = {}
+
+        def fail(constraint: str) -> None:
+            failures[constraint] = failures.get(constraint, 0) + 1
+
+        for _ in range(1 if both_fixed else self.max_trials):
+            # 1. The start, in the fixed goal's component when there is one.
+            if fixed_start is not None:
+                sx, sy = fixed_start
+            else:
+                _, point = scene.get_random_point(
+                    floor=floor, reference_point=fixed_goal, robot=spec, rng=rng
+                )
+                sx, sy = float(point[0]), float(point[1])
+            if self._initial_quat is not None:
+                quat = self._initial_quat
+            else:
+                half = 0.5 * float(rng.uniform(0.0, _TWO_PI))
+                quat = (0.0, 0.0, math.sin(half), math.cos(half))
+            # Land first: validity is checked on the robot's floor, and other robots that
+            # are already placed (multi-robot resets place robots one by one) count.
+            backend.land(idn, floor, (sx, sy, h), quat)
+            if not backend.is_valid_pose(idn, (sx, sy, h), quat):
+                if fixed_start is not None:
+                    raise ValueError(
+                        f"initial_pos {[sx, sy]} is not a valid pose for robot {idn}: its disc "
+                        f"overlaps an obstacle or another robot"
+                    )
+                fail("the start must be a valid pose (clear of obstacles and other robots)")
+                continue
+            # 2. The goal, in the start's component.
+            if fixed_goal is not None:
+                gx, gy = fixed_goal
+            else:
+                _, point = scene.get_random_point(
+                    floor=floor, reference_point=(sx, sy), robot=spec, rng=rng
+                )
+                gx, gy = float(point[0]), float(point[1])
+                if math.hypot(gx - sx, gy - sy) < self._goal_tolerance:
+                    fail(
+                        f"the goal must be at least goal_tolerance ({self._goal_tolerance} m) "
+                        f"from the start"
+                    )
+                    continue
+                if not backend.is_valid_pose(idn, (gx, gy, h), quat):
+                    fail("the goal must be a valid pose (clear of obstacles and other robots)")
+                    continue
+            # 3. The exact geodesic. A new goal costs only its corner solve here; the
+            # per-cell table is built on the episode's first lookup, for the goal kept.
+            field = goal_field if goal_field is not None else scene.goal_field(floor, (gx, gy), robot=spec)
+            geodesic = field.exact_distance((sx, sy))
+            constraint = f"the geodesic must lie in path_range {self._path_range} m"
+            if path_range is not None and not path_range[0] < geodesic < path_range[1]:
+                fail(constraint)
+                continue
+            break
+        else:  # a fixed pair never gets here: it either breaks or raises
+            worst = max(failures, key=failures.__getitem__)
+            detail = "; ".join(f"{c}: failed {n} time(s)" for c, n in failures.items())
+            raise SamplingError(
+                f"could not sample an episode for robot {idn} on floor {floor} in "
+                f"{self.max_trials} trials: {worst} ({detail})"
+            )
+        self._start_xy = (sx, sy)
+        self._start_quat = quat
+        self._goal_xy = (gx, gy)
+        self._goal_field = field
+        self._field_distance = field.distance
+        self._geodesic_dist = geodesic
+        # Decided once per episode, so the potential never jumps between metrics.
+        geodesic_metric = self._reward_type == "geodesic" and geodesic < math.inf
+        self._metric = "geodesic" if geodesic_metric else "l2"
+        # The robot stands at the start: it was landed there in the accepted trial.
+
+    # ------------------------------------------------------------------ per step
+    def _geodesic_at(self, x: float, y: float) -> float:
+        """Geodesic distance (m) from (x, y) to the goal: the goal field's O(1) lookup.
+
+        ``inf`` where the robot's centre cannot reach the goal (over void, off the map).
+        """
+        return self._field_distance(x, y)
+
+    def _potential_at(self, x: float, y: float, geodesic: float, held: float) -> float:
+        if self._metric == "l2":
+            gx, gy = self._goal_xy  # type: ignore[misc]
+            return math.hypot(gx - x, gy - y)
+        # No geodesic here (e.g. over void): keep the last potential (see Notes).
+        return geodesic if geodesic < math.inf else held
+
+    def step(self, env: TaskEnv, action: Any) -> tuple[float, bool, bool, dict[str, Any]]:
+        """Account for one control step the environment has just taken.
+
+        In order: the path length grows by the planar distance moved; every termination
+        condition is evaluated (none short-circuits); every reward function is evaluated;
+        ``info`` is filled.
+
+        Parameters
+        ----------
+        env : TaskEnv
+            The environment, whose backend has already advanced one control step.
+        action : array_like
+            The action that was applied (passed on to conditions and rewards).
+
+        Returns
+        -------
+        reward : float
+            Sum of ``info["reward_breakdown"]``.
+        terminated : bool
+            A condition other than the timeout ended the episode.
+        truncated : bool
+            The timeout ended the episode (both flags can be True on the same step).
+        info : dict
+            ``success``, ``done``, ``path_length`` (m), ``spl``, ``soft_spl``,
+            ``geodesic_dist`` (m, at the start), ``distance_to_goal`` (m, geodesic now),
+            ``collisions``, ``reward_breakdown`` (name -> float), ``termination_conditions``
+            (name -> {"done", "success"}), ``episode_length``, ``potential_metric``.
+
+        Raises
+        ------
+        TaskStateError
+            If no episode is running (before reset, or after the episode ended); the task
+            is then unchanged.
+        """
+        if (self._state, _Event.STEP) not in _TRANSITIONS:
+            self.check_step()
+        try:
+            pos, quat = env.backend.get_pose(self._robot_idn)
+            x, y, z = pos.tolist()
+            px, py, _ = self._robot_xyz
+            self._path_length += math.hypot(x - px, y - py)
+            self._robot_xyz = (x, y, z)
+            self._robot_quat = quat.tolist()
+            self._steps += 1
+            contact = bool(env.backend.in_contact(self._robot_idn))
+            self._in_contact = contact
+            if contact:
+                self._collisions += 1
+            geodesic = self._geodesic_at(x, y)
+            self._distance_to_goal = geodesic
+            self._potential = self._potential_at(x, y, geodesic, self._potential)
+
+            results: dict[str, tuple[bool, bool]] = {}
+            done = success = terminated = truncated = False
+            for name, condition in self._terminations.items():
+                result = condition.step(self, env, action)
+                results[name] = result
+                if result[0]:
+                    done = True
+                    if result[1]:
+                        success = True
+                    if condition.is_truncation:
+                        truncated = True
+                    else:
+                        terminated = True
+            self._results = results
+            self._success = success
+
+            breakdown = {name: fn.step(self, env, action) for name, fn in self._rewards.items()}
+            reward = sum(breakdown.values(), 0.0)  # the sum a user gets from the breakdown
+            info = self._info(success, done, breakdown, results)
+        except BaseException:
+            self._move(_Event.FAIL)
+            raise
+        self._state = _TRANSITIONS[(self._state, _Event.END if done else _Event.STEP)]
+        return reward, terminated, truncated, info
+
+    def _info(
+        self,
+        success: bool,
+        done: bool,
+        breakdown: dict[str, float],
+        results: Mapping[str, tuple[bool, bool]],
+    ) -> dict[str, Any]:
+        d0, length, d_t = self._geodesic_dist, self._path_length, self._distance_to_goal
+        return {
+            "success": success,
+            "done": done,
+            "path_length": length,
+            "spl": _spl(success, d0, length),
+            "soft_spl": _soft_spl(d_t, d0, length),
+            "geodesic_dist": d0,
+            "distance_to_goal": d_t,
+            "collisions": self._collisions,
+            "reward_breakdown": breakdown,
+            "termination_conditions": {
+                name: {"done": d, "success": s} for name, (d, s) in results.items()
+            },
+            "episode_length": self._steps,
+            "potential_metric": self._metric,
+        }
+
+    # ------------------------------------------------------------------ observations
+    def _require_episode(self, what: str) -> None:
+        if self._state is IDLE or self._state is ERROR:
+            raise TaskStateError(
+                f"{what} needs an episode, but the task is {self._state.name}: "
+                f"{_ILLEGAL_HINT[self._state]}"
+            )
+
+    def _obs_values(self, env: TaskEnv) -> list[float]:
+        """Goal (2), linear velocity (3), angular velocity (3), all in the robot frame."""
+        lin, ang = env.backend.get_velocity(self._robot_idn)
+        # The pose recorded at the last reset or step: the one the metrics saw.
+        x, y, _ = self._robot_xyz
+        qx, qy, qz, qw = self._robot_quat
+        # Rotation matrix R (robot -> world) of the normalised quaternion; R^T maps world
+        # vectors into the robot frame. Plain floats: this runs on every step.
+        s = 2.0 / (qx * qx + qy * qy + qz * qz + qw * qw)
+        r00 = 1.0 - s * (qy * qy + qz * qz)
+        r01 = s * (qx * qy - qz * qw)
+        r02 = s * (qx * qz + qy * qw)
+        r10 = s * (qx * qy + qz * qw)
+        r11 = 1.0 - s * (qx * qx + qz * qz)
+        r12 = s * (qy * qz - qx * qw)
+        r20 = s * (qx * qz - qy * qw)
+        r21 = s * (qy * qz + qx * qw)
+        r22 = 1.0 - s * (qx * qx + qy * qy)
+        vx, vy, vz = lin.tolist()
+        wx, wy, wz = ang.tolist()
+        # The goal in the heading frame: rotate by -yaw, yaw = atan2(R10, R00).
+        gx, gy = self._goal_xy  # type: ignore[misc]
+        dx, dy = gx - x, gy - y
+        h = math.hypot(r00, r10)
+        if h > 1e-12:
+            c, sn = r00 / h, r10 / h
+        else:  # +x points straight up or down: take the heading from the +y axis
+            yaw = math.atan2(-r01, r11)
+            c, sn = math.cos(yaw), math.sin(yaw)
+        lx, ly = c * dx + sn * dy, c * dy - sn * dx
+        if self._goal_in_polar:
+            rho = math.hypot(lx, ly)
+            phi = math.atan2(ly, lx) if rho > 0.0 else 0.0
+            lx, ly = rho, (math.pi if phi == -math.pi else phi)
+        values = (
+            lx,
+            ly,
+            r00 * vx + r10 * vy + r20 * vz,
+            r01 * vx + r11 * vy + r21 * vz,
+            r02 * vx + r12 * vy + r22 * vz,
+            r00 * wx + r10 * wy + r20 * wz,
+            r01 * wx + r11 * wy + r21 * wz,
+            r02 * wx + r12 * wy + r22 * wz,
+        )
+        # Keep inside the observation space (e.g. the vertical speed of a fall).
+        return [
+            lo if value < lo else hi if value > hi else value
+            for value, lo, hi in zip(values, self._obs_low, self._obs_high)
+        ]
+
+    @property
+    def observation_bounds(self) -> tuple[NDArray[np.float32], NDArray[np.float32]]:
+        """``(low, high)`` of the 8 low-dimensional observation values, float32 arrays.
+
+        In the order of :meth:`get_low_dim_obs`. The goal lies within the floor's diagonal
+        plus 1 m (``rho`` in ``[0, that]`` and ``phi`` in ``[-pi, pi]`` when polar); linear
+        velocities within ``sqrt(2) * max_linear_velocity`` and angular ones within
+        ``max_angular_velocity``. Observations are clipped to these bounds (a falling
+        robot's vertical speed can exceed them).
+
+        Raises
+        ------
+        TaskStateError
+            Before the task has met an environment (:meth:`load`).
+        """
+        if self._env is None:
+            raise TaskStateError("observation_bounds needs an environment: call load(env) first")
+        return (
+            np.array(self._obs_low, dtype=np.float32),
+            np.array(self._obs_high, dtype=np.float32),
+        )
+
+    def get_obs(self, env: TaskEnv) -> dict[str, NDArray[np.float32]]:
+        """Return the task's low-dimensional observation, fresh float32 arrays.
+
+        Returns
+        -------
+        dict
+            ``xy_pos_to_goal`` (2,): the goal minus the robot's position in the robot's
+            heading frame (+x ahead, +y left), in metres; or ``(rho, phi)`` (m, rad in
+            (-pi, pi]) when ``goal_in_polar``. ``robot_lin_vel`` (3,) m/s and
+            ``robot_ang_vel`` (3,) rad/s: world velocities rotated into the robot frame.
+            Values are clipped to :attr:`observation_bounds`.
+
+        Notes
+        -----
+        The pose is the one the task recorded at the last reset or step (what its
+        rewards and metrics saw; the environment has not moved the robot since), the
+        velocities are read from the backend.
+
+        Raises
+        ------
+        TaskStateError
+            Before the first reset (there is no goal yet).
+        """
+        self._require_episode("get_obs()")
+        # One fresh buffer per call, split three ways (cheaper than three arrays).
+        flat = np.array(self._obs_values(env), dtype=np.float32)
+        return {
+            "xy_pos_to_goal": flat[0:2],
+            "robot_lin_vel": flat[2:5],
+            "robot_ang_vel": flat[5:8],
+        }
+
+    def get_low_dim_obs(self, env: TaskEnv) -> NDArray[np.float32]:
+        """Return OmniGibson's flat ``low_dim`` observation: :meth:`get_obs`'s three arrays
+        concatenated in the order ``xy_pos_to_goal``, ``robot_lin_vel``, ``robot_ang_vel``
+        (8 float32 values, fresh array)."""
+        self._require_episode("get_low_dim_obs()")
+        return np.array(self._obs_values(env), dtype=np.float32)
+
+    # ------------------------------------------------------------------ OmniGibson API
+    def get_goal_pos(self) -> NDArray[np.float64] | None:
+        """Return this episode's goal (x, y, z) in metres, z the floor height (fresh array).
+
+        Before the first reset: the fixed goal, or None when the goal is sampled.
+        """
+        if self._goal_xy is None:
+            return None
+        return np.array((*self._goal_xy, self._floor_height))
+
+    def get_start_pos(self) -> NDArray[np.float64] | None:
+        """Return this episode's start (x, y, z) in metres (None before the first reset)."""
+        if self._start_xy is None:
+            return None
+        return np.array((*self._start_xy, self._floor_height))
+
+    def get_current_pos(self, env: TaskEnv) -> NDArray[np.float64]:
+        """Return the robot's current position (x, y, z) in metres (fresh array)."""
+        pos, _ = env.backend.get_pose(self._robot_idn)
+        return np.array(pos, dtype=np.float64)
+
+    def get_potential(self, env: TaskEnv) -> float:
+        """Return the potential (m) at the robot's current position.
+
+        The xy L2 distance to the goal, or the geodesic distance when ``reward_type`` is
+        ``"geodesic"`` and the goal is reachable (``potential_metric``).
+        """
+        self._require_episode("get_potential()")
+        x, y, _ = env.backend.get_pose(self._robot_idn)[0].tolist()
+        return self._potential_at(x, y, self._geodesic_at(x, y), self._potential)
+
+    def get_shortest_path_to_goal(
+        self, env: TaskEnv, start_xy_pos: ArrayLike | None = None, entire_path: bool = False
+    ) -> tuple[NDArray[np.float64], float] | tuple[None, None]:
+        """Return the shortest path to the goal and its geodesic length.
+
+        Parameters
+        ----------
+        env : TaskEnv
+        start_xy_pos : array_like, shape (2,), optional
+            Where the path starts (m); default: the robot's current position.
+        entire_path : bool
+            True: the whole any-angle polyline. False: ``scene.num_waypoints`` waypoints
+            ``scene.waypoint_spacing`` apart (OmniGibson's convention).
+
+        Returns
+        -------
+        waypoints : ndarray (N, 2) or None
+            World (x, y) in metres.
+        geodesic_distance : float or None
+            Metres; ``(None, None)`` when the goal is not reachable from the start.
+        """
+        self._require_episode("get_shortest_path_to_goal()")
+        if start_xy_pos is None:
+            start_xy_pos = env.backend.get_pose(self._robot_idn)[0][:2]
+        return env.scene.get_shortest_path(
+            self._floor, start_xy_pos, self._goal_xy, entire_path=entire_path, robot=self._spec
+        )
+
+    def __repr__(self) -> str:
+        return (
+            f"PointNavigationTask(robot_idn={self._robot_idn}, floor={self._floor}, "
+            f"reward_type={self._reward_type!r}, state={self._state.name})"
+        )

@@ -1,0 +1,520 @@
+"""What PointNavigationTask computes, step by step, on tiny maps where it can be done by hand.
+
+Maps are 0.1 m grids with a one-cell wall around them; the robot has radius 0.1 m and drives
+0.05 m per step at full forward speed (0.5 m/s at 10 Hz), so positions are easy to predict.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from pointnav_core.backend import RobotSpec
+from pointnav_core.env import PointNavEnv
+from pointnav_core.maps import FREE, OBSTACLE, VOID
+from pointnav_core.rewards import PointGoalReward
+from pointnav_core.scenes import Scene
+from pointnav_core.task import PointNavigationTask, TaskState, TaskStateError
+from pointnav_core.terminations import TerminationCondition
+
+RES = 0.1
+ROBOT = RobotSpec(radius=0.1)
+STEP = 0.05  # metres per step at full forward speed
+FORWARD = np.array([1.0, 0.0], dtype=np.float32)
+BACKWARD = np.array([-1.0, 0.0], dtype=np.float32)
+STOP = np.zeros(2, dtype=np.float32)
+
+
+def quat(yaw: float) -> tuple[float, float, float, float]:
+    return (0.0, 0.0, math.sin(yaw / 2), math.cos(yaw / 2))
+
+
+def room(rows: int = 20, cols: int = 60) -> np.ndarray:
+    """A walled room: free inside x in (0.1, cols/10 - 0.1), y in (0.1, rows/10 - 0.1)."""
+    grid = np.full((rows, cols), FREE, dtype=np.uint8)
+    grid[0, :] = grid[-1, :] = grid[:, 0] = grid[:, -1] = OBSTACLE
+    return grid
+
+
+def make_env(grid: np.ndarray | list[np.ndarray], **task) -> PointNavEnv:
+    return PointNavEnv(scene=Scene.from_array(grid, RES), robot=ROBOT, task=task)
+
+
+def planar_distance(env: PointNavEnv, xy) -> float:
+    pos = env.task.get_current_pos(env)
+    return math.hypot(xy[0] - pos[0], xy[1] - pos[1])
+
+
+# ------------------------------------------------------------------------------ rewards
+
+
+def test_l2_potential_reward_matches_the_formula_on_every_step():
+    goal = (3.0, 1.0)
+    env = make_env(
+        room(),
+        initial_pos=(1.0, 1.0, 0.0),
+        initial_quat=quat(0.0),
+        goal_pos=(*goal, 0.0),
+        reward_config={"r_potential": 2.0},
+    )
+    _, info = env.reset(seed=0)
+    assert info["potential_metric"] == "l2"
+    previous = 2.0
+    actions = [FORWARD] * 10 + [np.array([0.5, 1.0], np.float32)] * 5 + [BACKWARD] * 3
+    for k, action in enumerate(actions, start=1):
+        _, reward, terminated, truncated, info = env.step(action)
+        current = planar_distance(env, goal)
+        breakdown = info["reward_breakdown"]
+        assert breakdown["potential"] == pytest.approx(2.0 * (previous - current), abs=1e-12)
+        assert breakdown["collision"] == 0.0
+        assert breakdown["pointgoal"] == 0.0
+        assert sum(breakdown.values()) == reward
+        assert (terminated, truncated) == (False, False)
+        if k == 10:  # ten steps straight ahead: 0.5 m closer, reward 2 * 0.5 in total
+            assert env.task.get_current_pos(env)[:2] == pytest.approx([1.5, 1.0], abs=1e-12)
+            assert current == pytest.approx(1.5, abs=1e-12)
+        previous = current
+
+
+def wall_with_gap() -> np.ndarray:
+    """4 m x 4 m room split by a wall at x in [2.0, 2.1] from y = 0 up to y = 3.0."""
+    grid = room(40, 40)
+    grid[:30, 20] = OBSTACLE
+    return grid
+
+
+def test_geodesic_potential_reward_uses_the_geodesic_distance_around_the_wall():
+    start, goal = (1.0, 1.0), (3.0, 1.0)
+    env = make_env(
+        wall_with_gap(),
+        initial_pos=(*start, 0.0),
+        initial_quat=quat(math.pi / 2),  # facing +y, along the wall
+        goal_pos=(*goal, 0.0),
+        reward_type="geodesic",
+    )
+    _, info = env.reset(seed=0)
+    assert info["potential_metric"] == "geodesic"
+    # By hand: the robot's centre bends around the eroded wall end, at (1.9, 3.1) and
+    # (2.2, 3.1) (0.1 m radius on a 0.1 m grid).
+    def by_hand(x: float, y: float) -> float:
+        return math.hypot(1.9 - x, 3.1 - y) + 0.3 + math.hypot(2.2 - goal[0], 3.1 - goal[1])
+
+    assert info["geodesic_dist"] == pytest.approx(by_hand(*start), abs=1e-3)
+    assert info["geodesic_dist"] > 2.0 + 2.0  # far longer than the straight line (2 m)
+    previous = info["distance_to_goal"]
+    for _ in range(20):
+        _, reward, _, _, info = env.step(FORWARD)
+        pos = env.task.get_current_pos(env)
+        current = env.scene.geodesic_distance(0, pos, goal, robot=ROBOT)
+        assert info["distance_to_goal"] == pytest.approx(current, abs=1e-12)
+        assert current == pytest.approx(by_hand(pos[0], pos[1]), abs=1e-3)
+        assert info["reward_breakdown"]["potential"] == pytest.approx(previous - current, abs=1e-12)
+        assert sum(info["reward_breakdown"].values()) == reward
+        previous = current
+
+
+def test_unreachable_goal_uses_l2_potential_for_the_whole_episode():
+    grid = room(20, 40)
+    grid[:, 20] = OBSTACLE  # two closed rooms
+    env = make_env(
+        grid,
+        initial_pos=(1.0, 1.0, 0.0),
+        initial_quat=quat(0.0),
+        goal_pos=(3.0, 1.0, 0.0),
+        reward_type="geodesic",
+    )
+    _, info = env.reset(seed=0)
+    assert info["geodesic_dist"] == math.inf
+    assert info["potential_metric"] == "l2"
+    previous = 2.0
+    for _ in range(5):
+        _, reward, _, _, info = env.step(FORWARD)
+        current = planar_distance(env, (3.0, 1.0))
+        assert info["reward_breakdown"]["potential"] == pytest.approx(previous - current, abs=1e-12)
+        assert math.isfinite(reward)
+        assert info["potential_metric"] == "l2"
+        assert info["spl"] == 0.0 and info["soft_spl"] == 0.0
+        assert info["distance_to_goal"] == math.inf
+        previous = current
+
+
+def test_geodesic_potential_stays_finite_while_the_robot_slides_along_a_wall():
+    # Standing against a wall, the robot's centre is in a cell whose centre is closer to
+    # the wall than its radius; the geodesic must still be defined there.
+    env = make_env(
+        room(20, 60),
+        initial_pos=(3.0, 1.0, 0.0),
+        initial_quat=quat(math.radians(80)),  # nearly straight at the top wall
+        goal_pos=(5.0, 1.5, 0.0),
+        reward_type="geodesic",
+    )
+    env.reset(seed=0)
+    touched = 0
+    for _ in range(40):
+        _, reward, _, _, info = env.step(FORWARD)
+        touched += env.backend.in_contact(0)
+        assert math.isfinite(reward)
+        assert math.isfinite(info["distance_to_goal"])
+        assert info["distance_to_goal"] >= planar_distance(env, (5.0, 1.5)) - 1e-9
+    assert touched > 10  # it really did slide along the wall
+
+
+def test_collision_penalty_exactly_on_the_steps_that_touch_the_wall():
+    # The right wall's inner face is at x = 5.9, so the robot's centre stops at x = 5.8.
+    env = make_env(
+        room(),
+        initial_pos=(5.025, 1.0, 0.0),
+        initial_quat=quat(0.0),
+        goal_pos=(1.0, 1.0, 0.0),
+        reward_config={"r_collision": 0.25},
+    )
+    env.reset(seed=0)
+    contacts = []
+    for k in range(1, 21):
+        _, reward, terminated, _, info = env.step(FORWARD)
+        free_x = 5.025 + STEP * k  # where it would be without the wall
+        expect_contact = free_x > 5.8
+        assert info["reward_breakdown"]["collision"] == (-0.25 if expect_contact else 0.0)
+        assert sum(info["reward_breakdown"].values()) == reward
+        contacts.append(expect_contact)
+        assert info["collisions"] == sum(contacts)
+        assert not terminated
+    assert contacts.index(True) == 15  # the 16th step is the first to touch
+    assert env.task.get_current_pos(env)[0] == pytest.approx(5.8, abs=1e-6)
+    for _ in range(3):  # backing away touches nothing
+        _, _, _, _, info = env.step(BACKWARD)
+        assert info["reward_breakdown"]["collision"] == 0.0
+        assert info["collisions"] == 5
+
+
+def test_max_collision_ends_the_episode_when_the_counter_exceeds_max_collisions():
+    env = make_env(
+        room(),
+        initial_pos=(5.025, 1.0, 0.0),
+        initial_quat=quat(0.0),
+        goal_pos=(1.0, 1.0, 0.0),
+        termination_config={"max_collisions": 3},
+    )
+    env.reset(seed=0)
+    for k in range(1, 19):  # contacts on steps 16, 17, 18: the counter reaches 3
+        _, _, terminated, truncated, info = env.step(FORWARD)
+        assert (terminated, truncated) == (False, False), k
+    _, _, terminated, truncated, info = env.step(FORWARD)  # step 19: the 4th contact
+    assert (terminated, truncated) == (True, False)
+    assert info["collisions"] == 4
+    assert info["termination_conditions"]["max_collision"] == {"done": True, "success": False}
+    assert info["success"] is False and info["done"] is True
+    assert env.task.state is TaskState.DONE
+
+
+def test_goal_reward_is_paid_on_the_success_step_only():
+    env = make_env(
+        room(),
+        initial_pos=(1.0, 1.0, 0.0),
+        initial_quat=quat(0.0),
+        goal_pos=(2.02, 1.0, 0.0),
+        goal_tolerance=0.5,
+        reward_config={"r_pointgoal": 7.0},
+    )
+    env.reset(seed=0)
+    steps = 0
+    while True:
+        _, reward, terminated, truncated, info = env.step(FORWARD)
+        steps += 1
+        if terminated:
+            break
+        assert info["reward_breakdown"]["pointgoal"] == 0.0
+        assert info["spl"] == 0.0  # reported on every step, 0 until success
+    # Distance 1.02 - 0.05 k < 0.5 first at k = 11.
+    assert steps == 11
+    assert info["reward_breakdown"]["pointgoal"] == 7.0
+    assert sum(info["reward_breakdown"].values()) == reward
+    assert info["success"] is True and truncated is False
+    assert info["termination_conditions"]["pointgoal"] == {"done": True, "success": True}
+    assert info["path_length"] == pytest.approx(11 * STEP, abs=1e-12)
+    assert info["spl"] == 1.0  # drove straight: L = 0.55 <= d0 = 1.02
+    assert info["soft_spl"] == pytest.approx(1.0 - 0.47 / 1.02, abs=1e-9)
+
+
+# ------------------------------------------------------------------------------ episode end
+
+
+@pytest.mark.parametrize("episodes", [3])
+def test_timeout_truncates_after_exactly_max_steps_in_every_episode(episodes):
+    env = make_env(room(), initial_pos=(1.0, 1.0, 0.0), goal_pos=(5.0, 1.0, 0.0),
+                   termination_config={"max_steps": 5})
+    for _ in range(episodes):
+        env.reset()
+        for k in range(1, 5):
+            _, _, terminated, truncated, info = env.step(STOP)
+            assert (terminated, truncated) == (False, False)
+            assert info["episode_length"] == k
+        _, _, terminated, truncated, info = env.step(STOP)
+        assert (terminated, truncated) == (False, True)
+        assert info["episode_length"] == 5
+        assert info["termination_conditions"]["timeout"] == {"done": True, "success": False}
+        assert info["done"] is True and info["success"] is False
+
+
+def test_timeout_and_success_on_the_same_step_are_both_reported():
+    env = make_env(room(), initial_pos=(1.0, 1.0, 0.0), initial_quat=quat(0.0),
+                   goal_pos=(1.52, 1.0, 0.0), termination_config={"max_steps": 1})
+    env.reset(seed=0)
+    _, _, terminated, truncated, info = env.step(FORWARD)
+    assert (terminated, truncated) == (True, True)
+    assert info["success"] is True
+
+
+def test_falling_ends_an_episode_that_drives_into_void():
+    grid = room(20, 60)
+    grid[1:-1, 40:-1] = VOID  # a hole from x = 4.0 on
+    env = make_env(grid, initial_pos=(3.025, 1.0, 0.0), initial_quat=quat(0.0),
+                   goal_pos=(1.0, 1.0, 0.0), reward_type="geodesic")
+    env.reset(seed=0)
+    for k in range(1, 20):  # x = 3.025 + 0.05 k stays below 4.0 up to k = 19
+        _, reward, terminated, _, info = env.step(FORWARD)
+        assert not terminated, k
+    _, reward, terminated, truncated, info = env.step(FORWARD)  # over the hole
+    assert (terminated, truncated) == (True, False)
+    assert info["termination_conditions"]["falling"] == {"done": True, "success": False}
+    assert info["success"] is False
+    assert env.task.get_current_pos(env)[2] < -0.03
+    assert math.isfinite(reward)  # no geodesic over void: the potential is held
+
+
+# ------------------------------------------------------------------------------ metrics
+
+
+def test_one_step_success_gets_spl_of_its_efficiency():
+    # OmniGibson reported SPL = 0 here: it never counted the final step.
+    env = make_env(room(), initial_pos=(1.0, 1.0, 0.0), initial_quat=quat(0.0),
+                   goal_pos=(1.6, 1.0, 0.0), goal_tolerance=0.58)
+    _, info = env.reset(seed=0)
+    d0 = info["geodesic_dist"]
+    assert d0 == pytest.approx(0.6, abs=1e-12)
+    _, _, terminated, _, info = env.step(FORWARD)
+    assert terminated and info["success"]
+    assert info["path_length"] == pytest.approx(STEP, abs=1e-12)
+    assert info["spl"] == d0 / max(d0, info["path_length"]) == 1.0
+
+
+def test_spl_counts_the_final_step_in_the_path_length():
+    # Start 1 cm from the goal and drive 5 cm: L > d0, so SPL = d0 / L.
+    env = make_env(room(), initial_pos=(1.0, 1.0, 0.0), initial_quat=quat(math.pi),
+                   goal_pos=(1.01, 1.0, 0.0), goal_tolerance=0.5)
+    _, info = env.reset(seed=0)
+    _, _, _, _, info = env.step(FORWARD)
+    assert info["success"]
+    assert info["path_length"] == pytest.approx(0.05, abs=1e-12)
+    assert info["spl"] == pytest.approx(0.01 / 0.05, abs=1e-9)
+
+
+# ------------------------------------------------------------------------------ observations
+
+
+@pytest.mark.parametrize("polar", [False, True])
+def test_goal_observation_of_a_rotated_robot_matches_hand_values(polar):
+    # Facing +y, a goal 2 m along +x and 0.5 m along +y is 0.5 m ahead and 2 m to the right.
+    env = make_env(room(40, 60), initial_pos=(1.0, 1.0, 0.0), initial_quat=quat(math.pi / 2),
+                   goal_pos=(3.0, 1.5, 0.0), goal_in_polar=polar)
+    obs, _ = env.reset(seed=0)
+    expected = [math.hypot(0.5, 2.0), math.atan2(-2.0, 0.5)] if polar else [0.5, -2.0]
+    assert obs["xy_pos_to_goal"].dtype == np.float32
+    np.testing.assert_allclose(obs["xy_pos_to_goal"], expected, atol=1e-6)
+    # One step ahead (+y in the world): 0.05 m nearer along the robot's x, still facing +y.
+    obs, *_ = env.step(FORWARD)
+    expected = [math.hypot(0.45, 2.0), math.atan2(-2.0, 0.45)] if polar else [0.45, -2.0]
+    np.testing.assert_allclose(obs["xy_pos_to_goal"], expected, atol=1e-6)
+    # World velocity (0, 0.5, 0) is straight ahead in the robot frame.
+    np.testing.assert_allclose(obs["robot_lin_vel"], [0.5, 0.0, 0.0], atol=1e-6)
+    np.testing.assert_allclose(obs["robot_ang_vel"], [0.0, 0.0, 0.0], atol=1e-6)
+
+
+def test_angular_velocity_observation_is_the_yaw_rate():
+    env = make_env(room(40, 60), initial_pos=(2.0, 2.0, 0.0), initial_quat=quat(1.0),
+                   goal_pos=(5.0, 2.0, 0.0))
+    env.reset(seed=0)
+    obs, *_ = env.step(np.array([0.0, -0.5], np.float32))  # turn right at 0.75 rad/s
+    np.testing.assert_allclose(obs["robot_ang_vel"], [0.0, 0.0, -0.75], atol=1e-6)
+    np.testing.assert_allclose(obs["robot_lin_vel"], [0.0, 0.0, 0.0], atol=1e-6)
+
+
+def test_observations_are_fresh_arrays_on_every_call():
+    env = make_env(room(), initial_pos=(1.0, 1.0, 0.0), goal_pos=(3.0, 1.0, 0.0))
+    first, _ = env.reset(seed=0)
+    second = env.task.get_obs(env)
+    for key in first:
+        assert not np.shares_memory(first[key], second[key])
+    first["xy_pos_to_goal"][:] = 99.0
+    assert env.task.get_obs(env)["xy_pos_to_goal"][0] != 99.0
+
+
+# ------------------------------------------------------------------------------ sampling and floors
+
+
+def test_sampled_episodes_respect_path_range_and_reachability():
+    env = make_env(wall_with_gap(), path_range=(3.0, 4.5), goal_tolerance=0.3)
+    for seed in range(5):
+        _, info = env.reset(seed=seed)
+        task = env.task
+        assert 3.0 < info["geodesic_dist"] < 4.5
+        start, goal = task.get_start_pos(), task.get_goal_pos()
+        _, length = env.scene.get_shortest_path(0, start, goal, entire_path=True, robot=ROBOT)
+        assert length == pytest.approx(info["geodesic_dist"], abs=1e-9)
+        assert math.hypot(*(goal[:2] - start[:2])) >= 0.3
+        assert env.backend.is_valid_pose(0, start)
+
+
+def test_fixed_start_with_sampled_goal_and_fixed_goal_with_sampled_start():
+    env = make_env(room(), initial_pos=(1.0, 1.0, 0.0), goal_tolerance=0.2)
+    env.reset(seed=1)
+    assert env.task.get_start_pos()[:2].tolist() == [1.0, 1.0]
+    assert math.isfinite(env.task.geodesic_dist)
+    env = make_env(room(), goal_pos=(4.0, 1.0, 0.0), goal_tolerance=0.2)
+    env.reset(seed=1)
+    assert env.task.get_goal_pos()[:2].tolist() == [4.0, 1.0]
+    assert math.isfinite(env.task.geodesic_dist)
+
+
+def test_task_on_an_upper_floor_lands_the_robot_at_that_floor_height():
+    env = make_env([room(), room()], floor=1, initial_pos=(1.0, 1.0, 0.0), goal_pos=(3.0, 1.0, 0.0))
+    _, info = env.reset(seed=0)
+    assert env.task.get_current_pos(env)[2] == 3.0
+    assert env.task.get_goal_pos()[2] == 3.0
+    _, _, terminated, _, info = env.step(FORWARD)
+    assert not terminated  # standing on floor 1 is not a fall
+    env = make_env([room(), room()], floor=1)  # and sampled
+    env.reset(seed=0)
+    assert env.task.get_current_pos(env)[2] == 3.0
+
+
+def test_same_seed_same_episode_and_different_seeds_differ():
+    env = make_env(wall_with_gap())
+    starts = []
+    for seed in (5, 5, 6):
+        env.reset(seed=seed)
+        starts.append((*env.task.get_start_pos(), *env.task.get_goal_pos()))
+    assert starts[0] == starts[1]
+    assert starts[0] != starts[2]
+
+
+# ------------------------------------------------------------------------------ lifecycle
+
+
+def test_lifecycle_follows_the_transition_table():
+    env = make_env(room(), initial_pos=(1.0, 1.0, 0.0), goal_pos=(5.0, 1.0, 0.0),
+                   termination_config={"max_steps": 2})
+    task = env.task
+    assert task.state is TaskState.IDLE
+    env.reset(seed=0)
+    assert task.state is TaskState.RUNNING
+    env.step(STOP)
+    assert task.state is TaskState.RUNNING
+    env.step(STOP)
+    assert task.state is TaskState.DONE
+    env.reset()
+    assert task.state is TaskState.RUNNING
+
+
+def test_step_after_the_episode_ended_raises_and_changes_nothing():
+    env = make_env(room(), initial_pos=(1.0, 1.0, 0.0), initial_quat=quat(0.0),
+                   goal_pos=(5.0, 1.0, 0.0), termination_config={"max_steps": 1})
+    env.reset(seed=0)
+    env.step(FORWARD)
+    pose = env.backend.get_pose(0)
+    length = env.task.episode_length
+    with pytest.raises(TaskStateError, match="call reset"):
+        env.step(FORWARD)
+    with pytest.raises(TaskStateError):
+        env.task.step(env, FORWARD)
+    assert env.task.state is TaskState.DONE
+    assert env.task.episode_length == length
+    np.testing.assert_array_equal(env.backend.get_pose(0)[0], pose[0])
+
+
+def test_default_configs_are_read_only_and_tasks_do_not_share_them():
+    with pytest.raises(TypeError):
+        PointNavigationTask.default_termination_config["max_steps"] = 3  # type: ignore[index]
+    with pytest.raises(TypeError):
+        PointNavigationTask.default_reward_config["r_pointgoal"] = 0.0  # type: ignore[index]
+    a = PointNavigationTask(termination_config={"max_steps": 7})
+    b = PointNavigationTask()
+    assert a.termination_config["max_steps"] == 7
+    assert b.termination_config["max_steps"] == 500
+    assert PointNavigationTask.default_termination_config["max_steps"] == 500
+
+
+def test_visualization_parameters_are_kept():
+    task = PointNavigationTask(visualize_goal=True, visualize_path=True, goal_height=0.2,
+                               waypoint_height=0.1, waypoint_width=0.05, n_vis_waypoints=4)
+    assert (task.visualize_goal, task.visualize_path) == (True, True)
+    assert (task.goal_height, task.waypoint_height, task.waypoint_width) == (0.2, 0.1, 0.05)
+    assert task.n_vis_waypoints == 4
+
+
+# ------------------------------------------------------------------------------ composition
+
+
+class _StopAfterTwoContacts(TerminationCondition):
+    name = "two_contacts"
+
+    def reset(self, task, env):
+        super().reset(task, env)
+        self.seen = 0
+
+    def terminate(self, task, env, action):
+        self.seen += task.in_contact
+        return self.seen >= 2
+
+
+class _TaskWithExtraCondition(PointNavigationTask):
+    def _create_termination_conditions(self):
+        conditions = super()._create_termination_conditions()
+        conditions["two_contacts"] = _StopAfterTwoContacts()
+        return conditions
+
+
+def test_a_subclass_can_add_a_termination_condition():
+    task = _TaskWithExtraCondition(initial_pos=(5.025, 1.0, 0.0), initial_quat=quat(0.0),
+                                   goal_pos=(1.0, 1.0, 0.0))
+    env = PointNavEnv(scene=Scene.from_array(room(), RES), robot=ROBOT, task=task)
+    env.reset(seed=0)
+    for _ in range(16):
+        _, _, terminated, _, info = env.step(FORWARD)
+        assert not terminated
+    _, _, terminated, _, info = env.step(FORWARD)  # the second contact
+    assert terminated
+    assert info["termination_conditions"]["two_contacts"] == {"done": True, "success": False}
+
+
+class _TaskWithoutGoal(PointNavigationTask):
+    def _create_termination_conditions(self):
+        conditions = super()._create_termination_conditions()
+        del conditions["pointgoal"]
+        return conditions
+
+
+def test_goal_reward_without_a_goal_condition_fails_at_reset():
+    task = _TaskWithoutGoal(initial_pos=(1.0, 1.0, 0.0), goal_pos=(3.0, 1.0, 0.0))
+    env = PointNavEnv(scene=Scene.from_array(room(), RES), robot=ROBOT, task=task)
+    with pytest.raises(ValueError, match="pointgoal"):
+        env.reset(seed=0)
+    assert task.state is TaskState.ERROR
+    assert isinstance(task.reward_functions["pointgoal"], PointGoalReward)
+
+
+def test_omnigibson_accessors():
+    env = make_env(room(), initial_pos=(1.0, 1.0, 0.0), initial_quat=quat(0.0),
+                   goal_pos=(3.0, 1.0, 0.0))
+    task = env.task
+    assert task.get_goal_pos().tolist() == [3.0, 1.0, 0.0]
+    env.reset(seed=0)
+    assert task.get_current_pos(env).tolist() == [1.0, 1.0, 0.0]
+    assert task.get_potential(env) == pytest.approx(2.0)
+    path, length = task.get_shortest_path_to_goal(env, entire_path=True)
+    assert length == pytest.approx(2.0, abs=1e-9)
+    np.testing.assert_allclose(path[[0, -1]], [[1.0, 1.0], [3.0, 1.0]], atol=1e-9)
+    waypoints, _ = task.get_shortest_path_to_goal(env, start_xy_pos=(2.0, 1.0))
+    assert waypoints.shape == (env.scene.num_waypoints, 2)
