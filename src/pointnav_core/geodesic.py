@@ -93,6 +93,7 @@ class Planner:
         self.corner_cells = rows * w + cols
         self.corner_labels = self.labels[rows, cols]
         self._cell_graph: sparse.csr_matrix | None = None
+        self._margins: tuple[NDArray[np.int64], NDArray[np.int64]] | None = None
         self._component_graphs: dict[int, tuple[NDArray[np.int64], sparse.csr_matrix]] = {}
         self._fields = BoundedCache(field_cache_size)
 
@@ -183,6 +184,31 @@ class Planner:
         graph = sparse.csr_matrix((weight, (i, j)), shape=(n, n))
         self._component_graphs[label] = (ids, graph)
         return ids, graph
+
+    def margin_sources(self) -> tuple[NDArray[np.int64], NDArray[np.int64]]:
+        """Margin cells (FREE, not usable) and, for each, a usable cell a few steps away.
+
+        The link spreads through FREE cells only, never across a wall, up to the robot
+        radius plus two cells deep. Flat cell indices; cached.
+        """
+        if self._margins is not None:
+            return self._margins
+        h, w = self.shape
+        source = np.where(self.usable, np.arange(h * w).reshape(h, w), -1)
+        margin = (self.tmap.codes == FREE) & ~self.usable
+        for _ in range(int(math.ceil(self.radius / self.tmap.resolution)) + 2):
+            todo = margin & (source < 0)
+            if not todo.any():
+                break
+            padded = np.pad(source, 1, constant_values=-1)
+            for dr, dc in ((-1, 0), (1, 0), (0, -1), (0, 1)):
+                nb = padded[1 + dr : 1 + dr + h, 1 + dc : 1 + dc + w]
+                take = todo & (nb >= 0)
+                source[take] = nb[take]
+                todo &= ~take
+        linked = margin & (source >= 0)
+        self._margins = (np.flatnonzero(linked), source[linked])
+        return self._margins
 
     def cell_graph(self) -> sparse.csr_matrix:
         """16-connected graph of usable cells, plus an empty last row for a super source.
@@ -321,22 +347,12 @@ class GoalField:
         n_cells = h * w
         root = np.full(n_cells, _UNREACHABLE, dtype=np.int64)
         if self.label != 0:
-            root = self._grid_roots().reshape(h, w)
+            root = self._grid_roots()
             # A robot can stand in a FREE cell whose *centre* is too close to an obstacle
-            # (the erosion is decided at cell centres). Such margin cells take the root of
-            # a neighbouring cell of the component, so the distance never jumps to infinity.
-            # The roots spread through FREE cells only (never across a wall), a few cells deep.
-            margin = (planner.tmap.codes == FREE) & (planner.labels == 0)
-            for _ in range(int(math.ceil(planner.radius / planner.tmap.resolution)) + 2):
-                todo = margin & (root == _UNREACHABLE)
-                if not todo.any():
-                    break
-                padded = np.pad(root, 1, constant_values=_UNREACHABLE)
-                for dr, dc in ((-1, 0), (1, 0), (0, -1), (0, 1)):
-                    nb = padded[1 + dr : 1 + dr + h, 1 + dc : 1 + dc + w]
-                    take = todo & (nb != _UNREACHABLE)
-                    root[take] = nb[take]
-                    todo &= ~take
+            # (the erosion is decided at cell centres): such margin cells take the root of
+            # a nearby usable cell, so the distance never jumps to infinity.
+            cells, sources = planner.margin_sources()
+            root[cells] = root[sources]
         self._root_rows = root.reshape(h, w).tolist()
         return self._root_rows
 
@@ -462,9 +478,14 @@ class GoalField:
         h, w = self.planner.shape
         if not (0 <= r < h and 0 <= c < w):
             return math.inf
-        root = self._lookup(r, c)
-        if root == _UNREACHABLE:
-            return math.inf
+        rows = self._root_rows
+        code = rows[r][c] if rows is not None else _UNREACHABLE + 1
+        if code <= -3:  # settled (see _lookup): the common case, inlined
+            root = _TO_GOAL if code == -3 else -code - 4
+        else:
+            root = self._lookup(r, c)
+            if root == _UNREACHABLE:
+                return math.inf
         return math.hypot(gr - self._pos_r[root], gc - self._pos_c[root]) + self._dist[root]
 
     def point_distance(self, g: NDArray[np.float64]) -> float:
@@ -474,11 +495,13 @@ class GoalField:
             return math.inf
         return math.hypot(g[0] - self._pos_r[parent], g[1] - self._pos_c[parent]) + self._dist[parent]
 
-    def best_parent(self, g: NDArray[np.float64]) -> int:
+    def best_parent(self, g: NDArray[np.float64], exact: bool = True) -> int:
         """First corner (or -1: the goal) on the shortest path from an exact grid point.
 
-        With the root table built, the cell's root is used when the exact point sees it (one
-        segment test); otherwise the corners are searched exactly.
+        ``exact=True`` searches the corners the point sees (optimal, independent of what
+        was looked up before). ``exact=False`` follows the root of the point's cell when
+        the point sees it (a lookup and one segment test; what a controller needs each
+        step) and searches only when it does not.
         """
         r, c = math.floor(g[0]), math.floor(g[1])
         h, w = self.planner.shape
@@ -490,20 +513,27 @@ class GoalField:
             return self._lookup(r, c)
         if label != self.label:
             return _UNREACHABLE
-        if self._root_rows is not None:
+        if not exact:
             root = self._lookup(r, c)
             if root != _UNREACHABLE:
-                target = np.array([self._pos_r[root], self._pos_c[root]])
-                if self.planner.visible(g, target) and (
-                    root == _TO_GOAL or self.planner.tangent(self.corner_ids[root], target - g)
-                ):
+                gr, gc = float(g[0]), float(g[1])
+                tr, tc = self._pos_r[root], self._pos_c[root]
+                tangent = root == _TO_GOAL or (
+                    (tr - gr) * self._diag_r[root] * (tc - gc) * self._diag_c[root] <= 0.0
+                )
+                if tangent and self.planner.visible_one(gr, gc, tr, tc):
                     return root
         return int(self._search(g[None, :])[0])
 
-    def path(self, g: NDArray[np.float64]) -> tuple[NDArray[np.float64], float] | tuple[None, None]:
-        """Any-angle path from grid point ``g`` to the goal and its length (cells)."""
+    def path(
+        self, g: NDArray[np.float64], exact: bool = True
+    ) -> tuple[NDArray[np.float64], float] | tuple[None, None]:
+        """Any-angle path from grid point ``g`` to the goal and its length (cells).
+
+        See :meth:`best_parent` for ``exact``.
+        """
         g = np.asarray(g, dtype=np.float64)
-        parent = self.best_parent(g)
+        parent = self.best_parent(g, exact)
         if parent == _UNREACHABLE:
             return None, None
         points = [g]

@@ -99,10 +99,16 @@ class FloorGoalField:
         g = self.tmap.world_to_grid(_as_xy(source_xy, "source_xy"))
         return self.field.point_distance(g) * self._res
 
-    def path(self, source_xy: ArrayLike) -> tuple[NDArray[np.float64], float] | tuple[None, None]:
-        """Any-angle path (N, 2) in world metres from ``source_xy`` to the goal, and its length."""
+    def path(
+        self, source_xy: ArrayLike, exact: bool = True
+    ) -> tuple[NDArray[np.float64], float] | tuple[None, None]:
+        """Any-angle path (N, 2) in world metres from ``source_xy`` to the goal, and its length.
+
+        ``exact=False`` follows the source cell's root when the source sees it (fast, for
+        controllers); ``exact=True`` searches the corners (optimal).
+        """
         g = self.tmap.world_to_grid(_as_xy(source_xy, "source_xy"))
-        points, length = self.field.path(g)
+        points, length = self.field.path(g, exact)
         if points is None:
             return None, None
         return self.tmap.grid_to_world(points), float(length) * self._res
