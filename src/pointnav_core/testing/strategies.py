@@ -397,7 +397,9 @@ def scenes(
     if not (isinstance(max_side, int) and max_side >= 2):
         raise ValueError(f"max_side must be an int >= 2, got {max_side!r}")
     if not resolutions or not all(math.isfinite(r) and r > 0 for r in resolutions):
-        raise ValueError(f"resolutions must be a non-empty tuple of numbers > 0, got {resolutions!r}")
+        raise ValueError(
+            f"resolutions must be a non-empty tuple of numbers > 0, got {resolutions!r}"
+        )
     n = draw(st.integers(1, max_floors))
     res = draw(st.sampled_from(tuple(resolutions)))
     origin = (draw(st.floats(-10.0, 10.0)), draw(st.floats(-10.0, 10.0)))
@@ -535,7 +537,8 @@ def action_sequences(
     overshoot : float
         How far beyond ``[-1, 1]`` components may go, >= 0 (exercises clipping).
     """
-    if not (isinstance(min_steps, int) and isinstance(max_steps, int) and 0 <= min_steps <= max_steps):
+    ints = isinstance(min_steps, int) and isinstance(max_steps, int)
+    if not (ints and 0 <= min_steps <= max_steps):
         raise ValueError(
             f"min_steps and max_steps must be ints with 0 <= min_steps <= max_steps, got "
             f"{min_steps!r} and {max_steps!r}"

@@ -1,0 +1,17 @@
+"""A pymunk backend for pointnav-core: robots as rigid discs with real contacts.
+
+Registered as ``"pymunk"`` in the entry-point group ``pointnav_core.backends``:
+
+>>> from pointnav_core.backend import get_backend
+>>> get_backend("pymunk") is PymunkBackend
+True
+"""
+
+from pointnav_pymunk.backend import (
+    CONTACT_SLOP,
+    OVERLAP_TOLERANCE,
+    TOUCH_TOLERANCE,
+    PymunkBackend,
+)
+
+__all__ = ["CONTACT_SLOP", "OVERLAP_TOLERANCE", "TOUCH_TOLERANCE", "PymunkBackend"]

@@ -1,0 +1,864 @@
+"""The pymunk backend: robots as rigid discs with real contacts in a 2D physics engine."""
+
+from __future__ import annotations
+
+import math
+import weakref
+from collections.abc import Mapping, Sequence
+from typing import Any
+
+import numpy as np
+import pymunk
+from numpy.typing import ArrayLike, NDArray
+
+from pointnav_core.backend import RobotSpec
+from pointnav_core.maps import VOID
+from pointnav_pymunk.geometry import floor_pieces
+
+__all__ = ["CONTACT_SLOP", "OVERLAP_TOLERANCE", "TOUCH_TOLERANCE", "PymunkBackend"]
+
+#: Largest overlap (m) with an obstacle or another robot that a robot may have at the end
+#: of a control step (the conformance kit's bound). In practice it is at most
+#: :data:`TOUCH_TOLERANCE`.
+OVERLAP_TOLERANCE = 1e-3
+#: Overlap (m) that pymunk leaves in a resting contact (``Space.collision_slop``).
+CONTACT_SLOP = 1e-6
+#: Overlap (m) up to which two shapes count as touching: deeper overlaps left at the end
+#: of a step are removed, and :meth:`PymunkBackend.is_valid_pose` accepts poses that
+#: overlap by at most this much (so a robot resting against a wall stands validly).
+TOUCH_TOLERANCE = 10.0 * CONTACT_SLOP
+
+_SETTLE_DEPTH = TOUCH_TOLERANCE  # m: deeper overlaps at the end of a step are settled
+_MAX_SETTLE = 8  # settling sub-steps per control step, at most
+_MAX_SUBSTEPS = 4096
+_SUBSTEP_FRACTION = 0.4  # of the thinnest wall / smallest robot pair, travel per sub-step
+_MIN_SIZE = 1e-3  # m: walls and robot pairs thinner than this count as this thick
+_PUSH_EPS = 1e-9  # m/s: a command into a contact faster than this is a hit
+_MASS = 1.0  # kg, a driving robot
+_HOLD_MASS = 1e6  # kg, a robot told to stand still (braked: it is not shoved)
+_MOTOR_MARGIN = 4.0  # motor force lets a robot reverse at full speed within a sub-step, x2
+_GRAVITY = 9.81  # m/s^2
+_MIN_FIRST_DROP = 0.05  # m: a fall must be visible on the step it starts, at any rate
+
+_WALL, _ROBOT = 1, 2  # collision types, and shape-filter categories
+_WALLS_ONLY = pymunk.ShapeFilter(mask=_WALL)
+
+
+class _Floor:
+    """One floor: its grid for VOID checks and its pymunk Space of static obstacles."""
+
+    __slots__ = (
+        "index",
+        "height",
+        "codes",
+        "rows",
+        "width",
+        "res",
+        "inv_res",
+        "ox",
+        "oy",
+        "pieces",
+        "thickness",
+        "space",
+        "depth",
+    )
+
+    def __init__(self, index: int, tmap: Any, height: float, plan: Any) -> None:
+        codes = np.asarray(tmap.codes)
+        self.index = index
+        self.height = height
+        self.rows, self.width = (int(n) for n in codes.shape)
+        self.codes = codes.astype(np.uint8).tobytes()
+        self.res = float(tmap.resolution)
+        self.inv_res = 1.0 / self.res
+        self.ox, self.oy = (float(v) for v in tmap.origin)
+        self.pieces, self.thickness = floor_pieces(tmap, plan)
+        self.space: pymunk.Space = None  # type: ignore[assignment]  # set by build_space
+        self.depth = 0.0  # deepest overlap seen while measuring (m)
+
+    def build_space(self, hit_wall: Any, hit_robot: Any) -> None:
+        """A fresh space holding this floor's obstacles as static convex shapes."""
+        space = pymunk.Space()
+        space.collision_slop = CONTACT_SLOP
+        space.collision_bias = 0.0  # correct an overlap fully in the next sub-step
+        space.iterations = 10
+        static = pymunk.Body(body_type=pymunk.Body.STATIC)  # ours, so it can be removed
+        shapes = []
+        for ring in self.pieces:
+            shape = pymunk.Poly(static, ring)
+            shape.collision_type = _WALL
+            shape.filter = pymunk.ShapeFilter(categories=_WALL)
+            shape.friction = 0.0
+            shape.elasticity = 0.0
+            shapes.append(shape)
+        space.add(static, *shapes)
+        space.on_collision(_ROBOT, _WALL, post_solve=hit_wall)
+        space.on_collision(_ROBOT, _ROBOT, post_solve=hit_robot)
+        self.space = space
+
+    def code(self, x: float, y: float) -> int:
+        """Cell code under world point (x, y); VOID off the map."""
+        col = math.floor((x - self.ox) * self.inv_res)
+        row = math.floor((y - self.oy) * self.inv_res)
+        if 0 <= col < self.width and 0 <= row < self.rows:
+            return self.codes[row * self.width + col]
+        return VOID
+
+
+class _Robot:
+    """One robot: its spec, its pymunk parts and its per-step state."""
+
+    __slots__ = (
+        "spec",
+        "radius",
+        "holonomic",
+        "floor",
+        "z",
+        "body",
+        "shape",
+        "control",
+        "joint",
+        "space",
+        "present",
+        "placed",
+        "falling",
+        "fall_speed",
+        "contact",
+        "vel",
+        "cmd",
+        "touching",
+        "start",
+    )
+
+    def __init__(self, spec: RobotSpec) -> None:
+        self.spec = spec
+        self.radius = spec.radius
+        self.holonomic = spec.drive == "holonomic"
+        self.floor = 0
+        self.z = 0.0
+        self.space: pymunk.Space | None = None
+        self.present = True
+        self.placed = False
+        self.falling = False
+        self.fall_speed = 0.0
+        self.contact = False
+        self.vel = (0.0, 0.0, 0.0, 0.0)  # world (vx, vy, vz) m/s and yaw rate rad/s
+        self.cmd = (0.0, 0.0, 0.0)  # body-frame (vx, vy, w) of the current step
+        # Contacts found by the last pymunk step: (nx, ny, other robot or None), the
+        # normal pointing from the obstacle towards this robot.
+        self.touching: list[tuple[float, float, Any]] = []
+        self.start = (0.0, 0.0, 0.0)
+        self.build(0.0, 0.0, 0.0)
+
+    def build(self, x: float, y: float, yaw: float) -> None:
+        """(Re)create the pymunk parts at pose (x, y, yaw), outside any space."""
+        body = pymunk.Body(_MASS, math.inf)
+        body.position = (x, y)
+        body.angle = yaw
+        shape = pymunk.Circle(body, self.radius)
+        shape.collision_type = _ROBOT
+        shape.filter = pymunk.ShapeFilter(categories=_ROBOT)
+        shape.friction = 0.0
+        shape.elasticity = 0.0
+        control = pymunk.Body(body_type=pymunk.Body.KINEMATIC)
+        control.position = (x, y)
+        joint = pymunk.PivotJoint(control, body, (0.0, 0.0), (0.0, 0.0))
+        joint.max_bias = 0.0  # a velocity motor: it never pulls towards a position
+        joint.max_force = 0.0
+        self.body, self.shape, self.control, self.joint = body, shape, control, joint
+        self.space = None
+
+    def solid(self) -> bool:
+        """Whether the robot is in the world's physics (others can touch it)."""
+        return self.present and self.placed and not self.falling
+
+
+def _empty_spaces(spaces: list[pymunk.Space]) -> None:
+    """Take everything out of the spaces and drop them.
+
+    pymunk frees a space by walking its contents with callbacks that no longer work once
+    the interpreter is shutting down (it then prints errors); an empty space has nothing
+    to walk. Run when the backend is collected, at exit, and when spaces are rebuilt.
+    """
+    for space in spaces:
+        space.remove(*space.constraints, *space.shapes, *space.bodies)
+    spaces.clear()
+
+
+def _planar_quat(yaw: float) -> NDArray[np.float64]:
+    half = 0.5 * math.remainder(yaw, 2.0 * math.pi)
+    return np.array((0.0, 0.0, math.sin(half), math.cos(half)))
+
+
+def _yaw_of(orientation: ArrayLike) -> float:
+    q = np.asarray(orientation, dtype=np.float64)
+    if q.shape != (4,) or not np.isfinite(q).all():
+        raise ValueError(
+            "orientation must be a finite (x, y, z, w) quaternion of shape (4,), "
+            f"got {orientation!r}"
+        )
+    x, y, z, w = q.tolist()
+    if x * x + y * y + z * z + w * w < 1e-12:
+        raise ValueError(f"orientation must be a non-zero quaternion, got {orientation!r}")
+    return math.atan2(2.0 * (w * z + x * y), w * w + x * x - y * y - z * z)
+
+
+def _xy(position: ArrayLike, *, allow_2d: bool) -> tuple[float, ...]:
+    p = np.asarray(position, dtype=np.float64)
+    shapes = ((2,), (3,)) if allow_2d else ((3,),)
+    if p.shape not in shapes or not np.isfinite(p).all():
+        want = "(x, y) or (x, y, z)" if allow_2d else "(x, y, z)"
+        raise ValueError(f"position must be finite {want} in metres, got {position!r}")
+    return tuple(p.tolist())
+
+
+def _chord(yaw: float, vx: float, vy: float, w: float, h: float) -> tuple[float, float]:
+    """World velocity whose straight motion over ``h`` s ends where the exact arc ends.
+
+    The arc of body velocity (vx, vy) turning at ``w`` rad/s from heading ``yaw``; written
+    with sin(a)/a, a = w h / 2, so it stays accurate as w -> 0.
+    """
+    a = 0.5 * w * h
+    s = math.sin(a) / a if a != 0.0 else 1.0
+    mid = yaw + a
+    c, sn = math.cos(mid), math.sin(mid)
+    return s * (vx * c - vy * sn), s * (vx * sn + vy * c)
+
+
+def _project(
+    ux: float, uy: float, limits: list[tuple[float, float, float]]
+) -> tuple[float, float]:
+    """The velocity closest to (ux, uy) with ``n . u >= c`` for every (nx, ny, c), c <= 0.
+
+    A 2D quadratic programme solved by enumerating active sets (one or two constraints);
+    zero is always feasible, since every c <= 0.
+    """
+
+    def feasible(vx: float, vy: float) -> bool:
+        return all(nx * vx + ny * vy >= c - 1e-12 for nx, ny, c in limits)
+
+    if feasible(ux, uy):
+        return ux, uy
+    best, best_d = (0.0, 0.0), ux * ux + uy * uy
+    for nx, ny, c in limits:
+        gap = c - (nx * ux + ny * uy)
+        if gap > 0.0:
+            vx, vy = ux + gap * nx, uy + gap * ny
+            d = gap * gap
+            if d < best_d and feasible(vx, vy):
+                best, best_d = (vx, vy), d
+    for i, (ax, ay, ac) in enumerate(limits):
+        for bx, by, bc in limits[i + 1 :]:
+            det = ax * by - ay * bx
+            if abs(det) < 1e-12:
+                continue
+            vx = (ac * by - ay * bc) / det
+            vy = (ax * bc - ac * bx) / det
+            d = (vx - ux) ** 2 + (vy - uy) ** 2
+            if d < best_d and feasible(vx, vy):
+                best, best_d = (vx, vy), d
+    return best
+
+
+class PymunkBackend:
+    """2D rigid-body backend on pymunk: discs with real contacts against walls and robots.
+
+    Each floor is one pymunk ``Space`` holding the floor's obstacles as static convex
+    shapes (OBSTACLE cells merged into rectangles, or the scene's shapely obstacle polygons
+    cut into convex pieces when the scene was built from polygons) and the robots standing
+    on it. A robot is a dynamic disc of its spec's radius (frictionless, inelastic, never
+    spun by contacts) pulled towards its commanded velocity by a velocity motor: a pivot
+    joint to a kinematic control body with no position correction and a finite force, as
+    in pymunk's own examples, so the solver resolves motors and contacts together. One
+    control step of ``1 / action_frequency`` seconds is split into sub-steps short enough
+    that no robot moves more than 0.4 of the thinnest wall (one map cell, or the thinnest
+    obstacle polygon) or of the smallest sum of two robots' radii per sub-step, so a robot
+    at full speed cannot pass through a wall one cell thick, nor through another robot.
+
+    Semantics follow the kinematic backend. A robot's contact flag says that it hit or
+    pushed against an obstacle or a robot during the step: pymunk found a contact and the
+    robot's command drove into it (into a robot: into that robot's actual motion, so the
+    robot that is hit is flagged too); touching while driving along a wall or backing
+    away is not a hit. Rotation is never blocked. A robot whose centre moves over VOID or
+    off the map stops moving in x, y and falls (its z drops by at least 0.05 m on that
+    step, then under gravity). :meth:`get_velocity` reports the effective velocities of
+    the last step (displacement over its duration). No robot ends a step overlapping an
+    obstacle or another robot by more than :data:`OVERLAP_TOLERANCE` (1 mm); in practice
+    by at most :data:`TOUCH_TOLERANCE` (1e-5 m).
+
+    Parameters
+    ----------
+    min_substeps : int
+        Fewest pymunk steps per control step, >= 1; more are used automatically when a
+        robot is fast compared with the walls and robots it could hit.
+    fall_speed : float
+        Downward speed in m/s with which a fall starts, > 0; gravity (9.81 m/s^2) then
+        accelerates it.
+
+    Notes
+    -----
+    How a step runs. A robot touching nothing gets its commanded velocity outright (the
+    exact arc of its drive, sub-step by sub-step), so open-space motion equals the
+    kinematic backend's. A robot in contact at the start of a step gets its new command
+    less the part that points into its contacts (into a robot: less what that robot is
+    itself commanded to move away); after that its velocity is the solver's, which slides
+    it along walls (contacts are frictionless). The motors are strong enough to reverse
+    full speed within one sub-step, so a robot keeps to its command unless a contact stops
+    it. A robot told to stand still is braked (its mass becomes 1e6 kg instead of 1 kg),
+    so a robot that drives into it stops rather than shoving it: the braked robot moves by
+    micrometres at most. At the end of a step, overlaps deeper than
+    :data:`TOUCH_TOLERANCE` (left by a hit in the last sub-step) are removed by pymunk's own
+    position correction in extra sub-steps in which nothing moves. The step is
+    deterministic: the same calls give the same results, and :meth:`reset` rebuilds every
+    space, so an episode does not depend on earlier ones.
+
+    Examples
+    --------
+    >>> import types
+    >>> from pointnav_core.maps import TraversableMap
+    >>> floor = TraversableMap([[0, 0, 0, 0, 1]], resolution=1.0)
+    >>> scene = types.SimpleNamespace(floors=[floor], n_floors=1, get_floor_height=lambda f=0: 0.0)
+    >>> backend = PymunkBackend()
+    >>> backend.load(scene, [RobotSpec(radius=0.25)], action_frequency=1.0)
+    >>> backend.land(0, 0, (1.5, 0.5, 0.0), (0.0, 0.0, 0.0, 1.0))
+    >>> backend.step({0: np.array([1.0, 0.0])})  # 0.5 m/s for 1 s
+    >>> backend.get_pose(0)[0].round(9).tolist(), backend.in_contact(0)
+    ([2.0, 0.5, 0.0], False)
+    >>> for _ in range(6):
+    ...     backend.step({0: np.array([1.0, 0.0])})
+    >>> round(float(backend.get_pose(0)[0][0]), 3), backend.in_contact(0)  # at the wall
+    (3.75, True)
+    """
+
+    def __init__(self, min_substeps: int = 1, fall_speed: float = 1.0) -> None:
+        if (
+            isinstance(min_substeps, bool)
+            or not isinstance(min_substeps, (int, np.integer))
+            or not 1 <= min_substeps <= _MAX_SUBSTEPS
+        ):
+            raise ValueError(
+                f"min_substeps must be an int in [1, {_MAX_SUBSTEPS}], got {min_substeps!r}"
+            )
+        fall_speed_f = float(fall_speed)
+        if not math.isfinite(fall_speed_f) or fall_speed_f <= 0.0:
+            raise ValueError(f"fall_speed must be a finite number > 0 (m/s), got {fall_speed!r}")
+        self.min_substeps = int(min_substeps)
+        self.fall_speed = fall_speed_f
+        self._floors: list[_Floor] = []
+        self._robots: list[_Robot] = []
+        self._by_shape: dict[pymunk.Shape, _Robot] = {}
+        self._dt = 0.1
+        self._measuring = False
+        # The live spaces, emptied when this backend is collected or at interpreter exit.
+        self._spaces: list[pymunk.Space] = []
+        weakref.finalize(self, _empty_spaces, self._spaces)
+
+    # ------------------------------------------------------------------ lifecycle
+    @property
+    def n_robots(self) -> int:
+        """Number of robots loaded (0 before :meth:`load`)."""
+        return len(self._robots)
+
+    @property
+    def action_frequency(self) -> float:
+        """Control steps per second (Hz)."""
+        return 1.0 / self._dt
+
+    def load(
+        self, scene: Any, robots: Sequence[RobotSpec], action_frequency: float = 10.0
+    ) -> None:
+        """Build one pymunk space per floor of ``scene`` and one robot per spec.
+
+        Parameters
+        ----------
+        scene : Scene
+            Uses ``floors`` (list of TraversableMap), ``n_floors``,
+            ``get_floor_height(floor)`` and, when present, ``floor_plans`` (the shapely
+            polygons each floor was built from, or None; a map's own ``geometry`` is
+            used otherwise): a floor with polygons collides with the polygons, any
+            other floor with its OBSTACLE cells.
+        robots : sequence of RobotSpec
+            Robot ``idn`` is ``robots[idn]``.
+        action_frequency : float
+            Control steps per second (Hz), > 0.
+
+        Notes
+        -----
+        Robots start present, unplaced, at rest at x = y = 0 on floor 0.
+        """
+        freq = float(action_frequency)
+        if not math.isfinite(freq) or freq <= 0.0:
+            raise ValueError(
+                f"action_frequency must be a finite number > 0 (Hz), got {action_frequency!r}"
+            )
+        specs = list(robots)
+        for i, spec in enumerate(specs):
+            if not isinstance(spec, RobotSpec):
+                raise TypeError(f"robots[{i}] must be a RobotSpec, got {type(spec).__name__}")
+        n_floors = int(scene.n_floors)
+        if n_floors < 1 or len(scene.floors) != n_floors:
+            raise ValueError(
+                f"scene must have n_floors >= 1 floors, got n_floors={n_floors} "
+                f"and {len(scene.floors)} maps"
+            )
+        plans = list(getattr(scene, "floor_plans", None) or ())
+        plans += [None] * (n_floors - len(plans))
+        self._floors = [
+            _Floor(
+                f,
+                scene.floors[f],
+                float(scene.get_floor_height(f)),
+                plans[f] or getattr(scene.floors[f], "geometry", None),
+            )
+            for f in range(n_floors)
+        ]
+        self._robots = [_Robot(spec) for spec in specs]
+        for rb in self._robots:
+            rb.z = self._floors[0].height
+        self._dt = 1.0 / freq
+        self._rebuild()
+
+    def _rebuild(self) -> None:
+        """Fresh spaces with the static obstacles; robots' parts rebuilt, in no space."""
+        _empty_spaces(self._spaces)
+        for floor in self._floors:
+            floor.build_space(self._hit_wall, self._hit_robot)
+            self._spaces.append(floor.space)
+        self._by_shape = {}
+        for rb in self._robots:
+            x, y = rb.body.position
+            rb.build(x, y, rb.body.angle)
+            self._by_shape[rb.shape] = rb
+
+    def reset(self) -> None:
+        """Return every robot to its state after :meth:`load`, keeping its pose.
+
+        Velocities and contact flags become zero, falls end, and every robot is present
+        again but unplaced: it takes part in no collision until :meth:`land` or
+        :meth:`set_pose` places it. Every space is rebuilt, so what happens next does not
+        depend on what happened before.
+        """
+        for rb in self._robots:
+            rb.present = True
+            rb.placed = False
+            self._at_rest(rb)
+        self._rebuild()
+
+    @staticmethod
+    def _at_rest(rb: _Robot) -> None:
+        rb.falling = False
+        rb.fall_speed = 0.0
+        rb.contact = False
+        rb.vel = (0.0, 0.0, 0.0, 0.0)
+        rb.cmd = (0.0, 0.0, 0.0)
+        rb.touching = []
+        rb.body.velocity = (0.0, 0.0)
+        rb.body.angular_velocity = 0.0
+
+    def _robot(self, idn: int) -> _Robot:
+        if isinstance(idn, (bool, np.bool_)) or not isinstance(idn, (int, np.integer)):
+            raise TypeError(f"idn must be an int robot index, got {idn!r}")
+        if not 0 <= idn < len(self._robots):
+            if not self._robots:
+                raise RuntimeError("no robots: call load(scene, robots) first")
+            raise ValueError(f"idn must be in [0, {len(self._robots)}), got {idn}")
+        return self._robots[idn]
+
+    def _floor(self, floor: int) -> _Floor:
+        if isinstance(floor, (bool, np.bool_)) or not isinstance(floor, (int, np.integer)):
+            raise TypeError(f"floor must be an int floor index, got {floor!r}")
+        if not 0 <= floor < len(self._floors):
+            raise ValueError(f"floor must be in [0, {len(self._floors)}), got {floor}")
+        return self._floors[floor]
+
+    # ------------------------------------------------------------------ membership
+    def _sync_space(self, rb: _Robot) -> None:
+        """Put the robot's parts in its floor's space when solid, else in no space."""
+        want = self._floors[rb.floor].space if rb.solid() else None
+        if rb.space is want:
+            return
+        parts = (rb.body, rb.shape, rb.control, rb.joint)
+        if rb.space is not None:
+            rb.space.remove(*parts)
+        if want is not None:
+            want.add(*parts)
+        rb.space = want
+        self._forget(rb)
+
+    def _forget(self, rb: _Robot) -> None:
+        """Drop the contacts known for and against a robot that moved or left."""
+        rb.touching = []
+        for other in self._robots:
+            if other.touching:
+                other.touching = [t for t in other.touching if t[2] is not rb]
+
+    def _teleport(self, rb: _Robot, x: float, y: float, yaw: float) -> None:
+        rb.body.position = (x, y)
+        rb.body.angle = yaw
+        rb.control.position = (x, y)
+        if rb.space is not None:
+            rb.space.reindex_shapes_for_body(rb.body)
+        self._forget(rb)
+
+    # ------------------------------------------------------------------ poses
+    def land(self, idn: int, floor: int, position: ArrayLike, orientation: ArrayLike) -> None:
+        """Place robot ``idn`` at rest on ``floor``: x, y from ``position``, z = floor height.
+
+        Parameters
+        ----------
+        idn : int
+            Robot index.
+        floor : int
+            Floor index.
+        position : array_like, shape (2,) or (3,)
+            World x, y in metres; a z is ignored.
+        orientation : array_like, shape (4,)
+            ``(x, y, z, w)`` quaternion; only its yaw matters.
+        """
+        rb = self._robot(idn)
+        fl = self._floor(floor)
+        xy = _xy(position, allow_2d=True)
+        yaw = _yaw_of(orientation)
+        self._at_rest(rb)
+        rb.floor = fl.index
+        rb.z = fl.height
+        rb.placed = True
+        self._teleport(rb, xy[0], xy[1], yaw)
+        self._sync_space(rb)
+
+    def set_pose(self, idn: int, position: ArrayLike, orientation: ArrayLike) -> None:
+        """Teleport robot ``idn`` (at rest) to world ``position`` and ``orientation``.
+
+        Parameters
+        ----------
+        idn : int
+            Robot index.
+        position : array_like, shape (3,)
+            World x, y, z in metres. The robot stays on its floor (use :meth:`land` to
+            change floors).
+        orientation : array_like, shape (4,)
+            ``(x, y, z, w)`` quaternion; the backend is planar, so only its yaw is kept.
+        """
+        rb = self._robot(idn)
+        x, y, z = _xy(position, allow_2d=False)
+        yaw = _yaw_of(orientation)
+        self._at_rest(rb)
+        rb.z = z
+        rb.placed = True
+        self._teleport(rb, x, y, yaw)
+        self._sync_space(rb)
+
+    def get_pose(self, idn: int) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+        """Return robot ``idn``'s world position (3,) in metres and orientation (4,).
+
+        The orientation is the planar quaternion ``(0, 0, sin(yaw/2), cos(yaw/2))`` with
+        yaw in [-pi, pi], so its w is >= 0.
+        """
+        rb = self._robot(idn)
+        x, y = rb.body.position
+        return np.array((x, y, rb.z)), _planar_quat(rb.body.angle)
+
+    def get_velocity(self, idn: int) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+        """Return robot ``idn``'s world linear (3,) m/s and angular (3,) rad/s velocity.
+
+        These are the effective velocities of the last step: displacement and yaw change
+        divided by the step's duration (zero after load, reset, land and set_pose).
+        """
+        rb = self._robot(idn)
+        vx, vy, vz, wz = rb.vel
+        return np.array((vx, vy, vz)), np.array((0.0, 0.0, wz))
+
+    def get_robot_floor(self, idn: int) -> int:
+        """The floor robot ``idn`` was last landed on (0 until then)."""
+        return self._robot(idn).floor
+
+    def in_contact(self, idn: int) -> bool:
+        """Whether robot ``idn`` hit or pushed against an obstacle or robot in the last step."""
+        return self._robot(idn).contact
+
+    def set_present(self, idn: int, present: bool) -> None:
+        """Take robot ``idn`` out of the world (``False``) or bring it back (``True``).
+
+        An absent robot keeps its pose (and a fall in progress) but is not moved by
+        :meth:`step`, has no velocity and collides with nothing; bringing it back does not
+        check whether its pose is still free.
+        """
+        rb = self._robot(idn)
+        rb.present = bool(present)
+        if not rb.present:
+            rb.contact = False
+            rb.vel = (0.0, 0.0, 0.0, 0.0)
+        rb.body.velocity = (0.0, 0.0)
+        self._sync_space(rb)
+
+    def is_present(self, idn: int) -> bool:
+        """Whether robot ``idn`` is in the world."""
+        return self._robot(idn).present
+
+    def is_valid_pose(
+        self,
+        idn: int,
+        position: ArrayLike,
+        orientation: ArrayLike | None = None,
+        *,
+        floor: int | None = None,
+    ) -> bool:
+        """Whether robot ``idn`` could stand at ``position``.
+
+        Parameters
+        ----------
+        idn : int
+            Robot index.
+        position : array_like, shape (2,) or (3,)
+            World x, y (and an ignored z) in metres.
+        orientation : array_like, shape (4,), optional
+            Ignored (a disc looks the same in every heading); validated when given.
+        floor : int, optional
+            Floor to test on; default: the robot's floor (:meth:`get_robot_floor`).
+
+        Returns
+        -------
+        bool
+            True when the centre is on the map and not over VOID, the disc overlaps no
+            obstacle of the floor (the shapes the robots collide with: OBSTACLE cells, or
+            the obstacle polygons of a scene built from polygons) by more than
+            :data:`TOUCH_TOLERANCE` (touching is fine, and so is a resting contact), and
+            it overlaps no other present, placed, non-falling robot on that floor by more
+            than that.
+        """
+        rb = self._robot(idn)
+        fl = self._floors[rb.floor] if floor is None else self._floor(floor)
+        xy = _xy(position, allow_2d=True)
+        if orientation is not None:
+            _yaw_of(orientation)
+        x, y = xy[0], xy[1]
+        if fl.code(x, y) == VOID:
+            return False
+        r = rb.radius
+        limit = r - TOUCH_TOLERANCE
+        for info in fl.space.point_query((x, y), r, _WALLS_ONLY):
+            if info.distance < limit:
+                return False
+        for other in self._robots:
+            if other is rb or other.floor != fl.index or not other.solid():
+                continue
+            reach = r + other.radius - TOUCH_TOLERANCE
+            ox, oy = other.body.position
+            if reach > 0.0 and (x - ox) ** 2 + (y - oy) ** 2 < reach * reach:
+                return False
+        return True
+
+    # ------------------------------------------------------------------ contacts
+    def _hit_wall(self, arbiter: pymunk.Arbiter, space: pymunk.Space, data: Any) -> None:
+        rb = self._by_shape[arbiter.shapes[0]]
+        n = arbiter.normal  # from the robot towards the wall
+        nx, ny = -n.x, -n.y
+        rb.touching.append((nx, ny, None))
+        u = rb.control.velocity  # the commanded velocity of this sub-step
+        if u.x * nx + u.y * ny < -_PUSH_EPS:
+            rb.contact = True
+        if self._measuring:
+            self._measure(rb, arbiter)
+
+    def _hit_robot(self, arbiter: pymunk.Arbiter, space: pymunk.Space, data: Any) -> None:
+        a_shape, b_shape = arbiter.shapes
+        a, b = self._by_shape[a_shape], self._by_shape[b_shape]
+        n = arbiter.normal  # from a towards b
+        a.touching.append((-n.x, -n.y, b))
+        b.touching.append((n.x, n.y, a))
+        # A hit when either robot's command drives into the other one's actual motion.
+        ua, ub = a.control.velocity, b.control.velocity
+        va, vb = a.body.velocity, b.body.velocity
+        if (
+            (ua.x - vb.x) * n.x + (ua.y - vb.y) * n.y > _PUSH_EPS
+            or (va.x - ub.x) * n.x + (va.y - ub.y) * n.y > _PUSH_EPS
+        ):
+            a.contact = b.contact = True
+        if self._measuring:
+            self._measure(a, arbiter)
+
+    def _measure(self, rb: _Robot, arbiter: pymunk.Arbiter) -> None:
+        floor = self._floors[rb.floor]
+        for point in arbiter.contact_point_set.points:
+            if -point.distance > floor.depth:
+                floor.depth = -point.distance
+
+    # ------------------------------------------------------------------ stepping
+    def step(self, actions: Mapping[int, ArrayLike]) -> None:
+        """Apply each given robot's action and advance one control step for all robots.
+
+        Parameters
+        ----------
+        actions : mapping of int to array_like
+            Robot index -> action in ``[-1, 1]`` (see :meth:`RobotSpec.scale_action`).
+            Robots without an entry get a zero command.
+
+        Raises
+        ------
+        ValueError
+            If an action has the wrong shape or is not finite, or an index is out of
+            range; no robot has moved then.
+        """
+        commands = {}
+        for idn, action in actions.items():
+            rb = self._robot(idn)
+            cmd = rb.spec._scaled(action)
+            commands[id(rb)] = cmd if rb.holonomic else (cmd[0], 0.0, cmd[1])
+        dt = self._dt
+        zero = (0.0, 0.0, 0.0)
+        moving: list[_Robot] = []
+        travel = 0.0
+        reach = self._reach()
+        for rb in self._robots:
+            rb.cmd = commands.get(id(rb), zero)
+            rb.contact = False
+            if not (rb.present and rb.placed):
+                rb.vel = (0.0, 0.0, 0.0, 0.0)
+            elif rb.falling:
+                self._fall(rb, first=False)
+            else:
+                x, y = rb.body.position
+                rb.start = (x, y, rb.body.angle)
+                if self._floors[rb.floor].code(x, y) == VOID:
+                    self._start_fall(rb)  # standing over nothing: falls without moving
+                    continue
+                vx, vy, _ = rb.cmd
+                travel = max(travel, math.hypot(vx, vy) * dt / reach[rb.floor])
+                moving.append(rb)
+        if not moving:
+            return
+        n_sub = min(max(self.min_substeps, math.ceil(travel)), _MAX_SUBSTEPS)
+        h = dt / n_sub
+        spaces = []
+        for rb in moving:
+            space = rb.space
+            if space is not None and space not in spaces:
+                spaces.append(space)
+            vx, vy, w = rb.cmd
+            mass = _HOLD_MASS if vx == 0.0 and vy == 0.0 else _MASS
+            if rb.body.mass != mass:
+                rb.body.mass = mass
+            rb.joint.max_force = mass * _MOTOR_MARGIN * rb.spec.max_linear_velocity / h
+            rb.body.angular_velocity = w  # infinite moment: contacts never change it
+        self._substeps(moving, spaces, n_sub, h)
+        self._settle(moving, spaces, h)
+        for rb in moving:
+            if rb.falling:
+                continue
+            x0, y0, yaw0 = rb.start
+            x, y = rb.body.position
+            rb.vel = ((x - x0) / dt, (y - y0) / dt, 0.0, (rb.body.angle - yaw0) / dt)
+
+    def _reach(self) -> list[float]:
+        """Longest safe motion (m) per sub-step on each floor.
+
+        0.4 of the thinnest wall, and of the smallest sum of radii of two robots standing
+        there that can touch (two point robots never do): between two collision checks no
+        robot gets past a wall's middle, nor two robots past each other's centres.
+        """
+        sizes = [floor.thickness for floor in self._floors]
+        radii: list[list[float]] = [[] for _ in self._floors]
+        for rb in self._robots:
+            if rb.solid():
+                radii[rb.floor].append(rb.radius)
+        for f, rs in enumerate(radii):
+            if len(rs) >= 2:
+                rs.sort()
+                pair = rs[0] + rs[1] if rs[1] > 0.0 else next((r for r in rs if r > 0.0), math.inf)
+                sizes[f] = min(sizes[f], pair)
+        return [_SUBSTEP_FRACTION * max(size, _MIN_SIZE) for size in sizes]
+
+    def _substeps(
+        self, moving: list[_Robot], spaces: list[pymunk.Space], n_sub: int, h: float
+    ) -> None:
+        floors = self._floors
+        for k in range(n_sub):
+            last = k == n_sub - 1
+            velocities = []
+            for rb in moving:
+                if rb.falling:
+                    velocities.append(None)
+                    continue
+                vx, vy, w = rb.cmd
+                u = _chord(rb.body.angle, vx, vy, w, h)
+                rb.control.velocity = u
+                velocities.append(u)
+            for rb, u in zip(moving, velocities):
+                if u is None:
+                    continue
+                if not rb.touching:
+                    rb.body.velocity = u  # nothing to push against: exact motion
+                elif k == 0:
+                    rb.body.velocity = self._predict(rb, u)
+                rb.touching = []
+            self._measuring = last
+            if last:
+                for floor in floors:
+                    floor.depth = 0.0
+            for space in spaces:
+                space.step(h)
+            self._measuring = False
+            for rb in moving:
+                if not rb.falling:
+                    x, y = rb.body.position
+                    if floors[rb.floor].code(x, y) == VOID:
+                        self._start_fall(rb)
+
+    def _predict(self, rb: _Robot, u: tuple[float, float]) -> tuple[float, float]:
+        """Command ``u`` less what points into the robot's current contacts."""
+        limits = []
+        for nx, ny, other in rb.touching:
+            c = 0.0
+            if other is not None:  # the other robot's command for this sub-step
+                ov = other.control.velocity
+                c = min(0.0, nx * ov.x + ny * ov.y)
+            limits.append((nx, ny, c))
+        return _project(u[0], u[1], limits)
+
+    def _settle(self, moving: list[_Robot], spaces: list[pymunk.Space], h: float) -> None:
+        """Resolve overlaps left by the last sub-step, with nothing else moving."""
+        floors = self._floors
+        for _ in range(_MAX_SETTLE):
+            deep = [f.space for f in floors if f.depth > _SETTLE_DEPTH and f.space in spaces]
+            if not deep:
+                return
+            for rb in moving:
+                if rb.space in deep:
+                    rb.body.velocity = (0.0, 0.0)
+                    rb.touching = []
+            for floor in floors:
+                floor.depth = 0.0
+            self._measuring = True
+            for space in deep:
+                space.step(h)
+            self._measuring = False
+            for rb in moving:
+                if not rb.falling and rb.space in deep:
+                    x, y = rb.body.position
+                    if floors[rb.floor].code(x, y) == VOID:
+                        self._start_fall(rb)
+
+    def _start_fall(self, rb: _Robot) -> None:
+        """Take a robot whose centre is over VOID out of the physics and start its fall."""
+        x0, y0, yaw0 = rb.start
+        x, y = rb.body.position
+        rb.falling = True
+        rb.touching = []
+        self._sync_space(rb)
+        rb.body.velocity = (0.0, 0.0)
+        rb.body.angular_velocity = 0.0
+        dt = self._dt
+        self._fall(rb, first=True)
+        rb.vel = ((x - x0) / dt, (y - y0) / dt, rb.vel[2], (rb.body.angle - yaw0) / dt)
+
+    def _fall(self, rb: _Robot, *, first: bool) -> None:
+        dt = self._dt
+        if first:
+            rb.fall_speed = self.fall_speed
+        v0 = rb.fall_speed
+        drop = v0 * dt + 0.5 * _GRAVITY * dt * dt
+        if first and drop < _MIN_FIRST_DROP:
+            drop = _MIN_FIRST_DROP
+        rb.fall_speed = v0 + _GRAVITY * dt
+        rb.z -= drop
+        rb.vel = (0.0, 0.0, -drop / dt, 0.0)
