@@ -5,6 +5,11 @@ goal and 10 path waypoints), with ``TopDownRenderer.draw`` (numpy, bounding-box 
 for comparison, with Pillow ``ImageDraw`` on the same cached floor (translucent markers as
 an alpha-composited overlay), and prints the median and 90th percentile over many frames.
 
+Then times what a user calls: ``env.render()`` of a ``PointNavEnv`` on the same house with
+``visualize_goal`` and ``visualize_path`` on (the robot, start, goal and 10 waypoints), one
+frame after each step of the oracle (only ``render`` is timed). It also reports the cost of
+the markers on ``env.step`` (visualisation off, goal only, goal and path).
+
 Run::
 
     python benchmarks/bench_render.py
@@ -95,6 +100,60 @@ def time_frames(draw: Callable[[], np.ndarray], frames: int) -> tuple[float, flo
     return float(np.median(times) * 1e3), float(np.percentile(times, 90) * 1e3)
 
 
+def env_render_times(seed: int, frames: int, pixels_per_meter: float) -> tuple[float, float]:
+    """Median and 90th percentile of ``env.render()`` (ms), one frame per oracle step."""
+    from pointnav_core.env import PointNavEnv
+    from pointnav_core.policies import ShortestPathFollower
+    from pointnav_core.scenes import rooms
+
+    env = PointNavEnv(
+        scene=rooms(seed=seed, size=(20.0, 20.0)),
+        task={"visualize_goal": True, "visualize_path": True},
+        render_mode="rgb_array",
+    )
+    env.render_pixels_per_meter = pixels_per_meter
+    oracle = ShortestPathFollower(env)
+    env.reset(seed=seed)
+    env.render()  # the first frame prepares the floor picture (once per env)
+    times = np.empty(frames)
+    episode = 0
+    for i in range(frames):
+        _, _, terminated, truncated, _ = env.step(oracle.act())
+        if terminated or truncated:
+            episode += 1
+            env.reset(seed=seed + episode)
+        t0 = time.perf_counter()
+        env.render()
+        times[i] = time.perf_counter() - t0
+    return float(np.median(times) * 1e3), float(np.percentile(times, 90) * 1e3)
+
+
+def env_step_times(seed: int, steps: int) -> list[tuple[str, float]]:
+    """Median ``env.step`` time (us) with visualisation off, goal markers only, and both."""
+    from pointnav_core.env import PointNavEnv
+    from pointnav_core.scenes import rooms
+
+    scene = rooms(seed=seed, size=(20.0, 20.0))
+    rows = []
+    settings = [("off", {}), ("goal", {"visualize_goal": True}),
+                ("goal+path", {"visualize_goal": True, "visualize_path": True})]
+    rng = np.random.default_rng(seed)
+    actions = rng.uniform(-0.2, 1.0, size=(steps, 2)).astype(np.float32)
+    for name, flags in settings:
+        env = PointNavEnv(scene=scene, task={**flags, "termination_config": {"max_steps": 10**9}})
+        best = math.inf
+        for _ in range(3):  # best of three runs: the machines are shared
+            env.reset(seed=seed)
+            t0 = time.perf_counter()
+            for action in actions:
+                _, _, terminated, truncated, _ = env.step(action)
+                if terminated or truncated:
+                    env.reset()
+            best = min(best, (time.perf_counter() - t0) / steps * 1e6)
+        rows.append((name, best))
+    return rows
+
+
 def main(argv: Sequence[str] | None = None) -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--frames", type=int, default=200, help="frames timed per row (default 200)")
@@ -102,6 +161,7 @@ def main(argv: Sequence[str] | None = None) -> None:
     parser.add_argument("--robots", type=int, nargs="+", default=[1, 8], help="robot counts (default 1 8)")
     parser.add_argument("--seed", type=int, default=0, help="house and placement seed (default 0)")
     parser.add_argument("--no-pillow", action="store_true", help="skip the Pillow ImageDraw comparison")
+    parser.add_argument("--steps", type=int, default=5000, help="env steps timed per setting (default 5000)")
     args = parser.parse_args(argv)
 
     tmap = house(args.seed)
@@ -121,6 +181,13 @@ def main(argv: Sequence[str] | None = None) -> None:
         for name, fn in rows:
             median, p90 = time_frames(fn, args.frames)
             print(f"{name:<16}{n:>7}{len(markers):>9}{median:>11.3f}{p90:>9.3f}")
+
+    median, p90 = env_render_times(args.seed, args.frames, args.pixels_per_meter)
+    print(f"\nPointNavEnv.render(), 20 m x 20 m house, visualize_goal and visualize_path on, "
+          f"{args.frames} frames: median {median:.3f} ms, p90 {p90:.3f} ms")
+    print("PointNavEnv.step() by marker setting (best of 3 runs, random actions):")
+    for name, us in env_step_times(args.seed, args.steps):
+        print(f"  {name:<10}{us:8.1f} us/step")
 
 
 if __name__ == "__main__":

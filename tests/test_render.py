@@ -1,4 +1,5 @@
-"""Top-down rendering: floor colours and orientation, robots, heading ticks, markers, files.
+"""Top-down rendering: floor colours and orientation, robots, heading ticks, markers, files,
+and the frames of environments (``render_env``, ``record_episode``).
 
 The tests read pixels back at known world positions through ``world_to_pixel``.
 """
@@ -12,7 +13,10 @@ import numpy as np
 import pytest
 from PIL import Image
 
+from pointnav_core.backend import RobotSpec, make_backend
+from pointnav_core.env import PointNavEnv
 from pointnav_core.maps import FREE, OBSTACLE, VOID, TraversableMap
+from pointnav_core.policies import ShortestPathFollower
 from pointnav_core.render import (
     FLOOR_COLORS,
     GOAL_COLOR,
@@ -23,9 +27,13 @@ from pointnav_core.render import (
     RobotGlyph,
     TopDownRenderer,
     contrast_color,
+    record_episode,
+    render_env,
     save_gif,
     save_png,
 )
+from pointnav_core.scenes import Scene
+from pointnav_core.task import PointNavigationTask
 
 F, O, V = FREE, OBSTACLE, VOID
 # Row 0 is the bottom of the map (smallest y); the picture shows it at the bottom.
@@ -54,7 +62,8 @@ def open_floor() -> TraversableMap:
 
 
 def pixel_at(renderer: TopDownRenderer, frame: np.ndarray, xy) -> tuple[int, ...]:
-    col, row = renderer.world_to_pixel(xy)
+    """The pixel of ``frame`` at world point ``xy`` ((x, y), or (x, y, z) with z ignored)."""
+    col, row = renderer.world_to_pixel(np.asarray(xy, dtype=np.float64)[:2])
     return tuple(frame[int(math.floor(row)), int(math.floor(col))].tolist())
 
 
@@ -419,3 +428,243 @@ def test_save_functions_reject_bad_input(tmp_path):
     with pytest.raises(ValueError, match=r"^fps must be a finite number > 0"):
         save_gif([good], tmp_path / "x.gif", fps=0)
     assert not list(tmp_path.iterdir())
+
+
+# ------------------------------------------------------------------ environments: render_env
+# The frames of PointNavEnv.render() (and of any env with scene, backend, robots and tasks),
+# read back through a renderer of the same floor at the same (default) scale.
+
+
+def env_room() -> np.ndarray:
+    """A 6 m x 2 m walled room at 0.1 m/cell, with a pillar the path must go around."""
+    grid = np.full((20, 60), FREE, dtype=np.uint8)
+    grid[0, :] = grid[-1, :] = grid[:, 0] = grid[:, -1] = OBSTACLE
+    grid[5:20, 28:32] = OBSTACLE
+    return grid
+
+
+def make_env(grid=None, **task):
+    task.setdefault("initial_pos", (1.0, 1.0))
+    task.setdefault("initial_quat", (0.0, 0.0, 0.0, 1.0))
+    task.setdefault("goal_pos", (5.0, 1.5))
+    scene = Scene.from_array(env_room() if grid is None else grid, 0.1)
+    return PointNavEnv(scene=scene, robot=RobotSpec(radius=0.1), task=task, render_mode="rgb_array")
+
+
+def blend(below, color, alpha: float = 0.5) -> tuple[int, ...]:
+    """A pixel ``below`` under a translucent marker of ``color`` (as ``draw`` blends)."""
+    below = np.asarray(below, dtype=np.float32)
+    return tuple((below + np.float32(alpha) * (np.asarray(color, np.float32) - below) + 0.5).astype(np.uint8).tolist())
+
+
+def drive(env, steps: int) -> None:
+    oracle = ShortestPathFollower(env)
+    for _ in range(steps):
+        _, _, terminated, truncated, _ = env.step(oracle.act())
+        assert not (terminated or truncated)
+
+
+def reader(env, floor: int = 0) -> TopDownRenderer:
+    return TopDownRenderer(env.scene.floors[floor])
+
+
+@pytest.mark.parametrize("visualize_goal", [True, False])
+def test_goal_pixel_has_the_goal_colour_only_with_visualize_goal(visualize_goal):
+    env = make_env(visualize_goal=visualize_goal)
+    env.reset(seed=0)
+    drive(env, 15)  # off the start, so that the start marker shows too
+    frame, ref = env.render(), reader(env)
+    floor = ref.floor_image
+    goal, start = env.task.get_goal_pos(), env.task.get_start_pos()
+    free = FLOOR_COLORS["free"]
+    if visualize_goal:
+        assert pixel_at(ref, frame, goal) == blend(free, GOAL_COLOR)
+        assert pixel_at(ref, frame, start) == blend(free, START_COLOR)
+        got = np.array(pixel_at(ref, frame, goal))
+        # Moved towards the goal colour, and blue is its strongest channel.
+        assert np.abs(got - GOAL_COLOR).sum() < np.abs(np.array(free) - GOAL_COLOR).sum()
+        assert got.argmax() == 2
+    else:
+        assert pixel_at(ref, frame, goal) == pixel_at(ref, floor, goal) == free
+        assert pixel_at(ref, frame, start) == free
+    # The goal disc has radius goal_tolerance: 0.45 m away it is tinted, 0.6 m away it is not.
+    tinted = pixel_at(ref, frame, goal[:2] + (0.45, 0.0))
+    assert (tinted == blend(free, GOAL_COLOR)) is visualize_goal
+    assert pixel_at(ref, frame, goal[:2] + (0.6, 0.0)) == free
+
+
+def test_waypoint_pixels_are_green_and_lie_on_the_path():
+    env = make_env(visualize_path=True, n_vis_waypoints=8)
+    env.reset(seed=0)
+    drive(env, 10)
+    frame, ref = env.render(), reader(env)
+    task = env.task
+    robot_xy = task.get_current_pos(env)[:2]
+    marks = [m for m in task.markers if m.visible]
+    assert len(marks) == 8
+    green = blend(FLOOR_COLORS["free"], WAYPOINT_COLOR)
+    for m in marks:
+        if math.dist(m.position[:2], robot_xy) > 0.1 + 0.15:  # clear of the robot's disc
+            got = pixel_at(ref, frame, m.position)
+            assert got == green
+            assert got[1] > got[0] and got[1] > got[2]  # greenish
+    # Every green pixel is within waypoint_width (+ one pixel) of the path from the robot.
+    path, _ = env.scene.goal_field(0, task.get_goal_pos(), robot=env.robot).path(robot_xy, exact=False)
+    rows, cols = np.nonzero(np.all(frame == green, axis=-1))
+    assert len(rows) > 8 * 4
+    centres = pixel_centres_world(ref)[rows, cols]
+    a, b = path[:-1], path[1:]
+    t = np.clip(np.einsum("mnk,nk->mn", centres[:, None] - a, b - a) / ((b - a) ** 2).sum(1), 0, 1)
+    dist = np.hypot(*(centres[:, None] - (a + t[..., None] * (b - a))).transpose(2, 0, 1)).min(1)
+    assert dist.max() <= task.waypoint_width + 1.0 / ref.scale[0]
+
+
+def test_robot_disc_is_drawn_where_the_env_robot_is():
+    env = make_env()
+    env.reset(seed=0)
+    drive(env, 12)
+    frame, ref = env.render(), reader(env)
+    position, quat = env.backend.get_pose(0)
+    yaw = math.atan2(2 * quat[3] * quat[2], 1 - 2 * quat[2] ** 2)
+    color = ROBOT_PALETTE[0]
+    assert pixel_at(ref, frame, position) == color
+    behind = position[:2] - 0.07 * np.array([math.cos(yaw), math.sin(yaw)])
+    assert pixel_at(ref, frame, behind) == color
+    ahead = position[:2] + 0.07 * np.array([math.cos(yaw), math.sin(yaw)])
+    assert pixel_at(ref, frame, ahead) == contrast_color(color)  # the heading tick
+    outside = position[:2] + (0.0, 0.1 + 2.0 / ref.scale[1])
+    assert pixel_at(ref, frame, outside) != color
+    # Everything else is the floor: one robot, no markers.
+    changed = np.any(frame != ref.floor_image, axis=-1)
+    assert changed.sum() == pytest.approx(math.pi * (0.1 * 20) ** 2, abs=8)
+
+
+def test_hidden_waypoints_are_not_drawn():
+    grid = np.full((20, 60), FREE, dtype=np.uint8)
+    grid[0, :] = grid[-1, :] = grid[:, 0] = grid[:, -1] = OBSTACLE
+    grid[:, 30] = OBSTACLE  # two rooms, no door: the goal is unreachable
+    env = make_env(grid, visualize_goal=True, visualize_path=True, goal_pos=(5.0, 1.0))
+    env.reset(seed=0)
+    frame, ref = env.render(), reader(env)
+    assert not any(m.visible for m in env.task.markers if m.kind == "waypoint")
+    assert not np.all(frame == blend(FLOOR_COLORS["free"], WAYPOINT_COLOR), axis=-1).any()
+    assert pixel_at(ref, frame, (5.0, 1.0)) == blend(FLOOR_COLORS["free"], GOAL_COLOR)
+
+
+def test_render_before_reset_shows_the_floor_only():
+    env = make_env(visualize_goal=True, visualize_path=True)
+    np.testing.assert_array_equal(env.render(), reader(env).floor_image)
+
+
+def test_render_returns_a_fresh_frame_each_call_from_a_cached_renderer(monkeypatch):
+    env = make_env(visualize_goal=True)
+    env.reset(seed=0)
+    first = env.render()
+    reference = first.copy()
+    first[:] = 0
+    built = []
+    real_init = TopDownRenderer.__init__
+    monkeypatch.setattr(TopDownRenderer, "__init__", lambda self, *a, **k: built.append(1) or real_init(self, *a, **k))
+    np.testing.assert_array_equal(env.render(), reference)
+    assert built == []  # the floor picture was prepared once, at the first frame
+    render_env(env, pixels_per_meter=10)
+    assert built == [1]  # another scale: another renderer
+
+
+def test_default_scale_and_the_pixels_per_meter_options():
+    env = PointNavEnv(render_mode="rgb_array")  # the default 20 m x 15 m house
+    env.reset(seed=0)
+    assert env.render().shape == (300, 400, 3)
+    assert render_env(env, pixels_per_meter=40).shape == (600, 800, 3)
+    env.render_pixels_per_meter = 10
+    assert env.render().shape == (150, 200, 3)
+    assert render_env(env, pixels_per_meter=20).shape == (300, 400, 3)  # the argument wins
+    with pytest.raises(ValueError, match="^pixels_per_meter must be a finite number > 0"):
+        render_env(env, pixels_per_meter=0)
+
+
+class TwoRobotEnv:
+    """A minimal multi-robot env: what render_env and the tasks read, nothing more."""
+
+    def __init__(self, scene, n: int = 2, **task):
+        self.scene = scene
+        self.robots = tuple(RobotSpec(radius=0.15) for _ in range(n))
+        self.backend = make_backend("kinematic")
+        self.backend.load(scene, self.robots, 10.0)
+        self.tasks = [PointNavigationTask(robot_idn=i, **task) for i in range(n)]
+        self.np_random = np.random.default_rng(0)
+
+    def reset(self) -> None:
+        self.backend.reset()
+        for task in self.tasks:
+            task.reset(self)
+
+
+def test_render_env_draws_every_robot_in_its_colour_and_every_tasks_markers():
+    scene = Scene.from_array(env_room(), 0.1)
+    env = TwoRobotEnv(scene, visualize_goal=True, goal_tolerance=0.3)
+    np.testing.assert_array_equal(render_env(env), reader(env).floor_image)  # nobody placed yet
+    env.reset()
+    frame, ref = render_env(env), reader(env)
+    for idn, task in enumerate(env.tasks):
+        position, _ = env.backend.get_pose(idn)
+        assert pixel_at(ref, frame, position) == ROBOT_PALETTE[idn]
+        goal = task.get_goal_pos()
+        got = np.array(pixel_at(ref, frame, goal))
+        assert got.argmax() == 2 and not np.array_equal(got, FLOOR_COLORS["free"])  # bluish
+    # A robot out of the world is not drawn.
+    env.backend.set_present(1, False)
+    frame = render_env(env)
+    assert pixel_at(ref, frame, env.backend.get_pose(1)[0]) != ROBOT_PALETTE[1]
+    assert pixel_at(ref, frame, env.backend.get_pose(0)[0]) == ROBOT_PALETTE[0]
+
+
+def test_render_env_shows_the_first_tasks_floor_and_what_is_on_it():
+    grid = env_room()
+    scene = Scene.from_array([grid, grid[:, ::-1].copy()], 0.1, heights=[0.0, 3.0])
+    env = TwoRobotEnv(scene, visualize_goal=True)
+    env.tasks[1] = PointNavigationTask(robot_idn=1, floor=1, visualize_goal=True)
+    env.reset()
+    assert env.backend.get_robot_floor(1) == 1
+    frame, ref = render_env(env), reader(env, floor=0)
+    assert np.all(frame == ROBOT_PALETTE[0], axis=-1).any()
+    assert not np.all(frame == ROBOT_PALETTE[1], axis=-1).any()  # on the other floor
+    goal1 = env.tasks[1].get_goal_pos()
+    assert pixel_at(ref, frame, goal1) == pixel_at(ref, ref.floor_image, goal1)
+
+
+def test_record_episode_returns_the_episode_frames_and_writes_a_gif(tmp_path):
+    env = make_env(visualize_goal=True, visualize_path=True)
+    oracle = ShortestPathFollower(env)
+    frames = record_episode(env, lambda obs: oracle.act(), seed=0)
+    steps = env.task.episode_length
+    assert env.task.success and len(frames) == steps + 1
+    assert all(f.shape == frames[0].shape and f.dtype == np.uint8 for f in frames)
+    np.testing.assert_array_equal(frames[-1], env.render())
+    every = record_episode(env, lambda obs: oracle.act(), tmp_path / "episode.gif", seed=0, every=5)
+    assert len(every) == 1 + steps // 5 + (steps % 5 != 0)
+    np.testing.assert_array_equal(every[0], frames[0])
+    np.testing.assert_array_equal(every[-1], frames[-1])
+    with Image.open(tmp_path / "episode.gif") as im:
+        assert im.n_frames == len(every)
+        assert im.info["duration"] == 500  # 10 fps / 5: real time
+    with pytest.raises(ValueError, match="^every must be an integer >= 1"):
+        record_episode(env, lambda obs: oracle.act(), every=0)
+
+
+
+def test_demo_cli_writes_a_gif_and_a_png_with_markers(tmp_path, capsys):
+    from pointnav_core.cli import main
+
+    gif, png = tmp_path / "episode.gif", tmp_path / "episode.png"
+    argv = ["demo", "--episodes", "1", "--houses", "1", "--max-steps", "40", "--every", "10", "--quiet"]
+    assert main([*argv, "--gif", str(gif), "--png", str(png), "--pixels-per-meter", "10"]) == 0
+    assert f"wrote {gif} (5 frames)" in capsys.readouterr().out  # after reset, steps 10..40
+    with Image.open(gif) as im:
+        assert im.n_frames == 5 and im.size == (200, 150)
+        assert im.info["duration"] == 1000  # 10 fps / 10: real time
+    with Image.open(png) as im:
+        last = np.asarray(im.convert("RGB"))
+    # The demo shows the markers: the start disc is tinted red, the goal disc blue.
+    for color in (START_COLOR, GOAL_COLOR):
+        assert np.all(last == blend(FLOOR_COLORS["free"], color), axis=-1).any()

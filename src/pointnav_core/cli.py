@@ -3,6 +3,12 @@
 ``pointnav demo`` is the main job: it builds a generated house, drives the oracle
 (:class:`~pointnav_core.policies.ShortestPathFollower`) to sampled goals on the default
 kinematic backend, and prints success, SPL, SoftSPL, path length, collisions and speed.
+
+``--gif FILE`` writes the first episode as an animated GIF and ``--png FILE`` its last frame
+(top-down, :func:`pointnav_core.render.render_env`). When either is given, the demo's tasks
+show their markers (``visualize_goal`` and ``visualize_path``): the start in red, the goal in
+blue and the shortest path ahead as green waypoints. ``--every N`` keeps one frame in N in
+the GIF (which then still plays in real time).
 """
 
 from __future__ import annotations
@@ -31,6 +37,8 @@ def run_demo(
     drive: str = "differential",
     progress: bool = True,
     frames: list | None = None,
+    every: int = 1,
+    pixels_per_meter: float | None = None,
 ) -> dict[str, float]:
     """Run the oracle for ``episodes`` episodes spread over ``houses`` generated houses.
 
@@ -52,7 +60,14 @@ def run_demo(
     progress : bool
         Show a progress bar.
     frames : list, optional
-        If given, the rendered frames of the first episode are appended to it.
+        If given, the rendered frames of the first episode are appended to it, and the
+        tasks show their start, goal and path markers.
+    every : int
+        With ``frames``: keep the frame after reset, every ``every``-th step's frame, and
+        the last one.
+    pixels_per_meter : float, optional
+        With ``frames``: the picture scale (default 20 px/m, see
+        :func:`pointnav_core.render.render_env`).
 
     Returns
     -------
@@ -64,16 +79,24 @@ def run_demo(
         raise ValueError(f"episodes must be >= 1, got {episodes}")
     if houses < 1:
         raise ValueError(f"houses must be >= 1, got {houses}")
+    if every < 1:
+        raise ValueError(f"every must be >= 1, got {every}")
+    task: dict = {"termination_config": {"max_steps": max_steps}}
+    if frames is not None:
+        task.update(visualize_goal=True, visualize_path=True)
     envs = [
         PointNavEnv(
             scene=scenes.rooms(seed=seed + h),
             robot={"drive": drive},
-            task={"termination_config": {"max_steps": max_steps}},
+            task=task,
             backend=backend,
             render_mode="rgb_array" if frames is not None else None,
         )
         for h in range(houses)
     ]
+    if pixels_per_meter is not None:
+        for env in envs:
+            env.render_pixels_per_meter = pixels_per_meter  # read by render_env
     results: dict[str, list[float]] = {k: [] for k in ("success", "spl", "soft_spl", "path_length", "collisions")}
     steps = 0
     elapsed = 0.0
@@ -85,12 +108,14 @@ def run_demo(
         if record:
             frames.append(env.render())
         done = False
+        episode_steps = 0
         start = time.perf_counter()
         while not done:
             _, _, terminated, truncated, info = env.step(oracle.act())
             steps += 1
+            episode_steps += 1
             done = terminated or truncated
-            if record:
+            if record and (done or episode_steps % every == 0):
                 frames.append(env.render())
         elapsed += time.perf_counter() - start
         for key in results:
@@ -113,6 +138,8 @@ def _demo(args: argparse.Namespace) -> int:
         drive=args.drive,
         progress=not args.quiet,
         frames=frames,
+        every=args.every,
+        pixels_per_meter=args.pixels_per_meter,
     )
     rows = [
         ("episodes", f"{int(summary['episodes'])}"),
@@ -131,12 +158,22 @@ def _demo(args: argparse.Namespace) -> int:
         from pointnav_core.render import save_gif, save_png
 
         if args.gif:
-            save_gif(frames, args.gif)
+            save_gif(frames, args.gif, fps=PointNavEnv.metadata["render_fps"] / args.every)
             print(f"wrote {args.gif} ({len(frames)} frames)")
         if args.png:
             save_png(frames[-1], args.png)
             print(f"wrote {args.png}")
     return 0
+
+
+def _positive_int(text: str) -> int:
+    try:
+        value = int(text)
+    except ValueError:
+        value = 0
+    if value < 1:
+        raise argparse.ArgumentTypeError(f"must be an integer >= 1, got {text!r}")
+    return value
 
 
 def main(argv: Sequence[str] | None = None) -> int:
@@ -150,8 +187,17 @@ def main(argv: Sequence[str] | None = None) -> int:
     demo.add_argument("--max-steps", type=int, default=1000)
     demo.add_argument("--backend", default="kinematic")
     demo.add_argument("--drive", choices=("differential", "holonomic"), default="differential")
-    demo.add_argument("--gif", help="write the first episode as an animated GIF")
-    demo.add_argument("--png", help="write the first episode's last frame as a PNG")
+    demo.add_argument(
+        "--gif", help="write the first episode as an animated GIF (with start, goal and path markers)"
+    )
+    demo.add_argument("--png", help="write the first episode's last frame as a PNG (with markers)")
+    demo.add_argument(
+        "--every", type=_positive_int, default=1, metavar="N", help="keep one GIF frame in N (default 1)"
+    )
+    demo.add_argument(
+        "--pixels-per-meter", type=float, default=None, metavar="PPM",
+        help="picture scale of --gif/--png (default 20: a 20 m house is 400 px wide)",
+    )
     demo.add_argument("--quiet", action="store_true", help="no progress bar")
     demo.set_defaults(func=_demo)
     args = parser.parse_args(argv)

@@ -37,6 +37,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from pointnav_core.errors import PointNavError, SamplingError
+from pointnav_core.markers import VisualMarker, _waypoints_along
 from pointnav_core.metrics import _soft_spl, _spl
 from pointnav_core.rewards import CollisionReward, PointGoalReward, PotentialReward, RewardFunction
 from pointnav_core.terminations import (
@@ -271,9 +272,11 @@ class PointNavigationTask:
         (min, max) in metres: a sampled start/goal pair must have min < geodesic < max.
         Ignored when both the start and the goal are fixed.
     visualize_goal : bool
-        Show start and goal markers (discs of radius ``goal_tolerance``) when rendering.
+        Show start and goal markers (discs of radius ``goal_tolerance``) when rendering
+        (see :attr:`markers`).
     visualize_path : bool
-        Show the current shortest path as ``n_vis_waypoints`` markers when rendering.
+        Show the current shortest path as ``n_vis_waypoints`` markers when rendering,
+        moved after every step (see :attr:`markers`).
     goal_height : float
         Goal marker height (m), >= 0.
     waypoint_height : float
@@ -423,6 +426,14 @@ class PointNavigationTask:
         self._steps = 0
         self._success = False
         self._results: dict[str, tuple[bool, bool]] = {}
+        # Visual markers (pointnav_core.markers): touched only when visualize_goal or
+        # visualize_path is on. ``_markers`` is the tuple ``markers`` returns, None when a
+        # step moved the waypoints and it must be rebuilt.
+        self._waypoint_spacing = 0.2
+        self._goal_markers: tuple[VisualMarker, ...] = ()
+        self._waypoint_xy: NDArray[np.float64] | None = None
+        self._waypoint_visible: NDArray[np.bool_] | None = None
+        self._markers: tuple[VisualMarker, ...] | None = ()
 
     # ------------------------------------------------------------------ composition
     def _create_termination_conditions(self) -> dict[str, TerminationCondition]:
@@ -518,6 +529,33 @@ class PointNavigationTask:
     def n_vis_waypoints(self) -> int:
         """Number of waypoint markers."""
         return self._n_vis_waypoints
+
+    @property
+    def markers(self) -> tuple[VisualMarker, ...]:
+        """The markers this task shows now, as :class:`~pointnav_core.markers.VisualMarker`.
+
+        In order: the ``start`` and ``goal`` markers (radius ``goal_tolerance``, at
+        ``goal_height`` above the floor) when ``visualize_goal``, then ``n_vis_waypoints``
+        ``waypoint`` markers (radius ``waypoint_width``, at ``waypoint_height``) when
+        ``visualize_path``, placed along the shortest path from the robot to the goal at
+        reset and after every step (spacing and hiding rules:
+        :func:`~pointnav_core.markers.place_waypoints`; all hidden when the robot has no
+        path to the goal). Empty when both flags are off, and until a reset succeeds.
+        Markers are data for renderers: nothing collides with them.
+        """
+        if self._markers is None:
+            markers = self._goal_markers
+            if self._waypoint_xy is not None and self._waypoint_visible is not None:
+                z = self._floor_height + self._waypoint_height
+                radius = self._waypoint_width
+                markers += tuple(
+                    VisualMarker(kind="waypoint", position=(x, y, z), radius=radius, visible=shown)
+                    for (x, y), shown in zip(
+                        self._waypoint_xy.tolist(), self._waypoint_visible.tolist()
+                    )
+                )
+            self._markers = markers
+        return self._markers
 
     @property
     def reward_type(self) -> str:
@@ -662,6 +700,7 @@ class PointNavigationTask:
                 )
         self._spec = spec
         self._floor_height = float(scene.get_floor_height(self._floor))
+        self._waypoint_spacing = float(scene.waypoint_spacing)
         # Observation bounds (finite, so that Gymnasium's checker accepts the spaces): the
         # goal is on the floor, so within its diagonal (+1 m for a robot falling off an
         # edge); velocities within the robot's limits (sqrt(2) for a holonomic diagonal).
@@ -701,6 +740,7 @@ class PointNavigationTask:
             :meth:`load`), or the fixed start is occupied by another robot.
         """
         try:
+            self._clear_markers()
             if env is not self._env:
                 self.load(env)
             self._sample_episode(env)
@@ -720,6 +760,8 @@ class PointNavigationTask:
                 condition.reset(self, env)
             for reward in self._rewards.values():
                 reward.reset(self, env)
+            if self._visualize_goal or self._visualize_path:
+                self._place_markers(x, y)
         except BaseException:
             self._move(_Event.FAIL)
             raise
@@ -832,7 +874,7 @@ class PointNavigationTask:
 
         In order: the path length grows by the planar distance moved; every termination
         condition is evaluated (none short-circuits); every reward function is evaluated;
-        ``info`` is filled.
+        ``info`` is filled; the waypoint markers move (only with ``visualize_path``).
 
         Parameters
         ----------
@@ -898,11 +940,50 @@ class PointNavigationTask:
             breakdown = {name: fn.step(self, env, action) for name, fn in self._rewards.items()}
             reward = sum(breakdown.values(), 0.0)  # the sum a user gets from the breakdown
             info = self._info(success, done, breakdown, results)
+            if self._visualize_path:
+                self._place_waypoints(x, y)
         except BaseException:
             self._move(_Event.FAIL)
             raise
         self._state = _TRANSITIONS[(self._state, _Event.END if done else _Event.STEP)]
         return reward, terminated, truncated, info
+
+    # ------------------------------------------------------------------ markers
+    def _clear_markers(self) -> None:
+        self._goal_markers = ()
+        self._waypoint_xy = self._waypoint_visible = None
+        self._markers = ()
+
+    def _place_markers(self, x: float, y: float) -> None:
+        """Set this episode's markers, the robot standing at (x, y) (reset)."""
+        gx, gy = self._goal_xy  # type: ignore[misc]
+        if self._visualize_goal:
+            sx, sy = self._start_xy  # type: ignore[misc]
+            z = self._floor_height + self._goal_height
+            radius = self._goal_tolerance
+            self._goal_markers = (
+                VisualMarker(kind="start", position=(sx, sy, z), radius=radius),
+                VisualMarker(kind="goal", position=(gx, gy, z), radius=radius),
+            )
+        if self._visualize_path:
+            n = self._n_vis_waypoints
+            self._waypoint_xy = np.tile((gx, gy), (n, 1))
+            self._waypoint_visible = np.zeros(n, dtype=bool)
+            self._place_waypoints(x, y)
+        self._markers = None
+
+    def _place_waypoints(self, x: float, y: float) -> None:
+        """Move the waypoint markers onto the path from (x, y); hide them if there is none."""
+        # The goal field's cheap path (the source cell's root when the source sees it).
+        points, _ = self._goal_field.path((x, y), exact=False)  # type: ignore[union-attr]
+        if points is None:
+            self._waypoint_visible = np.zeros(self._n_vis_waypoints, dtype=bool)
+        else:
+            # The placement of markers.place_waypoints, without its checks.
+            self._waypoint_xy, self._waypoint_visible = _waypoints_along(
+                points, self._n_vis_waypoints, self._waypoint_spacing
+            )
+        self._markers = None
 
     def _info(
         self,

@@ -1,0 +1,196 @@
+"""Visual markers: the start, the goal and the path waypoints a task shows (SPEC section 8).
+
+A :class:`~pointnav_core.task.PointNavigationTask` built with ``visualize_goal`` or
+``visualize_path`` keeps its markers as part of its state, as :class:`VisualMarker` values
+(``task.markers``); renderers draw the visible ones
+(:func:`pointnav_core.render.render_env`). Markers are pure data: the backend never sees
+them, so they never collide with anything, and a task with both flags off does no marker
+work at all.
+
+========  ==========================  ===================  ==================================
+kind      where                       radius               when
+========  ==========================  ===================  ==================================
+start     the episode's start         ``goal_tolerance``   ``visualize_goal``; set at reset
+goal      the episode's goal          ``goal_tolerance``   ``visualize_goal``; set at reset
+waypoint  along the shortest path     ``waypoint_width``   ``visualize_path``; ``n_vis_waypoints``
+          from the robot to the goal                       of them, placed at reset and after
+                                                           every step
+========  ==========================  ===================  ==================================
+
+A marker's z is the floor's height plus ``goal_height`` (start and goal) or
+``waypoint_height`` (waypoints).
+
+Waypoint spacing
+----------------
+:func:`place_waypoints` spreads ``count`` waypoints over the path *between* the robot and
+the goal, on neither: waypoint ``k = 1 .. count`` sits at arc length ``k * s`` from the
+robot, with ``s = max(min_spacing, L / (count + 1))`` for a path of length ``L`` (the task
+passes ``scene.waypoint_spacing``, 0.2 m by default). A long path is therefore marked
+evenly along its whole length; on a path shorter than ``(count + 1) * min_spacing`` the
+waypoints stay ``min_spacing`` apart, and those that would lie at or past the goal are
+hidden. When there is no path (the goal is unreachable from where the robot stands, e.g.
+over void or in another component), every waypoint is hidden. Hidden waypoints sit at the
+path's end (the goal); when there is no path they stay where they last were (at the goal
+right after a reset).
+
+The path is the goal field's cheap one (``FloorGoalField.path(xy, exact=False)``: the
+robot's cell's root when the robot sees it), from the robot's position after the step.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+__all__ = ["MARKER_KINDS", "VisualMarker", "place_waypoints"]
+
+#: Valid values of :attr:`VisualMarker.kind`.
+MARKER_KINDS = ("start", "goal", "waypoint")
+
+
+@dataclass(frozen=True, kw_only=True)
+class VisualMarker:
+    """One marker a task shows: a flat disc floating just above its floor.
+
+    Parameters
+    ----------
+    kind : {"start", "goal", "waypoint"}
+        What it marks (renderers colour it by kind).
+    position : (float, float, float)
+        World centre (x, y, z) in metres; z is the floor's height plus the marker's
+        configured height. Stored as a tuple of three floats.
+    radius : float
+        Disc radius in metres, >= 0.
+    visible : bool, default True
+        Whether it is shown; a hidden marker's position means nothing.
+
+    Raises
+    ------
+    ValueError
+        When ``kind`` is not one of :data:`MARKER_KINDS` (the message lists them), the
+        position is not three finite numbers, the radius is negative or not finite, or
+        ``visible`` is not a bool.
+
+    Examples
+    --------
+    >>> VisualMarker(kind="goal", position=(1, 2.5, 0.06), radius=0.5)
+    VisualMarker(kind='goal', position=(1.0, 2.5, 0.06), radius=0.5, visible=True)
+    >>> VisualMarker(kind="flag", position=(0, 0, 0), radius=0.5)
+    Traceback (most recent call last):
+    ...
+    ValueError: kind must be one of ['start', 'goal', 'waypoint'], got 'flag'
+    """
+
+    kind: str
+    position: tuple[float, float, float]
+    radius: float
+    visible: bool = True
+
+    def __post_init__(self) -> None:
+        if not isinstance(self.kind, str) or self.kind not in MARKER_KINDS:
+            raise ValueError(f"kind must be one of {list(MARKER_KINDS)}, got {self.kind!r}")
+        try:
+            position = tuple(float(c) for c in self.position)
+        except (TypeError, ValueError):
+            position = ()
+        if len(position) != 3 or not all(math.isfinite(c) for c in position):
+            raise ValueError(
+                f"position must be a finite (x, y, z) point in metres, got {self.position!r}"
+            )
+        object.__setattr__(self, "position", position)
+        try:
+            radius = float(self.radius)
+        except (TypeError, ValueError):
+            radius = math.nan
+        if isinstance(self.radius, bool) or not (math.isfinite(radius) and radius >= 0.0):
+            raise ValueError(f"radius must be a finite number >= 0 (m), got {self.radius!r}")
+        object.__setattr__(self, "radius", radius)
+        if not isinstance(self.visible, (bool, np.bool_)):
+            raise ValueError(f"visible must be True or False, got {self.visible!r}")
+        object.__setattr__(self, "visible", bool(self.visible))
+
+
+def place_waypoints(
+    path: ArrayLike, count: int, min_spacing: float
+) -> tuple[NDArray[np.float64], NDArray[np.bool_]]:
+    """Place ``count`` waypoint markers along a path, and say which are shown.
+
+    Waypoint ``k = 1 .. count`` lies at arc length ``k * s`` from the path's start, with
+    ``s = max(min_spacing, L / (count + 1))`` for a path of length ``L``; it is shown when
+    it lies strictly before the path's end. Hidden ones sit at the path's end.
+
+    Parameters
+    ----------
+    path : array_like, shape (N, 2)
+        The polyline from the robot to the goal (m), N >= 1.
+    count : int
+        Number of waypoints, >= 1.
+    min_spacing : float
+        Smallest arc-length gap between waypoints (m), > 0.
+
+    Returns
+    -------
+    positions : ndarray of float64, shape (count, 2)
+        World (x, y) of each waypoint in metres, nearest the robot first.
+    visible : ndarray of bool, shape (count,)
+        Which waypoints are shown: a prefix of them, all of them on a path longer than
+        ``(count + 1) * min_spacing``, none on a path no longer than ``min_spacing``.
+
+    See Also
+    --------
+    pointnav_core.geodesic.resample_path : The interpolation used, at spacing ``s``.
+
+    Examples
+    --------
+    A 6 m path and 5 waypoints: 1 m apart, none on either end.
+
+    >>> xy, shown = place_waypoints([[0.0, 0.0], [6.0, 0.0]], 5, 0.2)
+    >>> xy[:, 0].tolist(), shown.tolist()
+    ([1.0, 2.0, 3.0, 4.0, 5.0], [True, True, True, True, True])
+
+    A 0.5 m path: 0.2 m apart, only the two before the goal are shown.
+
+    >>> xy, shown = place_waypoints([[0.0, 0.0], [0.0, 0.5]], 4, 0.2)
+    >>> xy[:, 1].round(6).tolist(), shown.tolist()
+    ([0.2, 0.4, 0.5, 0.5], [True, True, False, False])
+
+    A path of one point (the robot is at the goal): all hidden.
+
+    >>> place_waypoints([[1.0, 1.0]], 2, 0.2)[1].tolist()
+    [False, False]
+    """
+    pts = np.asarray(path, dtype=np.float64)
+    if pts.ndim != 2 or pts.shape[0] < 1 or pts.shape[1] != 2 or not np.isfinite(pts).all():
+        raise ValueError(
+            f"path must be a finite (N, 2) polyline in metres with N >= 1, got shape {pts.shape}"
+        )
+    if isinstance(count, bool) or int(count) != count or count < 1:
+        raise ValueError(f"count must be an integer >= 1, got {count!r}")
+    count = int(count)
+    if not (math.isfinite(min_spacing) and min_spacing > 0.0):
+        raise ValueError(f"min_spacing must be a finite number > 0 (m), got {min_spacing!r}")
+    return _waypoints_along(pts, count, float(min_spacing))
+
+
+def _waypoints_along(
+    pts: NDArray[np.float64], count: int, min_spacing: float
+) -> tuple[NDArray[np.float64], NDArray[np.bool_]]:
+    """:func:`place_waypoints` without the checks (the task's per-step call, on paths it
+    trusts): the same interpolation as :func:`~pointnav_core.geodesic.resample_path` at
+    spacing ``s``, with the arc lengths computed once."""
+    d = pts[1:] - pts[:-1]
+    arc = np.zeros(len(pts))
+    np.cumsum(np.sqrt(np.einsum("ij,ij->i", d, d)), out=arc[1:])
+    length = float(arc[-1])
+    spacing = max(min_spacing, length / (count + 1))
+    s = np.arange(1, count + 1) * spacing
+    positions = np.empty((count, 2))
+    positions[:, 0] = np.interp(s, arc, pts[:, 0])  # clamped to the end past it
+    positions[:, 1] = np.interp(s, arc, pts[:, 1])
+    # Strictly before the end, with room for rounding in k * s (k * s = L * k / (count + 1)
+    # can only reach L through rounding when the path is long).
+    visible = s < length - 1e-9 * max(1.0, length)
+    return positions, visible
