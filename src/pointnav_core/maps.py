@@ -255,10 +255,34 @@ class TraversableMap:
         key = round(radius / self.resolution, 9)
         return self._usable.get_or_create(key, lambda: self._erode(key))
 
+    def standable(self, radius: float = 0.0) -> NDArray[np.bool_]:
+        """Cells whose centre a robot of ``radius`` m can stand on in every backend.
+
+        The :meth:`usable` cells; on a map built from polygons, also clear of the rasterised
+        OBSTACLE and VOID squares, since one backend may collide with the polygons and
+        another with the grid. Sampling draws from these, so a start or goal is valid
+        everywhere and the same seed gives the same episode on every backend.
+        """
+        if self.geometry is None:
+            return self.usable(radius)
+        radius = _check_radius(radius)
+        key = ("standable", round(radius / self.resolution, 9))
+
+        def both() -> NDArray[np.bool_]:
+            mask = self.usable(radius) & self._erode_squares(key[1])
+            mask.flags.writeable = False
+            return mask
+
+        return self._usable.get_or_create(key, both)
+
     def _erode(self, r: float) -> NDArray[np.bool_]:
-        free = self.codes == FREE
         if self.geometry is not None:
-            return self._erode_polygons(free, r * self.resolution)
+            return self._erode_polygons(self.codes == FREE, r * self.resolution)
+        return self._erode_squares(r)
+
+    def _erode_squares(self, r: float) -> NDArray[np.bool_]:
+        """Exact erosion against the grid's blocked cell squares (radius in cells)."""
+        free = self.codes == FREE
         if r <= 0.5:
             # The disc stays inside its own cell, or touches a side neighbour exactly.
             mask = free.copy()
@@ -303,6 +327,16 @@ class TraversableMap:
             shapely.prepare(grown)
             rows, cols = np.nonzero(mask)
             mask[rows, cols] = ~shapely.intersects_xy(grown, x[rows, cols], y[rows, cols])
+        if radius > 0:
+            # The buffers draw the disc as an inscribed polygon, so they let through centres
+            # up to radius * (1 - cos(pi / 64)) closer than radius; such a centre is on the
+            # edge of the mask, so the edge cells are measured exactly.
+            edge = mask & ~ndimage.binary_erosion(mask, np.ones((3, 3), bool), border_value=1)
+            rows, cols = np.nonzero(edge)
+            if len(rows):
+                walls = shapely.union_all([outline.boundary, *obstacles])
+                near = shapely.distance(walls, shapely.points(x[rows, cols], y[rows, cols]))
+                mask[rows, cols] = near >= radius
         mask.flags.writeable = False
         return mask
 

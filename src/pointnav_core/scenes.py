@@ -317,13 +317,15 @@ class Scene:
         rng = _as_rng(rng)
         radius = robot_radius(robot)
         if floor is None:
-            candidates = [i for i, f in enumerate(self.floors) if f.usable(radius).any()]
+            candidates = [i for i, f in enumerate(self.floors) if f.standable(radius).any()]
             if not candidates:
                 raise SamplingError(f"no floor has a usable cell for a robot of radius {radius} m")
             floor = candidates[int(rng.integers(len(candidates)))]
         tmap = self._floor(floor)
+        # Standable cells: usable, and clear of the grid too on polygon maps (see
+        # TraversableMap.standable), so every backend accepts the point.
         if reference_point is None:
-            cells = np.flatnonzero(tmap.usable(radius))
+            cells = np.flatnonzero(tmap.standable(radius))
         else:
             ref = _as_xy(reference_point, "reference_point")
             label = int(tmap.component_at(ref, radius))
@@ -332,7 +334,7 @@ class Scene:
                     f"reference_point {ref.tolist()} is not usable on floor {floor} for a robot "
                     f"of radius {radius} m (blocked, too close to an obstacle, or off the map)"
                 )
-            cells = np.flatnonzero(tmap.components(radius) == label)
+            cells = np.flatnonzero((tmap.components(radius) == label) & tmap.standable(radius))
         if len(cells) == 0:
             raise SamplingError(
                 f"floor {floor} has no usable cell for a robot of radius {radius} m"
