@@ -2,6 +2,9 @@
 
 The lifecycle is explored by a RuleBasedStateMachine: resets with any seed, random steps,
 goal-seeking steps (so that successes happen), and illegal steps after an episode ended.
+Each episode property runs on every registered backend (the test ids are the backend
+names); sampling lives in the core, so the same seed also gives the same start and goal on
+all of them.
 """
 
 from __future__ import annotations
@@ -17,8 +20,10 @@ from hypothesis.stateful import (
     initialize,
     invariant,
     rule,
+    run_state_machine_as_test,
 )
 
+from pointnav_core.backend import available_backends
 from pointnav_core.env import PointNavEnv
 from pointnav_core.metrics import soft_spl, spl
 from pointnav_core.scenes import Scene
@@ -29,6 +34,9 @@ from pointnav_core.testing.strategies import (
     nav_task_kwargs,
     robot_actions,
 )
+from pointnav_core.transforms import quat2yaw
+
+BACKENDS = available_backends()
 
 distances = st.one_of(st.just(0.0), st.floats(0.0, 1e6), st.just(math.inf))
 lengths = st.one_of(st.just(0.0), st.floats(0.0, 1e6))
@@ -77,14 +85,18 @@ def goal_seeking_action(env: PointNavEnv, obs: dict) -> np.ndarray:
 
 
 class EpisodeLifecycle(RuleBasedStateMachine):
-    """One env through several episodes; every step's bookkeeping is checked."""
+    """One env on ``backend`` through several episodes; every step's bookkeeping is checked."""
+
+    def __init__(self, backend: str = "kinematic") -> None:
+        super().__init__()
+        self.backend = backend
 
     @initialize(
         scene=nav_scenes(), robot=nav_robot_specs(), kwargs=nav_task_kwargs(),
         seed=st.integers(0, 2**16),
     )
     def build(self, scene, robot, kwargs, seed):
-        self.env = PointNavEnv(scene=scene, robot=robot, task=kwargs)
+        self.env = PointNavEnv(scene=scene, robot=robot, task=kwargs, backend=self.backend)
         self.task = self.env.task
         assert self.task.state is TaskState.IDLE
         self.reset(seed)
@@ -177,10 +189,12 @@ class EpisodeLifecycle(RuleBasedStateMachine):
         assert self.obs in self.env.observation_space
 
 
-EpisodeLifecycle.TestCase.settings = settings(
-    EpisodeLifecycle.TestCase.settings, deadline=None, stateful_step_count=25
-)
-TestEpisodeLifecycle = EpisodeLifecycle.TestCase
+@pytest.mark.parametrize("backend", BACKENDS)
+def test_episode_lifecycle(backend):
+    # settings() starts from the loaded profile, so max_examples follows dev / ci.
+    run_state_machine_as_test(
+        lambda: EpisodeLifecycle(backend), settings=settings(deadline=None, stateful_step_count=25)
+    )
 
 
 def copy_scene(scene: Scene) -> Scene:
@@ -189,9 +203,9 @@ def copy_scene(scene: Scene) -> Scene:
     return Scene.from_array(np.array(tmap.codes), tmap.resolution, tmap.origin, [tmap.height])
 
 
-def run_twice(scene_a, scene_b, robot, kwargs, seed, actions):
-    a = PointNavEnv(scene=scene_a, robot=robot, task=kwargs)
-    b = PointNavEnv(scene=scene_b, robot=robot, task=kwargs)
+def run_twice(scene_a, scene_b, robot, kwargs, seed, actions, backend):
+    a = PointNavEnv(scene=scene_a, robot=robot, task=kwargs, backend=backend)
+    b = PointNavEnv(scene=scene_b, robot=robot, task=kwargs, backend=backend)
     obs_a, info_a = a.reset(seed=seed)
     obs_b, info_b = b.reset(seed=seed)
     assert info_a == info_b
@@ -219,8 +233,31 @@ episodes = {
 }
 
 
+@pytest.mark.parametrize("backend", BACKENDS)
 @settings(deadline=None)
 @given(**episodes)
-def test_same_seed_gives_identical_trajectories(scene, robot, kwargs, seed, data):
+def test_same_seed_gives_identical_trajectories(backend, scene, robot, kwargs, seed, data):
     actions = data.draw(st.lists(robot_actions(robot, overshoot=0.5), max_size=40), label="actions")
-    run_twice(scene, copy_scene(scene), robot, kwargs, seed, actions)
+    run_twice(scene, copy_scene(scene), robot, kwargs, seed, actions, backend)
+
+
+@settings(deadline=None)
+@given(scene=nav_scenes(), robot=nav_robot_specs(), kwargs=nav_task_kwargs(), seed=episodes["seed"])
+def test_same_seed_gives_the_same_start_and_goal_on_every_backend(scene, robot, kwargs, seed):
+    episodes_by_backend = []
+    for name in BACKENDS:
+        env = PointNavEnv(scene=scene, robot=robot, task=kwargs, backend=name)
+        _, info = env.reset(seed=seed)
+        position, orientation = env.backend.get_pose(0)
+        episode = (
+            info["geodesic_dist"],
+            position.tolist(),
+            env.task.get_goal_pos().tolist(),
+            float(quat2yaw(orientation)),
+        )
+        note(f"{name}: {episode}")
+        episodes_by_backend.append(episode)
+    first, *others = episodes_by_backend
+    for other in others:
+        assert other[:3] == first[:3]
+        assert math.remainder(other[3] - first[3], 2.0 * math.pi) == pytest.approx(0.0, abs=1e-12)

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import importlib
 import math
 import subprocess
 import sys
@@ -14,7 +13,7 @@ from gymnasium.utils.env_checker import check_env
 from gymnasium.wrappers import FlattenObservation
 
 import pointnav_core
-from pointnav_core.backend import RobotSpec
+from pointnav_core.backend import RobotSpec, available_backends
 from pointnav_core.env import PointNavEnv
 from pointnav_core.maps import FREE, OBSTACLE
 from pointnav_core.registration import ENV_IDS, register_envs
@@ -27,6 +26,8 @@ INFO_KEYS = {
     "collisions", "reward_breakdown", "termination_conditions", "episode_length",
     "potential_metric",
 }
+# The Gymnasium contract and seeding hold on every registered backend.
+BACKENDS = available_backends()
 
 
 def small_scene() -> Scene:
@@ -34,18 +35,6 @@ def small_scene() -> Scene:
     grid[0, :] = grid[-1, :] = grid[:, 0] = grid[:, -1] = OBSTACLE
     grid[10:20, 15:18] = OBSTACLE
     return Scene.from_array(grid, 0.1)
-
-
-def _render_env_available() -> bool:
-    try:
-        return hasattr(importlib.import_module("pointnav_core.render"), "render_env")
-    except ImportError:
-        return False
-
-
-needs_render_env = pytest.mark.skipif(
-    not _render_env_available(), reason="pointnav_core.render.render_env does not exist yet"
-)
 
 
 # ------------------------------------------------------------------------------ checkers
@@ -60,12 +49,14 @@ needs_render_env = pytest.mark.skipif(
     ],
     ids=["default", "geodesic-polar", "flat-holonomic"],
 )
-def test_gymnasium_check_env_passes(kwargs):
-    check_env(PointNavEnv(scene=small_scene(), **kwargs), skip_render_check=True)
+@pytest.mark.parametrize("backend", BACKENDS)
+def test_gymnasium_check_env_passes(kwargs, backend):
+    check_env(PointNavEnv(scene=small_scene(), backend=backend, **kwargs), skip_render_check=True)
 
 
-def test_gymnasium_check_env_passes_on_the_default_house():
-    check_env(PointNavEnv(), skip_render_check=True)
+@pytest.mark.parametrize("backend", BACKENDS)
+def test_gymnasium_check_env_passes_on_the_default_house(backend):
+    check_env(PointNavEnv(backend=backend), skip_render_check=True)
 
 
 def test_gymnasium_make_finds_the_registered_env_and_it_passes_check_env():
@@ -99,7 +90,6 @@ def test_register_envs_is_idempotent():
     assert ENV_IDS[ENV_ID] == "pointnav_core.env:PointNavEnv"
 
 
-@needs_render_env
 def test_gymnasium_check_env_render_modes():
     register_envs()
     env = gym.make(ENV_ID, scene=small_scene(), render_mode="rgb_array")
@@ -125,8 +115,9 @@ def test_close_can_be_called_twice():
 # ------------------------------------------------------------------------------ spaces and types
 
 
-def test_spaces_are_built_once_and_hold_every_observation():
-    env = PointNavEnv(scene=small_scene())
+@pytest.mark.parametrize("backend", BACKENDS)
+def test_spaces_are_built_once_and_hold_every_observation(backend):
+    env = PointNavEnv(scene=small_scene(), backend=backend)
     obs_space, act_space = env.observation_space, env.action_space
     assert list(obs_space.spaces) == ["xy_pos_to_goal", "robot_lin_vel", "robot_ang_vel"]
     assert act_space == gym.spaces.Box(-1.0, 1.0, (2,), np.float32)
@@ -166,8 +157,11 @@ def test_flat_observation_is_omnigibson_low_dim_and_matches_flatten_observation(
     np.testing.assert_array_equal(a, np.concatenate([dict_obs[k] for k in keys]))
 
 
-def test_rewards_are_python_floats_and_flags_python_bools():
-    env = PointNavEnv(scene=small_scene(), task={"termination_config": {"max_steps": 30}})
+@pytest.mark.parametrize("backend", BACKENDS)
+def test_rewards_are_python_floats_and_flags_python_bools(backend):
+    env = PointNavEnv(
+        scene=small_scene(), task={"termination_config": {"max_steps": 30}}, backend=backend
+    )
     _, info = env.reset(seed=1)
     assert set(info) == INFO_KEYS
     rng = np.random.default_rng(1)
@@ -237,16 +231,18 @@ def assert_same(a, b):
 
 
 @pytest.mark.parametrize("reward_type", ["l2", "geodesic"])
-def test_same_seed_gives_identical_trajectories_in_two_envs(reward_type):
+@pytest.mark.parametrize("backend", BACKENDS)
+def test_same_seed_gives_identical_trajectories_in_two_envs(reward_type, backend):
     kwargs = {"reward_type": reward_type, "termination_config": {"max_steps": 40}}
-    a = run(PointNavEnv(scene=small_scene(), task=kwargs), seed=11, n=120)
-    b = run(PointNavEnv(scene=small_scene(), task=kwargs), seed=11, n=120)
+    a = run(PointNavEnv(scene=small_scene(), task=kwargs, backend=backend), seed=11, n=120)
+    b = run(PointNavEnv(scene=small_scene(), task=kwargs, backend=backend), seed=11, n=120)
     assert_same(a, b)
-    c = run(PointNavEnv(scene=small_scene(), task=kwargs), seed=12, n=5)
+    c = run(PointNavEnv(scene=small_scene(), task=kwargs, backend=backend), seed=12, n=5)
     assert not np.array_equal(a[0][0]["xy_pos_to_goal"], c[0][0]["xy_pos_to_goal"])
 
 
 def test_env_accepts_a_task_instance_and_a_robot_spec():
+    # Kinematic only: collision_mode is that backend's argument (pymunk has no such mode).
     task = PointNavigationTask(goal_tolerance=0.2)
     robot = RobotSpec(radius=0.12, drive="holonomic")
     env = PointNavEnv(
@@ -259,11 +255,12 @@ def test_env_accepts_a_task_instance_and_a_robot_spec():
     env.step(np.array([1.0, 1.0, 0.0], dtype=np.float32))
 
 
-def test_out_of_range_actions_are_clipped():
+@pytest.mark.parametrize("backend", BACKENDS)
+def test_out_of_range_actions_are_clipped(backend):
     scene = small_scene()
     task = {"initial_pos": (1, 1, 0), "initial_quat": (0, 0, 0, 1), "goal_pos": (3, 2.5, 0)}
-    big = PointNavEnv(scene=scene, task=task)
-    one = PointNavEnv(scene=scene, task=task)
+    big = PointNavEnv(scene=scene, task=task, backend=backend)
+    one = PointNavEnv(scene=scene, task=task, backend=backend)
     big.reset(seed=0)
     one.reset(seed=0)
     a, *_ = big.step(np.array([5.0, -7.0], dtype=np.float32))
@@ -271,14 +268,15 @@ def test_out_of_range_actions_are_clipped():
     assert_same(a, b)
 
 
-def test_two_envs_sharing_one_scene_agree_on_the_same_seed():
+@pytest.mark.parametrize("backend", BACKENDS)
+def test_two_envs_sharing_one_scene_agree_on_the_same_seed(backend):
     grid = np.full((16, 20), FREE, dtype=np.uint8)
     grid[0, :] = grid[-1, :] = grid[:, 0] = grid[:, -1] = OBSTACLE
     grid[2:4, 2:4] = grid[2:4, 15:17] = grid[5:7, 12:14] = OBSTACLE
     scene = Scene.from_array(grid, 0.1)
     task = {"initial_pos": (1.35, 0.35, 0.0), "goal_pos": (1.05, 1.25, 0.0)}
-    first = PointNavEnv(scene=scene, robot=RobotSpec(radius=0.0), task=task)
-    second = PointNavEnv(scene=scene, robot=RobotSpec(radius=0.0), task=task)
+    first = PointNavEnv(scene=scene, robot=RobotSpec(radius=0.0), task=task, backend=backend)
+    second = PointNavEnv(scene=scene, robot=RobotSpec(radius=0.0), task=task, backend=backend)
     _, info_first = first.reset(seed=0)
     _, info_second = second.reset(seed=0)
     # Around the block's near corner (1.2, 0.5): 0.212 + 0.765 m.

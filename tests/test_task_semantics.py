@@ -2,6 +2,14 @@
 
 Maps are 0.1 m grids with a one-cell wall around them; the robot has radius 0.1 m and drives
 0.05 m per step at full forward speed (0.5 m/s at 10 Hz), so positions are easy to predict.
+
+Every test that runs an episode runs on every registered backend (the ``backend`` fixture;
+the ids are the backend names) with the same hand-computed numbers: in open space both
+shipped backends move a robot exactly along its drive's arc, and against these axis-aligned
+walls the kinematic backend's sliding and pymunk's frictionless contact response end the
+robot in the same place (to within pymunk's 1e-6 m contact slop) and flag the same steps.
+Where expectations depend on where the robot ends up, they are computed from the positions
+the env reports.
 """
 
 from __future__ import annotations
@@ -11,13 +19,15 @@ import math
 import numpy as np
 import pytest
 
-from pointnav_core.backend import RobotSpec
+from pointnav_core.backend import RobotSpec, available_backends
 from pointnav_core.env import PointNavEnv
 from pointnav_core.maps import FREE, OBSTACLE, VOID
 from pointnav_core.rewards import PointGoalReward
+from pointnav_core import scenes
 from pointnav_core.scenes import Scene
 from pointnav_core.task import PointNavigationTask, TaskState, TaskStateError
 from pointnav_core.terminations import TerminationCondition
+from pointnav_core.transforms import quat2yaw
 
 RES = 0.1
 ROBOT = RobotSpec(radius=0.1)
@@ -38,8 +48,14 @@ def room(rows: int = 20, cols: int = 60) -> np.ndarray:
     return grid
 
 
-def make_env(grid: np.ndarray | list[np.ndarray], **task) -> PointNavEnv:
-    return PointNavEnv(scene=Scene.from_array(grid, RES), robot=ROBOT, task=task)
+@pytest.fixture(params=available_backends())
+def backend(request) -> str:
+    """Every registered backend, by name (the test ids)."""
+    return request.param
+
+
+def make_env(backend: str, grid: np.ndarray | list[np.ndarray], **task) -> PointNavEnv:
+    return PointNavEnv(scene=Scene.from_array(grid, RES), robot=ROBOT, task=task, backend=backend)
 
 
 def planar_distance(env: PointNavEnv, xy) -> float:
@@ -50,9 +66,10 @@ def planar_distance(env: PointNavEnv, xy) -> float:
 # ------------------------------------------------------------------------------ rewards
 
 
-def test_l2_potential_reward_matches_the_formula_on_every_step():
+def test_l2_potential_reward_matches_the_formula_on_every_step(backend):
     goal = (3.0, 1.0)
     env = make_env(
+        backend,
         room(),
         initial_pos=(1.0, 1.0, 0.0),
         initial_quat=quat(0.0),
@@ -85,9 +102,10 @@ def wall_with_gap() -> np.ndarray:
     return grid
 
 
-def test_geodesic_potential_reward_uses_the_geodesic_distance_around_the_wall():
+def test_geodesic_potential_reward_uses_the_geodesic_distance_around_the_wall(backend):
     start, goal = (1.0, 1.0), (3.0, 1.0)
     env = make_env(
+        backend,
         wall_with_gap(),
         initial_pos=(*start, 0.0),
         initial_quat=quat(math.pi / 2),  # facing +y, along the wall
@@ -115,10 +133,11 @@ def test_geodesic_potential_reward_uses_the_geodesic_distance_around_the_wall():
         previous = current
 
 
-def test_unreachable_goal_uses_l2_potential_for_the_whole_episode():
+def test_unreachable_goal_uses_l2_potential_for_the_whole_episode(backend):
     grid = room(20, 40)
     grid[:, 20] = OBSTACLE  # two closed rooms
     env = make_env(
+        backend,
         grid,
         initial_pos=(1.0, 1.0, 0.0),
         initial_quat=quat(0.0),
@@ -140,10 +159,11 @@ def test_unreachable_goal_uses_l2_potential_for_the_whole_episode():
         previous = current
 
 
-def test_geodesic_potential_stays_finite_while_the_robot_slides_along_a_wall():
+def test_geodesic_potential_stays_finite_while_the_robot_slides_along_a_wall(backend):
     # Standing against a wall, the robot's centre is in a cell whose centre is closer to
     # the wall than its radius; the geodesic must still be defined there.
     env = make_env(
+        backend,
         room(20, 60),
         initial_pos=(3.0, 1.0, 0.0),
         initial_quat=quat(math.radians(80)),  # nearly straight at the top wall
@@ -161,9 +181,10 @@ def test_geodesic_potential_stays_finite_while_the_robot_slides_along_a_wall():
     assert touched > 10  # it really did slide along the wall
 
 
-def test_collision_penalty_exactly_on_the_steps_that_touch_the_wall():
+def test_collision_penalty_exactly_on_the_steps_that_touch_the_wall(backend):
     # The right wall's inner face is at x = 5.9, so the robot's centre stops at x = 5.8.
     env = make_env(
+        backend,
         room(),
         initial_pos=(5.025, 1.0, 0.0),
         initial_quat=quat(0.0),
@@ -189,8 +210,9 @@ def test_collision_penalty_exactly_on_the_steps_that_touch_the_wall():
         assert info["collisions"] == 5
 
 
-def test_max_collision_ends_the_episode_when_the_counter_exceeds_max_collisions():
+def test_max_collision_ends_the_episode_when_the_counter_exceeds_max_collisions(backend):
     env = make_env(
+        backend,
         room(),
         initial_pos=(5.025, 1.0, 0.0),
         initial_quat=quat(0.0),
@@ -209,8 +231,9 @@ def test_max_collision_ends_the_episode_when_the_counter_exceeds_max_collisions(
     assert env.task.state is TaskState.DONE
 
 
-def test_goal_reward_is_paid_on_the_success_step_only():
+def test_goal_reward_is_paid_on_the_success_step_only(backend):
     env = make_env(
+        backend,
         room(),
         initial_pos=(1.0, 1.0, 0.0),
         initial_quat=quat(0.0),
@@ -242,8 +265,8 @@ def test_goal_reward_is_paid_on_the_success_step_only():
 
 
 @pytest.mark.parametrize("episodes", [3])
-def test_timeout_truncates_after_exactly_max_steps_in_every_episode(episodes):
-    env = make_env(room(), initial_pos=(1.0, 1.0, 0.0), goal_pos=(5.0, 1.0, 0.0),
+def test_timeout_truncates_after_exactly_max_steps_in_every_episode(episodes, backend):
+    env = make_env(backend, room(), initial_pos=(1.0, 1.0, 0.0), goal_pos=(5.0, 1.0, 0.0),
                    termination_config={"max_steps": 5})
     for _ in range(episodes):
         env.reset()
@@ -258,8 +281,8 @@ def test_timeout_truncates_after_exactly_max_steps_in_every_episode(episodes):
         assert info["done"] is True and info["success"] is False
 
 
-def test_timeout_and_success_on_the_same_step_are_both_reported():
-    env = make_env(room(), initial_pos=(1.0, 1.0, 0.0), initial_quat=quat(0.0),
+def test_timeout_and_success_on_the_same_step_are_both_reported(backend):
+    env = make_env(backend, room(), initial_pos=(1.0, 1.0, 0.0), initial_quat=quat(0.0),
                    goal_pos=(1.52, 1.0, 0.0), termination_config={"max_steps": 1})
     env.reset(seed=0)
     _, _, terminated, truncated, info = env.step(FORWARD)
@@ -267,10 +290,10 @@ def test_timeout_and_success_on_the_same_step_are_both_reported():
     assert info["success"] is True
 
 
-def test_falling_ends_an_episode_that_drives_into_void():
+def test_falling_ends_an_episode_that_drives_into_void(backend):
     grid = room(20, 60)
     grid[1:-1, 40:-1] = VOID  # a hole from x = 4.0 on
-    env = make_env(grid, initial_pos=(3.025, 1.0, 0.0), initial_quat=quat(0.0),
+    env = make_env(backend, grid, initial_pos=(3.025, 1.0, 0.0), initial_quat=quat(0.0),
                    goal_pos=(1.0, 1.0, 0.0), reward_type="geodesic")
     env.reset(seed=0)
     for k in range(1, 20):  # x = 3.025 + 0.05 k stays below 4.0 up to k = 19
@@ -287,9 +310,9 @@ def test_falling_ends_an_episode_that_drives_into_void():
 # ------------------------------------------------------------------------------ metrics
 
 
-def test_one_step_success_gets_spl_of_its_efficiency():
+def test_one_step_success_gets_spl_of_its_efficiency(backend):
     # OmniGibson reported SPL = 0 here: it never counted the final step.
-    env = make_env(room(), initial_pos=(1.0, 1.0, 0.0), initial_quat=quat(0.0),
+    env = make_env(backend, room(), initial_pos=(1.0, 1.0, 0.0), initial_quat=quat(0.0),
                    goal_pos=(1.6, 1.0, 0.0), goal_tolerance=0.58)
     _, info = env.reset(seed=0)
     d0 = info["geodesic_dist"]
@@ -300,9 +323,9 @@ def test_one_step_success_gets_spl_of_its_efficiency():
     assert info["spl"] == d0 / max(d0, info["path_length"]) == 1.0
 
 
-def test_spl_counts_the_final_step_in_the_path_length():
+def test_spl_counts_the_final_step_in_the_path_length(backend):
     # Start 1 cm from the goal and drive 5 cm: L > d0, so SPL = d0 / L.
-    env = make_env(room(), initial_pos=(1.0, 1.0, 0.0), initial_quat=quat(math.pi),
+    env = make_env(backend, room(), initial_pos=(1.0, 1.0, 0.0), initial_quat=quat(math.pi),
                    goal_pos=(1.01, 1.0, 0.0), goal_tolerance=0.5)
     _, info = env.reset(seed=0)
     _, _, _, _, info = env.step(FORWARD)
@@ -315,9 +338,9 @@ def test_spl_counts_the_final_step_in_the_path_length():
 
 
 @pytest.mark.parametrize("polar", [False, True])
-def test_goal_observation_of_a_rotated_robot_matches_hand_values(polar):
+def test_goal_observation_of_a_rotated_robot_matches_hand_values(polar, backend):
     # Facing +y, a goal 2 m along +x and 0.5 m along +y is 0.5 m ahead and 2 m to the right.
-    env = make_env(room(40, 60), initial_pos=(1.0, 1.0, 0.0), initial_quat=quat(math.pi / 2),
+    env = make_env(backend, room(40, 60), initial_pos=(1.0, 1.0, 0.0), initial_quat=quat(math.pi / 2),
                    goal_pos=(3.0, 1.5, 0.0), goal_in_polar=polar)
     obs, _ = env.reset(seed=0)
     expected = [math.hypot(0.5, 2.0), math.atan2(-2.0, 0.5)] if polar else [0.5, -2.0]
@@ -332,8 +355,8 @@ def test_goal_observation_of_a_rotated_robot_matches_hand_values(polar):
     np.testing.assert_allclose(obs["robot_ang_vel"], [0.0, 0.0, 0.0], atol=1e-6)
 
 
-def test_angular_velocity_observation_is_the_yaw_rate():
-    env = make_env(room(40, 60), initial_pos=(2.0, 2.0, 0.0), initial_quat=quat(1.0),
+def test_angular_velocity_observation_is_the_yaw_rate(backend):
+    env = make_env(backend, room(40, 60), initial_pos=(2.0, 2.0, 0.0), initial_quat=quat(1.0),
                    goal_pos=(5.0, 2.0, 0.0))
     env.reset(seed=0)
     obs, *_ = env.step(np.array([0.0, -0.5], np.float32))  # turn right at 0.75 rad/s
@@ -341,8 +364,8 @@ def test_angular_velocity_observation_is_the_yaw_rate():
     np.testing.assert_allclose(obs["robot_lin_vel"], [0.0, 0.0, 0.0], atol=1e-6)
 
 
-def test_observations_are_fresh_arrays_on_every_call():
-    env = make_env(room(), initial_pos=(1.0, 1.0, 0.0), goal_pos=(3.0, 1.0, 0.0))
+def test_observations_are_fresh_arrays_on_every_call(backend):
+    env = make_env(backend, room(), initial_pos=(1.0, 1.0, 0.0), goal_pos=(3.0, 1.0, 0.0))
     first, _ = env.reset(seed=0)
     second = env.task.get_obs(env)
     for key in first:
@@ -354,8 +377,8 @@ def test_observations_are_fresh_arrays_on_every_call():
 # ------------------------------------------------------------------------------ sampling and floors
 
 
-def test_sampled_episodes_respect_path_range_and_reachability():
-    env = make_env(wall_with_gap(), path_range=(3.0, 4.5), goal_tolerance=0.3)
+def test_sampled_episodes_respect_path_range_and_reachability(backend):
+    env = make_env(backend, wall_with_gap(), path_range=(3.0, 4.5), goal_tolerance=0.3)
     for seed in range(5):
         _, info = env.reset(seed=seed)
         task = env.task
@@ -367,31 +390,31 @@ def test_sampled_episodes_respect_path_range_and_reachability():
         assert env.backend.is_valid_pose(0, start)
 
 
-def test_fixed_start_with_sampled_goal_and_fixed_goal_with_sampled_start():
-    env = make_env(room(), initial_pos=(1.0, 1.0, 0.0), goal_tolerance=0.2)
+def test_fixed_start_with_sampled_goal_and_fixed_goal_with_sampled_start(backend):
+    env = make_env(backend, room(), initial_pos=(1.0, 1.0, 0.0), goal_tolerance=0.2)
     env.reset(seed=1)
     assert env.task.get_start_pos()[:2].tolist() == [1.0, 1.0]
     assert math.isfinite(env.task.geodesic_dist)
-    env = make_env(room(), goal_pos=(4.0, 1.0, 0.0), goal_tolerance=0.2)
+    env = make_env(backend, room(), goal_pos=(4.0, 1.0, 0.0), goal_tolerance=0.2)
     env.reset(seed=1)
     assert env.task.get_goal_pos()[:2].tolist() == [4.0, 1.0]
     assert math.isfinite(env.task.geodesic_dist)
 
 
-def test_task_on_an_upper_floor_lands_the_robot_at_that_floor_height():
-    env = make_env([room(), room()], floor=1, initial_pos=(1.0, 1.0, 0.0), goal_pos=(3.0, 1.0, 0.0))
+def test_task_on_an_upper_floor_lands_the_robot_at_that_floor_height(backend):
+    env = make_env(backend, [room(), room()], floor=1, initial_pos=(1.0, 1.0, 0.0), goal_pos=(3.0, 1.0, 0.0))
     _, info = env.reset(seed=0)
     assert env.task.get_current_pos(env)[2] == 3.0
     assert env.task.get_goal_pos()[2] == 3.0
     _, _, terminated, _, info = env.step(FORWARD)
     assert not terminated  # standing on floor 1 is not a fall
-    env = make_env([room(), room()], floor=1)  # and sampled
+    env = make_env(backend, [room(), room()], floor=1)  # and sampled
     env.reset(seed=0)
     assert env.task.get_current_pos(env)[2] == 3.0
 
 
-def test_same_seed_same_episode_and_different_seeds_differ():
-    env = make_env(wall_with_gap())
+def test_same_seed_same_episode_and_different_seeds_differ(backend):
+    env = make_env(backend, wall_with_gap())
     starts = []
     for seed in (5, 5, 6):
         env.reset(seed=seed)
@@ -400,11 +423,53 @@ def test_same_seed_same_episode_and_different_seeds_differ():
     assert starts[0] != starts[2]
 
 
+def episodes_on_every_backend(scene: Scene, seeds) -> dict[str, list]:
+    """Per backend, each seed's episode: (geodesic, start position, goal, start yaw)."""
+    out = {}
+    for name in available_backends():
+        env = PointNavEnv(scene=scene, backend=name)
+        episodes = []
+        for seed in seeds:
+            _, info = env.reset(seed=seed)
+            position, orientation = env.backend.get_pose(0)
+            episodes.append((
+                info["geodesic_dist"],
+                position.tolist(),
+                env.task.get_goal_pos().tolist(),
+                float(quat2yaw(orientation)),
+            ))
+        out[name] = episodes
+    return out
+
+
+@pytest.mark.parametrize(
+    "make_scene",
+    [
+        pytest.param(lambda: Scene.from_array(wall_with_gap(), RES), id="grid"),
+        pytest.param(lambda: scenes.rooms(seed=1), id="rooms-polygons"),
+    ],
+)
+def test_same_seed_gives_the_same_start_and_goal_on_every_backend(make_scene):
+    # Sampling lives in the core; a backend only lands the robot and checks its pose. On a
+    # scene built from polygons the map has two shapes for each obstacle, its polygons and
+    # its OBSTACLE cells, and a backend may collide with either.
+    seeds = range(40)
+    episodes = episodes_on_every_backend(make_scene(), seeds)
+    first_name, first = next(iter(episodes.items()))
+    for name, other in episodes.items():
+        differ = [
+            seed
+            for seed, a, b in zip(seeds, first, other)
+            if a[:3] != b[:3] or abs(math.remainder(a[3] - b[3], 2.0 * math.pi)) > 1e-12
+        ]
+        assert not differ, f"{name} and {first_name} differ for seeds {differ}"
+
+
 # ------------------------------------------------------------------------------ lifecycle
 
 
-def test_lifecycle_follows_the_transition_table():
-    env = make_env(room(), initial_pos=(1.0, 1.0, 0.0), goal_pos=(5.0, 1.0, 0.0),
+def test_lifecycle_follows_the_transition_table(backend):
+    env = make_env(backend, room(), initial_pos=(1.0, 1.0, 0.0), goal_pos=(5.0, 1.0, 0.0),
                    termination_config={"max_steps": 2})
     task = env.task
     assert task.state is TaskState.IDLE
@@ -418,8 +483,8 @@ def test_lifecycle_follows_the_transition_table():
     assert task.state is TaskState.RUNNING
 
 
-def test_step_after_the_episode_ended_raises_and_changes_nothing():
-    env = make_env(room(), initial_pos=(1.0, 1.0, 0.0), initial_quat=quat(0.0),
+def test_step_after_the_episode_ended_raises_and_changes_nothing(backend):
+    env = make_env(backend, room(), initial_pos=(1.0, 1.0, 0.0), initial_quat=quat(0.0),
                    goal_pos=(5.0, 1.0, 0.0), termination_config={"max_steps": 1})
     env.reset(seed=0)
     env.step(FORWARD)
@@ -476,10 +541,10 @@ class _TaskWithExtraCondition(PointNavigationTask):
         return conditions
 
 
-def test_a_subclass_can_add_a_termination_condition():
+def test_a_subclass_can_add_a_termination_condition(backend):
     task = _TaskWithExtraCondition(initial_pos=(5.025, 1.0, 0.0), initial_quat=quat(0.0),
                                    goal_pos=(1.0, 1.0, 0.0))
-    env = PointNavEnv(scene=Scene.from_array(room(), RES), robot=ROBOT, task=task)
+    env = PointNavEnv(scene=Scene.from_array(room(), RES), robot=ROBOT, task=task, backend=backend)
     env.reset(seed=0)
     for _ in range(16):
         _, _, terminated, _, info = env.step(FORWARD)
@@ -496,17 +561,17 @@ class _TaskWithoutGoal(PointNavigationTask):
         return conditions
 
 
-def test_goal_reward_without_a_goal_condition_fails_at_reset():
+def test_goal_reward_without_a_goal_condition_fails_at_reset(backend):
     task = _TaskWithoutGoal(initial_pos=(1.0, 1.0, 0.0), goal_pos=(3.0, 1.0, 0.0))
-    env = PointNavEnv(scene=Scene.from_array(room(), RES), robot=ROBOT, task=task)
+    env = PointNavEnv(scene=Scene.from_array(room(), RES), robot=ROBOT, task=task, backend=backend)
     with pytest.raises(ValueError, match="pointgoal"):
         env.reset(seed=0)
     assert task.state is TaskState.ERROR
     assert isinstance(task.reward_functions["pointgoal"], PointGoalReward)
 
 
-def test_omnigibson_accessors():
-    env = make_env(room(), initial_pos=(1.0, 1.0, 0.0), initial_quat=quat(0.0),
+def test_omnigibson_accessors(backend):
+    env = make_env(backend, room(), initial_pos=(1.0, 1.0, 0.0), initial_quat=quat(0.0),
                    goal_pos=(3.0, 1.0, 0.0))
     task = env.task
     assert task.get_goal_pos().tolist() == [3.0, 1.0, 0.0]

@@ -43,6 +43,15 @@ class ShortestPathFollower:
         The robot steers towards the point this far (m) along the path (pure pursuit), so
         it rounds corners smoothly and never turns back to a corner it has just passed.
 
+    Notes
+    -----
+    Each step follows the goal field's cheap path (the root of the cell the robot stands
+    in), which is optimal for the cell's centre but can be a detour for the robot's exact
+    position. Two such paths in opposite directions from neighbouring points can trap a
+    robot that moves at once (holonomic drive) in a two-step cycle; so when the point to
+    steer towards turns back against the previous one, the follower asks for the exact
+    path instead.
+
     Examples
     --------
     >>> from pointnav_core.env import PointNavEnv
@@ -73,9 +82,15 @@ class ShortestPathFollower:
         if not math.isfinite(lookahead) or lookahead <= 0:
             raise ValueError(f"lookahead must be a finite number > 0 (m), got {lookahead!r}")
         self.lookahead = float(lookahead)
+        self._last_target: NDArray[np.float64] | None = None
 
-    def _carrot(self, xy: NDArray[np.float64]) -> NDArray[np.float64] | None:
-        """The point ``lookahead`` metres along the shortest path from ``xy`` (or the goal)."""
+    def _carrot(
+        self, xy: NDArray[np.float64], exact: bool = False
+    ) -> NDArray[np.float64] | None:
+        """The point ``lookahead`` metres along the shortest path from ``xy`` (or the goal).
+
+        ``exact=False`` takes the goal field's cheap path, ``exact=True`` searches.
+        """
         env, task = self.env, self.task
         spec = env.robots[task.robot_idn]
         goal = np.asarray(task.get_goal_pos(), dtype=np.float64)[:2]
@@ -83,7 +98,7 @@ class ShortestPathFollower:
         margin = tmap.resolution if self.margin is None else self.margin
         path = None
         for radius in (spec.radius + margin, spec.radius):
-            path, _ = env.scene.goal_field(task.floor, goal, robot=radius).path(xy, exact=False)
+            path, _ = env.scene.goal_field(task.floor, goal, robot=radius).path(xy, exact=exact)
             if path is not None:
                 break
         if path is None:
@@ -98,6 +113,12 @@ class ShortestPathFollower:
         xy = position[:2]
         action = np.zeros(spec.action_dim, dtype=np.float32)
         target = self._carrot(xy)
+        last, self._last_target = self._last_target, target
+        if target is not None and last is not None:
+            ahead, before = target - xy, last - xy
+            if float(ahead[0] * before[0] + ahead[1] * before[1]) < 0.0:
+                # The cheap path turns back: confirm it (see the class notes).
+                target = self._last_target = self._carrot(xy, exact=True)
         if target is None:
             return action
         dt = 1.0 / getattr(env, "action_frequency", 10.0)
