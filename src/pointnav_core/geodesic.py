@@ -94,6 +94,7 @@ class Planner:
         self.corner_labels = self.labels[rows, cols]
         self._cell_graph: sparse.csr_matrix | None = None
         self._margins: tuple[NDArray[np.int64], NDArray[np.int64]] | None = None
+        self._seed_graph: tuple[sparse.csr_matrix, int] | None = None
         self._component_graphs: dict[int, tuple[NDArray[np.int64], sparse.csr_matrix]] = {}
         self._fields = BoundedCache(field_cache_size)
 
@@ -185,6 +186,29 @@ class Planner:
         self._component_graphs[label] = (ids, graph)
         return ids, graph
 
+    def seed_graph(self) -> tuple[sparse.csr_matrix, int]:
+        """The cell graph plus one seed node per corner and one for a goal (cached).
+
+        Seed node ``first + i`` has a single edge to corner i's cell, and the last seed an
+        edge to a goal's cell; goal fields write their weights (and the goal's cell) in
+        place before each Dijkstra run, so the graph is built once per floor and radius.
+        """
+        if self._seed_graph is None:
+            base = self.cell_graph()
+            first = base.shape[0]
+            n_seeds = len(self.corners) + 1
+            n_nodes = first + n_seeds
+            graph = sparse.csr_matrix(
+                (
+                    np.concatenate([base.data, np.ones(n_seeds)]),
+                    np.concatenate([base.indices, self.corner_cells, [0]]).astype(base.indices.dtype),
+                    np.concatenate([base.indptr, base.nnz + np.arange(1, n_seeds + 1)]),
+                ),
+                shape=(n_nodes, n_nodes),
+            )
+            self._seed_graph = (graph, first)
+        return self._seed_graph
+
     def margin_sources(self) -> tuple[NDArray[np.int64], NDArray[np.int64]]:
         """Margin cells (FREE, not usable) and, for each, a usable cell a few steps away.
 
@@ -211,13 +235,12 @@ class Planner:
         return self._margins
 
     def cell_graph(self) -> sparse.csr_matrix:
-        """16-connected graph of usable cells, plus an empty last row for a super source.
+        """8-connected graph of usable cells, plus one spare empty row; edge weights in cells.
 
-        Nodes are flat cell indices. A step (one of the 8 king moves and 8 knight moves) is
-        an edge when the segment between the two cell centres is free, the same rule as
-        :meth:`visible`, so no step cuts a blocked corner. Knight moves bring the grid
-        metric within 3 % of Euclidean in every direction, which is what lets one Dijkstra
-        run pick each cell's root corner well.
+        Nodes are flat cell indices. A step is an edge when the segment between the two
+        cell centres is free (the rule of :meth:`visible`), so no diagonal step cuts a
+        blocked corner. The grid metric only proposes each cell's route (see GoalField);
+        distances come from the corners.
         """
         if self._cell_graph is not None:
             return self._cell_graph
@@ -360,46 +383,29 @@ class GoalField:
         planner = self.planner
         h, w = planner.shape
         n_cells = h * w
-        n = self._n
-        reached = np.isfinite(self.corner_dist)
-        local = np.flatnonzero(reached)
-        cells = planner.corner_cells[self.corner_ids[local]]
-        # One seed per cell: the corner with the smallest distance (written last wins).
-        order = np.argsort(-self.corner_dist[local], kind="stable")
-        source_of = np.full(n_cells + 1, _UNREACHABLE, dtype=np.int64)
-        source_of[cells[order]] = local[order]
-        goal_cell = int(math.floor(self.goal[0])) * w + int(math.floor(self.goal[1]))
-        source_of[goal_cell] = n
-        seeds = np.flatnonzero(source_of[:n_cells] != _UNREACHABLE)
-        weight = np.append(self.corner_dist, 0.0)[source_of[seeds]]
-        base = planner.cell_graph()
-        super_source = n_cells
-        graph = sparse.csr_matrix(
-            (
-                np.concatenate([base.data, np.maximum(weight, _EPS)]),
-                np.concatenate([base.indices, seeds]),
-                np.concatenate([base.indptr[:-1], [base.nnz + len(seeds)]]),
-            ),
-            shape=(n_cells + 1, n_cells + 1),
+        graph, first = planner.seed_graph()
+        n_corners = len(planner.corners)
+        # The seed edges' weights are the exact distances of this goal's corners (inf for
+        # the others), and the last seed is the goal's own cell.
+        weight = np.full(n_corners + 1, np.inf)
+        weight[self.corner_ids] = np.maximum(self.corner_dist, _EPS)
+        weight[-1] = _EPS
+        graph.data[-(n_corners + 1) :] = weight
+        graph.indices[-1] = int(math.floor(self.goal[0])) * w + int(math.floor(self.goal[1]))
+        _, _, sources = csgraph.dijkstra(
+            graph,
+            directed=True,
+            indices=np.arange(first, first + n_corners + 1),
+            min_only=True,
+            return_predecessors=True,
         )
-        _, pred = csgraph.dijkstra(
-            graph, directed=True, indices=super_source, return_predecessors=True
-        )
-        # Follow predecessors up to the seed each cell hangs from (pointer jumping).
-        anc = pred.astype(np.int64)
-        anc[anc < 0] = super_source
-        anc[super_source] = super_source
-        anc[seeds] = seeds
-        while True:
-            nxt = anc[anc]
-            if np.array_equal(nxt, anc):
-                break
-            anc = nxt
-        root = source_of[anc[:n_cells]]
-        root[pred[:n_cells] < 0] = _UNREACHABLE
-        root[seeds] = source_of[seeds]
+        seed = sources[:n_cells] - first
+        local = np.full(n_corners + 1, _UNREACHABLE, dtype=np.int64)
+        local[self.corner_ids] = np.arange(len(self.corner_ids))
+        local[-1] = self._n
+        root = np.where(seed >= 0, local[np.maximum(seed, 0)], _UNREACHABLE)
         # The goal's own code; corners keep their index and are pulled taut on first use.
-        root[root == n] = _TO_GOAL
+        root[root == self._n] = _TO_GOAL
         return root
 
     def _taut_root(self, r: int, c: int, v: int) -> int:
