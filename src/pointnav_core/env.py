@@ -2,26 +2,18 @@
 
 from __future__ import annotations
 
-import dataclasses
-import inspect
-import math
-from collections import OrderedDict
 from collections.abc import Mapping
 from typing import Any
 
 import gymnasium as gym
 import numpy as np
-from gymnasium import spaces
 from numpy.typing import NDArray
 
-from pointnav_core import scenes
+from pointnav_core import _envcommon, scenes
 from pointnav_core.backend import Backend, RobotSpec, make_backend
 from pointnav_core.task import PointNavigationTask
 
 __all__ = ["PointNavEnv"]
-
-_TASK_KEYS = tuple(inspect.signature(PointNavigationTask).parameters)
-_ROBOT_KEYS = tuple(f.name for f in dataclasses.fields(RobotSpec))
 
 
 class PointNavEnv(gym.Env[Any, np.ndarray]):
@@ -162,20 +154,13 @@ class PointNavEnv(gym.Env[Any, np.ndarray]):
             )
         if not isinstance(flatten_obs, (bool, np.bool_)):
             raise ValueError(f"flatten_obs must be True or False, got {flatten_obs!r}")
-        try:
-            frequency = float(action_frequency)
-        except (TypeError, ValueError):
-            frequency = math.nan
-        if isinstance(action_frequency, bool) or not (math.isfinite(frequency) and frequency > 0):
-            raise ValueError(
-                f"action_frequency must be a finite number > 0 (Hz), got {action_frequency!r}"
-            )
+        frequency = _envcommon.check_action_frequency(action_frequency)
         if scene is None:
             scene = scenes.rooms(seed=0)
         elif not isinstance(scene, scenes.Scene):
             raise ValueError(f"scene must be a pointnav_core Scene or None, got {scene!r}")
-        self.robot = _make_robot(robot)
-        self.task = _make_task(task)
+        self.robot = _envcommon.make_robot(robot)
+        self.task = _envcommon.make_task(task)
         if backend_kwargs is not None and not isinstance(backend_kwargs, Mapping):
             raise ValueError(f"backend_kwargs must be None or a dict, got {backend_kwargs!r}")
         self.scene = scene
@@ -190,20 +175,8 @@ class PointNavEnv(gym.Env[Any, np.ndarray]):
         self._idn = self.task.robot_idn
 
         self._action_shape = (self.robot.action_dim,)
-        self.action_space = spaces.Box(-1.0, 1.0, self._action_shape, dtype=np.float32)
-        low, high = self.task.observation_bounds
-        if self.flatten_obs:
-            self.observation_space = spaces.Box(low, high, dtype=np.float32)
-        else:
-            # An OrderedDict keeps this order (a plain dict would be sorted by key), so that
-            # FlattenObservation gives OmniGibson's low_dim order too.
-            self.observation_space = spaces.Dict(
-                OrderedDict(
-                    xy_pos_to_goal=spaces.Box(low[0:2], high[0:2], dtype=np.float32),
-                    robot_lin_vel=spaces.Box(low[2:5], high[2:5], dtype=np.float32),
-                    robot_ang_vel=spaces.Box(low[5:8], high[5:8], dtype=np.float32),
-                )
-            )
+        self.action_space = _envcommon.action_space(self.robot)
+        self.observation_space = _envcommon.observation_space(self.task, self.flatten_obs)
 
     # ------------------------------------------------------------------ Gymnasium API
     def reset(
@@ -250,61 +223,10 @@ class PointNavEnv(gym.Env[Any, np.ndarray]):
 
     # ------------------------------------------------------------------ helpers
     def _check_action(self, action: Any) -> Any:
-        if not (
-            type(action) is np.ndarray
-            and action.shape == self._action_shape
-            and action.dtype.kind == "f"
-        ):
-            try:
-                action = np.asarray(action, dtype=np.float64)
-            except (TypeError, ValueError):
-                raise ValueError(
-                    f"action must be an array of {self._action_shape[0]} numbers in [-1, 1], "
-                    f"got {action!r}"
-                ) from None
-            if action.shape != self._action_shape:
-                raise ValueError(
-                    f"action must have shape {self._action_shape} for a {self.robot.drive} "
-                    f"drive, got shape {action.shape}"
-                )
-        for value in action.tolist():
-            if not -math.inf < value < math.inf:  # also False for NaN
-                raise ValueError(f"action must be finite, got {action.tolist()}")
-        return action
+        return _envcommon.check_action(action, self._action_shape, self.robot.drive)
 
     def _get_obs(self) -> Any:
         if self.flatten_obs:
             return self.task.get_low_dim_obs(self)
         return self.task.get_obs(self)
 
-
-def _make_robot(robot: RobotSpec | Mapping[str, Any] | None) -> RobotSpec:
-    if robot is None:
-        return RobotSpec()
-    if isinstance(robot, RobotSpec):
-        return robot
-    if isinstance(robot, Mapping):
-        unknown = [key for key in robot if key not in _ROBOT_KEYS]
-        if unknown:
-            raise ValueError(
-                f"robot has an unknown key {unknown[0]!r}; valid keys are {list(_ROBOT_KEYS)}"
-            )
-        return RobotSpec(**robot)
-    raise ValueError(f"robot must be a RobotSpec, a dict of its fields, or None, got {robot!r}")
-
-
-def _make_task(task: PointNavigationTask | Mapping[str, Any] | None) -> PointNavigationTask:
-    if task is None:
-        return PointNavigationTask()
-    if isinstance(task, PointNavigationTask):
-        return task
-    if isinstance(task, Mapping):
-        unknown = [key for key in task if key not in _TASK_KEYS]
-        if unknown:
-            raise ValueError(
-                f"task has an unknown key {unknown[0]!r}; valid keys are {list(_TASK_KEYS)}"
-            )
-        return PointNavigationTask(**task)
-    raise ValueError(
-        f"task must be a PointNavigationTask, a dict of its arguments, or None, got {task!r}"
-    )

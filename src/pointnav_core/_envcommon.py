@@ -1,0 +1,197 @@
+"""Argument checks and space building shared by the single- and multi-robot environments.
+
+:class:`~pointnav_core.env.PointNavEnv` and :class:`~pointnav_core.parallel.MultiPointNavEnv`
+take the same kinds of arguments (a robot spec or a dict of its fields, a task or a dict of
+its arguments, an action frequency) and give a robot the same action and observation spaces,
+so both build them here. ``name`` arguments say what to call the value in an error message
+(``"robot"``, ``"task[2]"``, ``"action for robot_1"``).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import inspect
+import math
+from collections import OrderedDict
+from collections.abc import Mapping
+from typing import Any
+
+import numpy as np
+from gymnasium import spaces
+
+from pointnav_core.backend import RobotSpec
+from pointnav_core.task import PointNavigationTask
+
+__all__ = [
+    "ROBOT_KEYS",
+    "TASK_KEYS",
+    "action_space",
+    "check_action",
+    "check_action_frequency",
+    "make_robot",
+    "make_task",
+    "observation_space",
+]
+
+#: Keyword arguments of :class:`PointNavigationTask`, in signature order.
+TASK_KEYS = tuple(inspect.signature(PointNavigationTask).parameters)
+#: Fields of :class:`RobotSpec`, in declaration order.
+ROBOT_KEYS = tuple(f.name for f in dataclasses.fields(RobotSpec))
+
+
+def make_robot(robot: RobotSpec | Mapping[str, Any] | None, name: str = "robot") -> RobotSpec:
+    """Return a :class:`RobotSpec` from a spec, a dict of its fields, or None (the default).
+
+    Raises
+    ------
+    ValueError
+        For an unknown key (naming it and the valid ones), an invalid field, or a value of
+        another type.
+
+    Examples
+    --------
+    >>> make_robot({"radius": 0.2}).radius
+    0.2
+    >>> make_robot({"size": 1})  # doctest: +ELLIPSIS
+    Traceback (most recent call last):
+    ...
+    ValueError: robot has an unknown key 'size'; valid keys are ['radius', ...]
+    """
+    if robot is None:
+        return RobotSpec()
+    if isinstance(robot, RobotSpec):
+        return robot
+    if isinstance(robot, Mapping):
+        unknown = [key for key in robot if key not in ROBOT_KEYS]
+        if unknown:
+            raise ValueError(
+                f"{name} has an unknown key {unknown[0]!r}; valid keys are {list(ROBOT_KEYS)}"
+            )
+        return RobotSpec(**robot)
+    raise ValueError(f"{name} must be a RobotSpec, a dict of its fields, or None, got {robot!r}")
+
+
+def make_task(
+    task: PointNavigationTask | Mapping[str, Any] | None,
+    name: str = "task",
+    **fixed: Any,
+) -> PointNavigationTask:
+    """Return a :class:`PointNavigationTask` from a task, a dict of its arguments, or None.
+
+    Parameters
+    ----------
+    task : PointNavigationTask or dict or None
+        The task itself, its keyword arguments, or None for the defaults.
+    name : str
+        What to call ``task`` in error messages.
+    **fixed
+        Arguments the caller sets itself (a multi-robot env sets ``robot_idn``); a dict that
+        also gives one of them must give the same value.
+
+    Examples
+    --------
+    >>> make_task({"goal_tolerance": 0.3}, robot_idn=2).robot_idn
+    2
+    >>> make_task({"robot_idn": 1}, name="task[0]", robot_idn=0)
+    Traceback (most recent call last):
+    ...
+    ValueError: task[0] sets robot_idn=1, but the environment sets robot_idn=0 for it
+    """
+    if task is None:
+        return PointNavigationTask(**fixed)
+    if isinstance(task, PointNavigationTask):
+        for key, value in fixed.items():
+            if getattr(task, key) != value:
+                raise ValueError(
+                    f"{name} has {key}={getattr(task, key)!r}, but the environment needs "
+                    f"{key}={value!r} for it"
+                )
+        return task
+    if isinstance(task, Mapping):
+        unknown = [key for key in task if key not in TASK_KEYS]
+        if unknown:
+            raise ValueError(
+                f"{name} has an unknown key {unknown[0]!r}; valid keys are {list(TASK_KEYS)}"
+            )
+        for key, value in fixed.items():
+            if key in task and task[key] != value:
+                raise ValueError(
+                    f"{name} sets {key}={task[key]!r}, but the environment sets "
+                    f"{key}={value!r} for it"
+                )
+        return PointNavigationTask(**{**task, **fixed})
+    raise ValueError(
+        f"{name} must be a PointNavigationTask, a dict of its arguments, or None, got {task!r}"
+    )
+
+
+def check_action_frequency(action_frequency: Any) -> float:
+    """Return ``action_frequency`` (Hz) as a float, or raise ValueError unless finite and > 0."""
+    try:
+        frequency = float(action_frequency)
+    except (TypeError, ValueError):
+        frequency = math.nan
+    if isinstance(action_frequency, bool) or not (math.isfinite(frequency) and frequency > 0):
+        raise ValueError(
+            f"action_frequency must be a finite number > 0 (Hz), got {action_frequency!r}"
+        )
+    return frequency
+
+
+def action_space(robot: RobotSpec) -> spaces.Box:
+    """The robot's action space: a float32 ``Box`` in ``[-1, 1]`` of shape ``(action_dim,)``."""
+    return spaces.Box(-1.0, 1.0, (robot.action_dim,), dtype=np.float32)
+
+
+def observation_space(task: PointNavigationTask, flatten: bool) -> spaces.Space[Any]:
+    """The task's observation space: a ``Dict`` of its three arrays, or the flat ``(8,)`` Box.
+
+    ``task`` must have met its environment (:meth:`PointNavigationTask.load`).
+    """
+    low, high = task.observation_bounds
+    if flatten:
+        return spaces.Box(low, high, dtype=np.float32)
+    # An OrderedDict keeps this order (a plain dict would be sorted by key), so that
+    # FlattenObservation gives OmniGibson's low_dim order too.
+    return spaces.Dict(
+        OrderedDict(
+            xy_pos_to_goal=spaces.Box(low[0:2], high[0:2], dtype=np.float32),
+            robot_lin_vel=spaces.Box(low[2:5], high[2:5], dtype=np.float32),
+            robot_ang_vel=spaces.Box(low[5:8], high[5:8], dtype=np.float32),
+        )
+    )
+
+
+def check_action(
+    action: Any, shape: tuple[int], drive: str, name: str = "action"
+) -> np.ndarray:
+    """Return ``action`` as a float array of ``shape``, or raise ValueError naming ``name``.
+
+    A float ndarray of the right shape passes through as is (the per-step fast path);
+    anything else is converted. Values outside ``[-1, 1]`` are kept (the backend clips
+    them); NaN and infinity are rejected.
+
+    Examples
+    --------
+    >>> check_action([0.5, 2.0], (2,), "differential").tolist()
+    [0.5, 2.0]
+    >>> check_action([0.5], (2,), "differential", name="action for robot_1")
+    Traceback (most recent call last):
+    ...
+    ValueError: action for robot_1 must have shape (2,) for a differential drive, got shape (1,)
+    """
+    if not (type(action) is np.ndarray and action.shape == shape and action.dtype.kind == "f"):
+        try:
+            action = np.asarray(action, dtype=np.float64)
+        except (TypeError, ValueError):
+            raise ValueError(
+                f"{name} must be an array of {shape[0]} numbers in [-1, 1], got {action!r}"
+            ) from None
+        if action.shape != shape:
+            raise ValueError(
+                f"{name} must have shape {shape} for a {drive} drive, got shape {action.shape}"
+            )
+    for value in action.tolist():
+        if not -math.inf < value < math.inf:  # also False for NaN
+            raise ValueError(f"{name} must be finite, got {action.tolist()}")
+    return action

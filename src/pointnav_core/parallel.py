@@ -1,0 +1,728 @@
+"""Multi-robot point-goal navigation as a PettingZoo ``ParallelEnv``: ``MultiPointNav-v0``.
+
+| Import             | `from pointnav_core import parallel`, then `parallel.parallel_env()` |
+|--------------------|----------------------------------------------------------------------|
+| Actions            | Continuous                                                           |
+| Parallel API       | Yes                                                                  |
+| Manual Control     | No                                                                   |
+| Agents             | `agents = ["robot_0", ..., "robot_<n_robots - 1>"]`                 |
+| Agents             | `n_robots` (default 2)                                               |
+| Action Shape       | `(2,)` differential drive, `(3,)` holonomic                          |
+| Action Values      | `[-1, 1]`, float32                                                   |
+| Observation Shape  | `Dict` of `xy_pos_to_goal (2,)`, `robot_lin_vel (3,)`,               |
+|                    | `robot_ang_vel (3,)`; `(8,)` with `flatten_obs=True`                 |
+| Observation Values | bounded, float32 (as in `PointNavEnv`)                               |
+| State Shape        | `(8 * n_robots,)`                                                    |
+| State Values       | bounded, float32                                                     |
+
+Registered as ``pointnav_core/MultiPointNav-v0`` in PettingZoo's ``"parallel"`` and ``"aec"``
+registries when ``pointnav_core`` is imported, so after ``import pointnav_core``,
+``pettingzoo.make("parallel", "pointnav_core/MultiPointNav-v0")`` builds this env and
+``pettingzoo.make("aec", ...)`` its AEC form.
+
+Description
+-----------
+Many robots share one scene; each has its own :class:`~pointnav_core.task.PointNavigationTask`
+(its ``robot_idn`` is the robot's index) with its own start, goal and episode, exactly as
+in the single-robot :class:`~pointnav_core.env.PointNavEnv`: the same rewards, termination
+conditions, metrics and observations. Agent ``robot_<i>`` drives robot ``i``. Robots are
+solid for each other: the backend resolves robot-robot contacts like obstacle contacts, and
+such a contact counts as a collision for *both* robots (their tasks' ``collision`` reward
+and ``max_collision`` counter).
+
+Arguments
+---------
+``parallel_env(scene=None, n_robots=2, robot=None, task=None, backend="kinematic",
+backend_kwargs=None, max_cycles=500, render_mode=None, flatten_obs=False, finished="park",
+action_frequency=10.0)``
+
+| Argument           | Type                        | Default           | Description            |
+|--------------------|-----------------------------|-------------------|------------------------|
+| `scene`            | **Scene** or `None`         | `scenes.rooms(0)` | floors all robots share|
+| `n_robots`         | **int** >= 1                | `2`               | robots (and agents)    |
+| `robot`            | **RobotSpec**/dict, or list | `RobotSpec()`     | one for all, or each   |
+| `task`             | **dict**, or list           | `{}`              | task arguments: one for|
+|                    |                             |                   | all, or one per robot  |
+| `backend`          | **str**, class or instance  | `"kinematic"`     | any registered backend |
+| `backend_kwargs`   | **dict** or `None`          | `None`            | the backend's arguments|
+| `max_cycles`       | **int** >= 1                | `500`             | steps, then all agents |
+|                    |                             |                   | are truncated          |
+| `render_mode`      | **str** or `None`           | `None`            | `"rgb_array"` or None  |
+| `flatten_obs`      | **bool**                    | `False`           | flat `(8,)` `low_dim`  |
+| `finished`         | `"park"` or `"remove"`      | `"park"`          | a finished robot stays,|
+|                    |                             |                   | or leaves the world    |
+| `action_frequency` | **float**                   | `10.0`            | control rate (Hz)      |
+
+``task`` entries are :class:`~pointnav_core.task.PointNavigationTask` keyword arguments
+(a list may also hold ready tasks); the env sets ``robot_idn`` (an entry that gives one must
+give its own index). A list of ``robot`` or ``task`` entries must have ``n_robots`` entries.
+
+Observation and action spaces
+-----------------------------
+Per agent, the same as ``PointNavEnv`` for that robot: the action is ``(v, w)`` (or
+``(vx, vy, w)`` for a holonomic robot) in ``[-1, 1]``, scaled by the robot's maxima and held
+for one control step; the observation is the robot's own goal in its own frame and its own
+velocities (a ``Dict``, or OmniGibson's flat 8-vector with ``flatten_obs=True``). Agents do
+not observe each other: :meth:`MultiPointNavEnv.state` is the global view.
+``observation_space(agent)`` and ``action_space(agent)`` return the same object every call.
+
+State
+-----
+``state()`` is a float32 vector of ``8 * n_robots`` values, robot by robot:
+``x, y, z, yaw, goal_x, goal_y, goal_z, active`` (metres, radians; ``active`` is 1.0 while
+the robot's agent is in ``agents``, else 0.0). x and y are bounded by the union of the
+floors' extents plus 1 m, z by the floor heights minus 10 m and plus 1 m, yaw by
+``[-pi, pi]``; values are clipped to ``state_space``.
+
+Rewards
+-------
+Each agent gets its own task's reward (potential, collision, point-goal), a Python
+``float``; ``infos[agent]`` is that task's info (``success``, ``spl``, ``collisions``,
+``reward_breakdown``, ...), also at reset. Flags are Python ``bool``.
+
+Starting state
+--------------
+At ``reset`` the backend forgets every robot's place, then robots are placed one by one:
+first those with a fixed ``initial_pos`` (in index order), then the others. Each task samples
+its start as usual, and the backend's ``is_valid_pose`` already counts the robots placed
+before it, so **no two robots overlap**. Goals are **distinct**: two robots' goals on the
+same floor are at least ``max(tol_i + tol_j, r_i + r_j, cell)`` apart (``tol`` the goal
+tolerance, ``r`` the radius, ``cell`` the floor's map resolution), so that their success
+discs do not overlap, both robots can stand on their goals, and even point robots with no
+tolerance get goals at least a cell apart. A sampled goal that is too close to a goal
+chosen before (or to a fixed goal) is re-drawn, together with its start, up to
+``PointNavigationTask.max_trials`` times, then :class:`~pointnav_core.errors.SamplingError`
+names the robots. Fixed starts that would overlap, and fixed goals closer than that, are a
+``ValueError`` at construction.
+All randomness comes from the seed given to ``reset``.
+
+Episode end
+-----------
+Each agent's episode ends by its task's conditions (success, collisions, falling, its
+``max_steps`` timeout) or, for all agents at once, when the env has taken ``max_cycles``
+steps since reset (a truncation, as in PettingZoo's MPE; the task's own ``info`` does not
+count it). An agent whose episode ended is in that step's return dicts for the last time
+(its final observation) and is removed from ``agents`` in that step; it never comes back
+before the next ``reset``. Its robot stays **parked** in the world, standing still, as an
+obstacle for the others (``finished="park"``), or is taken out of the world
+(``finished="remove"``: nothing collides with it). A robot that fell (drove over void) has
+left its floor and is taken out of the world in either mode.
+
+Stepping rules
+--------------
+``step(actions)`` needs exactly one action for every agent in ``agents``:
+
+- a missing action (or ``None``) for an alive agent is a ``ValueError``;
+- an action for an agent that is not alive (its episode ended) is a ``ValueError``, and so
+  is one for an unknown agent;
+- an action of the wrong shape, or with NaN or infinity, is a ``ValueError`` naming the
+  agent; values outside ``[-1, 1]`` are clipped;
+- ``step`` when no agent is alive (before the first reset, or after every episode ended)
+  raises :class:`~pointnav_core.task.TaskStateError`: call ``reset``.
+
+All these are checked before anything moves, so a rejected step changes nothing. If a
+step fails half-way (a backend error), the episode is void and ``step`` raises until the
+next ``reset``.
+
+Rendering
+---------
+``render()`` (no arguments) returns a top-down ``(H, W, 3)`` uint8 image when
+``render_mode="rgb_array"`` (:func:`pointnav_core.render.render_env`): the first task's
+floor, every robot present on it (parked ones too) and, with ``visualize_goal`` /
+``visualize_path``, each task's markers. PettingZoo's ``render_test`` builds every env with
+``render_mode="human"`` first, so ``"human"`` is accepted at construction; it is not
+supported (there is no window), and ``render()`` then raises ``NotImplementedError``.
+
+Examples
+--------
+>>> import numpy as np
+>>> from pointnav_core import parallel
+>>> env = parallel.parallel_env(n_robots=3, task={"goal_tolerance": 0.3})
+>>> observations, infos = env.reset(seed=0)
+>>> env.agents, sorted(observations["robot_0"])
+(['robot_0', 'robot_1', 'robot_2'], ['robot_ang_vel', 'robot_lin_vel', 'xy_pos_to_goal'])
+>>> actions = {agent: np.array([1.0, 0.0], dtype=np.float32) for agent in env.agents}
+>>> observations, rewards, terminations, truncations, infos = env.step(actions)
+>>> type(rewards["robot_1"]), terminations["robot_1"], infos["robot_1"]["episode_length"]
+(<class 'float'>, False, 1)
+>>> env.state().shape, env.state_space.contains(env.state())
+((24,), True)
+
+Version History
+---------------
+* v0: Initial version.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping, Sequence
+from typing import Any, NoReturn
+
+import gymnasium
+import numpy as np
+from gymnasium import spaces
+from gymnasium.utils import seeding
+from numpy.typing import NDArray
+from pettingzoo import AECEnv, ParallelEnv
+from pettingzoo.utils.conversions import parallel_to_aec, parallel_to_aec_wrapper
+
+from pointnav_core import _envcommon, scenes
+from pointnav_core.backend import Backend, RobotSpec, make_backend
+from pointnav_core.errors import SamplingError
+from pointnav_core.task import PointNavigationTask, TaskStateError
+
+__all__ = [
+    "FINISHED_MODES",
+    "STATE_FIELDS",
+    "MultiPointNavEnv",
+    "env",
+    "parallel_env",
+    "raw_env",
+]
+
+#: What happens to a robot whose episode ended: stays as an obstacle, or leaves the world.
+FINISHED_MODES = ("park", "remove")
+#: The values ``state()`` holds for each robot, in order.
+STATE_FIELDS = ("x", "y", "z", "yaw", "goal_x", "goal_y", "goal_z", "active")
+
+# State bounds: margin (m) around the floors' extents (a robot falling off an edge), and
+# how far below the lowest floor a falling robot's z is still shown (it is clipped there).
+_XY_MARGIN = 1.0
+_Z_BELOW = 10.0
+_Z_ABOVE = 1.0
+
+
+def _prefixed(name: str, err: ValueError) -> ValueError:
+    message = str(err)
+    return ValueError(message if message.startswith(name) else f"{name}: {message}")
+
+
+def _check_int(name: str, value: Any, minimum: int) -> int:
+    if isinstance(value, (bool, np.bool_)) or not isinstance(value, (int, np.integer)):
+        raise ValueError(f"{name} must be an integer >= {minimum}, got {value!r}")
+    if value < minimum:
+        raise ValueError(f"{name} must be an integer >= {minimum}, got {value!r}")
+    return int(value)
+
+
+def _per_robot(value: Any, n: int, name: str) -> list[Any] | None:
+    """The list of per-robot entries when ``value`` is a list, else None (one shared value)."""
+    if not isinstance(value, (list, tuple)):
+        return None
+    if len(value) != n:
+        raise ValueError(
+            f"{name} must be one value for all robots or a list with one entry per robot "
+            f"(n_robots={n}), got a list of {len(value)}"
+        )
+    return list(value)
+
+
+def _make_robots(robot: Any, n: int) -> tuple[RobotSpec, ...]:
+    entries = _per_robot(robot, n, "robot")
+    if entries is None:
+        return (_envcommon.make_robot(robot),) * n
+    robots = []
+    for i, entry in enumerate(entries):
+        try:
+            robots.append(_envcommon.make_robot(entry, name=f"robot[{i}]"))
+        except ValueError as err:
+            raise _prefixed(f"robot[{i}]", err) from None
+    return tuple(robots)
+
+
+def _make_tasks(task: Any, n: int) -> list[PointNavigationTask]:
+    entries = _per_robot(task, n, "task")
+    if entries is None:
+        if isinstance(task, PointNavigationTask) and n > 1:
+            raise ValueError(
+                f"task is a single PointNavigationTask, which drives one robot; for "
+                f"n_robots={n} pass a dict of its arguments (shared by all robots) or a list "
+                f"of {n} tasks or dicts"
+            )
+        return [_envcommon.make_task(task, name="task", robot_idn=i) for i in range(n)]
+    tasks = []
+    for i, entry in enumerate(entries):
+        try:
+            tasks.append(_envcommon.make_task(entry, name=f"task[{i}]", robot_idn=i))
+        except ValueError as err:
+            raise _prefixed(f"task[{i}]", err) from None
+    if len({id(t) for t in tasks}) != n:
+        raise ValueError("task must not hold the same PointNavigationTask twice")
+    return tasks
+
+
+def _goal_separation(
+    scene: scenes.Scene, tasks: Sequence[PointNavigationTask], robots: Sequence[RobotSpec]
+) -> list[list[float]]:
+    """Minimum distance (m) between the goals of robots i and j (on the same floor).
+
+    ``max(tol_i + tol_j, r_i + r_j, cell)``: the success discs do not overlap, both robots
+    fit on their goals, and even point robots with no tolerance get goals a cell apart.
+    """
+    cells = [float(scene.floors[t.floor].resolution) for t in tasks]
+    return [
+        [
+            max(ti.goal_tolerance + tj.goal_tolerance, ri.radius + rj.radius, cell)
+            for tj, rj in zip(tasks, robots)
+        ]
+        for ti, ri, cell in zip(tasks, robots, cells)
+    ]
+
+
+class MultiPointNavEnv(ParallelEnv[str, Any, np.ndarray]):
+    """Many robots, one scene, one :class:`PointNavigationTask` each: a PettingZoo ParallelEnv.
+
+    The module docstring (:mod:`pointnav_core.parallel`) is this env's documentation page:
+    agents, spaces, state, rewards, starting state, episode end, stepping rules.
+
+    Parameters
+    ----------
+    scene : Scene, optional
+        The floors all robots share; default ``scenes.rooms(seed=0)``.
+    n_robots : int
+        Number of robots (agents ``robot_0`` ... ``robot_<n_robots - 1>``), >= 1.
+    robot : RobotSpec or dict or None, or a list of them
+        One spec for every robot, or one per robot.
+    task : dict or None, or a list of dicts, None or PointNavigationTask
+        ``PointNavigationTask`` arguments for every robot, or one entry per robot; the env
+        sets each task's ``robot_idn``.
+    backend : str or type or Backend
+        A registered backend name (``pointnav_core.backend.available_backends()``), a
+        backend class, or an instance.
+    backend_kwargs : dict, optional
+        Arguments of the backend's constructor (name or class only).
+    max_cycles : int
+        Steps after which every agent still alive is truncated, >= 1.
+    render_mode : {None, "rgb_array"}
+        ``"human"`` is accepted for PettingZoo's ``render_test`` but cannot render.
+    flatten_obs : bool
+        Flat ``(8,)`` observations instead of the ``Dict``.
+    finished : {"park", "remove"}
+        A finished robot stays as an obstacle, or leaves the world.
+    action_frequency : float
+        Control rate (Hz), > 0.
+
+    Raises
+    ------
+    ValueError
+        For any invalid argument, naming it (``task[2]: goal_tolerance ...``).
+    """
+
+    metadata = {"render_modes": ["rgb_array"], "name": "MultiPointNav-v0", "render_fps": 10}
+
+    def __init__(
+        self,
+        scene: scenes.Scene | None = None,
+        n_robots: int = 2,
+        robot: RobotSpec | Mapping[str, Any] | Sequence[Any] | None = None,
+        task: Mapping[str, Any] | Sequence[Any] | None = None,
+        backend: str | type | Backend = "kinematic",
+        backend_kwargs: Mapping[str, Any] | None = None,
+        max_cycles: int = 500,
+        render_mode: str | None = None,
+        *,
+        flatten_obs: bool = False,
+        finished: str = "park",
+        action_frequency: float = 10.0,
+    ) -> None:
+        if render_mode is not None and render_mode not in (*self.metadata["render_modes"], "human"):
+            raise ValueError(
+                f"render_mode must be None or one of {self.metadata['render_modes']}, "
+                f"got {render_mode!r}"
+            )
+        n = _check_int("n_robots", n_robots, 1)
+        self.max_cycles = _check_int("max_cycles", max_cycles, 1)
+        if not isinstance(finished, str) or finished not in FINISHED_MODES:
+            raise ValueError(f"finished must be one of {list(FINISHED_MODES)}, got {finished!r}")
+        if not isinstance(flatten_obs, (bool, np.bool_)):
+            raise ValueError(f"flatten_obs must be True or False, got {flatten_obs!r}")
+        frequency = _envcommon.check_action_frequency(action_frequency)
+        if scene is None:
+            scene = scenes.rooms(seed=0)
+        elif not isinstance(scene, scenes.Scene):
+            raise ValueError(f"scene must be a pointnav_core Scene or None, got {scene!r}")
+        if backend_kwargs is not None and not isinstance(backend_kwargs, Mapping):
+            raise ValueError(f"backend_kwargs must be None or a dict, got {backend_kwargs!r}")
+        self.robots = _make_robots(robot, n)
+        tasks = _make_tasks(task, n)
+
+        self.scene = scene
+        self.render_mode = render_mode
+        self.flatten_obs = bool(flatten_obs)
+        self.finished = finished
+        self.action_frequency = frequency
+        self.backend = make_backend(backend, **dict(backend_kwargs or {}))
+        self.backend.load(scene, self.robots, frequency)
+        for i, t in enumerate(tasks):
+            try:
+                t.load(self)  # fails here, naming the parameter, if it does not fit
+            except ValueError as err:
+                raise _prefixed(f"task[{i}]", err) from None
+        #: One task per robot, indexed by ``robot_idn`` (read it, don't replace entries).
+        self.tasks = tasks
+        self._separation = _goal_separation(scene, tasks, self.robots)
+        self._check_fixed_positions()
+        # Robots with a fixed start are placed first, so no sampled start can take it.
+        self._reset_order = sorted(range(n), key=lambda i: tasks[i].initial_pos is None)
+
+        self.possible_agents = [f"robot_{i}" for i in range(n)]
+        self.agents: list[str] = []
+        self._index = {agent: i for i, agent in enumerate(self.possible_agents)}
+        self.action_spaces = {
+            agent: _envcommon.action_space(rb)
+            for agent, rb in zip(self.possible_agents, self.robots)
+        }
+        self.observation_spaces = {
+            agent: _envcommon.observation_space(t, self.flatten_obs)
+            for agent, t in zip(self.possible_agents, tasks)
+        }
+        self.state_space = self._build_state_space()
+        self._state_low = self.state_space.low.astype(np.float64)
+        self._state_high = self.state_space.high.astype(np.float64)
+
+        # Per-agent hot-path values, one lookup per agent and step: robot index, action
+        # shape, drive, the task's step and its observation function.
+        self._observe = [t.get_low_dim_obs if self.flatten_obs else t.get_obs for t in tasks]
+        self._slots = {
+            agent: (i, (rb.action_dim,), rb.drive, t.step, self._observe[i])
+            for i, (agent, rb, t) in enumerate(zip(self.possible_agents, self.robots, tasks))
+        }
+        self._active = [False] * n
+        self._cycles = 0
+        self._np_random: np.random.Generator | None = None
+        self._np_random_seed: int | None = None
+        # True until a reset completes, and after a step or reset that failed half-way.
+        self._void = True
+        self._started = False  # whether reset() was ever called
+
+    # ------------------------------------------------------------------ construction
+    def _check_fixed_positions(self) -> None:
+        tasks, robots = self.tasks, self.robots
+        for i, ti in enumerate(tasks):
+            for j in range(i + 1, len(tasks)):
+                tj = tasks[j]
+                if ti.floor != tj.floor:
+                    continue
+                si, sj = ti.initial_pos, tj.initial_pos
+                if si is not None and sj is not None:
+                    gap = math.hypot(*(si[:2] - sj[:2]))
+                    need = robots[i].radius + robots[j].radius
+                    if gap < need:
+                        raise ValueError(
+                            f"task[{i}] and task[{j}] have fixed initial_pos {si[:2].tolist()} "
+                            f"and {sj[:2].tolist()}, {gap:.3g} m apart: the robots would "
+                            f"overlap (fixed starts must be at least the sum of the radii, "
+                            f"{need:.3g} m, apart)"
+                        )
+                gi, gj = ti.goal_pos, tj.goal_pos
+                if gi is not None and gj is not None:
+                    gap = math.hypot(*(gi[:2] - gj[:2]))
+                    need = self._separation[i][j]
+                    if gap < need:
+                        raise ValueError(
+                            f"task[{i}] and task[{j}] have fixed goal_pos {gi[:2].tolist()} and "
+                            f"{gj[:2].tolist()}, {gap:.3g} m apart: goals must be distinct, at "
+                            f"least max(sum of goal tolerances, sum of radii, one cell) = "
+                            f"{need:.3g} m apart"
+                        )
+
+    def _build_state_space(self) -> spaces.Box:
+        scene = self.scene
+        extents = [scene.floors[f].extent for f in range(scene.n_floors)]
+        heights = [float(scene.get_floor_height(f)) for f in range(scene.n_floors)]
+        xmin = min(e[0] for e in extents) - _XY_MARGIN
+        xmax = max(e[1] for e in extents) + _XY_MARGIN
+        ymin = min(e[2] for e in extents) - _XY_MARGIN
+        ymax = max(e[3] for e in extents) + _XY_MARGIN
+        zmin, zmax = min(heights) - _Z_BELOW, max(heights) + _Z_ABOVE
+        low = [xmin, ymin, zmin, -math.pi, xmin, ymin, zmin, 0.0]
+        high = [xmax, ymax, zmax, math.pi, xmax, ymax, zmax, 1.0]
+        n = len(self.robots)
+        return spaces.Box(
+            np.array(low * n, dtype=np.float32),
+            np.array(high * n, dtype=np.float32),
+            dtype=np.float32,
+        )
+
+    # ------------------------------------------------------------------ PettingZoo API
+    def observation_space(self, agent: str) -> spaces.Space[Any]:
+        """The observation space of ``agent`` (the same object on every call)."""
+        try:
+            return self.observation_spaces[agent]
+        except KeyError:
+            raise KeyError(
+                f"unknown agent {agent!r}; possible agents are {self.possible_agents}"
+            ) from None
+
+    def action_space(self, agent: str) -> spaces.Box:
+        """The action space of ``agent`` (the same object on every call)."""
+        try:
+            return self.action_spaces[agent]  # type: ignore[return-value]
+        except KeyError:
+            raise KeyError(
+                f"unknown agent {agent!r}; possible agents are {self.possible_agents}"
+            ) from None
+
+    @property
+    def np_random(self) -> np.random.Generator:
+        """The env's random generator, seeded by ``reset(seed=...)`` (the tasks' only source)."""
+        if self._np_random is None:
+            self._np_random, self._np_random_seed = seeding.np_random()
+        return self._np_random
+
+    def reset(
+        self, seed: int | None = None, options: dict[str, Any] | None = None
+    ) -> tuple[dict[str, Any], dict[str, dict[str, Any]]]:
+        """Start a new episode for every robot; the same ``seed`` gives the same episodes.
+
+        ``options`` is accepted for API compatibility and not used. Returns observations and
+        infos keyed by agent (each info is that robot's task info at step 0).
+        """
+        if options is not None and not isinstance(options, Mapping):
+            raise ValueError(f"options must be None or a dict, got {options!r}")
+        if seed is not None or self._np_random is None:
+            self._np_random, self._np_random_seed = seeding.np_random(seed)
+        self.agents = []
+        self._void = True
+        self._started = True
+        self.backend.reset()
+        infos: list[dict[str, Any]] = [{}] * len(self.tasks)
+        placed: list[int] = []
+        for i in self._reset_order:
+            infos[i] = self._reset_robot(i, placed)
+            placed.append(i)
+        self._active = [True] * len(self.tasks)
+        self._cycles = 0
+        self.agents = self.possible_agents[:]
+        self._void = False
+        observe = self._observe
+        observations = {agent: observe[i](self) for i, agent in enumerate(self.agents)}
+        return observations, {agent: infos[i] for i, agent in enumerate(self.agents)}
+
+    def _reset_robot(self, i: int, placed: list[int]) -> dict[str, Any]:
+        """Reset task ``i`` until its goal is distinct from the goals decided so far."""
+        task, tasks = self.tasks[i], self.tasks
+        if task.goal_pos is not None:  # fixed goals were checked against each other
+            return task.reset(self)
+        # Goals to keep clear of: those placed, and the fixed goals of robots still to come.
+        others = [
+            j
+            for j in range(len(tasks))
+            if j != i
+            and tasks[j].floor == task.floor
+            and (j in placed or tasks[j].goal_pos is not None)
+        ]
+        separation = self._separation[i]
+        clash = -1
+        for _ in range(PointNavigationTask.max_trials):
+            info = task.reset(self)
+            gx, gy = task.goal_xy  # type: ignore[misc]
+            for j in others:
+                ox, oy = tasks[j].goal_xy  # type: ignore[misc]
+                if math.hypot(gx - ox, gy - oy) < separation[j]:
+                    clash = j
+                    break
+            else:
+                return info
+        raise SamplingError(
+            f"could not sample a goal for robot {i} distinct from the other robots' goals in "
+            f"{PointNavigationTask.max_trials} trials: goals must be at least max(sum of goal "
+            f"tolerances, sum of radii, one cell) apart (last clash: robot {clash}, "
+            f"{separation[clash]:.3g} m); use fewer robots, smaller goal_tolerance or a "
+            f"larger scene"
+        )
+
+    def step(
+        self, actions: Mapping[str, Any]
+    ) -> tuple[
+        dict[str, Any],
+        dict[str, float],
+        dict[str, bool],
+        dict[str, bool],
+        dict[str, dict[str, Any]],
+    ]:
+        """Apply one action per alive agent for one control step.
+
+        Returns observations, rewards, terminations, truncations and infos, each keyed by
+        the agents that acted; those whose episode ended are no longer in ``agents``. See
+        the module docstring's "Stepping rules" for what is an error.
+        """
+        agents = self.agents
+        if not agents:
+            self._no_agents()
+        if type(actions) is not dict and not isinstance(actions, Mapping):
+            raise ValueError(
+                f"actions must be a dict of agent -> action for the agents in env.agents "
+                f"{agents}, got {type(actions).__name__}"
+            )
+        if len(actions) != len(agents):
+            self._bad_keys(actions)
+        # Check every action before anything moves: a rejected step changes nothing.
+        slots, check = self._slots, _envcommon.check_action
+        commands: dict[int, np.ndarray] = {}
+        todo = []
+        for agent in agents:
+            i, shape, drive, task_step, observe = slots[agent]
+            try:
+                action = actions[agent]
+            except KeyError:  # as many keys as agents, so one is missing and one is extra
+                self._bad_keys(actions)
+            if action is None:
+                raise ValueError(
+                    f"missing action for {agent}: got None, but {agent} is alive; every agent "
+                    f"in env.agents must act"
+                )
+            try:
+                action = check(action, shape, drive)
+            except ValueError as err:
+                raise ValueError(f"{agent}: {err}") from None
+            commands[i] = action
+            todo.append((agent, i, action, task_step, observe))
+
+        observations: dict[str, Any] = {}
+        rewards: dict[str, float] = {}
+        terminations: dict[str, bool] = {}
+        truncations: dict[str, bool] = {}
+        infos: dict[str, dict[str, Any]] = {}
+        try:
+            self.backend.step(commands)
+            self._cycles += 1
+            cut = self._cycles >= self.max_cycles
+            alive = []
+            ended = []
+            for agent, i, action, task_step, observe in todo:
+                reward, terminated, truncated, info = task_step(self, action)
+                if cut:
+                    truncated = True
+                observations[agent] = observe(self)
+                rewards[agent] = reward
+                terminations[agent] = terminated
+                truncations[agent] = truncated
+                infos[agent] = info
+                if terminated or truncated:
+                    ended.append(i)
+                else:
+                    alive.append(agent)
+            for i in ended:
+                self._finish(i)
+            self.agents = alive
+        except BaseException:
+            self.agents = []
+            self._void = True
+            raise
+        return observations, rewards, terminations, truncations, infos
+
+    def _finish(self, i: int) -> None:
+        self._active[i] = False
+        fell = self.tasks[i].termination_results.get("falling", (False, False))[0]
+        if self.finished == "remove" or fell:
+            self.backend.set_present(i, False)
+
+    def _no_agents(self) -> NoReturn:
+        if not self._started:
+            reason = "no episode has started: call reset() first"
+        elif self._void:
+            reason = (
+                "the last reset or step failed half-way, so there is no valid episode: "
+                "call reset()"
+            )
+        else:
+            reason = "every agent's episode has ended: call reset() to start new ones"
+        raise TaskStateError(f"step() needs alive agents, but env.agents is empty: {reason}")
+
+    def _bad_keys(self, actions: Mapping[str, Any]) -> NoReturn:
+        alive = set(self.agents)
+        for agent in self.agents:
+            if agent not in actions:
+                raise ValueError(
+                    f"missing action for {agent}: every agent in env.agents {self.agents} must "
+                    f"act (agents whose episode ended must not)"
+                )
+        for key in actions:
+            if key in alive:
+                continue
+            if key in self._index:
+                raise ValueError(
+                    f"got an action for {key}, which is not alive: its episode has ended; step() "
+                    f"takes actions only for the agents in env.agents {self.agents}"
+                )
+            raise ValueError(
+                f"got an action for unknown agent {key!r}; step() takes actions only for the "
+                f"agents in env.agents {self.agents}"
+            )
+        raise ValueError(  # only a Mapping whose len() disagrees with its keys gets here
+            f"actions must hold exactly one action per agent in env.agents {self.agents}, "
+            f"got {len(actions)} for keys {list(actions)}"
+        )
+
+    def state(self) -> NDArray[np.float32]:
+        """Return the global state: ``x, y, z, yaw, goal_x, goal_y, goal_z, active`` per robot.
+
+        A fresh float32 array of shape ``(8 * n_robots,)``, clipped to ``state_space``.
+
+        Raises
+        ------
+        TaskStateError
+            Before the first reset, or after a reset or step that failed half-way.
+        """
+        if self._void:
+            raise TaskStateError("state() needs an episode: call reset() first")
+        values: list[float] = []
+        backend = self.backend
+        for i, task in enumerate(self.tasks):
+            pos, quat = backend.get_pose(i)
+            x, y, z = pos.tolist()
+            qx, qy, qz, qw = quat.tolist()
+            yaw = math.atan2(2.0 * (qw * qz + qx * qy), 1.0 - 2.0 * (qy * qy + qz * qz))
+            gx, gy = task.goal_xy  # type: ignore[misc]
+            values += (x, y, z, yaw, gx, gy, task.floor_height, 1.0 if self._active[i] else 0.0)
+        state = np.clip(np.array(values), self._state_low, self._state_high)
+        return state.astype(np.float32)
+
+    def render(self) -> NDArray[np.uint8] | None:
+        """Return a top-down RGB image (H, W, 3) uint8 when ``render_mode="rgb_array"``."""
+        if self.render_mode is None:
+            gymnasium.logger.warn(
+                "You are calling render method without specifying any render mode. "
+                "You can specify the render_mode at initialization, e.g. "
+                'parallel_env(render_mode="rgb_array")'
+            )
+            return None
+        if self.render_mode == "human":
+            raise NotImplementedError(
+                'render_mode="human" is not supported (pointnav-core opens no window): use '
+                'render_mode="rgb_array" and show or save the frames '
+                "(pointnav_core.render.save_gif)"
+            )
+        # Imported here: drawing is only needed when rendering.
+        from pointnav_core.render import render_env
+
+        return render_env(self)
+
+    def close(self) -> None:
+        """Release the backend's resources (if it holds any)."""
+        close = getattr(self.backend, "close", None)
+        if callable(close):
+            close()
+
+    def __repr__(self) -> str:
+        return (
+            f"MultiPointNavEnv(n_robots={len(self.robots)}, backend="
+            f"{type(self.backend).__name__}, agents={self.agents})"
+        )
+
+
+def parallel_env(**kwargs: Any) -> MultiPointNavEnv:
+    """Build the parallel env: ``MultiPointNavEnv(**kwargs)`` (see the module docstring)."""
+    return MultiPointNavEnv(**kwargs)
+
+
+def raw_env(**kwargs: Any) -> AECEnv[str, Any, Any]:
+    """Build the AEC form without PettingZoo's order-enforcing wrapper."""
+    return parallel_to_aec_wrapper(MultiPointNavEnv(**kwargs))
+
+
+def env(**kwargs: Any) -> AECEnv[str, Any, Any]:
+    """Build the AEC form: ``parallel_to_aec(parallel_env(**kwargs))`` (order-enforced)."""
+    return parallel_to_aec(MultiPointNavEnv(**kwargs))
