@@ -19,6 +19,7 @@ from hypothesis.stateful import RuleBasedStateMachine, initialize, invariant, ru
 
 from pointnav_core.backend import RobotSpec
 from pointnav_core.maps import FREE, OBSTACLE, VOID, TraversableMap
+from pointnav_core.testing.conformance import obstacle_distance
 from pointnav_core.testing.strategies import robot_actions
 from pointnav_kinematic import KinematicBackend
 
@@ -96,21 +97,6 @@ def scene_of(tmap: TraversableMap) -> types.SimpleNamespace:
     )
 
 
-def obstacle_signed_distance(tmap: TraversableMap, x: float, y: float) -> float:
-    """Signed distance (m) from (x, y) to the nearest OBSTACLE square, negative inside."""
-    rows, cols = np.nonzero(tmap.codes == OBSTACLE)
-    if rows.size == 0:
-        return math.inf
-    res = tmap.resolution
-    x0 = tmap.origin[0] + cols * res
-    y0 = tmap.origin[1] + rows * res
-    gx = np.maximum(np.maximum(x0 - x, 0.0), x - (x0 + res))
-    gy = np.maximum(np.maximum(y0 - y, 0.0), y - (y0 + res))
-    inside = (x0 < x) & (x < x0 + res) & (y0 < y) & (y < y0 + res)
-    depth = np.minimum.reduce([x - x0, x0 + res - x, y - y0, y0 + res - y])
-    return float(np.where(inside, -depth, np.hypot(gx, gy)).min())
-
-
 def commanded_displacement(spec: RobotSpec, action, yaw: float, dt: float) -> tuple[float, float]:
     """Closed-form displacement of a constant command over dt (textbook formulas)."""
     a = np.clip(np.asarray(action, dtype=float), -1.0, 1.0)
@@ -144,7 +130,7 @@ def assert_no_overlap(
         if not backend.is_present(idn) or (placed is not None and idn not in placed):
             continue
         pos = backend.get_pose(idn)[0]
-        sd = obstacle_signed_distance(world.tmap, pos[0], pos[1])
+        sd = obstacle_distance(world.tmap, pos[0], pos[1])
         assert sd >= spec.radius - TOUCH, (
             f"robot {idn} at {pos} overlaps an obstacle by {spec.radius - sd}"
         )

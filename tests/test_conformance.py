@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import math
 import subprocess
 import sys
 import types
@@ -33,6 +32,7 @@ from pointnav_core.testing.conformance import (
     backend_factory,
     format_report,
     get_check,
+    obstacle_distance,
     run_checks,
 )
 from pointnav_kinematic import KinematicBackend
@@ -303,20 +303,6 @@ def test_cli_lists_the_checks(capsys):
 # ----------------------------------------------------------------------- properties, every backend
 
 
-def _overlap(tmap: TraversableMap, x: float, y: float, radius: float) -> float:
-    rows, cols = np.nonzero(tmap.codes == OBSTACLE)
-    if rows.size == 0:
-        return -math.inf
-    res = tmap.resolution
-    x0 = tmap.origin[0] + cols * res
-    y0 = tmap.origin[1] + rows * res
-    gx = np.maximum(np.maximum(x0 - x, 0.0), x - (x0 + res))
-    gy = np.maximum(np.maximum(y0 - y, 0.0), y - (y0 + res))
-    inside = (x0 < x) & (x < x0 + res) & (y0 < y) & (y < y0 + res)
-    depth = np.minimum.reduce([x - x0, x0 + res - x, y - y0, y0 + res - y])
-    return float(radius - np.where(inside, -depth, np.hypot(gx, gy)).min())
-
-
 @pytest.mark.parametrize("name", BACKENDS)
 @given(data=st.data())
 def test_a_robot_never_ends_a_step_in_an_obstacle_and_reports_its_motion(name, data):
@@ -339,7 +325,7 @@ def test_a_robot_never_ends_a_step_in_an_obstacle_and_reports_its_motion(name, d
         after = backend.get_pose(0)[0]
         np.testing.assert_allclose(backend.get_velocity(0)[0], (after - before) * 10.0, atol=1e-6)
         if after[2] == height:  # not falling
-            depth = _overlap(scene.floors[floor], after[0], after[1], spec.radius)
+            depth = spec.radius - obstacle_distance(scene.floors[floor], after[0], after[1])
             assert depth <= OVERLAP_TOLERANCE
 
 

@@ -10,6 +10,7 @@ import pytest
 
 from pointnav_core.backend import RobotSpec
 from pointnav_core.maps import FREE, OBSTACLE, VOID, TraversableMap
+from pointnav_core.testing.conformance import obstacle_distance
 from pointnav_kinematic import KinematicBackend
 
 IDENTITY = (0.0, 0.0, 0.0, 1.0)
@@ -43,21 +44,6 @@ def loaded(floors, specs, *, mode="slide", freq=10.0) -> KinematicBackend:
     backend = KinematicBackend(collision_mode=mode)
     backend.load(scene_of(*floors), specs, action_frequency=freq)
     return backend
-
-
-def obstacle_clearance(tmap: TraversableMap, x: float, y: float) -> float:
-    """Signed distance (m) from (x, y) to the nearest OBSTACLE square, negative inside."""
-    rows, cols = np.nonzero(tmap.codes == OBSTACLE)
-    if rows.size == 0:
-        return math.inf
-    res = tmap.resolution
-    x0 = tmap.origin[0] + cols * res
-    y0 = tmap.origin[1] + rows * res
-    gx = np.maximum(np.maximum(x0 - x, 0.0), x - (x0 + res))
-    gy = np.maximum(np.maximum(y0 - y, 0.0), y - (y0 + res))
-    inside = (x0 < x) & (x < x0 + res) & (y0 < y) & (y < y0 + res)
-    depth = np.minimum.reduce([x - x0, x0 + res - x, y - y0, y0 + res - y])
-    return float(np.where(inside, -depth, np.hypot(gx, gy)).min())
 
 
 def position(backend: KinematicBackend, idn: int = 0) -> np.ndarray:
@@ -248,7 +234,7 @@ def test_driving_into_a_wall_sets_contact_and_stops_at_the_wall():
     for _ in range(5):
         backend.step({0: [1.0, 0.0]})
         flags.append(backend.in_contact(0))
-        assert obstacle_clearance(floor, *position(backend)[:2]) >= 0.18 - 1e-9
+        assert obstacle_distance(floor, *position(backend)[:2]) >= 0.18 - 1e-9
     assert flags == [False, False, True, True, True]
     assert position(backend)[0] == pytest.approx(5.9 - 0.18, abs=1e-8)
 
@@ -263,7 +249,7 @@ def test_slide_mode_keeps_the_tangential_part_of_the_motion():
     # Only the tangential (+y) part of the 0.05 m step survives.
     assert pos[1] == pytest.approx(3.0 + 0.05 * math.sqrt(0.5), abs=1e-9)
     assert pos[0] == pytest.approx(5.72, abs=1e-6)
-    assert obstacle_clearance(floor, *pos[:2]) >= 0.18 - 1e-9
+    assert obstacle_distance(floor, *pos[:2]) >= 0.18 - 1e-9
 
 
 def test_stop_mode_stays_at_the_contact_point():
@@ -303,7 +289,7 @@ def test_concave_corner_stops_a_sliding_robot():
     backend.land(0, 0, (5.5, 5.5), quat(math.pi / 4))
     for _ in range(20):
         backend.step({0: [1.0, 0.0]})
-        assert obstacle_clearance(floor, *position(backend)[:2]) >= 0.18 - 1e-9
+        assert obstacle_distance(floor, *position(backend)[:2]) >= 0.18 - 1e-9
     np.testing.assert_allclose(position(backend)[:2], [5.72, 5.72], atol=1e-8)
     assert backend.in_contact(0)
 
@@ -321,7 +307,7 @@ def test_one_cell_wall_at_huge_speed_does_not_tunnel(radius, mode):
     x, y, _ = position(backend)
     assert backend.in_contact(0)
     assert x <= 2.0 - radius + 1e-9
-    assert obstacle_clearance(floor, x, y) >= radius - 1e-9
+    assert obstacle_distance(floor, x, y) >= radius - 1e-9
 
 
 def test_point_robot_never_enters_an_obstacle_cell():
@@ -336,7 +322,7 @@ def test_point_robot_never_enters_an_obstacle_cell():
             backend.step({0: [1.0, 0.2]})
             x, y, _ = position(backend)
             assert floor.cell_class_at([x, y]) != OBSTACLE
-            assert obstacle_clearance(floor, x, y) >= 0.0
+            assert obstacle_distance(floor, x, y) >= 0.0
 
 
 def test_two_robots_head_on_are_both_flagged_and_never_overlap():

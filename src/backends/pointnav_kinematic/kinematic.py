@@ -9,7 +9,15 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from pointnav_core.backend import RobotSpec
+from pointnav_core.backend import (
+    RobotSpec,
+    RobotStateBackend,
+    _planar_quat_floats,
+    check_load,
+    parse_orientation,
+    parse_position,
+    planar_quat,
+)
 from pointnav_core.maps import FREE, OBSTACLE
 from pointnav_kinematic.geometry import (
     FloorGeometry,
@@ -32,8 +40,6 @@ _PLACE = 1.0e-9
 _ACTIVE = 2.0e-9
 # Accepted overlap in is_valid_pose (touching is allowed).
 _TOUCH = 1.0e-9
-_GRAVITY = 9.81  # m/s^2
-_MIN_FIRST_DROP = 0.05  # m: a fall must be visible on the step it starts, at any rate
 _MAX_TURN = 0.25  # rad per sub-step: the chord stays close to the arc
 _MAX_SUBSTEPS = 1024  # beyond this, segments grow; collisions stay exact regardless
 _MAX_SLIDES = 4  # contacts resolved per segment (two walls and a corner, plus one)
@@ -106,35 +112,7 @@ def _arc(
     return s * (vx * c - vy * sn), s * (vx * sn + vy * c)
 
 
-def _planar_quat(yaw: float) -> NDArray[np.float64]:
-    half = 0.5 * math.remainder(yaw, 2.0 * math.pi)
-    return np.array((0.0, 0.0, math.sin(half), math.cos(half)))
-
-
-def _yaw_of(orientation: ArrayLike) -> float:
-    q = np.asarray(orientation, dtype=np.float64)
-    if q.shape != (4,) or not np.isfinite(q).all():
-        raise ValueError(
-            "orientation must be a finite (x, y, z, w) quaternion of shape (4,), "
-            f"got {orientation!r}"
-        )
-    x, y, z, w = q.tolist()
-    if x * x + y * y + z * z + w * w < 1e-12:
-        raise ValueError(f"orientation must be a non-zero quaternion, got {orientation!r}")
-    # Heading of the rotated +x axis; scale-free, so a non-unit quaternion is fine.
-    return math.atan2(2.0 * (w * z + x * y), w * w + x * x - y * y - z * z)
-
-
-def _xy(position: ArrayLike, *, allow_2d: bool) -> tuple[float, ...]:
-    p = np.asarray(position, dtype=np.float64)
-    shapes = ((2,), (3,)) if allow_2d else ((3,),)
-    if p.shape not in shapes or not np.isfinite(p).all():
-        want = "(x, y) or (x, y, z)" if allow_2d else "(x, y, z)"
-        raise ValueError(f"position must be finite {want} in metres, got {position!r}")
-    return tuple(p.tolist())
-
-
-class KinematicBackend:
+class KinematicBackend(RobotStateBackend):
     """Physics-free backend: robots are discs that follow their commands exactly.
 
     Each :meth:`step` integrates every robot's drive in closed form over one control
@@ -187,27 +165,13 @@ class KinematicBackend:
             raise ValueError(
                 f"collision_mode must be one of {list(COLLISION_MODES)}, got {collision_mode!r}"
             )
-        fall_speed_f = float(fall_speed)
-        if not math.isfinite(fall_speed_f) or fall_speed_f <= 0.0:
-            raise ValueError(f"fall_speed must be a finite number > 0 (m/s), got {fall_speed!r}")
+        super().__init__(fall_speed=fall_speed)
         self.collision_mode = collision_mode
-        self.fall_speed = fall_speed_f
         self._stop = collision_mode == "stop"
         self._floors: list[FloorGeometry] = []
         self._robots: list[_Robot] = []
-        self._dt = 0.1
 
     # ------------------------------------------------------------------ lifecycle
-    @property
-    def n_robots(self) -> int:
-        """Number of robots loaded (0 before :meth:`load`)."""
-        return len(self._robots)
-
-    @property
-    def action_frequency(self) -> float:
-        """Control steps per second (Hz)."""
-        return 1.0 / self._dt
-
     def load(
         self, scene: Any, robots: Sequence[RobotSpec], action_frequency: float = 10.0
     ) -> None:
@@ -227,27 +191,13 @@ class KinematicBackend:
         -----
         Robots start present, unplaced, at rest at x = y = 0 on floor 0.
         """
-        freq = float(action_frequency)
-        if not math.isfinite(freq) or freq <= 0.0:
-            raise ValueError(
-                f"action_frequency must be a finite number > 0 (Hz), got {action_frequency!r}"
-            )
-        specs = list(robots)
-        for i, spec in enumerate(specs):
-            if not isinstance(spec, RobotSpec):
-                raise TypeError(f"robots[{i}] must be a RobotSpec, got {type(spec).__name__}")
-        n_floors = int(scene.n_floors)
-        if n_floors < 1 or len(scene.floors) != n_floors:
-            raise ValueError(
-                f"scene must have n_floors >= 1 floors, got n_floors={n_floors} "
-                f"and {len(scene.floors)} maps"
-            )
+        specs, n_floors, dt = check_load(scene, robots, action_frequency)
         self._floors = [
             FloorGeometry(scene.floors[f], float(scene.get_floor_height(f)))
             for f in range(n_floors)
         ]
         self._robots = [_Robot(spec, self._floors[0]) for spec in specs]
-        self._dt = 1.0 / freq
+        self._dt = dt
 
     def reset(self) -> None:
         """Return every robot to its state after :meth:`load`, keeping its pose.
@@ -270,22 +220,6 @@ class KinematicBackend:
         rb.vel = (0.0, 0.0, 0.0, 0.0)
         rb.cmd = (0.0, 0.0, 0.0)
 
-    def _robot(self, idn: int) -> _Robot:
-        if isinstance(idn, (bool, np.bool_)) or not isinstance(idn, (int, np.integer)):
-            raise TypeError(f"idn must be an int robot index, got {idn!r}")
-        if not 0 <= idn < len(self._robots):
-            if not self._robots:
-                raise RuntimeError("no robots: call load(scene, robots) first")
-            raise ValueError(f"idn must be in [0, {len(self._robots)}), got {idn}")
-        return self._robots[idn]
-
-    def _floor_geom(self, floor: int) -> FloorGeometry:
-        if isinstance(floor, (bool, np.bool_)) or not isinstance(floor, (int, np.integer)):
-            raise TypeError(f"floor must be an int floor index, got {floor!r}")
-        if not 0 <= floor < len(self._floors):
-            raise ValueError(f"floor must be in [0, {len(self._floors)}), got {floor}")
-        return self._floors[floor]
-
     # ------------------------------------------------------------------ poses
     def land(self, idn: int, floor: int, position: ArrayLike, orientation: ArrayLike) -> None:
         """Place robot ``idn`` at rest on ``floor``: x, y from ``position``, z = floor height.
@@ -302,9 +236,9 @@ class KinematicBackend:
             ``(x, y, z, w)`` quaternion; only its yaw matters.
         """
         rb = self._robot(idn)
-        geom = self._floor_geom(floor)
-        xy = _xy(position, allow_2d=True)
-        yaw = _yaw_of(orientation)
+        geom = self._floor(floor)
+        xy = parse_position(position, allow_2d=True)
+        yaw = parse_orientation(orientation)
         rb.floor = int(floor)
         rb.geom = geom
         rb.fast = geom.fast_clearance(rb.radius)
@@ -326,8 +260,8 @@ class KinematicBackend:
             ``(x, y, z, w)`` quaternion; the backend is planar, so only its yaw is kept.
         """
         rb = self._robot(idn)
-        x, y, z = _xy(position, allow_2d=False)
-        yaw = _yaw_of(orientation)
+        x, y, z = parse_position(position)
+        yaw = parse_orientation(orientation)
         rb.x, rb.y, rb.z, rb.yaw = x, y, z, yaw
         rb.placed = True
         self._at_rest(rb)
@@ -339,42 +273,17 @@ class KinematicBackend:
         yaw in [-pi, pi], so its w is >= 0.
         """
         rb = self._robot(idn)
-        return np.array((rb.x, rb.y, rb.z)), _planar_quat(rb.yaw)
+        return np.array((rb.x, rb.y, rb.z)), planar_quat(rb.yaw)
 
-    def get_velocity(self, idn: int) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-        """Return robot ``idn``'s world linear (3,) m/s and angular (3,) rad/s velocity.
+    def get_pose_floats(self, idn: int) -> tuple[float, ...]:
+        """Return :meth:`get_pose`'s seven numbers as a tuple of floats, without arrays.
 
-        These are the effective velocities of the last step: displacement and yaw change
-        divided by the step's duration (zero after load, reset, land and set_pose).
+        ``(x, y, z, qx, qy, qz, qw)``. Not part of the :class:`~pointnav_core.backend.Backend`
+        protocol: an optional fast path that the task reads on every step instead of
+        :meth:`get_pose`, only when no subclass has overridden ``get_pose``.
         """
         rb = self._robot(idn)
-        vx, vy, vz, wz = rb.vel
-        return np.array((vx, vy, vz)), np.array((0.0, 0.0, wz))
-
-    def get_robot_floor(self, idn: int) -> int:
-        """The floor robot ``idn`` was last landed on (0 until then)."""
-        return self._robot(idn).floor
-
-    def in_contact(self, idn: int) -> bool:
-        """Whether robot ``idn`` hit or pushed against an obstacle or robot in the last step."""
-        return self._robot(idn).contact
-
-    def set_present(self, idn: int, present: bool) -> None:
-        """Take robot ``idn`` out of the world (``False``) or bring it back (``True``).
-
-        An absent robot keeps its pose (and a fall in progress) but is not moved by
-        :meth:`step`, has no velocity and collides with nothing; bringing it back does not
-        check whether its pose is still free.
-        """
-        rb = self._robot(idn)
-        rb.present = bool(present)
-        if not rb.present:
-            rb.contact = False
-            rb.vel = (0.0, 0.0, 0.0, 0.0)
-
-    def is_present(self, idn: int) -> bool:
-        """Whether robot ``idn`` is in the world."""
-        return self._robot(idn).present
+        return (rb.x, rb.y, rb.z, *_planar_quat_floats(rb.yaw))
 
     def is_valid_pose(
         self,
@@ -405,11 +314,11 @@ class KinematicBackend:
             overlaps no other present, placed, non-falling robot on that floor.
         """
         rb = self._robot(idn)
-        geom = rb.geom if floor is None else self._floor_geom(floor)
+        geom = rb.geom if floor is None else self._floor(floor)
         fl = rb.floor if floor is None else int(floor)
-        xy = _xy(position, allow_2d=True)
+        xy = parse_position(position, allow_2d=True)
         if orientation is not None:
-            _yaw_of(orientation)
+            parse_orientation(orientation)
         x, y = xy[0], xy[1]
         cell = geom.cell_index(x, y)
         if cell < 0 or geom.codes[cell] != FREE:  # VOID, OBSTACLE or off the map
@@ -493,19 +402,6 @@ class KinematicBackend:
             rb.vel = (dx / dt, dy / dt, 0.0, w)
         if slow:
             self._slow_step(slow, moving, dt)
-
-    def _fall(self, rb: _Robot, *, first: bool) -> None:
-        dt = self._dt
-        if first:
-            rb.falling = True
-            rb.fall_speed = self.fall_speed
-        v0 = rb.fall_speed
-        drop = v0 * dt + 0.5 * _GRAVITY * dt * dt
-        if first and drop < _MIN_FIRST_DROP:
-            drop = _MIN_FIRST_DROP
-        rb.fall_speed = v0 + _GRAVITY * dt
-        rb.z -= drop
-        rb.vel = (0.0, 0.0, -drop / dt, 0.0)
 
     def _slow_step(self, slow: list[_Robot], solid: list[_Robot], dt: float) -> None:
         # All slow robots advance together in sub-steps, in index order within each, so

@@ -11,7 +11,15 @@ import numpy as np
 import pymunk
 from numpy.typing import ArrayLike, NDArray
 
-from pointnav_core.backend import RobotSpec
+from pointnav_core.backend import (
+    RobotSpec,
+    RobotStateBackend,
+    _planar_quat_floats,
+    check_load,
+    parse_orientation,
+    parse_position,
+    planar_quat,
+)
 from pointnav_core.maps import VOID
 from pointnav_pymunk.geometry import floor_pieces
 
@@ -37,8 +45,6 @@ _PUSH_EPS = 1e-9  # m/s: a command into a contact faster than this is a hit
 _MASS = 1.0  # kg, a driving robot
 _HOLD_MASS = 1e6  # kg, a robot told to stand still (braked: it is not shoved)
 _MOTOR_MARGIN = 4.0  # motor force lets a robot reverse at full speed within a sub-step, x2
-_GRAVITY = 9.81  # m/s^2
-_MIN_FIRST_DROP = 0.05  # m: a fall must be visible on the step it starts, at any rate
 
 _WALL, _ROBOT = 1, 2  # collision types, and shape-filter categories
 _WALLS_ONLY = pymunk.ShapeFilter(mask=_WALL)
@@ -185,33 +191,6 @@ def _empty_spaces(spaces: list[pymunk.Space]) -> None:
     spaces.clear()
 
 
-def _planar_quat(yaw: float) -> NDArray[np.float64]:
-    half = 0.5 * math.remainder(yaw, 2.0 * math.pi)
-    return np.array((0.0, 0.0, math.sin(half), math.cos(half)))
-
-
-def _yaw_of(orientation: ArrayLike) -> float:
-    q = np.asarray(orientation, dtype=np.float64)
-    if q.shape != (4,) or not np.isfinite(q).all():
-        raise ValueError(
-            "orientation must be a finite (x, y, z, w) quaternion of shape (4,), "
-            f"got {orientation!r}"
-        )
-    x, y, z, w = q.tolist()
-    if x * x + y * y + z * z + w * w < 1e-12:
-        raise ValueError(f"orientation must be a non-zero quaternion, got {orientation!r}")
-    return math.atan2(2.0 * (w * z + x * y), w * w + x * x - y * y - z * z)
-
-
-def _xy(position: ArrayLike, *, allow_2d: bool) -> tuple[float, ...]:
-    p = np.asarray(position, dtype=np.float64)
-    shapes = ((2,), (3,)) if allow_2d else ((3,),)
-    if p.shape not in shapes or not np.isfinite(p).all():
-        want = "(x, y) or (x, y, z)" if allow_2d else "(x, y, z)"
-        raise ValueError(f"position must be finite {want} in metres, got {position!r}")
-    return tuple(p.tolist())
-
-
 def _chord(yaw: float, vx: float, vy: float, w: float, h: float) -> tuple[float, float]:
     """World velocity whose straight motion over ``h`` s ends where the exact arc ends.
 
@@ -260,7 +239,7 @@ def _project(
     return best
 
 
-class PymunkBackend:
+class PymunkBackend(RobotStateBackend):
     """2D rigid-body backend on pymunk: discs with real contacts against walls and robots.
 
     Each floor is one pymunk ``Space`` holding the floor's obstacles as static convex
@@ -339,31 +318,17 @@ class PymunkBackend:
             raise ValueError(
                 f"min_substeps must be an int in [1, {_MAX_SUBSTEPS}], got {min_substeps!r}"
             )
-        fall_speed_f = float(fall_speed)
-        if not math.isfinite(fall_speed_f) or fall_speed_f <= 0.0:
-            raise ValueError(f"fall_speed must be a finite number > 0 (m/s), got {fall_speed!r}")
+        super().__init__(fall_speed=fall_speed)
         self.min_substeps = int(min_substeps)
-        self.fall_speed = fall_speed_f
         self._floors: list[_Floor] = []
         self._robots: list[_Robot] = []
         self._by_shape: dict[pymunk.Shape, _Robot] = {}
-        self._dt = 0.1
         self._measuring = False
         # The live spaces, emptied when this backend is collected or at interpreter exit.
         self._spaces: list[pymunk.Space] = []
         weakref.finalize(self, _empty_spaces, self._spaces)
 
     # ------------------------------------------------------------------ lifecycle
-    @property
-    def n_robots(self) -> int:
-        """Number of robots loaded (0 before :meth:`load`)."""
-        return len(self._robots)
-
-    @property
-    def action_frequency(self) -> float:
-        """Control steps per second (Hz)."""
-        return 1.0 / self._dt
-
     def load(
         self, scene: Any, robots: Sequence[RobotSpec], action_frequency: float = 10.0
     ) -> None:
@@ -386,21 +351,7 @@ class PymunkBackend:
         -----
         Robots start present, unplaced, at rest at x = y = 0 on floor 0.
         """
-        freq = float(action_frequency)
-        if not math.isfinite(freq) or freq <= 0.0:
-            raise ValueError(
-                f"action_frequency must be a finite number > 0 (Hz), got {action_frequency!r}"
-            )
-        specs = list(robots)
-        for i, spec in enumerate(specs):
-            if not isinstance(spec, RobotSpec):
-                raise TypeError(f"robots[{i}] must be a RobotSpec, got {type(spec).__name__}")
-        n_floors = int(scene.n_floors)
-        if n_floors < 1 or len(scene.floors) != n_floors:
-            raise ValueError(
-                f"scene must have n_floors >= 1 floors, got n_floors={n_floors} "
-                f"and {len(scene.floors)} maps"
-            )
+        specs, n_floors, dt = check_load(scene, robots, action_frequency)
         plans = list(getattr(scene, "floor_plans", None) or ())
         plans += [None] * (n_floors - len(plans))
         self._floors = [
@@ -415,7 +366,7 @@ class PymunkBackend:
         self._robots = [_Robot(spec) for spec in specs]
         for rb in self._robots:
             rb.z = self._floors[0].height
-        self._dt = 1.0 / freq
+        self._dt = dt
         self._rebuild()
 
     def _rebuild(self) -> None:
@@ -454,22 +405,6 @@ class PymunkBackend:
         rb.touching = []
         rb.body.velocity = (0.0, 0.0)
         rb.body.angular_velocity = 0.0
-
-    def _robot(self, idn: int) -> _Robot:
-        if isinstance(idn, (bool, np.bool_)) or not isinstance(idn, (int, np.integer)):
-            raise TypeError(f"idn must be an int robot index, got {idn!r}")
-        if not 0 <= idn < len(self._robots):
-            if not self._robots:
-                raise RuntimeError("no robots: call load(scene, robots) first")
-            raise ValueError(f"idn must be in [0, {len(self._robots)}), got {idn}")
-        return self._robots[idn]
-
-    def _floor(self, floor: int) -> _Floor:
-        if isinstance(floor, (bool, np.bool_)) or not isinstance(floor, (int, np.integer)):
-            raise TypeError(f"floor must be an int floor index, got {floor!r}")
-        if not 0 <= floor < len(self._floors):
-            raise ValueError(f"floor must be in [0, {len(self._floors)}), got {floor}")
-        return self._floors[floor]
 
     # ------------------------------------------------------------------ membership
     def _sync_space(self, rb: _Robot) -> None:
@@ -517,8 +452,8 @@ class PymunkBackend:
         """
         rb = self._robot(idn)
         fl = self._floor(floor)
-        xy = _xy(position, allow_2d=True)
-        yaw = _yaw_of(orientation)
+        xy = parse_position(position, allow_2d=True)
+        yaw = parse_orientation(orientation)
         self._at_rest(rb)
         rb.floor = fl.index
         rb.z = fl.height
@@ -540,8 +475,8 @@ class PymunkBackend:
             ``(x, y, z, w)`` quaternion; the backend is planar, so only its yaw is kept.
         """
         rb = self._robot(idn)
-        x, y, z = _xy(position, allow_2d=False)
-        yaw = _yaw_of(orientation)
+        x, y, z = parse_position(position)
+        yaw = parse_orientation(orientation)
         self._at_rest(rb)
         rb.z = z
         rb.placed = True
@@ -556,44 +491,29 @@ class PymunkBackend:
         """
         rb = self._robot(idn)
         x, y = rb.body.position
-        return np.array((x, y, rb.z)), _planar_quat(rb.body.angle)
+        return np.array((x, y, rb.z)), planar_quat(rb.body.angle)
 
-    def get_velocity(self, idn: int) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-        """Return robot ``idn``'s world linear (3,) m/s and angular (3,) rad/s velocity.
+    def get_pose_floats(self, idn: int) -> tuple[float, ...]:
+        """Return :meth:`get_pose`'s seven numbers as a tuple of floats, without arrays.
 
-        These are the effective velocities of the last step: displacement and yaw change
-        divided by the step's duration (zero after load, reset, land and set_pose).
+        ``(x, y, z, qx, qy, qz, qw)``. Not part of the :class:`~pointnav_core.backend.Backend`
+        protocol: an optional fast path that the task reads on every step instead of
+        :meth:`get_pose`, only when no subclass has overridden ``get_pose``.
         """
         rb = self._robot(idn)
-        vx, vy, vz, wz = rb.vel
-        return np.array((vx, vy, vz)), np.array((0.0, 0.0, wz))
-
-    def get_robot_floor(self, idn: int) -> int:
-        """The floor robot ``idn`` was last landed on (0 until then)."""
-        return self._robot(idn).floor
-
-    def in_contact(self, idn: int) -> bool:
-        """Whether robot ``idn`` hit or pushed against an obstacle or robot in the last step."""
-        return self._robot(idn).contact
+        x, y = rb.body.position
+        return (x, y, rb.z, *_planar_quat_floats(rb.body.angle))
 
     def set_present(self, idn: int, present: bool) -> None:
         """Take robot ``idn`` out of the world (``False``) or bring it back (``True``).
 
-        An absent robot keeps its pose (and a fall in progress) but is not moved by
-        :meth:`step`, has no velocity and collides with nothing; bringing it back does not
-        check whether its pose is still free.
+        As :meth:`RobotStateBackend.set_present`; the robot's body also stops, and leaves
+        or rejoins its floor's space.
         """
-        rb = self._robot(idn)
-        rb.present = bool(present)
-        if not rb.present:
-            rb.contact = False
-            rb.vel = (0.0, 0.0, 0.0, 0.0)
+        super().set_present(idn, present)
+        rb = self._robots[idn]
         rb.body.velocity = (0.0, 0.0)
         self._sync_space(rb)
-
-    def is_present(self, idn: int) -> bool:
-        """Whether robot ``idn`` is in the world."""
-        return self._robot(idn).present
 
     def is_valid_pose(
         self,
@@ -628,9 +548,9 @@ class PymunkBackend:
         """
         rb = self._robot(idn)
         fl = self._floors[rb.floor] if floor is None else self._floor(floor)
-        xy = _xy(position, allow_2d=True)
+        xy = parse_position(position, allow_2d=True)
         if orientation is not None:
-            _yaw_of(orientation)
+            parse_orientation(orientation)
         x, y = xy[0], xy[1]
         if fl.code(x, y) == VOID:
             return False
@@ -850,15 +770,3 @@ class PymunkBackend:
         dt = self._dt
         self._fall(rb, first=True)
         rb.vel = ((x - x0) / dt, (y - y0) / dt, rb.vel[2], (rb.body.angle - yaw0) / dt)
-
-    def _fall(self, rb: _Robot, *, first: bool) -> None:
-        dt = self._dt
-        if first:
-            rb.fall_speed = self.fall_speed
-        v0 = rb.fall_speed
-        drop = v0 * dt + 0.5 * _GRAVITY * dt * dt
-        if first and drop < _MIN_FIRST_DROP:
-            drop = _MIN_FIRST_DROP
-        rb.fall_speed = v0 + _GRAVITY * dt
-        rb.z -= drop
-        rb.vel = (0.0, 0.0, -drop / dt, 0.0)

@@ -49,7 +49,8 @@ Check                       What it asks of a backend
 Tolerances are stated with each check: a robot may end a step overlapping an obstacle or
 another robot by at most :data:`OVERLAP_TOLERANCE` (1 mm), positions read back after
 ``set_pose`` agree to :data:`POSE_TOLERANCE`, and open-space motion to
-:data:`MOTION_TOLERANCE`.
+:data:`MOTION_TOLERANCE`. Overlap with obstacles is measured by :func:`obstacle_distance`,
+an exact reference that backend tests may use too.
 """
 
 from __future__ import annotations
@@ -81,6 +82,7 @@ __all__ = [
     "backend_factory",
     "format_report",
     "get_check",
+    "obstacle_distance",
     "run_checks",
 ]
 
@@ -149,11 +151,40 @@ def _fmt(values: Any) -> str:
     return "(" + ", ".join(f"{float(v):.9g}" for v in np.ravel(values)) + ")"
 
 
-def _obstacle_overlap(tmap: TraversableMap, x: float, y: float, radius: float) -> float:
-    """How deep (m) a disc at (x, y) overlaps the OBSTACLE cell squares; <= 0 when clear."""
+def obstacle_distance(tmap: TraversableMap, x: float, y: float) -> float:
+    """Return the signed distance (m) from a point to the OBSTACLE cell squares of a map.
+
+    An exact reference, computed square by square with numpy and independent of any
+    backend: a disc of radius ``r`` centred at ``(x, y)`` overlaps an obstacle by
+    ``r - obstacle_distance(tmap, x, y)`` (clear when that is <= 0).
+
+    Parameters
+    ----------
+    tmap : TraversableMap
+        The floor; its OBSTACLE cells are closed squares of side ``tmap.resolution``.
+    x, y : float
+        World coordinates in metres.
+
+    Returns
+    -------
+    float
+        The distance to the nearest OBSTACLE square; inside a square, minus the depth
+        into the square it is deepest in (the distance to that square's nearest side);
+        ``inf`` when the map has no OBSTACLE cell.
+
+    Examples
+    --------
+    >>> tmap = TraversableMap([[0, 0, 0, 0, 1]], resolution=1.0)  # a wall at 4 <= x <= 5
+    >>> obstacle_distance(tmap, 2.5, 0.5)
+    1.5
+    >>> obstacle_distance(tmap, 4.25, 0.5)
+    -0.25
+    >>> obstacle_distance(TraversableMap([[0]], resolution=1.0), 0.5, 0.5)
+    inf
+    """
     rows, cols = np.nonzero(np.asarray(tmap.codes) == OBSTACLE)
     if rows.size == 0:
-        return -math.inf
+        return math.inf
     res = tmap.resolution
     x0 = tmap.origin[0] + cols * res
     y0 = tmap.origin[1] + rows * res
@@ -161,8 +192,7 @@ def _obstacle_overlap(tmap: TraversableMap, x: float, y: float, radius: float) -
     gy = np.maximum(np.maximum(y0 - y, 0.0), y - (y0 + res))
     inside = (x0 < x) & (x < x0 + res) & (y0 < y) & (y < y0 + res)
     depth = np.minimum.reduce([x - x0, x0 + res - x, y - y0, y0 + res - y])
-    distance = np.where(inside, -depth, np.hypot(gx, gy))
-    return float(radius - distance.min())
+    return float(np.where(inside, -depth, np.hypot(gx, gy)).min())
 
 
 def _expect_clear_of_walls(
@@ -171,7 +201,7 @@ def _expect_clear_of_walls(
     for idn in idns:
         x, y, _ = _xyz(backend, idn)
         floor = backend.get_robot_floor(idn)
-        depth = _obstacle_overlap(scene.floors[floor], x, y, specs[idn].radius)
+        depth = specs[idn].radius - obstacle_distance(scene.floors[floor], x, y)
         _expect(
             depth <= OVERLAP_TOLERANCE,
             f"robot {idn} (radius {specs[idn].radius} m) ended {when} at {_fmt((x, y))} "
