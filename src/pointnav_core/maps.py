@@ -222,11 +222,15 @@ class TraversableMap:
 
     def cell_class_at(self, xy: ArrayLike) -> NDArray[np.uint8]:
         """Cell code at world points: FREE, OBSTACLE, or VOID (also for off-map points)."""
+        return self._sample(self.codes, xy, VOID).astype(np.uint8)
+
+    def _sample(self, grid: NDArray[Any], xy: ArrayLike, outside: Any) -> NDArray[Any]:
+        """Values of a per-cell ``grid`` at world points; ``outside`` for off-map points."""
         cells = self.world_to_cell(xy)
         inside = self.in_bounds(cells)
         rows = np.where(inside, cells[..., 0], 0)
         cols = np.where(inside, cells[..., 1], 0)
-        return np.where(inside, self.codes[rows, cols], VOID).astype(np.uint8)
+        return np.where(inside, grid[rows, cols], outside)
 
     # ------------------------------------------------------------------ erosion
     @property
@@ -358,21 +362,11 @@ class TraversableMap:
 
     def is_usable(self, xy: ArrayLike, radius: float = 0.0) -> NDArray[np.bool_]:
         """Whether world points lie in usable cells for a robot of ``radius`` (off-map: False)."""
-        cells = self.world_to_cell(xy)
-        inside = self.in_bounds(cells)
-        usable = self.usable(radius)
-        rows = np.where(inside, cells[..., 0], 0)
-        cols = np.where(inside, cells[..., 1], 0)
-        return inside & usable[rows, cols]
+        return self._sample(self.usable(radius), xy, False)
 
     def component_at(self, xy: ArrayLike, radius: float = 0.0) -> NDArray[np.int32]:
         """Component id at world points (0 where the point is not usable or off the map)."""
-        cells = self.world_to_cell(xy)
-        inside = self.in_bounds(cells)
-        labels = self.components(radius)
-        rows = np.where(inside, cells[..., 0], 0)
-        cols = np.where(inside, cells[..., 1], 0)
-        return np.where(inside, labels[rows, cols], 0).astype(np.int32)
+        return self._sample(self.components(radius), xy, 0).astype(np.int32)
 
     def __repr__(self) -> str:
         h, w = self.shape
