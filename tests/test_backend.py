@@ -134,6 +134,33 @@ def test_scale_action_returns_a_fresh_array():
     assert action[0] == 0.5 and spec.scale_action(action)[0] == 0.25
 
 
+@pytest.mark.parametrize(
+    "dtype", [np.float32, np.float64, ">f8", np.float16, np.longdouble, np.int64, object]
+)
+@pytest.mark.parametrize("drive", ["differential", "holonomic"])
+def test_scale_action_of_an_array_is_that_of_its_float64_values(drive, dtype):
+    # 1-d float32 and float64 arrays skip the conversion (what env.step passes); every
+    # dtype, layout and shape must give what the values as a list of floats give.
+    spec = RobotSpec(max_linear_velocity=0.7, max_angular_velocity=1.3, drive=drive)
+    values = np.array([0.3, -1.7, 0.55, 2.0, -0.123456789], dtype=np.float64)
+    for action in (values[: spec.action_dim], values[::2][: spec.action_dim]):
+        action = action.astype(dtype)
+        expected = spec._scaled(np.asarray(action, dtype=np.float64).tolist())
+        scaled = spec._scaled(action)
+        assert scaled == expected and all(type(v) is float for v in scaled)
+    n = spec.action_dim
+    for wrong in (values[: n + 1], values[: n - 1], values[:4].reshape(2, 2)):
+        with pytest.raises(ValueError) as from_array:
+            spec._scaled(wrong.astype(dtype))
+        with pytest.raises(ValueError) as from_list:
+            spec._scaled(wrong.astype(np.float64).tolist())
+        assert str(from_array.value) == str(from_list.value)
+    if np.dtype(dtype).kind == "f":
+        bad = np.full(spec.action_dim, np.nan, dtype=dtype)
+        with pytest.raises(ValueError, match=r"action must be finite, got \[nan, nan"):
+            spec._scaled(bad)
+
+
 @pytest.mark.parametrize("bad", [float("nan"), float("inf"), -float("inf")])
 def test_scale_action_rejects_non_finite_values(bad):
     with pytest.raises(ValueError, match="action must be finite"):

@@ -19,7 +19,7 @@ import math
 import numpy as np
 import pytest
 
-from pointnav_core.backend import RobotSpec, available_backends
+from pointnav_core.backend import RobotSpec, available_backends, get_backend
 from pointnav_core.env import PointNavEnv
 from pointnav_core.maps import FREE, OBSTACLE, VOID
 from pointnav_core.rewards import PointGoalReward
@@ -583,3 +583,118 @@ def test_omnigibson_accessors(backend):
     np.testing.assert_allclose(path[[0, -1]], [[1.0, 1.0], [3.0, 1.0]], atol=1e-9)
     waypoints, _ = task.get_shortest_path_to_goal(env, start_xy_pos=(2.0, 1.0))
     assert waypoints.shape == (env.scene.num_waypoints, 2)
+
+
+# ------------------------------------------------------------------------------ fast paths
+
+
+def obstacle_course() -> np.ndarray:
+    """A room with a pillar and a trench: random driving meets walls, falls and goals."""
+    grid = room(30, 40)
+    grid[12:18, 15:18] = OBSTACLE
+    grid[4:26, 26:32] = VOID
+    return grid
+
+
+def drive_randomly(env: PointNavEnv, steps: int, seed: int):
+    """Yield each step's result for ``steps`` random actions (mostly forward, so that the
+    robot reaches walls and holes), resetting as episodes end."""
+    rng = np.random.default_rng(seed)
+    env.reset(seed=seed)
+    for _ in range(steps):
+        result = env.step(rng.uniform((-0.2, -1.0), (1.0, 1.0)).astype(np.float32))
+        yield result
+        if result[2] or result[3]:
+            env.reset()
+
+
+def test_float_twins_give_exactly_the_numbers_of_get_pose_and_get_velocity(backend):
+    # The task reads get_pose_floats / get_velocity_floats on every step when a backend
+    # has them: they must be get_pose / get_velocity without the arrays, bit for bit.
+    env = make_env(backend, obstacle_course(), termination_config={"max_steps": 30})
+    b = env.backend
+    for _ in drive_randomly(env, 200, seed=1):  # with contacts and falls
+        position, orientation = b.get_pose(0)
+        linear, angular = b.get_velocity(0)
+        pose, velocity = b.get_pose_floats(0), b.get_velocity_floats(0)
+        assert pose == (*position.tolist(), *orientation.tolist())
+        assert velocity == (*linear.tolist(), *angular.tolist())
+        assert all(type(v) is float for v in pose + velocity)
+
+
+def arrays_only(backend: str) -> type:
+    """The backend class, read only through the protocol's get_pose and get_velocity."""
+    base = get_backend(backend)
+
+    class ArraysOnly(base):
+        def get_pose(self, idn):
+            return super().get_pose(idn)
+
+        def get_velocity(self, idn):
+            return super().get_velocity(idn)
+
+    return ArraysOnly
+
+
+@pytest.mark.parametrize(("reward_type", "polar"), [("geodesic", False), ("l2", True)])
+def test_the_float_twins_and_the_protocol_methods_give_the_same_episodes(
+    backend, reward_type, polar
+):
+    # Overriding get_pose and get_velocity turns the twins off (the task must not bypass an
+    # override), so the second env runs the protocol path: everything must be identical.
+    # Seed 1 drives into the trench, seed 2 reaches goals; both touch walls.
+    runs = []
+    for backend_cls in (get_backend(backend), arrays_only(backend)):
+        env = PointNavEnv(scene=Scene.from_array(obstacle_course(), RES), robot=ROBOT,
+                          task={"reward_type": reward_type, "goal_in_polar": polar,
+                                "goal_tolerance": 0.6, "termination_config": {"max_steps": 30}},
+                          backend=backend_cls)
+        steps = []
+        for seed in (1, 2):
+            for obs, reward, terminated, truncated, info in drive_randomly(env, 200, seed):
+                obs_bytes = {key: (value.dtype, value.tobytes()) for key, value in obs.items()}
+                steps.append((obs_bytes, reward, terminated, truncated, info))
+        runs.append(steps)
+    fast, protocol = runs
+    ended = [name for *_, info in fast for name, c in info["termination_conditions"].items()
+             if c["done"]]
+    assert {"falling", "pointgoal", "timeout"} <= set(ended)
+    assert fast == protocol
+
+
+def test_a_backend_subclass_that_changes_get_velocity_is_read_through_it(backend):
+    class Boastful(get_backend(backend)):
+        def get_velocity(self, idn):
+            linear, angular = super().get_velocity(idn)
+            return linear * 2.0, angular * 2.0
+
+    observed = []
+    for backend_cls in (get_backend(backend), Boastful):
+        env = PointNavEnv(scene=Scene.from_array(room(), RES), robot=ROBOT, backend=backend_cls,
+                          task={"initial_pos": (1.0, 1.0, 0.0), "initial_quat": quat(0.0),
+                                "goal_pos": (3.0, 1.0, 0.0)})
+        env.reset(seed=0)
+        obs, *_ = env.step(np.array([0.5, 0.5], np.float32))
+        observed.append(obs)
+    plain, boastful = observed
+    assert plain["robot_lin_vel"][0] > 0.2 and plain["robot_ang_vel"][2] > 0.7
+    np.testing.assert_array_equal(boastful["robot_lin_vel"], 2.0 * plain["robot_lin_vel"])
+    np.testing.assert_array_equal(boastful["robot_ang_vel"], 2.0 * plain["robot_ang_vel"])
+
+
+def test_a_get_pose_patched_on_the_backend_instance_is_read_from_the_next_episode(backend):
+    env = make_env(backend, room(), initial_pos=(1.0, 1.0, 0.0), initial_quat=quat(0.0),
+                   goal_pos=(3.0, 1.0, 0.0))
+    env.reset(seed=0)
+    env.step(STOP)
+    real = env.backend.get_pose
+
+    def shifted(idn):
+        position, orientation = real(idn)
+        return position + np.array([1.0, 0.0, 0.0]), orientation
+
+    env.backend.get_pose = shifted
+    env.reset(seed=0)
+    _, _, _, _, info = env.step(STOP)
+    assert env.task.robot_xyz[0] == pytest.approx(2.0, abs=1e-12)  # the patched position
+    assert info["distance_to_goal"] == pytest.approx(1.0, abs=1e-9)

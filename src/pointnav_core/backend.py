@@ -28,6 +28,13 @@ Units are metres, seconds and radians; the world frame has x, y on the floor and
 quaternions are ``(x, y, z, w)``. Actions are in ``[-1, 1]`` and are turned into velocities
 by :meth:`RobotSpec.scale_action`.
 
+Outside the protocol, a backend may offer a fast path for the task's per-step reads:
+``get_pose_floats(idn)`` and ``get_velocity_floats(idn)``, the numbers of ``get_pose`` and
+``get_velocity`` as one flat tuple of Python floats (no arrays). The task uses such a *float
+twin* only if it is defined at least as far down the class hierarchy as the method it
+mirrors (so a subclass that overrides ``get_pose`` alone is still read through it), and
+falls back to the protocol method otherwise. Both shipped backends have them.
+
 For backend authors, the module also holds what the shipped backends share and a new one
 may reuse: :class:`RobotStateBackend` (a base class with the robot index checks, the
 simple accessors, presence and the fall of a robot over VOID), and the argument checks

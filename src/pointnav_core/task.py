@@ -223,6 +223,32 @@ def _check_index(name: str, value: Any) -> int:
     return int(value)
 
 
+def _owner(cls: type, name: str) -> type | None:
+    """The class in ``cls``'s MRO that defines attribute ``name`` (None if none does)."""
+    for klass in cls.__mro__:
+        if name in vars(klass):
+            return klass
+    return None
+
+
+def _float_twin(backend: Any, twin: str, method: str) -> Any:
+    """``backend``'s bound ``twin`` of protocol ``method``, or None to call ``method`` itself.
+
+    A backend may offer ``get_pose_floats(idn)`` and ``get_velocity_floats(idn)``: the
+    numbers of ``get_pose(idn)`` and ``get_velocity(idn)`` as one flat tuple of Python
+    floats, without building arrays (the task reads them on every step). They are optional;
+    a twin is used only if it is defined at least as far down the class hierarchy as the
+    method it mirrors and neither is set on the instance, so that a subclass or a patch
+    that changes ``get_pose`` but not its twin is still read through ``get_pose``.
+    """
+    if twin in getattr(backend, "__dict__", ()) or method in getattr(backend, "__dict__", ()):
+        return None
+    twin_owner, method_owner = _owner(type(backend), twin), _owner(type(backend), method)
+    if twin_owner is None or method_owner is None or not issubclass(twin_owner, method_owner):
+        return None
+    return getattr(backend, twin)
+
+
 def _merge_config(
     name: str, defaults: Mapping[str, Any], overrides: Mapping[str, Any] | None
 ) -> Mapping[str, Any]:
@@ -400,11 +426,20 @@ class PointNavigationTask:
             raise ValueError(f"reward_config: {err}") from None
         self._terminations: Mapping[str, TerminationCondition] = MappingProxyType(terminations)
         self._rewards: Mapping[str, RewardFunction] = MappingProxyType(rewards)
+        # The same, as tuples of (name, object) pairs for the per-step loops (both
+        # mappings are read-only, so these never go stale).
+        self._termination_items = tuple(terminations.items())
+        self._reward_items = tuple(rewards.items())
 
         self._state = IDLE
         # Bound at the first meeting with an env (load): caches for the per-step path.
         self._env: Any = None
         self._spec: Any = None
+        # The backend last stepped with, and its float twins of get_pose / get_velocity
+        # (None: read the protocol methods); see _float_twin.
+        self._backend: Any = None
+        self._pose_floats: Any = None
+        self._velocity_floats: Any = None
         self._floor_height = 0.0
         self._obs_low: tuple[float, ...] = ()
         self._obs_high: tuple[float, ...] = ()
@@ -743,6 +778,7 @@ class PointNavigationTask:
             self._clear_markers()
             if env is not self._env:
                 self.load(env)
+            self._bind(env.backend)  # every episode: a backend patched since is seen
             self._sample_episode(env)
             pos, quat = env.backend.get_pose(self._robot_idn)
             x, y, z = pos.tolist()
@@ -770,7 +806,7 @@ class PointNavigationTask:
             False,
             False,
             {name: 0.0 for name in self._rewards},
-            self._results,
+            {name: {"done": False, "success": False} for name in self._terminations},
         )
 
     def _sample_episode(self, env: TaskEnv) -> None:
@@ -906,14 +942,22 @@ class PointNavigationTask:
         if (self._state, _Event.STEP) not in _TRANSITIONS:
             self.check_step()
         try:
-            pos, quat = env.backend.get_pose(self._robot_idn)
-            x, y, z = pos.tolist()
+            backend = env.backend
+            if backend is not self._backend:
+                self._bind(backend)
+            idn = self._robot_idn
+            if self._pose_floats is not None:
+                x, y, z, *quat = self._pose_floats(idn)
+            else:
+                pos, orientation = backend.get_pose(idn)
+                x, y, z = pos.tolist()
+                quat = orientation.tolist()
             px, py, _ = self._robot_xyz
             self._path_length += math.hypot(x - px, y - py)
             self._robot_xyz = (x, y, z)
-            self._robot_quat = quat.tolist()
+            self._robot_quat = quat
             self._steps += 1
-            contact = bool(env.backend.in_contact(self._robot_idn))
+            contact = bool(backend.in_contact(idn))
             self._in_contact = contact
             if contact:
                 self._collisions += 1
@@ -921,14 +965,18 @@ class PointNavigationTask:
             self._distance_to_goal = geodesic
             self._potential = self._potential_at(x, y, geodesic, self._potential)
 
+            # Each condition's result, and the same as info["termination_conditions"].
             results: dict[str, tuple[bool, bool]] = {}
+            conditions: dict[str, dict[str, bool]] = {}
             done = success = terminated = truncated = False
-            for name, condition in self._terminations.items():
+            for name, condition in self._termination_items:
                 result = condition.step(self, env, action)
                 results[name] = result
-                if result[0]:
+                is_done, is_success = result
+                conditions[name] = {"done": is_done, "success": is_success}
+                if is_done:
                     done = True
-                    if result[1]:
+                    if is_success:
                         success = True
                     if condition.is_truncation:
                         truncated = True
@@ -937,9 +985,11 @@ class PointNavigationTask:
             self._results = results
             self._success = success
 
-            breakdown = {name: fn.step(self, env, action) for name, fn in self._rewards.items()}
+            breakdown: dict[str, float] = {}
+            for name, fn in self._reward_items:
+                breakdown[name] = fn.step(self, env, action)
             reward = sum(breakdown.values(), 0.0)  # the sum a user gets from the breakdown
-            info = self._info(success, done, breakdown, results)
+            info = self._info(success, done, breakdown, conditions)
             if self._visualize_path:
                 self._place_waypoints(x, y)
         except BaseException:
@@ -947,6 +997,15 @@ class PointNavigationTask:
             raise
         self._state = _TRANSITIONS[(self._state, _Event.END if done else _Event.STEP)]
         return reward, terminated, truncated, info
+
+    def _bind(self, backend: Any) -> None:
+        """Remember ``backend`` and its float twins of get_pose and get_velocity, if any.
+
+        Done at every reset, and by a step or an observation that meets another backend.
+        """
+        self._pose_floats = _float_twin(backend, "get_pose_floats", "get_pose")
+        self._velocity_floats = _float_twin(backend, "get_velocity_floats", "get_velocity")
+        self._backend = backend
 
     # ------------------------------------------------------------------ markers
     def _clear_markers(self) -> None:
@@ -990,7 +1049,7 @@ class PointNavigationTask:
         success: bool,
         done: bool,
         breakdown: dict[str, float],
-        results: Mapping[str, tuple[bool, bool]],
+        conditions: dict[str, dict[str, bool]],
     ) -> dict[str, Any]:
         d0, length, d_t = self._geodesic_dist, self._path_length, self._distance_to_goal
         return {
@@ -1003,9 +1062,7 @@ class PointNavigationTask:
             "distance_to_goal": d_t,
             "collisions": self._collisions,
             "reward_breakdown": breakdown,
-            "termination_conditions": {
-                name: {"done": d, "success": s} for name, (d, s) in results.items()
-            },
+            "termination_conditions": conditions,
             "episode_length": self._steps,
             "potential_metric": self._metric,
         }
@@ -1020,7 +1077,15 @@ class PointNavigationTask:
 
     def _obs_values(self, env: TaskEnv) -> list[float]:
         """Goal (2), linear velocity (3), angular velocity (3), all in the robot frame."""
-        lin, ang = env.backend.get_velocity(self._robot_idn)
+        backend = env.backend
+        if backend is not self._backend:
+            self._bind(backend)
+        if self._velocity_floats is not None:
+            vx, vy, vz, wx, wy, wz = self._velocity_floats(self._robot_idn)
+        else:
+            lin, ang = backend.get_velocity(self._robot_idn)
+            vx, vy, vz = lin.tolist()
+            wx, wy, wz = ang.tolist()
         # The pose recorded at the last reset or step: the one the metrics saw.
         x, y, _ = self._robot_xyz
         qx, qy, qz, qw = self._robot_quat
@@ -1036,8 +1101,6 @@ class PointNavigationTask:
         r20 = s * (qx * qz - qy * qw)
         r21 = s * (qy * qz + qx * qw)
         r22 = 1.0 - s * (qx * qx + qy * qy)
-        vx, vy, vz = lin.tolist()
-        wx, wy, wz = ang.tolist()
         # The goal in the heading frame: rotate by -yaw, yaw = atan2(R10, R00).
         gx, gy = self._goal_xy  # type: ignore[misc]
         dx, dy = gx - x, gy - y
