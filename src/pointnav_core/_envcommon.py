@@ -19,6 +19,7 @@ from typing import Any
 import numpy as np
 from gymnasium import spaces
 
+from pointnav_core import scenes
 from pointnav_core.backend import RobotSpec
 from pointnav_core.task import PointNavigationTask
 
@@ -123,6 +124,25 @@ def make_task(
     raise ValueError(
         f"{name} must be a PointNavigationTask, a dict of its arguments, or None, got {task!r}"
     )
+
+
+def check_world_args(
+    scene: Any, flatten_obs: Any, action_frequency: Any, backend_kwargs: Any
+) -> tuple[scenes.Scene, float]:
+    """Check the constructor arguments both envs share; return the scene and the frequency.
+
+    ``scene`` None means the default generated house (``scenes.rooms(seed=0)``).
+    """
+    if not isinstance(flatten_obs, (bool, np.bool_)):
+        raise ValueError(f"flatten_obs must be True or False, got {flatten_obs!r}")
+    frequency = check_action_frequency(action_frequency)
+    if scene is None:
+        scene = scenes.rooms(seed=0)
+    elif not isinstance(scene, scenes.Scene):
+        raise ValueError(f"scene must be a pointnav_core Scene or None, got {scene!r}")
+    if backend_kwargs is not None and not isinstance(backend_kwargs, Mapping):
+        raise ValueError(f"backend_kwargs must be None or a dict, got {backend_kwargs!r}")
+    return scene, frequency
 
 
 def check_action_frequency(action_frequency: Any) -> float:

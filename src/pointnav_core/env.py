@@ -152,17 +152,11 @@ class PointNavEnv(gym.Env[Any, np.ndarray]):
                 f"render_mode must be None or one of {self.metadata['render_modes']}, "
                 f"got {render_mode!r}"
             )
-        if not isinstance(flatten_obs, (bool, np.bool_)):
-            raise ValueError(f"flatten_obs must be True or False, got {flatten_obs!r}")
-        frequency = _envcommon.check_action_frequency(action_frequency)
-        if scene is None:
-            scene = scenes.rooms(seed=0)
-        elif not isinstance(scene, scenes.Scene):
-            raise ValueError(f"scene must be a pointnav_core Scene or None, got {scene!r}")
+        scene, frequency = _envcommon.check_world_args(
+            scene, flatten_obs, action_frequency, backend_kwargs
+        )
         self.robot = _envcommon.make_robot(robot)
         self.task = _envcommon.make_task(task)
-        if backend_kwargs is not None and not isinstance(backend_kwargs, Mapping):
-            raise ValueError(f"backend_kwargs must be None or a dict, got {backend_kwargs!r}")
         self.scene = scene
         self.robots = (self.robot,)
         self.render_mode = render_mode

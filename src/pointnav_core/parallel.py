@@ -335,15 +335,9 @@ class MultiPointNavEnv(ParallelEnv[str, Any, np.ndarray]):
         self.max_cycles = _check_int("max_cycles", max_cycles, 1)
         if not isinstance(finished, str) or finished not in FINISHED_MODES:
             raise ValueError(f"finished must be one of {list(FINISHED_MODES)}, got {finished!r}")
-        if not isinstance(flatten_obs, (bool, np.bool_)):
-            raise ValueError(f"flatten_obs must be True or False, got {flatten_obs!r}")
-        frequency = _envcommon.check_action_frequency(action_frequency)
-        if scene is None:
-            scene = scenes.rooms(seed=0)
-        elif not isinstance(scene, scenes.Scene):
-            raise ValueError(f"scene must be a pointnav_core Scene or None, got {scene!r}")
-        if backend_kwargs is not None and not isinstance(backend_kwargs, Mapping):
-            raise ValueError(f"backend_kwargs must be None or a dict, got {backend_kwargs!r}")
+        scene, frequency = _envcommon.check_world_args(
+            scene, flatten_obs, action_frequency, backend_kwargs
+        )
         self.robots = _make_robots(robot, n)
         tasks = _make_tasks(task, n)
 
