@@ -129,7 +129,6 @@ def accuracy(args):
     sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "tests"))
     from test_geodesic_accuracy import RADIUS as R, relative_errors
 
-    import shapely  # noqa: F401
     from geodesic_reference import ContinuousGeodesic, house_plan
     from scipy.sparse import csgraph
 
