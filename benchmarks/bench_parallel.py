@@ -28,7 +28,6 @@ import time
 from collections.abc import Callable
 from typing import Any
 
-
 from pointnav_core import parallel
 
 
