@@ -67,10 +67,6 @@ def test_gymnasium_make_finds_the_registered_env_and_it_passes_check_env():
     check_env(env.unwrapped, skip_render_check=True)
 
 
-@pytest.mark.skipif(
-    "register_envs" not in getattr(pointnav_core, "__all__", ()),
-    reason="pointnav_core/__init__.py does not call registration.register_envs() yet",
-)
 def test_gymnasium_make_finds_the_env_after_importing_the_package_only():
     # A fresh interpreter: nothing but the package import may register the id.
     code = (
