@@ -12,7 +12,6 @@ import pytest
 from gymnasium.utils.env_checker import check_env
 from gymnasium.wrappers import FlattenObservation
 
-import pointnav_core
 from pointnav_core.backend import RobotSpec, available_backends
 from pointnav_core.env import PointNavEnv
 from pointnav_core.maps import FREE, OBSTACLE
