@@ -568,7 +568,7 @@ class GoalField:
             keys[i, :n][~self.planner.tangent(self.corner_ids, self.corner_pos - p)] = np.inf
         best = np.full(len(points), _UNREACHABLE, dtype=np.int32)
         todo = np.arange(len(points))
-        batch = 4
+        batch = 32
         while len(todo):
             k = min(batch, n + 1)
             sub = keys[todo]
