@@ -6,7 +6,7 @@
 | Parallel API       | Yes                                                                  |
 | Manual Control     | No                                                                   |
 | Agents             | `agents = ["robot_0", ..., "robot_<n_robots - 1>"]`                 |
-| Agents             | `n_robots` (default 2)                                               |
+| Number of Agents   | `n_robots` (default 2)                                               |
 | Action Shape       | `(2,)` differential drive, `(3,)` holonomic                          |
 | Action Values      | `[-1, 1]`, float32                                                   |
 | Observation Shape  | `Dict` of `xy_pos_to_goal (2,)`, `robot_lin_vel (3,)`,               |
