@@ -1,8 +1,10 @@
 """Hypothesis settings profiles for the whole suite.
 
-``dev`` is fast for local runs; ``ci`` draws more examples and has no deadline (CI machines
-are shared and slow). Choose with ``HYPOTHESIS_PROFILE``; the default is ``ci`` when the
-``CI`` environment variable is set, else ``dev``.
+``dev`` is fast for local runs and draws new examples each time; ``ci`` draws more examples,
+has no deadline (CI machines are shared and slow) and is derandomised, so a CI verdict is
+reproducible (a red CI is a real, replayable failure, not a flake). Choose with
+``HYPOTHESIS_PROFILE``; the default is ``ci`` when the ``CI`` environment variable is set,
+else ``dev``.
 """
 
 import os
@@ -14,6 +16,7 @@ settings.register_profile(
     "ci",
     max_examples=200,
     deadline=None,
+    derandomize=True,
     print_blob=True,
     suppress_health_check=[HealthCheck.too_slow],
 )
