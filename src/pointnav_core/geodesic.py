@@ -9,17 +9,21 @@ whose two side neighbours towards it are usable. So the geodesic is exact on the
 visibility graph of those corners (computed once per floor and radius), not a count of grid
 steps, and paths are any-angle (string-pulled) from the true source to the true target.
 
-A :class:`GoalField` holds, for one goal, the geodesic distance of every corner (one
-Dijkstra run on the corner graph) and assigns every cell its best visible corner lazily, a
-tile of cells at a time, so that any later query to the same goal is a table lookup:
+A :class:`GoalField` holds, for one goal, the exact geodesic distance of every corner (one
+Dijkstra run on the corner graph); exact point queries search the corners a point sees. On
+its first per-step lookup it also builds a root table, so that any later query to the same
+goal is a lookup:
 
 ====================  =====================================================  ===========
 stage                 work                                                   cached per
 ====================  =====================================================  ===========
-:class:`Planner`      usable cells, components, corners, corner graph        floor, radius
+:class:`Planner`      usable cells, components, corners, corner graph,       floor, radius
+                      cell graph with one seed node per corner
 :class:`GoalField`    goal visibility, Dijkstra over corners                 floor, radius, goal
-tile of 16x16 cells   nearest visible corner of each cell (vectorised)       goal field
-query                 ``|p - corner| + D(corner)``                           --
+root table            one seeded multi-source Dijkstra on the cell grid      goal field
+                      proposes each cell's root corner
+a cell's first use    root pulled taut, checked visible, else searched       goal field
+query                 ``|p - root| + D(root)``                               --
 ====================  =====================================================  ===========
 
 Internally everything is in *grid units* (cells) and grid coordinates ``(row, col)`` whose
