@@ -109,8 +109,19 @@ def test_from_movingai_reads_walls_as_obstacles(tmp_path):
     path = tmp_path / "tiny.map"
     path.write_text("type octile\nheight 3\nwidth 4\nmap\n....\n.@@.\n....\n")
     scene = Scene.from_movingai(path, resolution=1.0)
-    assert scene.floors[0].codes.tolist()[1] == [0, 1, 1, 0]
+    tmap = scene.floors[0]
+    # Character (1, 0..3) still covers x in [0, 4), y in [1, 2).
+    assert tmap.cell_class_at([[0.5, 1.5], [1.5, 1.5], [2.5, 1.5], [3.5, 1.5]]).tolist() == [0, 1, 1, 0]
     assert scene.get_shortest_path(0, (0.5, 1.5), (3.5, 1.5), entire_path=True)[1] > 3.0
+
+
+def test_from_movingai_out_of_bounds_is_a_wall_not_a_drop(tmp_path):
+    # SPEC: out of bounds in a game map is a wall. A passable border must not be a cliff.
+    path = tmp_path / "open.map"
+    path.write_text("type octile\nheight 2\nwidth 2\nmap\n..\n..\n")
+    tmap = Scene.from_movingai(path, resolution=1.0).floors[0]
+    just_outside = [[-0.5, 0.5], [2.5, 0.5], [0.5, -0.5], [0.5, 2.5], [-0.5, -0.5]]
+    assert tmap.cell_class_at(just_outside).tolist() == [OBSTACLE] * 5
 
 
 def test_from_movingai_names_an_unknown_character(tmp_path):

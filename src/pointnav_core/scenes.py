@@ -36,7 +36,7 @@ from pointnav_core import floorplans, loaders
 from pointnav_core.errors import SamplingError
 from pointnav_core.floorplans import FloorPlan
 from pointnav_core.geodesic import GoalField, Planner, planner_for, resample_path
-from pointnav_core.maps import TraversableMap
+from pointnav_core.maps import OBSTACLE, TraversableMap
 
 __all__ = ["Scene", "FloorGoalField", "robot_radius", "rooms", "maze", "clutter"]
 
@@ -244,9 +244,14 @@ class Scene:
         """Scene from a MovingAI ``.map`` grid benchmark file.
 
         ``resolution`` is metres per map character; the default 0.5 m makes a corridor one
-        character wide passable for the default robot (radius 0.18 m).
+        character wide passable for the default robot (radius 0.18 m). Out of bounds in a
+        game map is a wall, not a drop: the map is framed by one ring of OBSTACLE cells, and
+        the origin moves out by one cell so that character ``(row, col)`` still covers
+        ``[col, col + 1) x [row, row + 1)`` times ``resolution``.
         """
-        return cls([TraversableMap(loaders.read_movingai(path), resolution)], **kwargs)
+        codes = np.pad(loaders.read_movingai(path), 1, constant_values=OBSTACLE)
+        res = float(resolution)
+        return cls([TraversableMap(codes, res, origin=(-res, -res))], **kwargs)
 
     @staticmethod
     def _heights(heights: Sequence[float] | None, n: int) -> list[float]:
