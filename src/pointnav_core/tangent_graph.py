@@ -49,6 +49,7 @@ from scipy.sparse import csgraph
 from scipy.spatial import cKDTree
 
 from pointnav_core.collision import FloorCollision, convex_corners
+from pointnav_core.geodesic import path_length, resample_path
 
 if TYPE_CHECKING:
     from pointnav_core.maps import TraversableMap
@@ -436,11 +437,8 @@ _EDGE_DTYPE = np.dtype([("to", np.int64), ("side", np.int8), ("arr", np.float64)
 
 
 def _rings(poly: Any) -> list[Any]:
-    """Rings of a polygon oriented so that the blocked side is on the left (CCW exterior)."""
-    import shapely
-
-    oriented = shapely.orient_polygons(poly) if hasattr(shapely, "orient_polygons") else poly
-    parts = getattr(oriented, "geoms", [oriented])
+    """Exterior rings of a polygon's parts, counter-clockwise (the blocked side on the left)."""
+    parts = getattr(poly, "geoms", [poly])
     rings = []
     for part in parts:
         ext = part.exterior
@@ -910,43 +908,3 @@ def _cell_graph(usable: NDArray[np.bool_], res: float) -> sparse.csr_matrix:
     return sparse.csr_matrix(
         (np.concatenate(wt), (np.concatenate(src), np.concatenate(dst))), shape=(h * w, h * w)
     )
-
-
-def path_length(points: ArrayLike) -> float:
-    """Length of a polyline, shape (N, 2), in its own units."""
-    pts = np.asarray(points, dtype=np.float64)
-    if len(pts) < 2:
-        return 0.0
-    return float(np.hypot(*np.diff(pts, axis=0).T).sum())
-
-
-def resample_path(points: ArrayLike, spacing: float, count: int) -> NDArray[np.float64]:
-    """First ``count`` points spaced ``spacing`` apart along a polyline, padded with its end.
-
-    Parameters
-    ----------
-    points : array_like, shape (N, 2)
-        The polyline, N >= 1.
-    spacing : float
-        Arc-length spacing (same units as ``points``), > 0.
-    count : int
-        Number of points returned, >= 1.
-
-    Returns
-    -------
-    ndarray, shape (count, 2)
-        Points at arc lengths 0, spacing, 2*spacing, ...; past the end of the polyline the
-        last point repeats (as OmniGibson pads its waypoints with the target).
-
-    Examples
-    --------
-    >>> resample_path([[0.0, 0.0], [1.0, 0.0]], 0.4, 4).tolist()
-    [[0.0, 0.0], [0.4, 0.0], [0.8, 0.0], [1.0, 0.0]]
-    """
-    pts = np.asarray(points, dtype=np.float64)
-    seg = np.hypot(*np.diff(pts, axis=0).T) if len(pts) > 1 else np.zeros(0)
-    arc = np.concatenate([[0.0], np.cumsum(seg)])
-    s = np.minimum(np.arange(count) * float(spacing), arc[-1])
-    x = np.interp(s, arc, pts[:, 0])
-    y = np.interp(s, arc, pts[:, 1])
-    return np.stack([x, y], axis=1)
