@@ -102,3 +102,25 @@ def test_goal_field_exact_queries_equal_the_single_pair_search():
             assert got == math.inf
         else:
             assert got == pytest.approx(d, abs=1e-6)
+
+
+def test_lookup_fast_path_equals_the_vectorised_root_check():
+    # GoalField.distance re-derives the tangent in scalar math on the hot path; at every
+    # cell centre whose root was checked it must give the vectorised check's value.
+    from pointnav_core import scenes
+
+    scene = scenes.rooms(seed=3)
+    tmap = scene.floors[0]
+    planner = planner_for(tmap, 0.18)
+    _, goal = scene.get_random_point(0, robot=0.18, rng=5)
+    field = planner.goal_field(goal[:2])
+    field.distance(0.0, 0.0)  # builds the table
+    kind = np.asarray(field._table["kind"])
+    labels = np.asarray(field._table["label"])
+    cells = np.flatnonzero(kind == 2)[::7]
+    px = np.asarray(field._table["px"])[cells]
+    py = np.asarray(field._table["py"])[cells]
+    want = field._root_values(cells, labels[cells], px, py)
+    got = np.array([field.distance(x, y) for x, y in zip(px, py)])
+    assert len(cells) > 100
+    np.testing.assert_allclose(got, want, rtol=0, atol=1e-9)

@@ -27,7 +27,7 @@ cheaply. Distances are exact in the geometry; paths keep at least ``r`` from the
 (within 1e-9 m), and arcs are drawn as polylines that circumscribe the circle, so that the
 drawn path never cuts the clearance.
 
-A :class:`GoalField` holds a whole Dijkstra run from one goal (exact distance of every
+A goal field (:class:`~pointnav_core.tangent_field.GoalField`) holds a whole Dijkstra run from one goal (exact distance of every
 node) and answers exact point queries by the tangents a point sees. For the per-step hot
 path it also builds a root table on first use: a seeded multi-source Dijkstra on the grid
 proposes each cell's root node, every proposal is checked (the tangent from the root to the
@@ -44,8 +44,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
-from scipy import ndimage, sparse
-from scipy.sparse import csgraph
+from scipy import ndimage
 from scipy.spatial import cKDTree
 
 from pointnav_core.collision import FloorCollision, convex_corners
@@ -53,8 +52,9 @@ from pointnav_core.geodesic import path_length, resample_path
 
 if TYPE_CHECKING:
     from pointnav_core.maps import TraversableMap
+    from pointnav_core.tangent_field import GoalField
 
-__all__ = ["Planner", "GoalField", "planner_for", "resample_path", "path_length"]
+__all__ = ["Planner", "planner_for", "resample_path", "path_length"]
 
 _TWO_PI = 2.0 * math.pi
 _ANG_TOL = 1e-9
@@ -372,6 +372,8 @@ class Planner:
         key = (float(g[0]), float(g[1]))
         field = self._fields.pop(key, None)
         if field is None:
+            from pointnav_core.tangent_field import GoalField
+
             field = GoalField(self, g)
         self._fields[key] = field  # most recently used last
         self._trim_fields()
@@ -563,348 +565,3 @@ def _arc_points(p: Planner, node: int, s: int, pos_from: float, pos_to: float) -
         out.append(np.array([cx + reach * math.cos(ang), cy + reach * math.sin(ang)]))
     out.append(np.array(p.node_point(node, s, pos_to)))
     return out
-
-
-class GoalField:
-    """Geodesic distances (m) to one goal from every point of the floor.
-
-    Build it through :meth:`Planner.goal_field` (cached). A Dijkstra run from the goal
-    settles every node the goal reaches; :meth:`point_distance` and :meth:`path` are exact
-    for any point; :meth:`distance` is the per-step lookup through a root table.
-
-    Parameters
-    ----------
-    planner : Planner
-    goal : array_like, shape (2,)
-        Goal in world metres.
-    """
-
-    def __init__(self, planner: Planner, goal: ArrayLike) -> None:
-        self.planner = planner
-        self.goal = np.asarray(goal, dtype=np.float64).reshape(-1)[:2].copy()
-        gx, gy = float(self.goal[0]), float(self.goal[1])
-        self.goal_usable = planner.is_clear(gx, gy)
-        self._search = _Search(planner)
-        if self.goal_usable:
-            for c, s, pos, length in planner.point_links(gx, gy):
-                self._search.push(length, c, s, pos, -1, 0.0)
-            self._search.run()
-        self._table: dict[str, Any] | None = None
-
-    @property
-    def reachable_from_anywhere(self) -> bool:
-        """False when the robot does not fit at the goal (nothing reaches it)."""
-        return self.goal_usable
-
-    @property
-    def nbytes(self) -> int:
-        """Approximate memory held by this field, in bytes."""
-        labels = len(self._search.node) * 6 * 8
-        # The table holds six Python lists of one entry per cell (8-byte pointers to
-        # mostly shared small objects).
-        table = 0 if self._table is None else 6 * 8 * len(self._table["kind"])
-        return labels + table
-
-    # ------------------------------------------------------------- exact queries
-    def _best(self, x: float, y: float) -> tuple[float, int, float]:
-        """Best way to the goal from ``(x, y)``: ``(cost, label, departure)``; label -1: direct."""
-        p = self.planner
-        if not self.goal_usable or not p.is_clear(x, y):
-            return math.inf, -2, 0.0
-        gx, gy = float(self.goal[0]), float(self.goal[1])
-        best = (math.inf, -2, 0.0)
-        if p.segment_clear((x, y), (gx, gy)):
-            best = (math.hypot(gx - x, gy - y), -1, 0.0)
-        r = p.radius
-        search = self._search
-        for c, s, pos, length in p.point_links(x, y):
-            side = -s
-            dep = p._span[c] - pos
-            for lab in search.settled.get((c, side), ()):
-                lp = search.pos[lab]
-                if lp <= dep + _ANG_TOL and p._arc_free(c, side, lp, dep):
-                    total = search.cost[lab] + r * max(dep - lp, 0.0) + length
-                    if total < best[0]:
-                        best = (total, lab, dep)
-        return best
-
-    def point_distance(self, xy: ArrayLike) -> float:
-        """Exact geodesic distance (m) from world point ``xy`` to the goal (inf if none)."""
-        x, y = (float(v) for v in np.asarray(xy, dtype=np.float64).reshape(-1)[:2])
-        return self._best(x, y)[0]
-
-    def path(self, xy: ArrayLike, exact: bool = True) -> tuple[NDArray[np.float64], float] | tuple[None, None]:
-        """Shortest path (N, 2) from world point ``xy`` to the goal and its length (m).
-
-        ``exact`` is kept for compatibility: every path is exact.
-        """
-        x, y = (float(v) for v in np.asarray(xy, dtype=np.float64).reshape(-1)[:2])
-        cost, label, dep = self._best(x, y)
-        if label == -2:
-            return None, None
-        pts = [np.array([x, y])]
-        if label >= 0:
-            pts += self._search.trace(label, dep)
-        pts.append(self.goal.copy())
-        return np.array(pts), cost
-
-    # ------------------------------------------------------------- lookup table
-    def distance(self, x: float, y: float) -> float:
-        """Per-step geodesic lookup (m) from world point ``(x, y)``; ``inf`` if unreachable."""
-        t = self._table
-        if t is None:
-            t = self._build_table()
-        geo = self.planner.geo
-        col = math.floor((x - geo.origin[0]) / geo.resolution)
-        row = math.floor((y - geo.origin[1]) / geo.resolution)
-        h, w = geo.shape
-        if not (0 <= row < h and 0 <= col < w):
-            return math.inf
-        i = t["near"][row * w + col]
-        if i < 0:
-            return math.inf
-        kind = t["kind"][i]
-        if kind == 0:
-            return math.inf
-        if kind == 1:  # straight to the goal
-            return math.hypot(x - t["gx"], y - t["gy"])
-        if kind == 3:  # grid fallback from the cell centre
-            return t["value"][i] + math.hypot(x - t["px"][i], y - t["py"][i])
-        lab = t["label"][i]
-        p = self.planner
-        search = self._search
-        c, side = search.node[lab], search.side[lab]
-        r = p.radius
-        dx = p._cx[c] - x
-        dy = p._cy[c] - y
-        L = math.hypot(dx, dy)
-        if L > r:
-            # The tangent from (x, y) arriving winding -side is the one leaving the node.
-            heading = math.atan2(dy, dx) + side * math.asin(r / L) if r > 0 else math.atan2(dy, dx)
-            ccw = (heading + side * (math.pi / 2) - p._phi0[c]) % _TWO_PI
-            if ccw > _TWO_PI - _ANG_TOL:
-                ccw = 0.0
-            span = p._span[c]
-            if ccw <= span + _ANG_TOL:
-                dep = min(ccw, span) if side > 0 else span - min(ccw, span)
-                lp = search.pos[lab]
-                if dep >= lp - _ANG_TOL:
-                    return search.cost[lab] + r * max(dep - lp, 0.0) + math.sqrt(L * L - r * r)
-        qx, qy = p.node_point(c, side, search.pos[lab])
-        return search.cost[lab] + math.hypot(x - qx, y - qy)
-
-    def _root_values(
-        self, cells: NDArray[np.int64], labs: NDArray[np.int64], px: NDArray[np.float64], py: NDArray[np.float64]
-    ) -> NDArray[np.float64]:
-        """Exact value of leaving cell centres along settled labels' nodes; inf where not valid."""
-        p = self.planner
-        search = self._search
-        nodes = np.asarray(search.node)[labs]
-        sides = np.asarray(search.side)[labs]
-        lpos = np.asarray(search.pos)[labs]
-        lcost = np.asarray(search.cost)[labs]
-        ang, length, _, ok = _tangent_from_point(px, py, p.cx[nodes], p.cy[nodes], p.radius, -sides)
-        ccw, in_arc = _ccw_pos(ang, p.phi0[nodes], p.span[nodes])
-        dep = np.where(sides > 0, ccw, p.span[nodes] - ccw)
-        ok &= in_arc & (dep >= lpos - _ANG_TOL)
-        out = np.full(len(cells), np.inf)
-        if ok.any():
-            sub = np.flatnonzero(ok)
-            q = np.stack([p.cx[nodes[sub]] + p.radius * np.cos(ang[sub]), p.cy[nodes[sub]] + p.radius * np.sin(ang[sub])], 1)
-            clear = p.geo.segments_clear(np.stack([px[sub], py[sub]], 1), q, p.radius)
-            sub = sub[clear]
-            out[sub] = lcost[sub] + p.radius * np.maximum(dep[sub] - lpos[sub], 0.0) + length[sub]
-        return out
-
-    def _adopt_roots(self, kind, label, value, cx_all, cy_all, usable, gx, gy) -> None:  # type: ignore[no-untyped-def]
-        """Let cells whose proposed root failed its check try their neighbours' roots.
-
-        A neighbour's root is usually visible from a cell too (as Theta* inherits parents);
-        a few passes settle almost every cell exactly.
-        """
-        p = self.planner
-        h, w = usable.shape
-        for _ in range(16):
-            todo = np.flatnonzero(usable.ravel() & ((kind == 3) | (kind == 0)))
-            if not len(todo):
-                return
-            best = np.full(len(todo), np.inf)
-            best_lab = np.full(len(todo), -1)
-            best_kind = np.zeros(len(todo), dtype=np.int8)
-            rows, cols = np.divmod(todo, w)
-            px, py = cx_all[todo], cy_all[todo]
-            for dr in (-1, 0, 1):
-                for dc in (-1, 0, 1):
-                    if not (dr or dc):
-                        continue
-                    nr, nc = rows + dr, cols + dc
-                    inside = (nr >= 0) & (nr < h) & (nc >= 0) & (nc < w)
-                    nb = np.where(inside, nr * w + nc, 0)
-                    k = np.where(inside, kind[nb], 0)
-                    sel = np.flatnonzero(k == 2)
-                    if len(sel):
-                        val = self._root_values(todo[sel], label[nb[sel]], px[sel], py[sel])
-                        better = val < best[sel]
-                        best[sel[better]] = val[better]
-                        best_lab[sel[better]] = label[nb[sel[better]]]
-                        best_kind[sel[better]] = 2
-                    sel = np.flatnonzero((k == 1) & (best_kind != 1))
-                    if len(sel):
-                        clear = p.geo.segments_clear(np.stack([px[sel], py[sel]], 1), np.array([gx, gy]), p.radius)
-                        sel = sel[clear]
-                        best[sel] = np.hypot(px[sel] - gx, py[sel] - gy)
-                        best_kind[sel] = 1
-            found = best_kind > 0
-            if not found.any():
-                return
-            cells = todo[found]
-            kind[cells] = best_kind[found]
-            label[cells] = best_lab[found]
-
-    def _build_table(self) -> dict[str, Any]:
-        p = self.planner
-        geo = p.geo
-        h, w = geo.shape
-        res = geo.resolution
-        usable = p.usable
-        n_cells = h * w
-        flat = usable.ravel()
-        idx = np.flatnonzero(flat)
-        kind = np.zeros(n_cells, dtype=np.int8)
-        label = np.full(n_cells, -1, dtype=np.int64)
-        value = np.full(n_cells, np.inf)
-        rows, cols = np.divmod(idx, w)
-        px = geo.origin[0] + (cols + 0.5) * res
-        py = geo.origin[1] + (rows + 0.5) * res
-        cx_all = np.full(n_cells, np.nan)
-        cy_all = np.full(n_cells, np.nan)
-        cx_all[idx], cy_all[idx] = px, py
-        gx, gy = float(self.goal[0]), float(self.goal[1])
-        if self.goal_usable and len(idx):
-            # Seeds: the goal and every settled label's arrival point, at their cells.
-            search = self._search
-            n_lab = len(search.node)
-            # Seed each label at points along its arc ahead of the arrival, so that a cell
-            # behind the corner is proposed the arc point it leaves from.
-            xs, ys, costs, owner = [gx], [gy], [0.0], [0]
-            for j in range(n_lab):
-                node, side, pos = search.node[j], search.side[j], search.pos[j]
-                rest = p._span[node] - pos
-                for f in (0.0, 0.25, 0.5, 0.75, 1.0):
-                    q = pos + f * rest
-                    if f > 0 and (rest <= _ANG_TOL or not p._arc_free(node, side, pos, q)):
-                        break
-                    x, y = p.node_point(node, side, q)
-                    xs.append(x)
-                    ys.append(y)
-                    costs.append(search.cost[j] + p.radius * (q - pos))
-                    owner.append(j + 1)
-            seed_x, seed_y, seed_cost = np.array(xs), np.array(ys), np.array(costs)
-            seed_owner = np.array(owner)
-            scol = np.floor((seed_x - geo.origin[0]) / res).astype(np.int64)
-            srow = np.floor((seed_y - geo.origin[1]) / res).astype(np.int64)
-            inside = (scol >= 0) & (scol < w) & (srow >= 0) & (srow < h)
-            scell = np.where(inside, srow * w + scol, 0)
-            ok = inside & flat[scell]
-            seeds = np.flatnonzero(ok)
-            seed_val = seed_cost[seeds] + np.hypot(cx_all[scell[seeds]] - seed_x[seeds], cy_all[scell[seeds]] - seed_y[seeds])
-            graph = _cell_graph(usable, res)
-            # A super-source (index n_cells) joined to each seed's cell, weighted by its cost.
-            n = n_cells + 1 + len(seeds)
-            # One virtual node per seed, so the predecessor chain names the seed.
-            virt = n_cells + 1 + np.arange(len(seeds))
-            extra = sparse.csr_matrix(
-                (
-                    np.concatenate([seed_val + 1e-300, np.full(len(seeds), 1e-300)]),
-                    (np.concatenate([np.full(len(seeds), n_cells), virt]), np.concatenate([virt, scell[seeds]])),
-                ),
-                shape=(n, n),
-            )
-            big = sparse.bmat([[graph, None], [None, sparse.csr_matrix((n - n_cells, n - n_cells))]], format="csr") + extra
-            dist, pred = csgraph.dijkstra(big, directed=True, indices=n_cells, return_predecessors=True)
-            dist = dist[:n_cells]
-            # Find each cell's seed by pointer doubling up the predecessor tree.
-            anc = pred.astype(np.int64)
-            anc[anc < 0] = n_cells
-            anc[virt] = virt
-            anc[n_cells] = n_cells
-            while True:
-                nxt = anc[anc]
-                if np.array_equal(nxt, anc):
-                    break
-                anc = nxt
-            top = anc[:n_cells]
-            cell_seed = np.where(top > n_cells, top - (n_cells + 1), -1)
-            reach = np.isfinite(dist) & (cell_seed >= 0)
-            value[reach] = dist[reach]
-            kind[reach] = 3
-            seed_of = np.where(reach, seed_owner[seeds[np.maximum(cell_seed, 0)]], -1)
-            # Check each proposal: the straight segment from the cell centre to the goal, or
-            # the tangent from the seed's node, must be clear and leave the arc forward.
-            cells = np.flatnonzero(reach)
-            direct = seed_of[cells] == 0
-            if direct.any():
-                c = cells[direct]
-                clear = geo.segments_clear(np.stack([cx_all[c], cy_all[c]], 1), np.array([gx, gy]), p.radius)
-                kind[c[clear]] = 1
-            c = cells[~direct]
-            if len(c):
-                lab = seed_of[c] - 1
-                nodes = np.asarray(search.node)[lab]
-                sides = np.asarray(search.side)[lab]
-                lpos = np.asarray(search.pos)[lab]
-                ang, _, _, ok = _tangent_from_point(cx_all[c], cy_all[c], p.cx[nodes], p.cy[nodes], p.radius, -sides)
-                ccw, in_arc = _ccw_pos(ang, p.phi0[nodes], p.span[nodes])
-                dep = np.where(sides > 0, ccw, p.span[nodes] - ccw)
-                ok &= in_arc & (dep >= lpos - _ANG_TOL)
-                q = np.stack([p.cx[nodes] + p.radius * np.cos(ang), p.cy[nodes] + p.radius * np.sin(ang)], 1)
-                good = np.zeros(len(c), dtype=bool)
-                if ok.any():
-                    sub = np.flatnonzero(ok)
-                    good[sub] = geo.segments_clear(np.stack([cx_all[c[sub]], cy_all[c[sub]]], 1), q[sub], p.radius)
-                kind[c[good]] = 2
-                label[c[good]] = lab[good]
-                value[c[good]] = 0.0
-            self._adopt_roots(kind, label, value, cx_all, cy_all, usable, gx, gy)
-        # Cells the disc does not fit at read their nearest usable cell.
-        if len(idx):
-            _, (nr, nc) = ndimage.distance_transform_edt(~usable, return_indices=True)
-            near = (nr * w + nc).ravel()
-        else:
-            near = np.full(n_cells, -1)
-        table = {
-            "kind": kind.tolist(),
-            "label": label.tolist(),
-            "value": value.tolist(),
-            "px": cx_all.tolist(),
-            "py": cy_all.tolist(),
-            "near": near.tolist(),
-            "gx": gx,
-            "gy": gy,
-        }
-        self._table = table
-        return table
-
-
-def _cell_graph(usable: NDArray[np.bool_], res: float) -> sparse.csr_matrix:
-    """8-connected graph of usable cells (diagonals only past two usable sides), metres."""
-    h, w = usable.shape
-    ids = np.arange(h * w).reshape(h, w)
-    src, dst, wt = [], [], []
-    for dr, dc in ((0, 1), (1, 0), (1, 1), (1, -1)):
-        r0, r1 = 0, h - dr
-        c0, c1 = max(0, -dc), w - max(0, dc)
-        a = usable[r0:r1, c0:c1]
-        b = usable[r0 + dr : r1 + dr, c0 + dc : c1 + dc]
-        m = a & b
-        if dr and dc:
-            m &= usable[r0 + dr : r1 + dr, c0:c1] & usable[r0:r1, c0 + dc : c1 + dc]
-        ia = ids[r0:r1, c0:c1][m]
-        ib = ids[r0 + dr : r1 + dr, c0 + dc : c1 + dc][m]
-        d = res * math.hypot(dr, dc)
-        src += [ia, ib]
-        dst += [ib, ia]
-        wt += [np.full(len(ia), d), np.full(len(ia), d)]
-    return sparse.csr_matrix(
-        (np.concatenate(wt), (np.concatenate(src), np.concatenate(dst))), shape=(h * w, h * w)
-    )
