@@ -32,6 +32,8 @@ import shapely
 from numpy.typing import ArrayLike, NDArray
 from scipy import ndimage
 
+from pointnav_core.collision import FloorCollision
+
 __all__ = ["FREE", "OBSTACLE", "VOID", "CELL_CLASSES", "TraversableMap", "BoundedCache"]
 
 FREE = 0
@@ -163,6 +165,18 @@ class TraversableMap:
         self._labels = BoundedCache(8)
         # Owned by ``geodesic``; kept here so that planners live exactly as long as the map.
         self.planner_cache = BoundedCache(8)
+        self._collision: FloorCollision | None = None
+
+    @property
+    def collision(self) -> FloorCollision:
+        """The floor's :class:`~pointnav_core.collision.FloorCollision` (built once, cached).
+
+        The one blocked set that planning, sampling and every backend's collision test use:
+        every non-FREE cell, everything off the map, and the floor plan's polygons.
+        """
+        if self._collision is None:
+            self._collision = FloorCollision.from_map(self)
+        return self._collision
 
     # ------------------------------------------------------------------ geometry
     @property
