@@ -141,7 +141,7 @@ def place_waypoints(
 
     See Also
     --------
-    pointnav_core.geodesic.resample_path : The interpolation used, at spacing ``s``.
+    pointnav_core.paths.resample_path : The interpolation used, at spacing ``s``.
 
     Examples
     --------
@@ -179,7 +179,7 @@ def _waypoints_along(
     pts: NDArray[np.float64], count: int, min_spacing: float
 ) -> tuple[NDArray[np.float64], NDArray[np.bool_]]:
     """:func:`place_waypoints` without the checks (the task's per-step call, on paths it
-    trusts): the same interpolation as :func:`~pointnav_core.geodesic.resample_path` at
+    trusts): the same interpolation as :func:`~pointnav_core.paths.resample_path` at
     spacing ``s``, with the arc lengths computed once."""
     d = pts[1:] - pts[:-1]
     arc = np.zeros(len(pts))

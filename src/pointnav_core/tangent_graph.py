@@ -48,7 +48,7 @@ from scipy import ndimage
 from scipy.spatial import cKDTree
 
 from pointnav_core.collision import FloorCollision, convex_corners
-from pointnav_core.geodesic import path_length, resample_path
+from pointnav_core.paths import path_length, resample_path
 
 if TYPE_CHECKING:
     from pointnav_core.maps import TraversableMap
