@@ -6,7 +6,7 @@ import numpy as np
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from pointnav_core.geodesic import path_length, planner_for
+from pointnav_core.paths import path_length
 from pointnav_core.maps import FREE
 from pointnav_core.scenes import Scene
 from pointnav_core.testing.strategies import maps_with_points, traversable_maps
@@ -65,7 +65,9 @@ def test_paths_are_usable_free_and_as_long_as_reported(case):
     assert tmap.is_usable(path, radius).all()
     for p, q in zip(path[:-1], path[1:]):
         assert segment_is_free(tmap, radius, p, q)
-    assert math.isclose(path_length(path), dist, rel_tol=1e-9, abs_tol=1e-12)
+    # Arcs are drawn as pieces of at most 2 degrees outside the circle, each longer than
+    # its arc by a factor tan(a/2)/(a/2) <= 1 + 1.1e-4; straight parts are exact.
+    assert dist - 1e-9 <= path_length(path) <= dist * (1 + 1.1e-4) + 1e-9
     assert dist >= math.dist(a, b) - 1e-9
 
 
@@ -114,17 +116,3 @@ def test_random_points_are_usable_and_stay_in_the_reference_component(case, seed
     _, q = scene.get_random_point(0, reference_point=ref, robot=radius, rng=rng)
     assert tmap.component_at(q[:2], radius) == tmap.component_at(ref, radius)
     assert scene.get_shortest_path(0, ref, q[:2], robot=radius)[1] is not None
-
-
-@given(maps_with_points(n_points=1))
-@settings(max_examples=30)
-def test_corner_graph_edges_are_free_segments(case):
-    tmap, radius, _ = case
-    planner = planner_for(tmap, radius)
-    for label in np.unique(planner.corner_labels):
-        ids, graph = planner.component_graph(int(label))
-        coo = graph.tocoo()
-        for i, j in zip(coo.row, coo.col):
-            a = tmap.grid_to_world(planner.corners[ids[i]])
-            b = tmap.grid_to_world(planner.corners[ids[j]])
-            assert segment_is_free(tmap, radius, a, b)

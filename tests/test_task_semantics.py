@@ -114,12 +114,20 @@ def test_geodesic_potential_reward_uses_the_geodesic_distance_around_the_wall(ba
     )
     _, info = env.reset(seed=0)
     assert info["potential_metric"] == "geodesic"
-    # By hand: the robot's centre bends around the eroded wall end, at (1.9, 3.1) and
-    # (2.2, 3.1) (0.1 m radius on a 0.1 m grid).
-    def by_hand(x: float, y: float) -> float:
-        return math.hypot(1.9 - x, 3.1 - y) + 0.3 + math.hypot(2.2 - goal[0], 3.1 - goal[1])
+    # By hand: the robot's centre (radius r = 0.1 m) wraps the wall's two top corners,
+    # (2.0, 3.0) then (2.1, 3.0): a tangent, an arc up to the top of the first circle, the
+    # 0.1 m segment along y = 3.1, an arc down the second circle, a tangent to the goal.
+    r = ROBOT.radius
 
-    assert info["geodesic_dist"] == pytest.approx(by_hand(*start), abs=1e-3)
+    def by_hand(x: float, y: float) -> float:
+        d1 = math.hypot(x - 2.0, y - 3.0)
+        leave = (math.atan2(y - 3.0, x - 2.0) - math.acos(r / d1)) % (2 * math.pi)
+        d2 = math.hypot(goal[0] - 2.1, goal[1] - 3.0)
+        arrive = math.atan2(goal[1] - 3.0, goal[0] - 2.1) + math.acos(r / d2)
+        arcs = r * (leave - math.pi / 2) + r * (math.pi / 2 - arrive)
+        return math.sqrt(d1 * d1 - r * r) + arcs + 0.1 + math.sqrt(d2 * d2 - r * r)
+
+    assert info["geodesic_dist"] == pytest.approx(by_hand(*start), abs=1e-9)
     assert info["geodesic_dist"] > 2.0 + 2.0  # far longer than the straight line (2 m)
     previous = info["distance_to_goal"]
     for _ in range(20):
@@ -127,7 +135,7 @@ def test_geodesic_potential_reward_uses_the_geodesic_distance_around_the_wall(ba
         pos = env.task.get_current_pos(env)
         current = env.scene.geodesic_distance(0, pos, goal, robot=ROBOT)
         assert info["distance_to_goal"] == pytest.approx(current, abs=1e-12)
-        assert current == pytest.approx(by_hand(pos[0], pos[1]), abs=1e-3)
+        assert current == pytest.approx(by_hand(pos[0], pos[1]), abs=1e-9)
         assert info["reward_breakdown"]["potential"] == pytest.approx(previous - current, abs=1e-12)
         assert sum(info["reward_breakdown"].values()) == reward
         previous = current
@@ -399,6 +407,17 @@ def test_fixed_start_with_sampled_goal_and_fixed_goal_with_sampled_start(backend
     env.reset(seed=1)
     assert env.task.get_goal_pos()[:2].tolist() == [4.0, 1.0]
     assert math.isfinite(env.task.geodesic_dist)
+
+
+def test_a_start_sampled_for_a_fixed_goal_never_lands_within_its_tolerance(backend):
+    # A 1.4 m square room whose usable cells lie mostly within 0.5 m of its centre: a start
+    # drawn there would win the episode at reset.
+    goal = (0.7, 0.7, 0.0)
+    env = make_env(backend, room(14, 14), goal_pos=goal, goal_tolerance=0.5)
+    for seed in range(30):
+        _, info = env.reset(seed=seed)
+        start = env.task.get_start_pos()
+        assert math.hypot(start[0] - goal[0], start[1] - goal[1]) >= 0.5
 
 
 def test_task_on_an_upper_floor_lands_the_robot_at_that_floor_height(backend):

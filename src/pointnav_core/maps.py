@@ -14,11 +14,11 @@ off the map are :data:`VOID`; indices are never wrapped.
 
 Erosion
 -------
-The robot's centre may stand at a point when its disc of radius ``r`` does not overlap any
-blocked (OBSTACLE or VOID) cell square; off the map counts as VOID. :meth:`usable` answers
-this exactly for every cell centre, from a Euclidean distance transform (cached per radius).
-Two usable cells are connected when they share a side ("8-connected without cutting blocked
-corners" has the same components), which is also the planner's rule (see ``geodesic``).
+The robot's centre may stand at a point when its disc of radius ``r`` misses the floor's
+blocked set, :attr:`TraversableMap.collision` (every non-FREE cell square, off the map, and
+the floor plan's polygons; see :mod:`pointnav_core.collision`). :meth:`usable` answers this
+exactly for every cell centre (cached per radius), :meth:`is_usable` for any point; the
+planner, the sampler and every backend ask the same geometry.
 """
 
 from __future__ import annotations
@@ -28,7 +28,6 @@ from collections import OrderedDict
 from typing import Any, Callable, Hashable, TypeVar
 
 import numpy as np
-import shapely
 from numpy.typing import ArrayLike, NDArray
 from scipy import ndimage
 
@@ -106,9 +105,8 @@ class TraversableMap:
         World z of the floor, in metres.
     geometry : FloorPlan, optional
         The polygons the grid was rasterised from (anything with ``outline`` and
-        ``obstacles``). When given, erosion measures clearance from the polygons themselves
-        rather than from their staircase raster, which keeps geodesics unbiased along
-        rotated walls and furniture.
+        ``obstacles``). Its obstacle polygons join the blocked set, so a wall thinner than
+        a cell still blocks (see :attr:`collision`).
 
     Examples
     --------
@@ -253,15 +251,18 @@ class TraversableMap:
         return self.codes == FREE
 
     def usable(self, radius: float = 0.0) -> NDArray[np.bool_]:
-        """Cells where a robot disc of ``radius`` metres can stand (cached, read-only).
+        """Cells whose centre a robot disc of ``radius`` metres can stand on (cached, read-only).
 
-        A cell is usable when it is FREE and the disc centred on the cell centre overlaps
-        no OBSTACLE or VOID cell square (touching is allowed); off the map is VOID.
+        A centre is usable when the disc misses the floor's blocked set
+        (:attr:`collision`: every non-FREE cell square, off the map, and the floor plan's
+        polygons); touching is allowed. This is :meth:`FloorCollision.points_clear` at every
+        cell centre, computed fast: a distance transform decides all cells but a thin shell
+        (and those near polygons), which are tested exactly.
 
         Parameters
         ----------
         radius : float
-            Robot radius in metres, >= 0. 0 is a point robot: the FREE cells.
+            Robot radius in metres, >= 0. 0 is a point robot.
 
         Examples
         --------
@@ -270,117 +271,119 @@ class TraversableMap:
         (np.int64(25), np.int64(9), np.int64(1))
         """
         radius = _check_radius(radius)
-        key = round(radius / self.resolution, 9)
+        key = round(radius, 12)
         return self._usable.get_or_create(key, lambda: self._erode(key))
 
-    def standable(self, radius: float = 0.0) -> NDArray[np.bool_]:
-        """Cells whose centre a robot of ``radius`` m can stand on in every backend.
-
-        The :meth:`usable` cells; on a map built from polygons, also clear of the rasterised
-        OBSTACLE and VOID squares, since one backend may collide with the polygons and
-        another with the grid. Sampling draws from these, so a start or goal is valid
-        everywhere and the same seed gives the same episode on every backend.
-        """
-        if self.geometry is None:
-            return self.usable(radius)
-        radius = _check_radius(radius)
-        key = ("standable", round(radius / self.resolution, 9))
-
-        def both() -> NDArray[np.bool_]:
-            mask = self.usable(radius) & self._erode_squares(key[1])
-            mask.flags.writeable = False
-            return mask
-
-        return self._usable.get_or_create(key, both)
-
-    def _erode(self, r: float) -> NDArray[np.bool_]:
-        if self.geometry is not None:
-            return self._erode_polygons(self.codes == FREE, r * self.resolution)
-        return self._erode_squares(r)
-
-    def _erode_squares(self, r: float) -> NDArray[np.bool_]:
-        """Exact erosion against the grid's blocked cell squares (radius in cells)."""
+    def _erode(self, radius: float) -> NDArray[np.bool_]:
+        geo = self.collision
+        res = self.resolution
         free = self.codes == FREE
-        if r <= 0.5:
-            # The disc stays inside its own cell, or touches a side neighbour exactly.
-            mask = free.copy()
-            mask.flags.writeable = False
-            return mask
-        pad = int(math.ceil(r)) + 2
+        pad = 1
         padded = np.pad(free, pad, constant_values=False)
-        # Distance from each free cell centre to the nearest blocked cell centre, in cells.
-        edt = ndimage.distance_transform_edt(padded)
-        # The true distance d to the nearest blocked square satisfies
-        # edt - sqrt(2)/2 <= d <= edt - 1/2; decide the thin shell in between exactly.
-        usable = edt - math.sqrt(0.5) >= r
-        shell = (edt - 0.5 >= r) & ~usable
-        if shell.any():
-            rows, cols = np.nonzero(shell)
-            blocked = ~padded
-            k = int(math.ceil(r + 0.5))
-            touched = np.zeros(rows.shape, dtype=bool)
-            for dr in range(-k, k + 1):
-                gap_r = max(abs(dr) - 0.5, 0.0)
-                for dc in range(-k, k + 1):
-                    gap_c = max(abs(dc) - 0.5, 0.0)
-                    if gap_r * gap_r + gap_c * gap_c < r * r:
-                        touched |= blocked[rows + dr, cols + dc]
-            usable[rows[~touched], cols[~touched]] = True
-        mask = usable[pad:-pad, pad:-pad] & free
-        mask.flags.writeable = False
-        return mask
-
-    def _erode_polygons(self, free: NDArray[np.bool_], radius: float) -> NDArray[np.bool_]:
-        """Exact erosion against the source polygons: centre clearance >= radius."""
-        h, w = self.shape
-        ys, xs = np.mgrid[0:h, 0:w]
-        x = self.origin[0] + (xs + 0.5) * self.resolution
-        y = self.origin[1] + (ys + 0.5) * self.resolution
-        outline = self.geometry.outline
-        inner = outline.buffer(-radius, quad_segs=16, join_style="mitre") if radius > 0 else outline
-        mask = free & shapely.contains_xy(inner, x, y)
-        obstacles = list(self.geometry.obstacles)
-        if obstacles and radius > 0:
-            grown = shapely.union_all(obstacles).buffer(radius, quad_segs=16)
-            shapely.prepare(grown)
-            rows, cols = np.nonzero(mask)
-            mask[rows, cols] = ~shapely.intersects_xy(grown, x[rows, cols], y[rows, cols])
-        if radius > 0:
-            # The buffers draw the disc as an inscribed polygon, so they let through centres
-            # up to radius * (1 - cos(pi / 64)) closer than radius; such a centre is on the
-            # edge of the mask, so the edge cells are measured exactly.
-            edge = mask & ~ndimage.binary_erosion(mask, np.ones((3, 3), bool), border_value=1)
-            rows, cols = np.nonzero(edge)
-            if len(rows):
-                walls = shapely.union_all([outline.boundary, *obstacles])
-                near = shapely.distance(walls, shapely.points(x[rows, cols], y[rows, cols]))
-                mask[rows, cols] = near >= radius
-        mask.flags.writeable = False
-        return mask
+        # Distance (cells) from each cell centre to the nearest blocked cell centre, D. The
+        # nearest blocked square is between D - sqrt(1/2) and D - 1/2 cells away.
+        edt = np.asarray(ndimage.distance_transform_edt(padded))[pad:-pad, pad:-pad]
+        r = radius / res
+        sure = free & (edt - math.sqrt(0.5) >= r)
+        maybe = free & ~sure & (edt - 0.5 >= r - 1e-9)
+        if geo.polygons:
+            maybe |= sure
+            sure = np.zeros_like(sure)
+        rows, cols = np.nonzero(maybe)
+        if len(rows):
+            centres = np.stack([self.origin[0] + (cols + 0.5) * res, self.origin[1] + (rows + 0.5) * res], axis=1)
+            sure[rows, cols] = geo.points_clear(centres, radius)
+        sure.flags.writeable = False
+        return sure
 
     def components(self, radius: float = 0.0) -> NDArray[np.int32]:
         """Connected components of :meth:`usable` cells (0 = not usable, 1.. = component id).
 
-        Cells are connected through shared sides, the same rule the planner uses.
+        Two usable cells (side or diagonal neighbours) are connected when the disc can move
+        straight between their centres, checked exactly; so cells of one component are truly
+        reachable from each other. A passage no row of cell centres runs through (a door
+        narrower than the robot plus a cell) may split a component in two; the planner still
+        finds the way through it.
         """
         radius = _check_radius(radius)
-        key = round(radius / self.resolution, 9)
+        key = round(radius, 12)
+        return self._labels.get_or_create(key, lambda: self._label(radius))
 
-        def label() -> NDArray[np.int32]:
-            labels, _ = ndimage.label(self.usable(radius))
-            labels = labels.astype(np.int32)
-            labels.flags.writeable = False
-            return labels
+    def _label(self, radius: float) -> NDArray[np.int32]:
+        from scipy.sparse import coo_matrix
+        from scipy.sparse.csgraph import connected_components
 
-        return self._labels.get_or_create(key, label)
+        usable = self.usable(radius)
+        h, w = self.shape
+        res = self.resolution
+        ids = np.arange(h * w).reshape(h, w)
+        src, dst = [], []
+        for dr, dc in ((0, 1), (1, 0), (1, 1), (1, -1)):
+            c0, c1 = max(0, -dc), w - max(0, dc)
+            a = usable[0 : h - dr, c0:c1]
+            b = usable[dr:, c0 + dc : c1 + dc]
+            both = a & b
+            # A segment whose ends both have clearance >= r + length/2 is clear: every point
+            # of it is within length/2 of an end. The rest are tested exactly.
+            wide = self.usable(radius + 0.5 * res * math.hypot(dr, dc))
+            sure = both & wide[0 : h - dr, c0:c1] & wide[dr:, c0 + dc : c1 + dc]
+            ia = ids[0 : h - dr, c0:c1]
+            ib = ids[dr:, c0 + dc : c1 + dc]
+            test = both & ~sure
+            if test.any():
+                ta, tb = ia[test], ib[test]
+                pa = self.cell_to_world(np.stack(np.divmod(ta, w), axis=1))
+                pb = self.cell_to_world(np.stack(np.divmod(tb, w), axis=1))
+                ok = self.collision.segments_clear(pa, pb, radius)
+                src += [ia[sure], ta[ok]]
+                dst += [ib[sure], tb[ok]]
+            else:
+                src.append(ia[sure])
+                dst.append(ib[sure])
+        s, d = np.concatenate(src), np.concatenate(dst)
+        graph = coo_matrix((np.ones(len(s), np.int8), (s, d)), shape=(h * w, h * w))
+        _, comp = connected_components(graph, directed=False)
+        # Number components 1.. in order of first usable cell; 0 for unusable cells.
+        flat = usable.ravel()
+        _, first = np.unique(comp[flat], return_index=True)
+        order = np.argsort(first)
+        rank = np.zeros(comp.max() + 1, dtype=np.int32)
+        rank[np.unique(comp[flat])[order]] = np.arange(1, len(order) + 1, dtype=np.int32)
+        labels = np.where(flat, rank[comp], 0).astype(np.int32).reshape(h, w)
+        labels.flags.writeable = False
+        return labels
 
     def is_usable(self, xy: ArrayLike, radius: float = 0.0) -> NDArray[np.bool_]:
-        """Whether world points lie in usable cells for a robot of ``radius`` (off-map: False)."""
-        return self._sample(self.usable(radius), xy, False)
+        """Whether a robot disc of ``radius`` m fits at world points (exact; off-map: False)."""
+        pts = _as_points(xy, "xy")
+        return self.collision.points_clear(pts, _check_radius(radius))
 
     def component_at(self, xy: ArrayLike, radius: float = 0.0) -> NDArray[np.int32]:
-        """Component id at world points (0 where the point is not usable or off the map)."""
-        return self._sample(self.components(radius), xy, 0).astype(np.int32)
+        """Component id at world points: of a usable cell centre the disc can move to straight.
+
+        0 where the disc does not fit at the point, or sees no usable cell centre within two
+        cells (a point deep in a passage narrower than the robot plus a cell).
+        """
+        pts = _as_points(xy, "xy")
+        flat = pts.reshape(-1, 2)
+        labels = self.components(radius)
+        out = np.zeros(len(flat), dtype=np.int32)
+        clear = self.is_usable(flat, radius)
+        span = np.arange(-2, 3)
+        for i in np.flatnonzero(clear):
+            cell = self.world_to_cell(flat[i])
+            cand = np.stack(np.meshgrid(cell[0] + span, cell[1] + span, indexing="ij"), -1).reshape(-1, 2)
+            cand = cand[self.in_bounds(cand)]
+            cand = cand[labels[cand[:, 0], cand[:, 1]] > 0]
+            if not len(cand):
+                continue
+            centres = self.cell_to_world(cand)
+            order = np.argsort(np.hypot(*(centres - flat[i]).T), kind="stable")
+            ok = self.collision.segments_clear(np.broadcast_to(flat[i], centres.shape), centres, radius)
+            hit = order[ok[order]]
+            if len(hit):
+                out[i] = labels[cand[hit[0], 0], cand[hit[0], 1]]
+        return out.reshape(pts.shape[:-1])
 
     def __repr__(self) -> str:
         h, w = self.shape

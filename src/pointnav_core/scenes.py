@@ -35,7 +35,9 @@ from numpy.typing import ArrayLike, NDArray
 from pointnav_core import floorplans, loaders
 from pointnav_core.errors import SamplingError
 from pointnav_core.floorplans import FloorPlan
-from pointnav_core.geodesic import GoalField, Planner, planner_for, resample_path
+from pointnav_core.paths import resample_path
+from pointnav_core.tangent_field import GoalField
+from pointnav_core.tangent_graph import Planner, planner_for
 from pointnav_core.maps import OBSTACLE, TraversableMap
 
 __all__ = ["Scene", "FloorGoalField", "robot_radius", "rooms", "maze", "clutter"]
@@ -73,45 +75,35 @@ def _as_rng(rng: np.random.Generator | int | None) -> np.random.Generator:
 class FloorGoalField:
     """Geodesic distance to one goal on one floor, in metres (a cached view of a GoalField).
 
-    ``distance(x, y)`` is the per-step query: a table lookup plus one ``hypot`` (the table is
-    built on the first call). ``exact_distance`` and ``path`` check the exact point.
+    ``distance(x, y)`` is the per-step query: a table lookup plus one tangent (the table is
+    built on the first call). ``exact_distance`` and ``path`` are exact for the given point.
     """
 
     def __init__(self, tmap: TraversableMap, field: GoalField) -> None:
         self.tmap = tmap
         self.field = field
-        self._ox, self._oy = tmap.origin
-        self._inv_res = 1.0 / tmap.resolution
-        self._res = tmap.resolution
+        self.distance = field.distance
 
     @property
     def goal_usable(self) -> bool:
-        """Whether the goal lies in a usable cell (if not, nothing reaches it)."""
+        """Whether the robot fits at the goal (if not, nothing reaches it)."""
         return self.field.reachable_from_anywhere
 
-    def distance(self, x: float, y: float) -> float:
-        """Geodesic distance (m) from world point (x, y) to the goal; ``inf`` if unreachable."""
-        d = self.field.distance((y - self._oy) * self._inv_res, (x - self._ox) * self._inv_res)
-        return d * self._res
-
     def exact_distance(self, source_xy: ArrayLike) -> float:
-        """Geodesic distance (m) from the exact point ``source_xy``, checked, not looked up."""
-        g = self.tmap.world_to_grid(_as_xy(source_xy, "source_xy"))
-        return self.field.point_distance(g) * self._res
+        """Geodesic distance (m) from the exact point ``source_xy`` (``inf`` if none)."""
+        return float(self.field.point_distance(_as_xy(source_xy, "source_xy")))
 
     def path(
         self, source_xy: ArrayLike, exact: bool = True
     ) -> tuple[NDArray[np.float64], float] | tuple[None, None]:
-        """Any-angle path (N, 2) in world metres from ``source_xy`` to the goal, and its length.
+        """Shortest path (N, 2) in world metres from ``source_xy`` to the goal, and its length.
 
-        ``exact=False`` follows the source cell's root when the source sees it (fast, for
-        controllers); ``exact=True`` searches the corners (optimal).
+        Every path is exact; ``exact`` is accepted for compatibility.
         """
-        g = self.tmap.world_to_grid(_as_xy(source_xy, "source_xy"))
-        points, length = self.field.path(g, exact)
+        points, length = self.field.path(_as_xy(source_xy, "source_xy"))
         if points is None:
             return None, None
-        return self.tmap.grid_to_world(points), float(length) * self._res
+        return points, float(length)
 
 
 class Scene:
@@ -209,8 +201,9 @@ class Scene:
     ) -> Scene:
         """Scene of one floor from a shapely outline (outside = VOID) and obstacle polygons.
 
-        Cells are classified by their centres with shapely's vectorised predicates; the
-        robot's clearance is measured from the polygons themselves (see TraversableMap).
+        Cells are classified by their centres with shapely's vectorised predicates. The
+        obstacle polygons also join the floor's blocked set (see
+        :attr:`TraversableMap.collision`), so an obstacle thinner than a cell still blocks.
         """
         plan = FloorPlan(outline=floor, obstacles=tuple(obstacles))
         codes, origin = floorplans.rasterize(plan.outline, plan.obstacles, resolution)
@@ -280,7 +273,7 @@ class Scene:
         return self._floor(floor).height
 
     def planner(self, floor: int, robot: Any = None) -> Planner:
-        """The cached corner-graph planner of ``floor`` for ``robot``'s radius."""
+        """The cached tangent-graph planner of ``floor`` for ``robot``'s radius."""
         return planner_for(self._floor(floor), robot_radius(robot))
 
     def is_usable(self, floor: int, xy: ArrayLike, robot: Any = None) -> bool:
@@ -322,15 +315,15 @@ class Scene:
         rng = _as_rng(rng)
         radius = robot_radius(robot)
         if floor is None:
-            candidates = [i for i, f in enumerate(self.floors) if f.standable(radius).any()]
+            candidates = [i for i, f in enumerate(self.floors) if f.usable(radius).any()]
             if not candidates:
                 raise SamplingError(f"no floor has a usable cell for a robot of radius {radius} m")
             floor = candidates[int(rng.integers(len(candidates)))]
         tmap = self._floor(floor)
-        # Standable cells: usable, and clear of the grid too on polygon maps (see
-        # TraversableMap.standable), so every backend accepts the point.
+        # Usable cell centres: the disc misses the floor's one blocked set, which every
+        # backend collides with, so every backend accepts the point.
         if reference_point is None:
-            cells = np.flatnonzero(tmap.standable(radius))
+            cells = np.flatnonzero(tmap.usable(radius))
         else:
             ref = _as_xy(reference_point, "reference_point")
             label = int(tmap.component_at(ref, radius))
@@ -339,7 +332,7 @@ class Scene:
                     f"reference_point {ref.tolist()} is not usable on floor {floor} for a robot "
                     f"of radius {radius} m (blocked, too close to an obstacle, or off the map)"
                 )
-            cells = np.flatnonzero((tmap.components(radius) == label) & tmap.standable(radius))
+            cells = np.flatnonzero(tmap.components(radius) == label)
         if len(cells) == 0:
             raise SamplingError(
                 f"floor {floor} has no usable cell for a robot of radius {radius} m"
@@ -351,21 +344,31 @@ class Scene:
     # ---------------------------------------------------------------- geodesic
     def goal_field(self, floor: int, goal_xy: ArrayLike, robot: Any = None) -> FloorGoalField:
         """Cached geodesic distance field to ``goal_xy`` on ``floor`` (see FloorGoalField)."""
-        tmap = self._floor(floor)
-        goal = tmap.world_to_grid(_as_xy(goal_xy, "goal_xy"))
-        field = planner_for(tmap, robot_radius(robot)).goal_field(goal)
-        return FloorGoalField(tmap, field)
+        planner = planner_for(self._floor(floor), robot_radius(robot))
+        return FloorGoalField(self._floor(floor), planner.goal_field(_as_xy(goal_xy, "goal_xy")))
 
     def geodesic_distance(
         self, floor: int, source_xy: ArrayLike, target_xy: ArrayLike, robot: Any = None
     ) -> float:
         """Geodesic distance (m) between two points; ``math.inf`` when there is no path.
 
-        Exact for the given source point, and cheap for a new target (it does not build the
-        target's per-cell table, only its corner distances), which makes it the right call
-        for sampling start/goal pairs. Use :meth:`goal_field` for repeated queries.
+        Exact for the given points. Uses the target's goal field when it is cached, and one
+        A* search otherwise (no field is built). Use :meth:`goal_field` for repeated queries.
         """
-        return self.goal_field(floor, target_xy, robot).exact_distance(source_xy)
+        return self._shortest(floor, source_xy, target_xy, robot)[1]
+
+    def _shortest(
+        self, floor: int, source_xy: ArrayLike, target_xy: ArrayLike, robot: Any
+    ) -> tuple[NDArray[np.float64] | None, float]:
+        planner = planner_for(self._floor(floor), robot_radius(robot))
+        src, tgt = _as_xy(source_xy, "source_xy"), _as_xy(target_xy, "target_xy")
+        if planner.has_field(tgt):
+            points, length = planner.goal_field(tgt).path(src)
+        else:
+            points, length = planner.shortest_path(src, tgt)
+        if points is None:
+            return None, math.inf
+        return points, float(length)
 
     def get_shortest_path(
         self,
@@ -383,19 +386,21 @@ class Scene:
         source_xy, target_xy : array_like
             (x, y) or (x, y, z) in metres; z is ignored.
         entire_path : bool
-            True: the whole any-angle polyline, source, corners, target. False: the first
-            ``num_waypoints`` points spaced ``waypoint_spacing`` apart along it, padded
-            with the target (OmniGibson's convention).
+            True: the whole path, source, tangent points, arcs drawn as short pieces that
+            keep the full radius, target. False: the first ``num_waypoints`` points spaced
+            ``waypoint_spacing`` apart along it, padded with the target (OmniGibson's
+            convention).
         robot : RobotSpec, float or None
 
         Returns
         -------
         waypoints : ndarray (N, 2) or None
         geodesic_distance : float or None
-            Path length in metres. ``(None, None)`` when the target is unreachable from the
-            source, off the map, or not usable by the robot (nor is the source).
+            Exact length in metres of the shortest path of the disc's centre. ``(None,
+            None)`` when the target is unreachable from the source, or the robot does not
+            fit at either.
         """
-        points, length = self.goal_field(floor, target_xy, robot).path(source_xy)
+        points, length = self._shortest(floor, source_xy, target_xy, robot)
         if points is None:
             return None, None
         if not entire_path:

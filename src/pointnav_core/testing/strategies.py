@@ -251,7 +251,7 @@ def maps_with_points(
     """A map, a robot radius (m) and ``n_points`` usable world points (n, 2) on it.
 
     The radius is chosen so that some cell is usable; points lie anywhere inside usable
-    cells (not only at centres).
+    cells (not only at centres) where the disc fits, else at the cell's centre.
     """
     tmap = draw(traversable_maps(max_side=max_side))
     radius = draw(st.floats(0.0, max_radius_cells)) * tmap.resolution
@@ -262,7 +262,10 @@ def maps_with_points(
     for _ in range(n_points):
         r, c = cells[draw(st.integers(0, len(cells) - 1))]
         fr, fc = draw(st.floats(0.05, 0.95)), draw(st.floats(0.05, 0.95))
-        points.append(tmap.grid_to_world(np.array([r + fr, c + fc])))
+        point = tmap.grid_to_world(np.array([r + fr, c + fc]))
+        if not tmap.is_usable(point, radius):
+            point = tmap.cell_to_world(np.array([r, c]))
+        points.append(point)
     return tmap, radius, np.array(points)
 
 
