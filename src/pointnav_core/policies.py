@@ -13,10 +13,15 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from pointnav_core.geodesic import resample_path
+from pointnav_core.paths import resample_path
 from pointnav_core.transforms import quat2yaw
 
 __all__ = ["ShortestPathFollower"]
+
+
+#: Heading error (rad) below which a differential robot drives instead of turning; float32
+#: actions round a turn to about 1e-7 of its size, so the robot faces the point to ~1e-7.
+_FACING = 1e-6
 
 
 def _wrap(angle: float) -> float:
@@ -24,8 +29,21 @@ def _wrap(angle: float) -> float:
     return math.pi - (math.pi - angle) % (2.0 * math.pi)
 
 
+def _nearest_usable(tmap: Any, xy: NDArray[np.float64], radius: float, reach: int = 3) -> NDArray[np.float64] | None:
+    """Centre of the nearest cell within ``reach`` cells whose centre the disc fits at."""
+    usable = tmap.usable(radius)
+    row, col = (int(v) for v in tmap.world_to_cell(xy))
+    h, w = usable.shape
+    r0, r1, c0, c1 = max(row - reach, 0), min(row + reach + 1, h), max(col - reach, 0), min(col + reach + 1, w)
+    cells = np.argwhere(usable[r0:r1, c0:c1]) + (r0, c0)
+    if not len(cells):
+        return None
+    centres = tmap.cell_to_world(cells)
+    return centres[int(np.argmin(np.hypot(*(centres - xy).T)))]
+
+
 class ShortestPathFollower:
-    """Drive one robot along the geodesic to its task's goal.
+    """Drive one robot along the geodesic to its task's goal, without touching anything.
 
     Parameters
     ----------
@@ -34,23 +52,21 @@ class ShortestPathFollower:
     task : PointNavigationTask, optional
         The task whose robot this policy drives (default ``env.task``).
     margin : float
-        Extra clearance (m) kept from obstacles: the follower plans for a robot this much
-        wider, so that it does not graze corners, and falls back to the true radius where
-        the wider robot does not fit. Default: one map cell.
-    turn_threshold : float
-        Heading error (rad) above which the robot turns in place before driving.
+        Extra clearance (m) kept from obstacles where there is room: the follower plans for
+        a robot this much wider and falls back to the true radius where the wider robot does
+        not fit. Default 0.05 m.
     lookahead : float
-        The robot steers towards the point this far (m) along the path (pure pursuit), so
-        it rounds corners smoothly and never turns back to a corner it has just passed.
+        How far (m) along the path the follower looks for the point to head for.
 
     Notes
     -----
-    Each step follows the goal field's cheap path (the root of the cell the robot stands
-    in), which is optimal for the cell's centre but can be a detour for the robot's exact
-    position. Two such paths in opposite directions from neighbouring points can trap a
-    robot that moves at once (holonomic drive) in a two-step cycle; so when the point to
-    steer towards turns back against the previous one, the follower asks for the exact
-    path instead.
+    Every step heads straight for the farthest of four points up to ``lookahead`` along the
+    exact shortest path that the disc can reach in a straight line (checked against the
+    floor's blocked set), so the robot never cuts a corner the path wraps. The motion is
+    exactly that straight line: a differential robot turns in place until it faces the
+    point, then drives with no turn; a holonomic robot translates without turning. A robot
+    whose disc overlaps something (a rigid-body solver's slop, a pose set by hand) heads for
+    the nearest cell centre it fits at.
 
     Examples
     --------
@@ -67,43 +83,41 @@ class ShortestPathFollower:
         self,
         env: Any,
         task: Any = None,
-        margin: float | None = None,
-        turn_threshold: float = 0.35,
+        margin: float = 0.05,
         lookahead: float = 0.3,
     ) -> None:
         self.env = env
         self.task = task if task is not None else env.task
-        if margin is not None and (not math.isfinite(margin) or margin < 0):
+        if isinstance(margin, bool) or not isinstance(margin, (int, float)) or not math.isfinite(margin) or margin < 0:
             raise ValueError(f"margin must be a finite number >= 0 (m), got {margin!r}")
-        if not 0 < turn_threshold <= math.pi:
-            raise ValueError(f"turn_threshold must be in (0, pi] rad, got {turn_threshold!r}")
-        self.margin = margin
-        self.turn_threshold = float(turn_threshold)
-        if not math.isfinite(lookahead) or lookahead <= 0:
+        if isinstance(lookahead, bool) or not isinstance(lookahead, (int, float)) or not math.isfinite(lookahead) or lookahead <= 0:
             raise ValueError(f"lookahead must be a finite number > 0 (m), got {lookahead!r}")
+        self.margin = float(margin)
         self.lookahead = float(lookahead)
-        self._last_target: NDArray[np.float64] | None = None
 
-    def _carrot(
-        self, xy: NDArray[np.float64], exact: bool = False
-    ) -> NDArray[np.float64] | None:
-        """The point ``lookahead`` metres along the shortest path from ``xy`` (or the goal).
-
-        ``exact=False`` takes the goal field's cheap path, ``exact=True`` searches.
-        """
+    def _carrot(self, xy: NDArray[np.float64]) -> NDArray[np.float64] | None:
+        """The point to head for from ``xy`` (see the class notes), or None if there is none."""
         env, task = self.env, self.task
         spec = env.robots[task.robot_idn]
         goal = np.asarray(task.get_goal_pos(), dtype=np.float64)[:2]
         tmap = env.scene.floors[task.floor]
-        margin = tmap.resolution if self.margin is None else self.margin
         path = None
-        for radius in (spec.radius + margin, spec.radius):
-            path, _ = env.scene.goal_field(task.floor, goal, robot=radius).path(xy, exact=exact)
+        radii = (spec.radius + self.margin, spec.radius) if self.margin > 0 else (spec.radius,)
+        for radius in radii:
+            path, _ = env.scene.goal_field(task.floor, goal, robot=radius).path(xy)
             if path is not None:
                 break
         if path is None:
-            return None
-        return resample_path(path, self.lookahead, 2)[1]
+            centre = _nearest_usable(tmap, xy, spec.radius)
+            if centre is None:
+                return None
+            path, _ = env.scene.goal_field(task.floor, goal, robot=spec.radius).path(centre)
+            if path is None:
+                return None
+            return centre
+        ahead = resample_path(path, self.lookahead / 4, 5)[1:][::-1]
+        clear = tmap.collision.segments_clear(np.broadcast_to(xy, ahead.shape), ahead, spec.radius)
+        return ahead[int(np.argmax(clear))] if clear.any() else ahead[-1]
 
     def act(self) -> NDArray[np.float32]:
         """Action in [-1, 1] for the task's robot, from its current true pose."""
@@ -113,27 +127,22 @@ class ShortestPathFollower:
         xy = position[:2]
         action = np.zeros(spec.action_dim, dtype=np.float32)
         target = self._carrot(xy)
-        last, self._last_target = self._last_target, target
-        if target is not None and last is not None:
-            ahead, before = target - xy, last - xy
-            if float(ahead[0] * before[0] + ahead[1] * before[1]) < 0.0:
-                # The cheap path turns back: confirm it (see the class notes).
-                target = self._last_target = self._carrot(xy, exact=True)
         if target is None:
             return action
         dt = 1.0 / getattr(env, "action_frequency", 10.0)
         dx, dy = float(target[0] - xy[0]), float(target[1] - xy[1])
         dist = math.hypot(dx, dy)
+        if dist == 0.0:
+            return action
         yaw = float(quat2yaw(quat))
         bearing = _wrap(math.atan2(dy, dx) - yaw)
-        # Reach the waypoint in one step if it is that close, else go at full speed.
+        # Reach the point in one step if it is that close, else go at full speed.
         speed = min(1.0, dist / (spec.max_linear_velocity * dt))
-        turn = float(np.clip(bearing / (spec.max_angular_velocity * dt), -1.0, 1.0))
         if spec.drive == "holonomic":
             action[0] = speed * math.cos(bearing)
             action[1] = speed * math.sin(bearing)
-            action[2] = turn
+        elif abs(bearing) > _FACING:
+            action[1] = float(np.clip(bearing / (spec.max_angular_velocity * dt), -1.0, 1.0))
         else:
-            action[0] = speed * max(0.0, math.cos(bearing)) if abs(bearing) < self.turn_threshold else 0.0
-            action[1] = turn
+            action[0] = speed
         return action

@@ -854,15 +854,17 @@ class PointNavigationTask:
                     floor=floor, reference_point=(sx, sy), robot=spec, rng=rng
                 )
                 gx, gy = float(point[0]), float(point[1])
-                if math.hypot(gx - sx, gy - sy) < self._goal_tolerance:
-                    fail(
-                        f"the goal must be at least goal_tolerance ({self._goal_tolerance} m) "
-                        f"from the start"
-                    )
-                    continue
                 if not backend.is_valid_pose(idn, (gx, gy, h), quat):
                     fail("the goal must be a valid pose (clear of obstacles and other robots)")
                     continue
+            # A sampled start or goal never lands within success distance of the other,
+            # or the episode would be won before it starts.
+            if not both_fixed and math.hypot(gx - sx, gy - sy) < self._goal_tolerance:
+                fail(
+                    f"the goal must be at least goal_tolerance ({self._goal_tolerance} m) "
+                    f"from the start"
+                )
+                continue
             # 3. The exact geodesic. A new goal costs only its corner solve here; the
             # per-cell table is built on the episode's first lookup, for the goal kept.
             field = goal_field if goal_field is not None else scene.goal_field(floor, (gx, gy), robot=spec)
