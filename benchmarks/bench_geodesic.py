@@ -1,15 +1,54 @@
 """Geodesic speed and accuracy against the planners robot-learning code uses today.
 
-Speed (one run, so the ratios are meaningful on a shared machine): for generated houses on
-200x200, 400x400 and 1000x1000 grids, the time to build the per-floor planner (erosion,
-corners, corner graph), to build one goal field, to query a cached field (a distance lookup
-and a whole any-angle path), and, for the same start/goal pairs, one query of pyastar2d's
-C++ A* and of networkx A* on an 8-connected grid graph (how iGibson planned).
+Three modes; each prints the figures of one run, so that ratios are meaningful on a shared
+machine.
 
-Accuracy (``--accuracy``): relative error of ``get_shortest_path`` against the exact
-continuous geodesic on polygon floor plans at 0.05 m, beside an 8-connected grid search.
+Speed (default): for generated houses on 200x200, 400x400 and 1000x1000 grids, the time to
+build the per-floor planner of :mod:`pointnav_core.geodesic` (erosion, corners, corner
+graph), to build one goal field, to query a cached field (a distance lookup and a whole
+any-angle path), and, for the same start/goal pairs, one query of pyastar2d's C++ A* and of
+networkx A* on an 8-connected grid graph (how iGibson planned).
 
-Run: ``python benchmarks/bench_geodesic.py [--pairs 30] [--accuracy]``
+Accuracy (``--accuracy``, with the speed mode): relative error of ``get_shortest_path``
+against the exact continuous geodesic on polygon floor plans at 0.05 m, beside an
+8-connected grid search.
+
+Scale (``--scale``, alone): wall time and peak memory of three jobs per case, each alone in
+a child process (``benchkit.measure``; peak = the child's ``ru_maxrss`` minus its resident
+memory after imports and loading the case, so C allocations count):
+
+- ``scipy Dijkstra``: the 8-connected graph of the free cells, a diagonal move only where
+  both cells beside it are free (no corner cutting), built with numpy and ``scipy.sparse``
+  (the ``build`` lap), then one single-source ``csgraph.dijkstra`` from the start cell;
+- ``pyastar2d``: its C++ A* from the start cell to the goal cell on the same grid (weight 1
+  free, infinite blocked, ``allow_diagonal=True``). Its diagonal moves may cut blocked
+  corners and cost as much as straight ones, so its length, measured in metres along its
+  cells, can be longer or shorter than Dijkstra's;
+- ``tangent``: ``tangent_graph.Planner(FloorCollision(blocked, res, origin), r)`` (the
+  ``build`` lap), then its first ``shortest_path(start, goal)``.
+
+The grid searches plan a point on the cell grid (no erosion for the radius), the cheapest
+thing a grid planner does; the tangent planner plans the disc exactly, so lengths differ.
+The ratio tangent / Dijkstra (whole jobs) is printed against the target 3.0. A job still
+running after ``--limit`` seconds (default 600) is killed and shown as ``> limit``. Cases
+(r = 0.18 m; start and goal nudged to the nearest cell centre the disc fits at):
+
+- ``A``: 1000 x 1000 cells at 0.1 m, 2 % random single-cell clutter
+  (``np.random.default_rng(0).random((1000, 1000)) < 0.02``), start near (5, 5) m, goal near
+  (95, 95) m;
+- ``B``: a 2000 x 2000 perfect maze at 0.5 m (randomized depth-first search, iterative,
+  seed 0; corridors and walls one cell wide, like MovingAI's ``maze-*-1`` maps), start and
+  goal near opposite corners;
+- ``movingai``: ``den312d.map`` and ``maze-128-128-1.map`` from ``--movingai DIR`` (default
+  ``$POINTNAV_MOVINGAI`` or ``/work/shared/data/movingai``) through
+  ``Scene.from_movingai`` at 0.5 m, start and goal near opposite corners of the largest
+  free region; skipped with a note when the files are absent (they are optional).
+
+Run::
+
+    python benchmarks/bench_geodesic.py [--pairs 30] [--accuracy]
+    python benchmarks/bench_geodesic.py --scale [--cases A B movingai] [--limit 600]
+
 (needs the ``bench`` extra: ``pip install -e ".[bench]"``).
 """
 
@@ -17,14 +56,21 @@ from __future__ import annotations
 
 import argparse
 import math
+import random
 import statistics
 import sys
+import tempfile
 import time
+from dataclasses import dataclass
 from pathlib import Path
+from typing import Any
 
 import numpy as np
+from scipy import ndimage
 
+from benchkit import MOVINGAI_DIR, Measurement, machine, measure, movingai_maps, start_children
 from pointnav_core import scenes
+from pointnav_core.collision import FloorCollision
 
 RADIUS = 0.18
 
@@ -164,6 +210,263 @@ def accuracy(args):
           f"p95 {np.percentile(grid_err, 95)*100:.3f}%")
 
 
+# --------------------------------------------------------------------------- scale: cases
+#: Largest acceptable tangent-planner time (build + first path) over one grid Dijkstra.
+TARGET_RATIO = 3.0
+#: MovingAI maps used as extra cases when present.
+MOVINGAI_NAMES = ("den312d.map", "maze-128-128-1.map")
+
+
+@dataclass
+class Case:
+    """One scale case: a blocked grid, its geometry and a start/goal pair (world metres)."""
+
+    name: str
+    blocked: np.ndarray
+    resolution: float
+    origin: tuple[float, float]
+    start: np.ndarray
+    goal: np.ndarray
+
+
+def nearest_fitting_centre(
+    geo: FloorCollision, allowed: np.ndarray, target: tuple[float, float], radius: float
+) -> np.ndarray:
+    """Centre (m) of the ``allowed`` cell nearest ``target`` where a disc of ``radius`` fits."""
+    rows, cols = np.nonzero(allowed)
+    res, (ox, oy) = geo.resolution, geo.origin
+    centres = np.stack([ox + (cols + 0.5) * res, oy + (rows + 0.5) * res], axis=1)
+    order = np.argsort(np.hypot(centres[:, 0] - target[0], centres[:, 1] - target[1]), kind="stable")
+    for lo in range(0, len(order), 1024):  # nearest first, a batch at a time
+        batch = centres[order[lo : lo + 1024]]
+        ok = np.flatnonzero(geo.points_clear(batch, radius))
+        if len(ok):
+            return batch[ok[0]]
+    raise ValueError(f"no allowed cell fits a disc of radius {radius} m")
+
+
+def clutter_case(size: int = 1000, resolution: float = 0.1) -> Case:
+    """Case A: ``size`` squared cells with 2 % random single-cell clutter (seed 0)."""
+    rng = np.random.default_rng(0)
+    blocked = rng.random((size, size)) < 0.02
+    geo = FloorCollision(blocked, resolution, (0.0, 0.0))
+    extent = size * resolution
+    start = nearest_fitting_centre(geo, ~blocked, (0.05 * extent, 0.05 * extent), RADIUS)
+    goal = nearest_fitting_centre(geo, ~blocked, (0.95 * extent, 0.95 * extent), RADIUS)
+    name = f"A clutter {size}x{size} {resolution:g} m"
+    return Case(name, blocked, resolution, (0.0, 0.0), start, goal)
+
+
+def maze_grid(size: int, seed: int = 0) -> np.ndarray:
+    """A perfect maze of ``size`` x ``size`` cells (True = wall), by randomized depth-first search.
+
+    Rooms are the cells with both indices even, corridors and walls one cell wide (the
+    layout of MovingAI's ``maze-*-1`` maps); the odd last row and column, if any, are wall.
+    The search is iterative and seeded, so the maze depends on ``seed`` only.
+    """
+    if size < 1:
+        raise ValueError(f"size must be >= 1, got {size}")
+    n = (size + 1) // 2  # rooms per side
+    rnd = random.Random(seed)
+    visited = bytearray(n * n)
+    visited[0] = 1
+    stack = [0]
+    came, went = [], []
+    while stack:
+        cur = stack[-1]
+        i, j = divmod(cur, n)
+        options = []
+        if i > 0 and not visited[cur - n]:
+            options.append(cur - n)
+        if i < n - 1 and not visited[cur + n]:
+            options.append(cur + n)
+        if j > 0 and not visited[cur - 1]:
+            options.append(cur - 1)
+        if j < n - 1 and not visited[cur + 1]:
+            options.append(cur + 1)
+        if not options:
+            stack.pop()
+            continue
+        nxt = options[rnd.randrange(len(options))]
+        visited[nxt] = 1
+        came.append(cur)
+        went.append(nxt)
+        stack.append(nxt)
+    blocked = np.ones((size, size), dtype=bool)
+    blocked[0 : 2 * n : 2, 0 : 2 * n : 2] = False
+    a, b = np.asarray(came, dtype=np.int64), np.asarray(went, dtype=np.int64)
+    blocked[a // n + b // n, a % n + b % n] = False  # the wall between two rooms
+    return blocked
+
+
+def maze_case(size: int = 2000, resolution: float = 0.5, seed: int = 0) -> Case:
+    """Case B: a ``size`` squared perfect maze, start and goal near opposite corners."""
+    blocked = maze_grid(size, seed)
+    geo = FloorCollision(blocked, resolution, (0.0, 0.0))
+    extent = size * resolution
+    start = nearest_fitting_centre(geo, ~blocked, (0.0, 0.0), RADIUS)
+    goal = nearest_fitting_centre(geo, ~blocked, (extent, extent), RADIUS)
+    name = f"B maze {size}x{size} {resolution:g} m"
+    return Case(name, blocked, resolution, (0.0, 0.0), start, goal)
+
+
+def movingai_case(path: Path, resolution: float = 0.5) -> Case:
+    """A MovingAI map through ``Scene.from_movingai``: start and goal near opposite corners
+    of its largest 4-connected free region (where they are sure to be joined)."""
+    from pointnav_core.scenes import Scene
+
+    tmap = Scene.from_movingai(path, resolution=resolution).floors[0]
+    geo = tmap.collision
+    blocked = np.asarray(geo.blocked)
+    labels, count = ndimage.label(~blocked)
+    sizes = np.bincount(labels.ravel(), minlength=count + 1)
+    sizes[0] = 0
+    region = labels == int(np.argmax(sizes))
+    (ox, oy), (h, w) = geo.origin, blocked.shape
+    far = (ox + w * resolution, oy + h * resolution)
+    start = nearest_fitting_centre(geo, region, (ox, oy), RADIUS)
+    goal = nearest_fitting_centre(geo, region, far, RADIUS)
+    return Case(f"{path.name} {w}x{h} {resolution:g} m", blocked, resolution, geo.origin, start, goal)
+
+
+# --------------------------------------------------------------------------- scale: jobs (children)
+def load_case(path: str) -> dict[str, Any]:
+    """Child setup: import every planner and read the case file."""
+    import pyastar2d  # noqa: F401
+    from scipy.sparse import csgraph  # noqa: F401
+
+    import pointnav_core.tangent_graph  # noqa: F401
+
+    with np.load(path) as f:
+        case = {key: f[key] for key in f.files}
+    res = float(case["resolution"])
+    ox, oy = case["origin"]
+    for key in ("start", "goal"):
+        x, y = case[key]
+        case[key + "_cell"] = (int((y - oy) // res), int((x - ox) // res))
+    return case
+
+
+def grid_graph(free: np.ndarray) -> Any:
+    """8-connected graph (CSR, both directions) of the ``free`` cells, weights in cells.
+
+    A diagonal move needs all four cells of its 2x2 block free (no corner cutting).
+    """
+    from scipy import sparse
+
+    h, w = free.shape
+    idx = np.arange(h * w, dtype=np.int32).reshape(h, w)
+    block = free[:-1, :-1] & free[1:, 1:] & free[1:, :-1] & free[:-1, 1:]
+    moves = (
+        (free[:, :-1] & free[:, 1:], idx[:, :-1], idx[:, 1:], 1.0),
+        (free[:-1, :] & free[1:, :], idx[:-1, :], idx[1:, :], 1.0),
+        (block, idx[:-1, :-1], idx[1:, 1:], math.sqrt(2.0)),
+        (block, idx[:-1, 1:], idx[1:, :-1], math.sqrt(2.0)),
+    )
+    src = np.concatenate([a[m] for m, a, _, _ in moves])
+    dst = np.concatenate([b[m] for m, _, b, _ in moves])
+    wts = np.concatenate([np.full(int(m.sum()), c) for m, _, _, c in moves])
+    return sparse.csr_matrix(
+        (np.concatenate([wts, wts]), (np.concatenate([src, dst]), np.concatenate([dst, src]))),
+        shape=(h * w, h * w),
+    )
+
+
+def job_dijkstra(case: dict[str, Any], lap: Any) -> float:
+    """Graph of the free cells and one single-source Dijkstra; the goal's distance (m)."""
+    from scipy.sparse import csgraph
+
+    blocked = case["blocked"]
+    graph = grid_graph(~blocked)
+    lap("build")
+    w = blocked.shape[1]
+    (sr, sc), (gr, gc) = case["start_cell"], case["goal_cell"]
+    dist = csgraph.dijkstra(graph, directed=True, indices=sr * w + sc)
+    return float(dist[gr * w + gc]) * float(case["resolution"])
+
+
+def job_astar(case: dict[str, Any], lap: Any) -> float:
+    """pyastar2d from the start cell to the goal cell; the path's length (m)."""
+    import pyastar2d
+
+    weights = np.where(case["blocked"], np.inf, 1.0).astype(np.float32)
+    path = pyastar2d.astar_path(weights, case["start_cell"], case["goal_cell"], allow_diagonal=True)
+    if path is None:
+        return math.inf
+    steps = np.diff(path, axis=0)
+    return float(np.hypot(steps[:, 0], steps[:, 1]).sum()) * float(case["resolution"])
+
+
+def job_tangent(case: dict[str, Any], lap: Any) -> float:
+    """Tangent planner build, then its first exact shortest path; the length (m)."""
+    from pointnav_core.tangent_graph import Planner
+
+    geo = FloorCollision(case["blocked"], float(case["resolution"]), tuple(case["origin"]))
+    planner = Planner(geo, float(case["radius"]))
+    lap("build")
+    _, length = planner.shortest_path(case["start"], case["goal"])
+    return math.inf if length is None else float(length)
+
+
+JOBS = (("scipy Dijkstra", job_dijkstra), ("pyastar2d", job_astar), ("tangent", job_tangent))
+
+
+# --------------------------------------------------------------------------- scale: driver
+def _fmt_time(m: Measurement, key: str, limit: float) -> str:
+    if key in m.laps:
+        t = m.laps[key]
+        return f"{t:.3f}" if t < 10 else f"{t:.1f}"
+    return f"> {limit:g}" if m.timed_out else "-"
+
+
+def scale(case_names: list[str], limit: float, movingai_dir: Path) -> None:
+    """Build the chosen cases, measure every job on each, print the table."""
+    start_children()  # before the big arrays exist
+    print(f"machine: {machine()}")
+    print(f"radius {RADIUS} m, limit {limit:g} s per job; times in s, peak in MiB above setup")
+    builders: list[tuple[str, Any]] = []
+    if "A" in case_names:
+        builders.append(("A", clutter_case))
+    if "B" in case_names:
+        builders.append(("B", maze_case))
+    if "movingai" in case_names:
+        for path in movingai_maps(movingai_dir, MOVINGAI_NAMES):
+            builders.append((path.name, lambda p=path: movingai_case(p)))
+    header = f"{'case':34} {'job':15} {'build':>8} {'total':>8} {'peak':>8} {'length m':>10}"
+    with tempfile.TemporaryDirectory() as tmp:
+        for index, (_, build) in enumerate(builders):
+            t0 = time.perf_counter()
+            case = build()
+            file = str(Path(tmp) / f"case{index}.npz")
+            np.savez(file, blocked=case.blocked, resolution=case.resolution, origin=np.array(case.origin),
+                     start=case.start, goal=case.goal, radius=RADIUS)
+            h, w = case.blocked.shape
+            print(f"\n{case.name}: {h * w:,} cells, {case.blocked.mean():.1%} blocked, start "
+                  f"({case.start[0]:.2f}, {case.start[1]:.2f}), goal ({case.goal[0]:.2f}, "
+                  f"{case.goal[1]:.2f}) m; case built in {time.perf_counter() - t0:.1f} s")
+            print(header)
+            got = {}
+            for label, job in JOBS:
+                m = measure(load_case, job, (file,), limit=limit)
+                got[label] = m
+                peak = "-" if math.isnan(m.peak_mib) else f"{m.peak_mib:.0f}"
+                if m.timed_out and peak != "-":
+                    peak = ">= " + peak  # the peak until it was stopped
+                length = "-" if m.result is None else f"{m.result:.3f}"
+                print(f"{case.name:34} {label:15} {_fmt_time(m, 'build', limit):>8} "
+                      f"{_fmt_time(m, 'total', limit):>8} {peak:>8} {length:>10}", flush=True)
+                if m.error:
+                    print(f"  failed:\n{m.error}")
+            base, tan = got["scipy Dijkstra"].laps.get("total"), got["tangent"]
+            if base:
+                if "total" in tan.laps:
+                    ratio = tan.laps["total"] / base
+                    verdict = "met" if ratio <= TARGET_RATIO else "MISSED"
+                    print(f"  tangent / Dijkstra = {ratio:.1f} (target <= {TARGET_RATIO:g}): {verdict}")
+                elif tan.timed_out:
+                    print(f"  tangent / Dijkstra > {limit / base:.0f} (target <= {TARGET_RATIO:g}): MISSED")
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--pairs", type=int, default=20)
@@ -172,7 +475,16 @@ def main():
     parser.add_argument("--accuracy", action="store_true")
     parser.add_argument("--plans", type=int, default=3)
     parser.add_argument("--acc-pairs", type=int, default=70)
+    parser.add_argument("--scale", action="store_true", help="run the scale benchmark only")
+    parser.add_argument("--cases", nargs="+", choices=("A", "B", "movingai"), default=["A", "B", "movingai"])
+    parser.add_argument("--limit", type=float, default=600.0, help="seconds per scale job (default 600)")
+    parser.add_argument("--movingai", type=Path, default=MOVINGAI_DIR, help="folder of the MovingAI maps")
     args = parser.parse_args()
+    if not args.limit > 0:
+        parser.error(f"--limit must be > 0 seconds, got {args.limit}")
+    if args.scale:
+        scale(args.cases, args.limit, args.movingai)
+        return
     speed(args)
     if args.accuracy:
         accuracy(args)
