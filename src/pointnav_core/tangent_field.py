@@ -19,7 +19,7 @@ from numpy.typing import ArrayLike, NDArray
 from scipy import ndimage, sparse
 from scipy.sparse import csgraph
 
-from pointnav_core.tangent_graph import _ANG_TOL, _TWO_PI, Planner, _ccw_pos, _Search, _tangent_from_point
+from pointnav_core.tangent_graph import _ANG_TOL, _TWO_PI, Planner, _ccw_pos, _tangent_from_point
 
 __all__ = ["GoalField"]
 
@@ -43,11 +43,8 @@ class GoalField:
         self.goal = np.asarray(goal, dtype=np.float64).reshape(-1)[:2].copy()
         gx, gy = float(self.goal[0]), float(self.goal[1])
         self.goal_usable = planner.is_clear(gx, gy)
-        self._search = _Search(planner)
-        if self.goal_usable:
-            for c, s, pos, length in planner.point_links(gx, gy):
-                self._search.push(length, c, s, pos, -1, 0.0)
-            self._search.run()
+        links = planner.point_links(gx, gy) if self.goal_usable else []
+        self._search = planner.arc_graph().solve(links)
         self._table: dict[str, Any] | None = None
 
     @property
@@ -58,11 +55,9 @@ class GoalField:
     @property
     def nbytes(self) -> int:
         """Approximate memory held by this field, in bytes."""
-        labels = len(self._search.node) * 6 * 8
-        # The table holds six Python lists of one entry per cell (8-byte pointers to
-        # mostly shared small objects).
-        table = 0 if self._table is None else 6 * 8 * len(self._table["kind"])
-        return labels + table
+        table = 0 if self._table is None else sum(v.nbytes for v in self._table.values() if isinstance(v, np.ndarray))
+        table += 0 if self._table is None else 100 * len(self._table["fallback"])
+        return self._search.nbytes + table
 
     # ------------------------------------------------------------- exact queries
     def _best(self, x: float, y: float) -> tuple[float, int, float]:
@@ -79,7 +74,7 @@ class GoalField:
         for c, s, pos, length in p.point_links(x, y):
             side = -s
             dep = p._span[c] - pos
-            for lab in search.settled.get((c, side), ()):
+            for lab in search.on_arc(c, side):
                 lp = search.pos[lab]
                 if lp <= dep + _ANG_TOL and p._arc_free(c, side, lp, dep):
                     total = search.cost[lab] + r * max(dep - lp, 0.0) + length
@@ -119,7 +114,7 @@ class GoalField:
         h, w = geo.shape
         if not (0 <= row < h and 0 <= col < w):
             return math.inf
-        i = t["near"][row * w + col]
+        i = int(self.planner.near_usable[row * w + col])
         if i < 0:
             return math.inf
         kind = t["kind"][i]
@@ -128,11 +123,13 @@ class GoalField:
         if kind == 1:  # straight to the goal
             return math.hypot(x - t["gx"], y - t["gy"])
         if kind == 3:  # grid fallback from the cell centre
-            return t["value"][i] + math.hypot(x - t["px"][i], y - t["py"][i])
-        lab = t["label"][i]
+            ci, cj = divmod(i, w)
+            res = geo.resolution
+            return t["fallback"][i] + math.hypot(x - geo.origin[0] - (cj + 0.5) * res, y - geo.origin[1] - (ci + 0.5) * res)
+        lab = int(t["label"][i])
         p = self.planner
         search = self._search
-        c, side = search.node[lab], search.side[lab]
+        c, side = int(search.node[lab]), int(search.side[lab])
         r = p.radius
         dx = p._cx[c] - x
         dy = p._cy[c] - y
@@ -240,26 +237,26 @@ class GoalField:
         cx_all[idx], cy_all[idx] = px, py
         gx, gy = float(self.goal[0]), float(self.goal[1])
         if self.goal_usable and len(idx):
-            # Seeds: the goal and every settled label's arrival point, at their cells.
+            # Seed each arrival at points along its arc ahead of it, so that a cell behind the
+            # corner is proposed the arc point it leaves from; the goal is seed 0.
             search = self._search
-            n_lab = len(search.node)
-            # Seed each label at points along its arc ahead of the arrival, so that a cell
-            # behind the corner is proposed the arc point it leaves from.
-            xs, ys, costs, owner = [gx], [gy], [0.0], [0]
-            for j in range(n_lab):
-                node, side, pos = search.node[j], search.side[j], search.pos[j]
-                rest = p._span[node] - pos
-                for f in (0.0, 0.25, 0.5, 0.75, 1.0):
-                    q = pos + f * rest
-                    if f > 0 and (rest <= _ANG_TOL or not p._arc_free(node, side, pos, q)):
-                        break
-                    x, y = p.node_point(node, side, q)
-                    xs.append(x)
-                    ys.append(y)
-                    costs.append(search.cost[j] + p.radius * (q - pos))
-                    owner.append(j + 1)
-            seed_x, seed_y, seed_cost = np.array(xs), np.array(ys), np.array(costs)
-            seed_owner = np.array(owner)
+            arr_lab = search.arrivals()
+            a_node = search.node[arr_lab].astype(np.int64)
+            a_side = search.side[arr_lab].astype(np.int64)
+            a_pos = search.pos[arr_lab]
+            rest = p.span[a_node] - a_pos
+            xs, ys, costs, owner = [np.array([gx])], [np.array([gy])], [np.array([0.0])], [np.array([0])]
+            for f in (0.0, 0.25, 0.5, 0.75, 1.0):
+                q = a_pos + f * rest
+                ok = np.ones(len(q), bool) if f == 0 else (rest > _ANG_TOL) & p.arcs_free(a_node, a_side, a_pos, q)
+                ccw = np.where(a_side > 0, q, p.span[a_node] - q)
+                ang = p.phi0[a_node] + ccw
+                xs.append((p.cx[a_node] + p.radius * np.cos(ang))[ok])
+                ys.append((p.cy[a_node] + p.radius * np.sin(ang))[ok])
+                costs.append((search.cost[arr_lab] + p.radius * (q - a_pos))[ok])
+                owner.append(arr_lab[ok] + 1)
+            xs, ys, costs, owner = (np.concatenate(v) for v in (xs, ys, costs, owner))
+            seed_x, seed_y, seed_cost, seed_owner = xs, ys, costs, owner
             scol = np.floor((seed_x - geo.origin[0]) / res).astype(np.int64)
             srow = np.floor((seed_y - geo.origin[1]) / res).astype(np.int64)
             inside = (scol >= 0) & (scol < w) & (srow >= 0) & (srow < h)
@@ -267,7 +264,7 @@ class GoalField:
             ok = inside & flat[scell]
             seeds = np.flatnonzero(ok)
             seed_val = seed_cost[seeds] + np.hypot(cx_all[scell[seeds]] - seed_x[seeds], cy_all[scell[seeds]] - seed_y[seeds])
-            graph = _cell_graph(usable, res)
+            graph = p.cell_graph
             # A super-source (index n_cells) joined to each seed's cell, weighted by its cost.
             n = n_cells + 1 + len(seeds)
             # One virtual node per seed, so the predecessor chain names the seed.
@@ -313,19 +310,12 @@ class GoalField:
                 kind[c[good]] = 2
                 label[c[good]] = lab[good]
             self._adopt_roots(kind, label, value, cx_all, cy_all, usable, gx, gy)
-        # Cells the disc does not fit at read their nearest usable cell.
-        if len(idx):
-            _, (nr, nc) = ndimage.distance_transform_edt(~usable, return_indices=True)
-            near = (nr * w + nc).ravel()
-        else:
-            near = np.full(n_cells, -1)
+        # Compact: one byte of kind and an int32 root per cell; grid fallback values are few.
+        fb = np.flatnonzero(kind == 3)
         table = {
-            "kind": kind.tolist(),
-            "label": label.tolist(),
-            "value": value.tolist(),
-            "px": cx_all.tolist(),
-            "py": cy_all.tolist(),
-            "near": near.tolist(),
+            "kind": kind,
+            "label": label.astype(np.int32),
+            "fallback": dict(zip(fb.tolist(), value[fb].tolist())),
             "gx": gx,
             "gy": gy,
         }
