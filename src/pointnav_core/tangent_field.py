@@ -176,19 +176,18 @@ class GoalField:
         """Let cells whose proposed root failed its check try their neighbours' roots.
 
         A neighbour's root is usually visible from a cell too (as Theta* inherits parents);
-        a few passes settle almost every cell exactly.
+        a few passes settle almost every cell exactly. Each pass tests every distinct
+        (cell, root) pair once, and only cells next to a cell settled in the previous pass.
         """
         p = self.planner
         h, w = usable.shape
+        todo_mask = usable.ravel() & ((kind == 3) | (kind == 0))
         for _ in range(16):
-            todo = np.flatnonzero(usable.ravel() & ((kind == 3) | (kind == 0)))
+            todo = np.flatnonzero(todo_mask)
             if not len(todo):
                 return
-            best = np.full(len(todo), np.inf)
-            best_lab = np.full(len(todo), -1)
-            best_kind = np.zeros(len(todo), dtype=np.int8)
             rows, cols = np.divmod(todo, w)
-            px, py = cx_all[todo], cy_all[todo]
+            cells, roots = [], []
             for dr in (-1, 0, 1):
                 for dc in (-1, 0, 1):
                     if not (dr or dc):
@@ -197,25 +196,38 @@ class GoalField:
                     inside = (nr >= 0) & (nr < h) & (nc >= 0) & (nc < w)
                     nb = np.where(inside, nr * w + nc, 0)
                     k = np.where(inside, kind[nb], 0)
-                    sel = np.flatnonzero(k == 2)
-                    if len(sel):
-                        val = self._root_values(todo[sel], label[nb[sel]], px[sel], py[sel])
-                        better = val < best[sel]
-                        best[sel[better]] = val[better]
-                        best_lab[sel[better]] = label[nb[sel[better]]]
-                        best_kind[sel[better]] = 2
-                    sel = np.flatnonzero((k == 1) & (best_kind != 1))
-                    if len(sel):
-                        clear = p.geo.segments_clear(np.stack([px[sel], py[sel]], 1), np.array([gx, gy]), p.radius)
-                        sel = sel[clear]
-                        best[sel] = np.hypot(px[sel] - gx, py[sel] - gy)
-                        best_kind[sel] = 1
-            found = best_kind > 0
-            if not found.any():
+                    sel = (k == 1) | (k == 2)
+                    cells.append(todo[sel])
+                    roots.append(np.where(k[sel] == 1, -1, label[nb[sel]]))
+            pair = np.unique(np.stack([np.concatenate(cells), np.concatenate(roots)], axis=1), axis=0)
+            if not len(pair):
                 return
-            cells = todo[found]
-            kind[cells] = best_kind[found]
-            label[cells] = best_lab[found]
+            pc, pr = pair[:, 0], pair[:, 1]
+            val = np.full(len(pair), np.inf)
+            direct = pr < 0
+            if direct.any():
+                c = pc[direct]
+                clear = p.geo.segments_clear(np.stack([cx_all[c], cy_all[c]], 1), np.array([gx, gy]), p.radius)
+                val[np.flatnonzero(direct)[clear]] = np.hypot(cx_all[c[clear]] - gx, cy_all[c[clear]] - gy)
+            if (~direct).any():
+                c = pc[~direct]
+                val[~direct] = self._root_values(c, pr[~direct], cx_all[c], cy_all[c])
+            ok = np.isfinite(val)
+            if not ok.any():
+                return
+            pc, pr, val = pc[ok], pr[ok], val[ok]
+            # The best pair of each cell: sort by value, keep the first of each cell.
+            order = np.lexsort((val, pc))
+            pc, pr = pc[order], pr[order]
+            first = np.concatenate([[True], pc[1:] != pc[:-1]])
+            cells, best = pc[first], pr[first]
+            kind[cells] = np.where(best < 0, 1, 2)
+            label[cells] = np.where(best < 0, -1, best)
+            # Only cells next to a newly settled cell can gain a root next pass.
+            fresh = np.zeros(h * w, dtype=bool)
+            fresh[cells] = True
+            near = ndimage.binary_dilation(fresh.reshape(h, w), structure=np.ones((3, 3), bool)).ravel()
+            todo_mask = near & usable.ravel() & ((kind == 3) | (kind == 0))
 
     def _build_table(self) -> dict[str, Any]:
         p = self.planner
