@@ -133,6 +133,7 @@ class Planner:
         self._sights = np.full(self.n_nodes, np.nan)
         self._arc_graph: ArcGraph | None = None
         self._fb_edt: NDArray[np.float64] | None = None
+        self._fb_mask: NDArray[np.bool_] | None = None
         self._usable: NDArray[np.bool_] | None = None
         self._near: NDArray[np.int32] | None = None
         self._cell_graph: Any = None
@@ -234,6 +235,12 @@ class Planner:
             full = blocked | ((edt - 0.5 + math.sqrt(0.5)) * geo.resolution < self.radius)
             self._fb_edt = np.asarray(ndimage.distance_transform_edt(~full))
         return self._fb_edt
+
+    def fully_blocked_mask(self) -> NDArray[np.bool_]:
+        """Cells (padded by one ring) where no point is clear for the robot's disc."""
+        if self._fb_mask is None:
+            self._fb_mask = self._fully_blocked_edt() < 0.5
+        return self._fb_mask
 
     def sight_radius(self, x: float, y: float) -> float:
         """An upper bound (m) on how far a disc at ``(x, y)`` can move in a straight line.
