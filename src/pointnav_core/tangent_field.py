@@ -19,7 +19,7 @@ from numpy.typing import ArrayLike, NDArray
 from scipy import ndimage, sparse
 from scipy.sparse import csgraph
 
-from pointnav_core.tangent_graph import _ANG_TOL, _TWO_PI, Planner, _ccw_pos, _Search, _tangent_from_point
+from pointnav_core.tangent_graph import _ANG_TOL, _TWO_PI, Planner, _ccw_pos, _tangent_from_point
 
 __all__ = ["GoalField"]
 
@@ -43,11 +43,8 @@ class GoalField:
         self.goal = np.asarray(goal, dtype=np.float64).reshape(-1)[:2].copy()
         gx, gy = float(self.goal[0]), float(self.goal[1])
         self.goal_usable = planner.is_clear(gx, gy)
-        self._search = _Search(planner)
-        if self.goal_usable:
-            for c, s, pos, length in planner.point_links(gx, gy):
-                self._search.push(length, c, s, pos, -1, 0.0)
-            self._search.run()
+        links = planner.point_links(gx, gy) if self.goal_usable else []
+        self._search = planner.arc_graph().solve(links)
         self._table: dict[str, Any] | None = None
 
     @property
@@ -58,11 +55,9 @@ class GoalField:
     @property
     def nbytes(self) -> int:
         """Approximate memory held by this field, in bytes."""
-        labels = len(self._search.node) * 6 * 8
-        # The table holds six Python lists of one entry per cell (8-byte pointers to
-        # mostly shared small objects).
-        table = 0 if self._table is None else 6 * 8 * len(self._table["kind"])
-        return labels + table
+        table = 0 if self._table is None else sum(v.nbytes for v in self._table.values() if isinstance(v, np.ndarray))
+        table += 0 if self._table is None else 100 * len(self._table["fallback"])
+        return self._search.nbytes + table
 
     # ------------------------------------------------------------- exact queries
     def _best(self, x: float, y: float) -> tuple[float, int, float]:
@@ -79,7 +74,7 @@ class GoalField:
         for c, s, pos, length in p.point_links(x, y):
             side = -s
             dep = p._span[c] - pos
-            for lab in search.settled.get((c, side), ()):
+            for lab in search.on_arc(c, side):
                 lp = search.pos[lab]
                 if lp <= dep + _ANG_TOL and p._arc_free(c, side, lp, dep):
                     total = search.cost[lab] + r * max(dep - lp, 0.0) + length
@@ -119,7 +114,7 @@ class GoalField:
         h, w = geo.shape
         if not (0 <= row < h and 0 <= col < w):
             return math.inf
-        i = t["near"][row * w + col]
+        i = int(self.planner.near_usable[row * w + col])
         if i < 0:
             return math.inf
         kind = t["kind"][i]
@@ -128,11 +123,13 @@ class GoalField:
         if kind == 1:  # straight to the goal
             return math.hypot(x - t["gx"], y - t["gy"])
         if kind == 3:  # grid fallback from the cell centre
-            return t["value"][i] + math.hypot(x - t["px"][i], y - t["py"][i])
-        lab = t["label"][i]
+            ci, cj = divmod(i, w)
+            res = geo.resolution
+            return t["fallback"][i] + math.hypot(x - geo.origin[0] - (cj + 0.5) * res, y - geo.origin[1] - (ci + 0.5) * res)
+        lab = int(t["label"][i])
         p = self.planner
         search = self._search
-        c, side = search.node[lab], search.side[lab]
+        c, side = int(search.node[lab]), int(search.side[lab])
         r = p.radius
         dx = p._cx[c] - x
         dy = p._cy[c] - y
@@ -179,19 +176,18 @@ class GoalField:
         """Let cells whose proposed root failed its check try their neighbours' roots.
 
         A neighbour's root is usually visible from a cell too (as Theta* inherits parents);
-        a few passes settle almost every cell exactly.
+        a few passes settle almost every cell exactly. Each pass tests every distinct
+        (cell, root) pair once, and only cells next to a cell settled in the previous pass.
         """
         p = self.planner
         h, w = usable.shape
+        todo_mask = usable.ravel() & ((kind == 3) | (kind == 0))
         for _ in range(16):
-            todo = np.flatnonzero(usable.ravel() & ((kind == 3) | (kind == 0)))
+            todo = np.flatnonzero(todo_mask)
             if not len(todo):
                 return
-            best = np.full(len(todo), np.inf)
-            best_lab = np.full(len(todo), -1)
-            best_kind = np.zeros(len(todo), dtype=np.int8)
             rows, cols = np.divmod(todo, w)
-            px, py = cx_all[todo], cy_all[todo]
+            cells, roots = [], []
             for dr in (-1, 0, 1):
                 for dc in (-1, 0, 1):
                     if not (dr or dc):
@@ -200,25 +196,38 @@ class GoalField:
                     inside = (nr >= 0) & (nr < h) & (nc >= 0) & (nc < w)
                     nb = np.where(inside, nr * w + nc, 0)
                     k = np.where(inside, kind[nb], 0)
-                    sel = np.flatnonzero(k == 2)
-                    if len(sel):
-                        val = self._root_values(todo[sel], label[nb[sel]], px[sel], py[sel])
-                        better = val < best[sel]
-                        best[sel[better]] = val[better]
-                        best_lab[sel[better]] = label[nb[sel[better]]]
-                        best_kind[sel[better]] = 2
-                    sel = np.flatnonzero((k == 1) & (best_kind != 1))
-                    if len(sel):
-                        clear = p.geo.segments_clear(np.stack([px[sel], py[sel]], 1), np.array([gx, gy]), p.radius)
-                        sel = sel[clear]
-                        best[sel] = np.hypot(px[sel] - gx, py[sel] - gy)
-                        best_kind[sel] = 1
-            found = best_kind > 0
-            if not found.any():
+                    sel = (k == 1) | (k == 2)
+                    cells.append(todo[sel])
+                    roots.append(np.where(k[sel] == 1, -1, label[nb[sel]]))
+            pair = np.unique(np.stack([np.concatenate(cells), np.concatenate(roots)], axis=1), axis=0)
+            if not len(pair):
                 return
-            cells = todo[found]
-            kind[cells] = best_kind[found]
-            label[cells] = best_lab[found]
+            pc, pr = pair[:, 0], pair[:, 1]
+            val = np.full(len(pair), np.inf)
+            direct = pr < 0
+            if direct.any():
+                c = pc[direct]
+                clear = p.geo.segments_clear(np.stack([cx_all[c], cy_all[c]], 1), np.array([gx, gy]), p.radius)
+                val[np.flatnonzero(direct)[clear]] = np.hypot(cx_all[c[clear]] - gx, cy_all[c[clear]] - gy)
+            if (~direct).any():
+                c = pc[~direct]
+                val[~direct] = self._root_values(c, pr[~direct], cx_all[c], cy_all[c])
+            ok = np.isfinite(val)
+            if not ok.any():
+                return
+            pc, pr, val = pc[ok], pr[ok], val[ok]
+            # The best pair of each cell: sort by value, keep the first of each cell.
+            order = np.lexsort((val, pc))
+            pc, pr = pc[order], pr[order]
+            first = np.concatenate([[True], pc[1:] != pc[:-1]])
+            cells, best = pc[first], pr[first]
+            kind[cells] = np.where(best < 0, 1, 2)
+            label[cells] = np.where(best < 0, -1, best)
+            # Only cells next to a newly settled cell can gain a root next pass.
+            fresh = np.zeros(h * w, dtype=bool)
+            fresh[cells] = True
+            near = ndimage.binary_dilation(fresh.reshape(h, w), structure=np.ones((3, 3), bool)).ravel()
+            todo_mask = near & usable.ravel() & ((kind == 3) | (kind == 0))
 
     def _build_table(self) -> dict[str, Any]:
         p = self.planner
@@ -240,26 +249,26 @@ class GoalField:
         cx_all[idx], cy_all[idx] = px, py
         gx, gy = float(self.goal[0]), float(self.goal[1])
         if self.goal_usable and len(idx):
-            # Seeds: the goal and every settled label's arrival point, at their cells.
+            # Seed each arrival at points along its arc ahead of it, so that a cell behind the
+            # corner is proposed the arc point it leaves from; the goal is seed 0.
             search = self._search
-            n_lab = len(search.node)
-            # Seed each label at points along its arc ahead of the arrival, so that a cell
-            # behind the corner is proposed the arc point it leaves from.
-            xs, ys, costs, owner = [gx], [gy], [0.0], [0]
-            for j in range(n_lab):
-                node, side, pos = search.node[j], search.side[j], search.pos[j]
-                rest = p._span[node] - pos
-                for f in (0.0, 0.25, 0.5, 0.75, 1.0):
-                    q = pos + f * rest
-                    if f > 0 and (rest <= _ANG_TOL or not p._arc_free(node, side, pos, q)):
-                        break
-                    x, y = p.node_point(node, side, q)
-                    xs.append(x)
-                    ys.append(y)
-                    costs.append(search.cost[j] + p.radius * (q - pos))
-                    owner.append(j + 1)
-            seed_x, seed_y, seed_cost = np.array(xs), np.array(ys), np.array(costs)
-            seed_owner = np.array(owner)
+            arr_lab = search.arrivals()
+            a_node = search.node[arr_lab].astype(np.int64)
+            a_side = search.side[arr_lab].astype(np.int64)
+            a_pos = search.pos[arr_lab]
+            rest = p.span[a_node] - a_pos
+            xs, ys, costs, owner = [np.array([gx])], [np.array([gy])], [np.array([0.0])], [np.array([0])]
+            for f in (0.0, 0.25, 0.5, 0.75, 1.0):
+                q = a_pos + f * rest
+                ok = np.ones(len(q), bool) if f == 0 else (rest > _ANG_TOL) & p.arcs_free(a_node, a_side, a_pos, q)
+                ccw = np.where(a_side > 0, q, p.span[a_node] - q)
+                ang = p.phi0[a_node] + ccw
+                xs.append((p.cx[a_node] + p.radius * np.cos(ang))[ok])
+                ys.append((p.cy[a_node] + p.radius * np.sin(ang))[ok])
+                costs.append((search.cost[arr_lab] + p.radius * (q - a_pos))[ok])
+                owner.append(arr_lab[ok] + 1)
+            xs, ys, costs, owner = (np.concatenate(v) for v in (xs, ys, costs, owner))
+            seed_x, seed_y, seed_cost, seed_owner = xs, ys, costs, owner
             scol = np.floor((seed_x - geo.origin[0]) / res).astype(np.int64)
             srow = np.floor((seed_y - geo.origin[1]) / res).astype(np.int64)
             inside = (scol >= 0) & (scol < w) & (srow >= 0) & (srow < h)
@@ -267,7 +276,7 @@ class GoalField:
             ok = inside & flat[scell]
             seeds = np.flatnonzero(ok)
             seed_val = seed_cost[seeds] + np.hypot(cx_all[scell[seeds]] - seed_x[seeds], cy_all[scell[seeds]] - seed_y[seeds])
-            graph = _cell_graph(usable, res)
+            graph = p.cell_graph
             # A super-source (index n_cells) joined to each seed's cell, weighted by its cost.
             n = n_cells + 1 + len(seeds)
             # One virtual node per seed, so the predecessor chain names the seed.
@@ -313,19 +322,12 @@ class GoalField:
                 kind[c[good]] = 2
                 label[c[good]] = lab[good]
             self._adopt_roots(kind, label, value, cx_all, cy_all, usable, gx, gy)
-        # Cells the disc does not fit at read their nearest usable cell.
-        if len(idx):
-            _, (nr, nc) = ndimage.distance_transform_edt(~usable, return_indices=True)
-            near = (nr * w + nc).ravel()
-        else:
-            near = np.full(n_cells, -1)
+        # Compact: one byte of kind and an int32 root per cell; grid fallback values are few.
+        fb = np.flatnonzero(kind == 3)
         table = {
-            "kind": kind.tolist(),
-            "label": label.tolist(),
-            "value": value.tolist(),
-            "px": cx_all.tolist(),
-            "py": cy_all.tolist(),
-            "near": near.tolist(),
+            "kind": kind,
+            "label": label.astype(np.int32),
+            "fallback": dict(zip(fb.tolist(), value[fb].tolist())),
             "gx": gx,
             "gy": gy,
         }

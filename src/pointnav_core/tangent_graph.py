@@ -49,8 +49,10 @@ from scipy.spatial import cKDTree
 
 from pointnav_core.collision import FloorCollision, convex_corners
 from pointnav_core.paths import path_length, resample_path
+from pointnav_core.tangent_edges import build_edges, sight_radii
 
 if TYPE_CHECKING:
+    from pointnav_core.arc_graph import ArcGraph
     from pointnav_core.maps import TraversableMap
     from pointnav_core.tangent_field import GoalField
 
@@ -63,6 +65,8 @@ _COST_TOL = 1e-12
 _ARC_SAMPLES = 9
 #: Rays cast to bound how far a node can see.
 _SIGHT_RAYS = 128
+#: Side (cells) of the square tiles whose nodes get their edges built together.
+_TILE = 32
 #: Largest angle (rad) of one piece of a drawn arc.
 _ARC_PIECE = math.radians(2.0)
 #: Smallest radius (m) the planner uses.
@@ -124,10 +128,15 @@ class Planner:
         # rather than pass through the vertex two diagonal squares share.
         self.radius = max(float(radius), MIN_RADIUS)
         self._build_nodes()
-        self._edges: dict[tuple[int, int], tuple[list[float], NDArray[Any]]] = {}
-        self._sight_cache: dict[int, float] = {}
+        # (node, side) -> departure positions, targets, target sides, arrivals, lengths.
+        self._edges: dict[tuple[int, int], tuple[list[float], list[int], list[int], list[float], list[float]]] = {}
+        self._sights = np.full(self.n_nodes, np.nan)
+        self._arc_graph: ArcGraph | None = None
         self._fb_edt: NDArray[np.float64] | None = None
+        self._fb_mask: NDArray[np.bool_] | None = None
         self._usable: NDArray[np.bool_] | None = None
+        self._near: NDArray[np.int32] | None = None
+        self._cell_graph: Any = None
         self._fields: dict[tuple[float, float], GoalField] = {}
         self._field_bytes = 0
 
@@ -178,6 +187,13 @@ class Planner:
         for i, j in zip(*np.nonzero(~self.arc_clear)):
             self._blocked_ccw[int(i)].append(float(self.span[i] * k[j]))
         self._tree = cKDTree(np.stack([self.cx, self.cy], axis=1)) if self.n_nodes else None
+        # Nodes grouped by tile, so that a lazy search builds a tile's edges in one batch.
+        tcol = np.floor((self.cx - ox) / (res * _TILE)).astype(np.int64)
+        trow = np.floor((self.cy - oy) / (res * _TILE)).astype(np.int64)
+        tile = (trow + 1) * (geo.shape[1] // _TILE + 3) + (tcol + 1)
+        order = np.argsort(tile, kind="stable")
+        self._tile_of = tile
+        self._tile_nodes = {int(t): order[i:j] for t, i, j in _runs(tile[order])}
 
     def node_point(self, node: int, s: int, pos: float) -> tuple[float, float]:
         """World point at arc position ``pos`` (rad, along winding ``s``) of ``node``."""
@@ -197,6 +213,16 @@ class Planner:
             lo, hi = sp - p2, sp - p1
         return not any(lo + _ANG_TOL < b < hi - _ANG_TOL for b in blocked)
 
+    def arcs_free(
+        self, nodes: NDArray[np.int64], sides: NDArray[np.int64], p1: NDArray[np.float64], p2: NDArray[np.float64]
+    ) -> NDArray[np.bool_]:
+        """Vectorised :meth:`_arc_free` (only nodes with a blocked arc sample are looked at)."""
+        out = np.ones(len(nodes), dtype=bool)
+        some = np.flatnonzero(~self.arc_clear[nodes].all(axis=1))
+        for i in some.tolist():
+            out[i] = self._arc_free(int(nodes[i]), int(sides[i]), float(p1[i]), float(p2[i]))
+        return out
+
     # ------------------------------------------------------------------ sight
     def _fully_blocked_edt(self) -> NDArray[np.float64]:
         """Distance (cells) from each cell centre to the nearest cell no disc point can use."""
@@ -210,39 +236,34 @@ class Planner:
             self._fb_edt = np.asarray(ndimage.distance_transform_edt(~full))
         return self._fb_edt
 
+    def fully_blocked_mask(self) -> NDArray[np.bool_]:
+        """Cells (padded by one ring) where no point is clear for the robot's disc."""
+        if self._fb_mask is None:
+            self._fb_mask = self._fully_blocked_edt() < 0.5
+        return self._fb_mask
+
     def sight_radius(self, x: float, y: float) -> float:
         """An upper bound (m) on how far a disc at ``(x, y)`` can move in a straight line.
 
         Cast as :data:`_SIGHT_RAYS` rays marched through cells no disc can use; the bound
-        is the longest ray plus two cells.
+        is the longest ray plus two cells (see :func:`~pointnav_core.tangent_edges.sight_radii`).
         """
+        return float(self._sight_radii(np.array([x]), np.array([y]))[0])
+
+    def _sight_radii(self, xs: NDArray[np.float64], ys: NDArray[np.float64]) -> NDArray[np.float64]:
         geo = self.geo
-        res = geo.resolution
-        edt = self._fully_blocked_edt()
-        h, w = edt.shape
-        ang = np.linspace(0.0, _TWO_PI, _SIGHT_RAYS, endpoint=False)
-        ux, uy = np.cos(ang), np.sin(ang)
-        gx0 = (x - geo.origin[0]) / res + 1.0  # +1: the padding ring
-        gy0 = (y - geo.origin[1]) / res + 1.0
-        t = np.zeros(_SIGHT_RAYS)
-        active = np.ones(_SIGHT_RAYS, bool)
-        start = self.radius / res + 2.0
-        limit = math.hypot(h, w) + 2.0
-        for _ in range(4 * (h + w)):
-            if not active.any():
-                break
-            gx = gx0 + t * ux
-            gy = gy0 + t * uy
-            col = np.floor(gx).astype(np.int64)
-            row = np.floor(gy).astype(np.int64)
-            inside = (col >= 0) & (col < w) & (row >= 0) & (row < h)
-            d = np.where(inside, edt[np.clip(row, 0, h - 1), np.clip(col, 0, w - 1)], 0.0)
-            # Stop inside a cell no disc can use; advance by what the nearest such cell
-            # leaves free (or a quarter cell, which can only overestimate the reach).
-            stop = active & ((~inside) | ((d < 0.5) & (t > start)) | (t > limit))
-            active &= ~stop
-            t = np.where(active, t + np.maximum(d - math.sqrt(2.0), 0.25), t)
-        return float(t.max() + 2.0) * res
+        return sight_radii(self._fully_blocked_edt(), xs, ys, geo.origin, geo.resolution, self.radius, _SIGHT_RAYS)
+
+    def node_sights(self, nodes: NDArray[np.int64]) -> NDArray[np.float64]:
+        """Sight bounds (m) of ``nodes``, from their arcs' midpoints plus the radius; cached."""
+        nodes = np.asarray(nodes, dtype=np.int64)
+        todo = nodes[np.isnan(self._sights[nodes])]
+        if len(todo):
+            mid = self.phi0[todo] + self.span[todo] / 2
+            x = self.cx[todo] + self.radius * np.cos(mid)
+            y = self.cy[todo] + self.radius * np.sin(mid)
+            self._sights[todo] = self._sight_radii(x, y) + self.radius
+        return self._sights[nodes]
 
     # ------------------------------------------------------------------ edges
     def edges(self, node: int, s: int) -> tuple[list[float], NDArray[Any]]:
@@ -251,72 +272,34 @@ class Planner:
         Returns the departure positions (rad) and a record array with fields ``to``,
         ``side``, ``arr`` (arrival position at ``to``), ``length`` (m).
         """
-        key = (node, s)
-        got = self._edges.get(key)
+        dep, to, side, arr, length = self._edge_lists(node, s)
+        rec = np.empty(len(dep), dtype=_EDGE_DTYPE)
+        rec["to"], rec["side"], rec["arr"], rec["length"] = to, side, arr, length
+        return list(dep), rec
+
+    def _edge_lists(self, node: int, s: int) -> tuple[list[float], list[int], list[int], list[float], list[float]]:
+        got = self._edges.get((node, s))
         if got is None:
-            got = self._make_edges(node, s)
-            self._edges[key] = got
+            # Build the whole tile: the search will want the neighbours next.
+            tile = self._tile_nodes[int(self._tile_of[node])]
+            todo = np.array([n for n in tile.tolist() if (n, 1) not in self._edges], dtype=np.int64)
+            build_edges(self, todo)
+            got = self._edges[(node, s)]
         return got
 
-    def _node_sight(self, node: int) -> float:
-        got = self._sight_cache.get(node)
-        if got is None:
-            mid = self._phi0[node] + self._span[node] / 2
-            x = self._cx[node] + self.radius * math.cos(mid)
-            y = self._cy[node] + self.radius * math.sin(mid)
-            got = self.sight_radius(x, y) + self.radius
-            self._sight_cache[node] = got
-        return got
+    def build_all_edges(self) -> None:
+        """Build the edges of every node (a goal field needs them all)."""
+        todo = np.array([n for n in range(self.n_nodes) if (n, 1) not in self._edges], dtype=np.int64)
+        for i in range(0, len(todo), 4096):
+            build_edges(self, todo[i : i + 4096])
 
-    def _make_edges(self, a: int, s: int) -> tuple[list[float], NDArray[Any]]:
-        r = self.radius
-        cand = np.asarray(self._tree.query_ball_point((self._cx[a], self._cy[a]), self._node_sight(a)), dtype=np.int64)
-        cand = cand[cand != a]
-        out_dep: list[NDArray[np.float64]] = []
-        recs: list[NDArray[Any]] = []
-        ax, ay = self._cx[a], self._cy[a]
-        for sb in (s, -s):
-            bx, by = self.cx[cand], self.cy[cand]
-            dx, dy = bx - ax, by - ay
-            L = np.hypot(dx, dy)
-            if sb == s:
-                ok = L > 0
-                theta = np.zeros_like(L)
-                seg = L
-            else:
-                ok = L > 2 * r * (1 + 1e-12) if r > 0 else L > 0
-                theta = s * np.arcsin(np.clip(2 * r / np.where(ok, L, 1.0), -1.0, 1.0))
-                seg = np.sqrt(np.maximum(L * L - 4 * r * r, 0.0))
-            heading = np.arctan2(dy, dx) + theta
-            dep_ang = heading - s * (math.pi / 2)
-            arr_ang = heading - sb * (math.pi / 2)
-            dep_ccw, ok_a = _ccw_pos(dep_ang, self._phi0[a], self._span[a])
-            arr_ccw, ok_b = _ccw_pos(arr_ang, self.phi0[cand], self.span[cand])
-            ok &= ok_a & ok_b
-            idx = np.flatnonzero(ok)
-            if not len(idx):
-                continue
-            pa = np.stack([ax + r * np.cos(dep_ang[idx]), ay + r * np.sin(dep_ang[idx])], axis=1)
-            pb = np.stack([bx[idx] + r * np.cos(arr_ang[idx]), by[idx] + r * np.sin(arr_ang[idx])], axis=1)
-            clear = self.geo.segments_clear(pa, pb, r)
-            idx = idx[clear]
-            if not len(idx):
-                continue
-            dep = dep_ccw[idx] if s > 0 else self._span[a] - dep_ccw[idx]
-            arr = arr_ccw[idx] if sb > 0 else self.span[cand[idx]] - arr_ccw[idx]
-            rec = np.empty(len(idx), dtype=_EDGE_DTYPE)
-            rec["to"] = cand[idx]
-            rec["side"] = sb
-            rec["arr"] = arr
-            rec["length"] = seg[idx]
-            out_dep.append(dep)
-            recs.append(rec)
-        if not recs:
-            return [], np.empty(0, dtype=_EDGE_DTYPE)
-        dep_all = np.concatenate(out_dep)
-        rec_all = np.concatenate(recs)
-        order = np.argsort(dep_all, kind="stable")
-        return dep_all[order].tolist(), rec_all[order]
+    def arc_graph(self) -> ArcGraph:
+        """The whole tangent graph as a plain digraph (built on first use, then cached)."""
+        if self._arc_graph is None:
+            from pointnav_core.arc_graph import ArcGraph
+
+            self._arc_graph = ArcGraph(self)
+        return self._arc_graph
 
     def point_links(
         self, x: float, y: float
@@ -434,8 +417,40 @@ class Planner:
             self._usable = usable
         return self._usable
 
+    @property
+    def near_usable(self) -> NDArray[np.int32]:
+        """Flat index of each cell's nearest usable cell (-1 where none is), int32."""
+        if self._near is None:
+            usable = self.usable
+            h, w = usable.shape
+            if usable.any():
+                _, (nr, nc) = ndimage.distance_transform_edt(~usable, return_indices=True)
+                self._near = (nr * w + nc).ravel().astype(np.int32)
+            else:
+                self._near = np.full(h * w, -1, dtype=np.int32)
+        return self._near
+
+    @property
+    def cell_graph(self) -> Any:
+        """8-connected graph (CSR, metres) of usable cells, shared by the goal fields' tables."""
+        if self._cell_graph is None:
+            from pointnav_core.tangent_field import _cell_graph
+
+            self._cell_graph = _cell_graph(self.usable, self.geo.resolution)
+        return self._cell_graph
+
 
 _EDGE_DTYPE = np.dtype([("to", np.int64), ("side", np.int8), ("arr", np.float64), ("length", np.float64)])
+
+
+def _runs(sorted_keys: NDArray[np.int64]) -> list[tuple[int, int, int]]:
+    """``(key, start, end)`` of each run of equal values in a sorted array."""
+    if not len(sorted_keys):
+        return []
+    cut = np.flatnonzero(np.diff(sorted_keys)) + 1
+    starts = np.concatenate([[0], cut])
+    ends = np.concatenate([cut, [len(sorted_keys)]])
+    return list(zip(sorted_keys[starts].tolist(), starts.tolist(), ends.tolist()))
 
 
 def _rings(poly: Any) -> list[Any]:
@@ -518,7 +533,7 @@ class _Search:
                         total = g + r * max(fdep - pos, 0.0) + flen
                         self.count += 1
                         heapq.heappush(heap, (total, total, self.count, -1, 0, 0.0, lab, fdep))
-            deps, recs = p.edges(node, s)
+            deps, to, side, arr, length = p._edge_lists(node, s)
             start = bisect.bisect_left(deps, pos - _ANG_TOL)
             if start >= len(deps):
                 continue
@@ -527,8 +542,7 @@ class _Search:
                 d = deps[i]
                 if blocked and not p._arc_free(node, s, pos, d):
                     break
-                rec = recs[i]
-                self.push(g + r * max(d - pos, 0.0) + float(rec["length"]), int(rec["to"]), int(rec["side"]), float(rec["arr"]), lab, d)
+                self.push(g + r * max(d - pos, 0.0) + length[i], to[i], side[i], arr[i], lab, d)
         return None
 
     def trace(self, label: int, dep: float) -> list[NDArray[np.float64]]:

@@ -1,0 +1,203 @@
+"""The tangent graph as a plain weighted digraph, solved by scipy's Dijkstra.
+
+A label of the tangent-graph search is a position on a node's arc; the arc between two
+positions costs ``r * angle``. Splitting every arc at the ends of the tangent edges on it
+turns the graph into an ordinary digraph with non-negative weights:
+
+- a **vertex** is one end of one tangent edge: ``(node, side, position)``;
+- an **arc edge** joins consecutive vertices of one ``(node, side)`` arc in winding order,
+  weighted ``r * (pos2 - pos1)``, where the arc between them is clear;
+- a **tangent edge** joins its departure vertex to its arrival vertex, weighted by the
+  segment's length.
+
+Shortest paths in this graph are the label-setting search's shortest paths (a label that
+an earlier label on the same arc dominates is exactly a vertex reached more cheaply along
+the arc), so a goal field is one call of :func:`scipy.sparse.csgraph.dijkstra` in C instead
+of a Python heap loop. Distances are exact; only the vertex set is fixed per planner.
+"""
+
+from __future__ import annotations
+
+import itertools
+import math
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+from numpy.typing import NDArray
+from scipy import sparse
+from scipy.sparse import csgraph
+
+if TYPE_CHECKING:
+    from pointnav_core.tangent_graph import Planner
+
+__all__ = ["ArcGraph", "FieldLabels"]
+
+_ANG_TOL = 1e-9
+#: Added to every weight: scipy reads a stored zero as no edge.
+_EPS_W = 1e-300
+
+
+class ArcGraph:
+    """Every tangent edge of a planner, with its arcs split at the edges' ends.
+
+    Parameters
+    ----------
+    planner : Planner
+        Its edges are built for every node first.
+    """
+
+    def __init__(self, planner: Planner) -> None:
+        p = planner
+        self.p = p
+        p.build_all_edges()
+        keys = list(p._edges.keys())
+        vals = [p._edges[k] for k in keys]
+        counts = np.fromiter((len(v[0]) for v in vals), dtype=np.int64, count=len(vals))
+        n_e = int(counts.sum())
+        a_node = np.repeat(np.fromiter((k[0] for k in keys), dtype=np.int64, count=len(keys)), counts)
+        a_side = np.repeat(np.fromiter((k[1] for k in keys), dtype=np.int8, count=len(keys)), counts)
+
+        def flat(i: int, dtype: Any) -> NDArray[Any]:
+            return np.fromiter(itertools.chain.from_iterable(v[i] for v in vals), dtype=dtype, count=n_e)
+
+        dep, to, sb, arr, length = flat(0, np.float64), flat(1, np.int64), flat(2, np.int8), flat(3, np.float64), flat(4, np.float64)
+        # Vertex e: departure of edge e; vertex n_e + e: its arrival.
+        node = np.concatenate([a_node, to])
+        side = np.concatenate([a_side, sb])
+        pos = np.concatenate([dep, arr])
+        group = node * 2 + (side < 0)
+        order = np.lexsort((pos, group))
+        rank = np.empty(len(order), dtype=np.int64)
+        rank[order] = np.arange(len(order))
+        self.node = node[order].astype(np.int32)
+        self.side = side[order]
+        self.pos = pos[order]
+        self.group = group[order]
+        self.n_vertices = n_v = len(order)
+        g = self.group
+        self.grp_start = np.searchsorted(g, np.arange(2 * p.n_nodes), side="left")
+        self.grp_end = np.searchsorted(g, np.arange(2 * p.n_nodes), side="right")
+        # Arc edges between consecutive vertices of one arc, where the arc is clear.
+        k = np.flatnonzero(g[1:] == g[:-1])
+        free = self._arcs_free(k, k + 1)
+        k = k[free]
+        d = self.pos[k + 1] - self.pos[k]
+        tie = k[d <= _ANG_TOL]  # positions equal within tolerance: both ways
+        rows = [k, rank[:n_e], tie + 1]
+        cols = [k + 1, rank[n_e:], tie]
+        wts = [p.radius * np.maximum(d, 0.0), length, np.zeros(len(tie))]
+        self._rows = np.concatenate(rows)
+        self._cols = np.concatenate(cols)
+        self._w = np.concatenate(wts) + _EPS_W
+
+    def _arcs_free(self, i: NDArray[np.int64], j: NDArray[np.int64]) -> NDArray[np.bool_]:
+        """Whether the arc between vertices ``i`` and ``j`` (same arc, ``pos_i <= pos_j``) is clear."""
+        p = self.p
+        out = np.ones(len(i), dtype=bool)
+        has = np.fromiter((bool(p._blocked_ccw[n]) for n in self.node[i].tolist()), dtype=bool, count=len(i))
+        for q in np.flatnonzero(has).tolist():
+            a, b = int(i[q]), int(j[q])
+            out[q] = p._arc_free(int(self.node[a]), int(self.side[a]), float(self.pos[a]), float(self.pos[b]))
+        return out
+
+    def solve(self, links: list[tuple[int, int, float, float]]) -> FieldLabels:
+        """Dijkstra from a point whose tangents arrive at ``links``: ``(node, side, pos, length)``."""
+        p = self.p
+        n_v = self.n_vertices
+        n_x = len(links)
+        src = n_v + n_x
+        rows = [self._rows]
+        cols = [self._cols]
+        wts = [self._w]
+        x_node = np.array([c for c, _, _, _ in links], dtype=np.int32)
+        x_side = np.array([s for _, s, _, _ in links], dtype=np.int8)
+        x_pos = np.array([q for _, _, q, _ in links], dtype=np.float64)
+        x_len = np.array([ln for _, _, _, ln in links], dtype=np.float64)
+        rows.append(np.full(n_x, src))
+        cols.append(n_v + np.arange(n_x))
+        wts.append(x_len + _EPS_W)
+        # Each arrival continues to the first vertex at or after it on its arc.
+        for k, (c, s, q, _) in enumerate(links):
+            gi = 2 * c + (s < 0)
+            lo, hi = int(self.grp_start[gi]), int(self.grp_end[gi])
+            j = lo + int(np.searchsorted(self.pos[lo:hi], q - _ANG_TOL, side="left"))
+            if j < hi and p._arc_free(c, s, q, float(self.pos[j])):
+                rows.append(np.array([n_v + k]))
+                cols.append(np.array([j]))
+                wts.append(np.array([p.radius * max(float(self.pos[j]) - q, 0.0) + _EPS_W]))
+        n = src + 1
+        graph = sparse.csr_matrix((np.concatenate(wts), (np.concatenate(rows), np.concatenate(cols))), shape=(n, n))
+        dist, pred = csgraph.dijkstra(graph, directed=True, indices=src, return_predecessors=True)
+        return FieldLabels(self, dist[:src], pred[:src], x_node, x_side, x_pos)
+
+
+class FieldLabels:
+    """The vertices one Dijkstra run reached: exact costs and the predecessor tree.
+
+    Vertex ``v < n_vertices`` is a vertex of the :class:`ArcGraph`; the rest are the
+    arrivals of the source's own tangents. ``parent`` is -1 for those and for vertices
+    not reached. Arrays are compact (float64 cost, int32 parent, shared vertex data).
+    """
+
+    def __init__(
+        self,
+        graph: ArcGraph,
+        dist: NDArray[np.float64],
+        pred: NDArray[np.int32],
+        x_node: NDArray[np.int32],
+        x_side: NDArray[np.int8],
+        x_pos: NDArray[np.float64],
+    ) -> None:
+        self.graph = graph
+        n_v = graph.n_vertices
+        self.cost = dist
+        parent = pred.astype(np.int32)
+        parent[parent >= n_v + len(x_node)] = -1  # the source
+        self.parent = parent
+        self.node = np.concatenate([graph.node, x_node])
+        self.side = np.concatenate([graph.side, x_side])
+        self.pos = np.concatenate([graph.pos, x_pos])
+        self.group = self.node.astype(np.int64) * 2 + (self.side < 0)
+        self._extra: dict[tuple[int, int], list[int]] = {}
+        for k in range(len(x_node)):
+            self._extra.setdefault((int(x_node[k]), int(x_side[k])), []).append(n_v + k)
+
+    @property
+    def nbytes(self) -> int:
+        """Bytes held by this run (the shared graph vertices are not counted)."""
+        n_x = len(self.node) - self.graph.n_vertices
+        return int(self.cost.nbytes + self.parent.nbytes + self.group.nbytes + n_x * 13 + self.node.nbytes + self.side.nbytes + self.pos.nbytes)
+
+    def on_arc(self, node: int, side: int) -> list[int]:
+        """Reached vertices on the arc of ``node`` winding ``side``."""
+        gi = 2 * node + (side < 0)
+        lo, hi = int(self.graph.grp_start[gi]), int(self.graph.grp_end[gi])
+        out = [lo + i for i in np.flatnonzero(np.isfinite(self.cost[lo:hi])).tolist()]
+        extra = self._extra.get((node, side))
+        if extra:
+            out += [v for v in extra if math.isfinite(self.cost[v])]
+        return out
+
+    def arrivals(self) -> NDArray[np.int64]:
+        """Reached vertices entered by a tangent (not along their own arc)."""
+        reached = np.flatnonzero(np.isfinite(self.cost))
+        par = self.parent[reached]
+        along = (par >= 0) & (self.group[np.maximum(par, 0)] == self.group[reached])
+        return reached[~along]
+
+    def trace(self, label: int, dep: float) -> list[NDArray[np.float64]]:
+        """Points from the departure at ``dep`` on ``label``'s arc back to the source."""
+        from pointnav_core.tangent_graph import _arc_points
+
+        p = self.graph.p
+        pts: list[NDArray[np.float64]] = []
+        grp, par = self.group, self.parent
+        while label >= 0:
+            # Follow the arc back to where the path arrived on it.
+            while par[label] >= 0 and grp[par[label]] == grp[label]:
+                label = int(par[label])
+            pts += _arc_points(p, int(self.node[label]), int(self.side[label]), dep, float(self.pos[label]))
+            label = int(par[label])
+            if label >= 0:
+                dep = float(self.pos[label])
+        return pts
