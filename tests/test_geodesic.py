@@ -136,10 +136,16 @@ def test_field_lookup_matches_exact_queries_in_a_generated_house():
 
     scene = scenes.rooms(seed=0)
     rng = np.random.default_rng(0)
-    worst = 0.0
+    rel = []
     for _ in range(150):
         _, a = scene.get_random_point(0, robot=0.18, rng=rng)
         _, b = scene.get_random_point(0, reference_point=a, robot=0.18, rng=rng)
         field = scene.goal_field(0, b, robot=0.18)
-        worst = max(worst, abs(field.distance(*a[:2]) - field.exact_distance(a[:2])))
-    assert worst < 0.05
+        lookup, exact = field.distance(*a[:2]), field.exact_distance(a[:2])
+        # The lookup is the length of a real path from the point (through a checked root),
+        # so never shorter than the geodesic.
+        assert lookup >= exact - 1e-9
+        rel.append(lookup / exact - 1.0 if exact > 0 else 0.0)
+    rel = np.array(rel)
+    assert np.quantile(rel, 0.95) <= 1e-3
+    assert rel.max() <= 0.01

@@ -23,6 +23,9 @@ from pointnav_core.tangent_graph import _ANG_TOL, _TWO_PI, Planner, _ccw_pos, _t
 
 __all__ = ["GoalField"]
 
+#: Most neighbour-inheritance passes of the root table (each reaches one cell further).
+_ADOPT_PASSES = 64
+
 
 class GoalField:
     """Geodesic distances (m) to one goal from every point of the floor.
@@ -122,10 +125,13 @@ class GoalField:
             return math.inf
         if kind == 1:  # straight to the goal
             return math.hypot(x - t["gx"], y - t["gy"])
-        if kind == 3:  # grid fallback from the cell centre
-            ci, cj = divmod(i, w)
-            res = geo.resolution
-            return t["fallback"][i] + math.hypot(x - geo.origin[0] - (cj + 0.5) * res, y - geo.origin[1] - (ci + 0.5) * res)
+        if kind == 3:
+            # No checked root was proposed here: find the cell centre's exact one, once.
+            kind = self._settle_cell(i)
+            if kind == 1:
+                return math.hypot(x - t["gx"], y - t["gy"])
+            if kind != 2:
+                return math.inf
         lab = int(t["label"][i])
         p = self.planner
         search = self._search
@@ -148,6 +154,19 @@ class GoalField:
                     return search.cost[lab] + r * max(dep - lp, 0.0) + math.sqrt(L * L - r * r)
         qx, qy = p.node_point(c, side, search.pos[lab])
         return search.cost[lab] + math.hypot(x - qx, y - qy)
+
+    def _settle_cell(self, i: int) -> int:
+        """Give table cell ``i`` its exact root (the best way from its centre); its new kind."""
+        t = self._table
+        assert t is not None
+        geo = self.planner.geo
+        ci, cj = divmod(i, geo.shape[1])
+        cost, lab, _ = self._best(geo.origin[0] + (cj + 0.5) * geo.resolution, geo.origin[1] + (ci + 0.5) * geo.resolution)
+        kind = 0 if lab == -2 else 1 if lab == -1 else 2
+        t["kind"][i] = kind
+        t["label"][i] = max(lab, -1)
+        t["fallback"].pop(i, None)
+        return kind
 
     def _root_values(
         self, cells: NDArray[np.int64], labs: NDArray[np.int64], px: NDArray[np.float64], py: NDArray[np.float64]
@@ -172,22 +191,34 @@ class GoalField:
             out[sub] = lcost[sub] + p.radius * np.maximum(dep[sub] - lpos[sub], 0.0) + length[sub]
         return out
 
-    def _adopt_roots(self, kind, label, value, cx_all, cy_all, usable, gx, gy) -> None:  # type: ignore[no-untyped-def]
-        """Let cells whose proposed root failed its check try their neighbours' roots.
+    def _adopt_roots(self, kind, label, cx_all, cy_all, usable, gx, gy) -> None:  # type: ignore[no-untyped-def]
+        """Let cells try their neighbours' roots, and keep the best that checks out.
 
-        A neighbour's root is usually visible from a cell too (as Theta* inherits parents);
-        a few passes settle almost every cell exactly. Each pass tests every distinct
-        (cell, root) pair once, and only cells next to a cell settled in the previous pass.
+        A neighbour's root is usually visible from a cell too (as Theta* inherits parents).
+        The first pass takes the cells whose proposal failed and the cells on the border
+        between two roots (where the grid metric may have picked the worse of two routes
+        that almost tie); each pass tests every distinct (cell, root) pair once, own root
+        included, and the next pass only cells next to a cell that changed.
         """
         p = self.planner
         h, w = usable.shape
-        todo_mask = usable.ravel() & ((kind == 3) | (kind == 0))
-        for _ in range(16):
+        use = usable.ravel()
+        key = np.where(kind == 1, -1, np.where(kind == 2, label, -2))  # -2: no root
+        grid_key = key.reshape(h, w)
+        border = np.zeros((h, w), dtype=bool)
+        for dr, dc in ((0, 1), (1, 0), (1, 1), (1, -1)):
+            a = grid_key[0 : h - dr, max(0, -dc) : w - max(0, dc)]
+            b = grid_key[dr:, max(0, dc) : w - max(0, -dc)]
+            differ = (a != b) & (a > -2) & (b > -2)
+            border[0 : h - dr, max(0, -dc) : w - max(0, dc)] |= differ
+            border[dr:, max(0, dc) : w - max(0, -dc)] |= differ
+        todo_mask = use & ((key == -2) | border.ravel())
+        for _ in range(_ADOPT_PASSES):
             todo = np.flatnonzero(todo_mask)
             if not len(todo):
                 return
             rows, cols = np.divmod(todo, w)
-            cells, roots = [], []
+            cells, roots = [todo[key[todo] > -2]], [key[todo][key[todo] > -2]]
             for dr in (-1, 0, 1):
                 for dc in (-1, 0, 1):
                     if not (dr or dc):
@@ -195,10 +226,10 @@ class GoalField:
                     nr, nc = rows + dr, cols + dc
                     inside = (nr >= 0) & (nr < h) & (nc >= 0) & (nc < w)
                     nb = np.where(inside, nr * w + nc, 0)
-                    k = np.where(inside, kind[nb], 0)
-                    sel = (k == 1) | (k == 2)
+                    k = np.where(inside, key[nb], -2)
+                    sel = k > -2
                     cells.append(todo[sel])
-                    roots.append(np.where(k[sel] == 1, -1, label[nb[sel]]))
+                    roots.append(k[sel])
             pair = np.unique(np.stack([np.concatenate(cells), np.concatenate(roots)], axis=1), axis=0)
             if not len(pair):
                 return
@@ -221,13 +252,18 @@ class GoalField:
             pc, pr = pc[order], pr[order]
             first = np.concatenate([[True], pc[1:] != pc[:-1]])
             cells, best = pc[first], pr[first]
+            moved = key[cells] != best
+            cells, best = cells[moved], best[moved]
+            if not len(cells):
+                return
+            key[cells] = best
             kind[cells] = np.where(best < 0, 1, 2)
             label[cells] = np.where(best < 0, -1, best)
-            # Only cells next to a newly settled cell can gain a root next pass.
+            # Only cells next to a cell that changed can gain a better root next pass.
             fresh = np.zeros(h * w, dtype=bool)
             fresh[cells] = True
             near = ndimage.binary_dilation(fresh.reshape(h, w), structure=np.ones((3, 3), bool)).ravel()
-            todo_mask = near & usable.ravel() & ((kind == 3) | (kind == 0))
+            todo_mask = near & use
 
     def _build_table(self) -> dict[str, Any]:
         p = self.planner
@@ -321,7 +357,7 @@ class GoalField:
                 good = np.isfinite(self._root_values(c, lab, cx_all[c], cy_all[c]))
                 kind[c[good]] = 2
                 label[c[good]] = lab[good]
-            self._adopt_roots(kind, label, value, cx_all, cy_all, usable, gx, gy)
+            self._adopt_roots(kind, label, cx_all, cy_all, usable, gx, gy)
         # Compact: one byte of kind and an int32 root per cell; grid fallback values are few.
         fb = np.flatnonzero(kind == 3)
         table = {
@@ -332,6 +368,8 @@ class GoalField:
             "gy": gy,
         }
         self._table = table
+        # The table made this field bigger: keep the planner's cache within its budget.
+        self.planner._trim_fields()
         return table
 
 
