@@ -322,7 +322,8 @@ def polygon_episodes(draw: st.DrawFn) -> tuple[Scene, list, list, str, list]:
                 drive=draw(st.sampled_from(("differential", "holonomic"))),
             )
         )
-        starts.append((draw(st.floats(0.0, 3.0)), draw(st.floats(0.0, 3.0)), draw(st.floats(-4, 4))))
+        xy = (draw(st.floats(0.0, 3.0)), draw(st.floats(0.0, 3.0)))
+        starts.append((*xy, draw(st.floats(-4.0, 4.0))))
     steps = [
         [draw(st.none() | robot_actions(spec, overshoot=0.5)) for spec in specs]
         for _ in range(draw(st.integers(1, 8)))
@@ -360,7 +361,7 @@ def test_no_robot_ever_overlaps_a_polygon_and_deviations_are_contacts(episode):
             ex, ey = commanded_displacement(spec, action, yaw_of(q0), dt)
             error = math.hypot(p1[0] - p0[0] - ex, p1[1] - p0[1] - ey)
             if error > 1e-6 * (1.0 + math.hypot(ex, ey)):
-                assert backend.in_contact(idn), f"robot {idn} deviated by {error} m without contact"
+                assert backend.in_contact(idn), f"robot {idn} deviated {error} m without contact"
 
 
 # ----------------------------------------------------------------------- stateful

@@ -11,6 +11,7 @@ import math
 import numpy as np
 import pytest
 import shapely
+import shapely.ops
 from shapely import affinity
 from shapely.geometry import Point
 
@@ -42,7 +43,9 @@ def blocked_geometry(scene: Scene, floor: int = 0):
     tmap = scene.floors[floor]
     res, (ox, oy) = tmap.resolution, tmap.origin
     rows, cols = np.nonzero(np.asarray(tmap.codes) != FREE)
-    squares = shapely.box(ox + cols * res, oy + rows * res, ox + (cols + 1) * res, oy + (rows + 1) * res)
+    squares = shapely.box(
+        ox + cols * res, oy + rows * res, ox + (cols + 1) * res, oy + (rows + 1) * res
+    )
     h, w = tmap.codes.shape
     frame = shapely.box(ox - 50, oy - 50, ox + w * res + 50, oy + h * res + 50).difference(
         shapely.box(ox, oy, ox + w * res, oy + h * res)
@@ -55,7 +58,9 @@ def obstacle_geometry(scene: Scene, floor: int = 0):
     tmap = scene.floors[floor]
     res, (ox, oy) = tmap.resolution, tmap.origin
     rows, cols = np.nonzero(np.asarray(tmap.codes) == OBSTACLE)
-    squares = shapely.box(ox + cols * res, oy + rows * res, ox + (cols + 1) * res, oy + (rows + 1) * res)
+    squares = shapely.box(
+        ox + cols * res, oy + rows * res, ox + (cols + 1) * res, oy + (rows + 1) * res
+    )
     return shapely.union_all([*squares, *polygons(scene, floor)])
 
 
@@ -134,7 +139,8 @@ def test_stop_mode_stays_where_a_polygon_edge_is_met(angle):
     backend = loaded(scene, [RobotSpec(radius=R)], mode="stop")
     along = np.array([math.cos(angle), math.sin(angle)])
     normal = np.array([-along[1], along[0]])
-    backend.land(0, 0, np.array([3.0, 3.0]) + (0.01 + R + 0.1) * normal, quat(math.atan2(*-normal[::-1])))
+    start = np.array([3.0, 3.0]) + (0.01 + R + 0.1) * normal
+    backend.land(0, 0, start, quat(math.atan2(-normal[1], -normal[0])))  # facing the wall
     for _ in range(3):
         backend.step({0: [1.0, 0.0]})
     met = xy(backend)
@@ -148,7 +154,8 @@ def test_stop_mode_stays_where_a_polygon_edge_is_met(angle):
 @pytest.mark.parametrize("mode", ["slide", "stop"])
 def test_no_tunnelling_through_a_thin_polygon_at_any_speed(radius, mode):
     # 1 cm thick, tilted by 0.2 rad, and met head on: sliding has nowhere to go.
-    thin = affinity.rotate(shapely.box(2.99, -1.0, 3.0, 4.0), 0.2, origin=(3.0, 1.5), use_radians=True)
+    thin = shapely.box(2.99, -1.0, 3.0, 4.0)
+    thin = affinity.rotate(thin, 0.2, origin=(3.0, 1.5), use_radians=True)
     scene = Scene.from_polygons(shapely.box(0, 0, 6, 3), [thin], resolution=0.1)
     spec = RobotSpec(radius=radius, max_linear_velocity=500.0)
     backend = loaded(scene, [spec], mode)
@@ -330,3 +337,38 @@ def test_is_valid_pose_also_refuses_overlap_with_present_robots_on_a_polygon_flo
     assert backend.is_valid_pose(0, (1.0 + R + 0.1, 1.0))
     backend.set_present(1, False)
     assert backend.is_valid_pose(0, (1.2, 1.0))
+
+
+# ----------------------------------------------------------------------- capsule geometry
+
+
+def test_capsule_entry_and_segment_distance_agree_with_shapely():
+    from pointnav_kinematic.geometry import enter_capsule, segment_distance
+
+    rng = np.random.default_rng(11)
+    entered = 0
+    for _ in range(400):
+        a, b, p = rng.uniform(-2, 2, size=(3, 2))
+        d = rng.normal(size=2)
+        radius = rng.uniform(0.0, 0.8)
+        length = float(np.hypot(*(b - a)))
+        u = (b - a) / length
+        seg = (*a, *b, *u, length)
+        line = shapely.LineString([a, b])
+        dist, nx, ny = segment_distance(*p, seg)
+        assert dist == pytest.approx(Point(*p).distance(line), abs=1e-12)
+        nearest = np.array(shapely.ops.nearest_points(line, Point(*p))[0].coords[0])
+        if dist > 1e-9:
+            np.testing.assert_allclose([nx, ny], (p - nearest) / dist, atol=1e-9)
+        t = enter_capsule(*p, *d, seg, radius)
+        inside = Point(*p).distance(line) < radius
+        if inside:
+            assert t == 0.0
+            continue
+        # Before t the disc is clear; at t it touches (where t is finite).
+        for s in np.linspace(0.0, min(t, 10.0), 50)[:-1]:
+            assert Point(*(p + s * d)).distance(line) >= radius - 1e-9
+        if math.isfinite(t):
+            entered += 1
+            assert Point(*(p + t * d)).distance(line) == pytest.approx(radius, abs=1e-9)
+    assert entered > 50

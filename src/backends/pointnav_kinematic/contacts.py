@@ -76,6 +76,8 @@ def advance(robots: Sequence[Any], stop: bool) -> None:
                 pairs.append((a, b))
     start = [(rb.x, rb.y) for rb in moving]
     left = 1.0  # fraction of the sub-step still to go
+    # Contacts the robots rest against already: slide along them (or stop) before sweeping.
+    _resolve(moving, pairs, left, (None, None), stop)
     for _ in range(_EVENTS_PER_ROBOT * len(moving)):
         t_first, event = _first_hit(moving, pairs, left)
         if event is None:
@@ -92,7 +94,7 @@ def advance(robots: Sequence[Any], stop: bool) -> None:
         _resolve(moving, pairs, left, event, stop)
     # Anything left after that many contacts is dropped: the robots stay where they are.
     for rb, (x0, y0) in zip(moving, start):
-        if rb.contact:
+        if rb.contact and (rb.x != x0 or rb.y != y0):
             _undo_if_deeper(rb, x0, y0)
 
 
@@ -108,13 +110,16 @@ def _first_hit(
             continue
         x, y = rb.x, rb.y
         hit_r = _hit_radius(rb.radius)
+        speed = math.hypot(mx, my)
         for wall in rb.walls:
+            # Walls are convex: moving along their outward normal never brings the disc
+            # closer (that includes leaving an overlap), and a wall farther than the motion
+            # reaches is out of play. Both are cheaper to rule out than to sweep.
+            dist, nx, ny = wall_distance(x, y, wall)
+            if mx * nx + my * ny >= 0.0 or dist - hit_r > speed * t_first:
+                continue
             t = enter_wall(x, y, mx, my, wall, hit_r)
             if t < t_first:
-                if t == 0.0:  # overlapping already: only moving further in is a hit
-                    _, nx, ny = wall_distance(x, y, wall)
-                    if mx * nx + my * ny >= 0.0:
-                        continue
                 t_first, event = t, (rb, wall)
     for a, b in pairs:
         vx, vy = a.mx - b.mx, a.my - b.my
@@ -186,7 +191,7 @@ def _contacts(rb: Any, pairs: list[tuple[Any, Any]], event: tuple[Any, Any]) -> 
         dist = math.hypot(ex, ey)
         if dist <= r + other.radius + _ACTIVE:
             normal = (ex / dist, ey / dist) if dist > 0.0 else (1.0, 0.0)
-            forced = (event[0] is rb and event[1] is other) or (event[0] is other and event[1] is rb)
+            forced = event in ((rb, other), (other, rb))
             out.append((*normal, other, forced))
     return out
 

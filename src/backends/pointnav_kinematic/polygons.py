@@ -37,7 +37,7 @@ class EdgeIndex:
     Examples
     --------
     >>> index = EdgeIndex([shapely.box(2.99, 0.0, 3.02, 3.0)], bucket=0.5)
-    >>> len(index), len(index.near(2.5, 1.0, 2.8, 1.2))
+    >>> len(index), len(index.near(1.0, 1.0, 1.4, 1.2))  # buckets away from the wall
     (4, 0)
     >>> sorted(round(s[0], 2) for s in index.near(2.5, 1.0, 3.0, 1.2))  # the two long sides
     [2.99, 3.02]
@@ -69,8 +69,10 @@ class EdgeIndex:
                 y0 = ay + (by - ay) * k / pieces
                 x1 = ax + (bx - ax) * (k + 1) / pieces
                 y1 = ay + (by - ay) * (k + 1) / pieces
-                for gx in range(math.floor(min(x0, x1) * inv), math.floor(max(x0, x1) * inv) + 1):
-                    for gy in range(math.floor(min(y0, y1) * inv), math.floor(max(y0, y1) * inv) + 1):
+                gxs = range(math.floor(min(x0, x1) * inv), math.floor(max(x0, x1) * inv) + 1)
+                gys = range(math.floor(min(y0, y1) * inv), math.floor(max(y0, y1) * inv) + 1)
+                for gx in gxs:
+                    for gy in gys:
                         ids = buckets.setdefault((gx, gy), [])
                         if not ids or ids[-1] != i:
                             ids.append(i)
