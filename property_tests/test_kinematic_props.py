@@ -13,12 +13,15 @@ from dataclasses import dataclass
 
 import numpy as np
 import pytest
+import shapely
+from shapely import affinity
 from hypothesis import HealthCheck, given, note, settings
 from hypothesis import strategies as st
 from hypothesis.stateful import RuleBasedStateMachine, initialize, invariant, rule
 
 from pointnav_core.backend import RobotSpec
 from pointnav_core.maps import FREE, OBSTACLE, VOID, TraversableMap
+from pointnav_core.scenes import Scene
 from pointnav_core.testing.conformance import obstacle_distance
 from pointnav_core.testing.strategies import robot_actions
 from pointnav_kinematic import KinematicBackend
@@ -290,6 +293,75 @@ def test_no_robot_tunnels_through_a_one_cell_wall_at_any_speed(episode):
             pos = backend.get_pose(idn)[0]
             if backend.is_present(idn) and pos[2] == world.tmap.height:  # standing
                 assert pos[0] <= wall_x - spec.radius + TOUCH, f"robot {idn} crossed the wall"
+
+
+@st.composite
+def polygon_episodes(draw: st.DrawFn) -> tuple[Scene, list, list, str, list]:
+    """A 3 m room with a few thin walls at random angles, robots and their actions.
+
+    Returns the scene, the specs, the start poses (x, y, yaw), the collision mode and the
+    actions per step.
+    """
+    res = draw(st.sampled_from((0.1, 0.25, 0.5)))
+    walls = []
+    for _ in range(draw(st.integers(1, 3))):
+        cx, cy = draw(st.floats(0.5, 2.5)), draw(st.floats(0.5, 2.5))
+        length = draw(st.floats(0.2, 2.0))
+        thick = draw(st.sampled_from((0.005, 0.02, 0.3)))
+        wall = shapely.box(cx - length / 2, cy - thick / 2, cx + length / 2, cy + thick / 2)
+        angle = draw(st.floats(-math.pi, math.pi))
+        walls.append(affinity.rotate(wall, angle, origin=(cx, cy), use_radians=True))
+    scene = Scene.from_polygons(shapely.box(0.0, 0.0, 3.0, 3.0), walls, resolution=res)
+    specs, starts = [], []
+    for _ in range(draw(st.integers(1, 3))):
+        specs.append(
+            RobotSpec(
+                radius=draw(st.sampled_from((0.0, 0.05, 0.18))),
+                max_linear_velocity=draw(st.floats(0.1, 20.0)),
+                max_angular_velocity=draw(st.floats(0.1, 3.0)),
+                drive=draw(st.sampled_from(("differential", "holonomic"))),
+            )
+        )
+        xy = (draw(st.floats(0.0, 3.0)), draw(st.floats(0.0, 3.0)))
+        starts.append((*xy, draw(st.floats(-4.0, 4.0))))
+    steps = [
+        [draw(st.none() | robot_actions(spec, overshoot=0.5)) for spec in specs]
+        for _ in range(draw(st.integers(1, 8)))
+    ]
+    return scene, specs, starts, draw(st.sampled_from(("slide", "stop"))), steps
+
+
+@settings(deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(polygon_episodes())
+def test_no_robot_ever_overlaps_a_polygon_and_deviations_are_contacts(episode):
+    scene, specs, starts, mode, steps = episode
+    tmap = scene.floors[0]
+    walls = shapely.union_all(scene.floor_plans[0].obstacles)
+    backend = KinematicBackend(collision_mode=mode)
+    backend.load(scene, specs)
+    for idn, (x, y, yaw) in enumerate(starts):
+        if backend.is_valid_pose(idn, (x, y)):
+            backend.land(idn, 0, (x, y), quat(yaw))
+            # Independent reference: a valid pose is clear of the polygons by shapely.
+            assert shapely.Point(x, y).distance(walls) >= specs[idn].radius - TOUCH
+        else:
+            backend.set_present(idn, False)
+    dt = 0.1
+    for actions in steps:
+        before = [backend.get_pose(i) for i in range(len(specs))]
+        backend.step({i: a for i, a in enumerate(actions) if a is not None})
+        for idn, spec in enumerate(specs):
+            (p0, q0), (p1, _) = before[idn], backend.get_pose(idn)
+            if not backend.is_present(idn) or p1[2] < tmap.height:
+                continue
+            clearance = shapely.Point(p1[0], p1[1]).distance(walls)
+            assert clearance >= spec.radius - TOUCH, f"robot {idn} overlaps a wall"
+            assert obstacle_distance(tmap, p1[0], p1[1]) >= spec.radius - TOUCH
+            action = actions[idn] if actions[idn] is not None else np.zeros(spec.action_dim)
+            ex, ey = commanded_displacement(spec, action, yaw_of(q0), dt)
+            error = math.hypot(p1[0] - p0[0] - ex, p1[1] - p0[1] - ey)
+            if error > 1e-6 * (1.0 + math.hypot(ex, ey)):
+                assert backend.in_contact(idn), f"robot {idn} deviated {error} m without contact"
 
 
 # ----------------------------------------------------------------------- stateful

@@ -406,7 +406,8 @@ def test_is_valid_pose_rejects_void_and_off_map():
     grid[:, 7:] = VOID
     backend = loaded([TraversableMap(grid, 0.1)], [RobotSpec(radius=0.05)])
     assert backend.is_valid_pose(0, (0.5, 0.5))
-    assert backend.is_valid_pose(0, (0.69, 0.5))  # disc over VOID is fine, centre is not
+    assert backend.is_valid_pose(0, (0.65, 0.5))  # touching VOID (x >= 0.7) is fine
+    assert not backend.is_valid_pose(0, (0.69, 0.5))  # a robot may not stand overhanging it
     assert not backend.is_valid_pose(0, (0.75, 0.5))
     assert not backend.is_valid_pose(0, (-0.01, 0.5))
     assert not backend.is_valid_pose(0, (0.5, 1.2))

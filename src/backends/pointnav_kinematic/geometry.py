@@ -1,13 +1,15 @@
-"""Planar geometry for the kinematic backend: swept discs, grid squares and clearance.
+"""Planar geometry for the kinematic backend: swept discs, grid squares, polygon edges.
 
 Scalar functions here take and return plain floats: they run once per contact candidate
 inside a Python loop, where numpy's per-call overhead would dominate.
 
-A robot is a disc of radius ``r``. An obstacle is an axis-aligned cell square. The set of
-centre positions where a disc of radius ``R`` overlaps a square is the *rounded square*
-(the square grown by ``R``): the union of the square stretched by ``R`` along x, the
-square stretched by ``R`` along y, and four discs of radius ``R`` at its corners. A moving
-disc first touches the square when its centre enters that region.
+A robot is a disc of radius ``r``. An obstacle is an axis-aligned cell square or an edge of
+a floor plan's obstacle polygon. The set of centre positions where a disc of radius ``R``
+overlaps a square is the *rounded square* (the square grown by ``R``): the union of the
+square stretched by ``R`` along x, the square stretched by ``R`` along y, and four discs of
+radius ``R`` at its corners. For a segment it is the *capsule*: a rectangle of half-width
+``R`` along the segment and two discs of radius ``R`` at its ends. A moving disc first
+touches the obstacle when its centre enters that region.
 """
 
 from __future__ import annotations
@@ -18,14 +20,20 @@ import numpy as np
 from scipy import ndimage
 
 from pointnav_core.maps import OBSTACLE, VOID, TraversableMap
+from pointnav_kinematic.polygons import EdgeIndex, Segment
 
 __all__ = [
     "FloorGeometry",
     "enter_box",
+    "enter_capsule",
     "enter_disc",
     "enter_rounded_square",
+    "enter_wall",
+    "segment_distance",
     "square_distance",
+    "wall_distance",
 ]
+
 
 _INF = math.inf
 
@@ -134,6 +142,68 @@ def enter_rounded_square(
     return t
 
 
+def enter_capsule(
+    px: float, py: float, dx: float, dy: float, seg: Segment, radius: float
+) -> float:
+    """First ``t >= 0`` at which a disc of ``radius`` centred at ``p + t*d`` overlaps a segment.
+
+    Touching is not overlapping. Returns 0 if the disc overlaps it already and ``inf`` if
+    it never will along the line.
+
+    Examples
+    --------
+    >>> seg = (2.0, -1.0, 2.0, 1.0, 0.0, 1.0, 2.0)  # x = 2, -1 <= y <= 1
+    >>> enter_capsule(0.0, 0.0, 1.0, 0.0, seg, 0.5)
+    1.5
+    >>> enter_capsule(0.0, 1.5, 1.0, 0.0, seg, 0.5)  # grazing the end disc
+    inf
+    """
+    ax, ay, bx, by, ux, uy, length = seg
+    # The rectangle part, in the segment's frame: s along it, q across it.
+    rx = px - ax
+    ry = py - ay
+    t = enter_box(
+        rx * ux + ry * uy, ry * ux - rx * uy, dx * ux + dy * uy, dy * ux - dx * uy,
+        0.0, -radius, length, radius,
+    )
+    if t > 0.0 and radius > 0.0:
+        t2 = enter_disc(px, py, dx, dy, ax, ay, radius)
+        if t2 < t:
+            t = t2
+        t2 = enter_disc(px, py, dx, dy, bx, by, radius)
+        if t2 < t:
+            t = t2
+    return t
+
+
+def segment_distance(px: float, py: float, seg: Segment) -> tuple[float, float, float]:
+    """Distance from a point to a segment and the unit normal from the segment to the point.
+
+    Returns
+    -------
+    (float, float, float)
+        ``(distance, nx, ny)``: distance in metres (never negative: a segment has no
+        inside) and the unit vector from the nearest point of the segment towards ``p``;
+        on the segment itself, its left normal.
+
+    Examples
+    --------
+    >>> segment_distance(3.0, 0.5, (2.0, -1.0, 2.0, 1.0, 0.0, 1.0, 2.0))
+    (1.0, 1.0, 0.0)
+    >>> segment_distance(2.0, 4.0, (2.0, -1.0, 2.0, 1.0, 0.0, 1.0, 2.0))  # past the end
+    (3.0, 0.0, 1.0)
+    """
+    ax, ay, _, _, ux, uy, length = seg
+    s = (px - ax) * ux + (py - ay) * uy
+    s = 0.0 if s < 0.0 else length if s > length else s
+    vx = px - (ax + s * ux)
+    vy = py - (ay + s * uy)
+    dist = math.sqrt(vx * vx + vy * vy)
+    if dist > 0.0:
+        return dist, vx / dist, vy / dist
+    return 0.0, -uy, ux
+
+
 def square_distance(
     px: float, py: float, x0: float, y0: float, x1: float, y1: float
 ) -> tuple[float, float, float]:
@@ -167,23 +237,28 @@ def square_distance(
 
 
 class FloorGeometry:
-    """One floor's grid, preprocessed for fast motion queries.
+    """One floor's blocked set, preprocessed for fast motion queries.
 
     Parameters
     ----------
     tmap : TraversableMap
-        The floor's traversability grid.
+        The floor: its grid, and through ``tmap.collision`` the obstacle polygons of the
+        floor plan it was built from, if any.
     height : float
         World z of the floor in metres.
 
     Attributes
     ----------
+    collision : FloorCollision
+        The floor's one collision geometry (``tmap.collision``), for exact pose queries.
     codes : bytes
         Row-major cell codes; cell ``(row, col)`` is ``codes[row * width + col]``.
     edge : bytes
         Row-major flags of *edge* obstacle cells: obstacles with a side neighbour that is
         not an obstacle (or off the map). A disc approaching from free space meets an edge
         cell first, so contact queries only look at these.
+    edges : EdgeIndex
+        The boundary segments of the obstacle polygons.
     """
 
     def __init__(self, tmap: TraversableMap, height: float) -> None:
@@ -194,17 +269,31 @@ class FloorGeometry:
         self.inv_res = 1.0 / self.res
         self.ox, self.oy = (float(v) for v in tmap.origin)
         self.codes = codes.astype(np.uint8).tobytes()
+        self.collision = tmap.collision
+        # Buckets of a few cells: one step's search box spans one to four of them.
+        self.edges = EdgeIndex(self.collision.polygons, bucket=4.0 * self.res)
         obstacle = codes == OBSTACLE
         self.has_obstacles = bool(obstacle.any())
         pad = np.pad(obstacle, 1, constant_values=False)
         interior = pad[:-2, 1:-1] & pad[2:, 1:-1] & pad[1:-1, :-2] & pad[1:-1, 2:]
         self.edge = (obstacle & ~interior).astype(np.uint8).tobytes()
         # Lower bounds, in metres, on the distance from ANY point of a cell to the nearest
-        # obstacle square / VOID-or-off-map square: centre-to-centre distance minus two
-        # half diagonals (one for each square).
+        # obstacle square or polygon / VOID-or-off-map square: centre-to-centre distance
+        # minus two half diagonals (one for each square).
         slack = math.sqrt(2.0)
-        if self.has_obstacles:
-            edt = ndimage.distance_transform_edt(~obstacle)
+        blocking = obstacle
+        self._polygon_off_map = False
+        if len(self.edges):
+            blocking = obstacle | self.edges.touched_cells(codes.shape, self.res, tmap.origin)
+            x0, y0, x1, y1 = shapely_bounds(self.collision.polygons)
+            self._polygon_off_map = not (
+                x0 >= self.ox
+                and y0 >= self.oy
+                and x1 <= self.ox + self.width * self.res
+                and y1 <= self.oy + self.rows * self.res
+            )
+        if blocking.any():
+            edt = ndimage.distance_transform_edt(~blocking)
             self._clear_obstacle = (np.asarray(edt) - slack) * self.res
         else:
             self._clear_obstacle = np.full(codes.shape, np.inf)
@@ -218,11 +307,15 @@ class FloorGeometry:
 
         A disc of ``radius`` whose centre starts anywhere in cell ``i`` and moves less
         than ``fast_clearance(radius)[i]`` metres (along any path) neither touches an
-        obstacle square nor puts its centre over VOID. Row-major, cached per radius.
+        obstacle square or polygon nor puts its centre over VOID. Row-major, cached per
+        radius.
         """
         grid = self._fast.get(radius)
         if grid is None:
-            budget = np.minimum(self._clear_obstacle - radius, self._clear_void)
+            void = self._clear_void
+            if self._polygon_off_map:  # the disc may reach a polygon beyond the map's edge
+                void = void - radius
+            budget = np.minimum(self._clear_obstacle - radius, void)
             grid = memoryview(np.ascontiguousarray(budget, dtype=np.float64).ravel())
             self._fast[radius] = grid
         return grid
@@ -263,3 +356,34 @@ class FloorGeometry:
                 out.append((x0, y0, x0 + res, y0 + res))
                 col = edge.find(1, col + 1, base + c1 + 1)
         return out
+
+    def walls(
+        self, xmin: float, ymin: float, xmax: float, ymax: float
+    ) -> list[tuple[float, ...]]:
+        """Edge obstacle squares (4-tuples) and polygon edges (:data:`Segment`) near the box."""
+        out: list[tuple[float, ...]] = list(self.edge_squares(xmin, ymin, xmax, ymax))
+        if len(self.edges):
+            out.extend(self.edges.near(xmin, ymin, xmax, ymax))
+        return out
+
+
+def shapely_bounds(polygons: tuple) -> tuple[float, float, float, float]:
+    """Bounding box ``(xmin, ymin, xmax, ymax)`` in metres of a non-empty set of polygons."""
+    b = np.array([p.bounds for p in polygons])
+    return float(b[:, 0].min()), float(b[:, 1].min()), float(b[:, 2].max()), float(b[:, 3].max())
+
+
+def wall_distance(px: float, py: float, wall: tuple[float, ...]) -> tuple[float, float, float]:
+    """:func:`square_distance` or :func:`segment_distance`, as the wall's kind asks."""
+    if len(wall) == 4:
+        return square_distance(px, py, *wall)
+    return segment_distance(px, py, wall)  # type: ignore[arg-type]
+
+
+def enter_wall(
+    px: float, py: float, dx: float, dy: float, wall: tuple[float, ...], radius: float
+) -> float:
+    """:func:`enter_rounded_square` or :func:`enter_capsule`, as the wall's kind asks."""
+    if len(wall) == 4:
+        return enter_rounded_square(px, py, dx, dy, *wall, radius)
+    return enter_capsule(px, py, dx, dy, wall, radius)  # type: ignore[arg-type]

@@ -9,6 +9,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from pointnav_core.collision import TOUCH_TOL
 from pointnav_core.backend import (
     RobotSpec,
     RobotStateBackend,
@@ -18,31 +19,18 @@ from pointnav_core.backend import (
     parse_position,
     planar_quat,
 )
-from pointnav_core.maps import FREE, OBSTACLE
-from pointnav_kinematic.geometry import (
-    FloorGeometry,
-    enter_disc,
-    enter_rounded_square,
-    square_distance,
-)
+from pointnav_kinematic.contacts import advance
+from pointnav_kinematic.geometry import FloorGeometry
 
 __all__ = ["COLLISION_MODES", "KinematicBackend"]
 
 #: Valid values of ``collision_mode``.
 COLLISION_MODES = ("slide", "stop")
 
-# Contact tolerances, in metres. A blocked robot is placed _PLACE beyond contact and a
-# motion only counts as hitting something when it comes within _HIT of it, so a robot
-# that rests against a flat wall can slide along the wall's other cells without
-# "hitting" them through rounding. Constraints within _ACTIVE are treated as touching.
-_HIT = 0.5e-9
-_PLACE = 1.0e-9
-_ACTIVE = 2.0e-9
-# Accepted overlap in is_valid_pose (touching is allowed).
-_TOUCH = 1.0e-9
+# Accepted overlap between robots in is_valid_pose (touching is allowed), as for walls.
+_TOUCH = TOUCH_TOL
 _MAX_TURN = 0.25  # rad per sub-step: the chord stays close to the arc
 _MAX_SUBSTEPS = 1024  # beyond this, segments grow; collisions stay exact regardless
-_MAX_SLIDES = 4  # contacts resolved per segment (two walls and a corner, plus one)
 
 
 class _Robot:
@@ -68,6 +56,9 @@ class _Robot:
         "cmd",
         "travel",
         "stopped",
+        "mx",
+        "my",
+        "walls",
     )
 
     def __init__(self, spec: RobotSpec, geom: FloorGeometry) -> None:
@@ -90,6 +81,9 @@ class _Robot:
         self.cmd = (0.0, 0.0, 0.0)
         self.travel = 0.0
         self.stopped = False
+        # This sub-step's chord (m) and the walls near it, for contacts.advance.
+        self.mx = self.my = 0.0
+        self.walls: list[tuple[float, ...]] = []
 
     def solid(self) -> bool:
         """Whether other robots can collide with this one."""
@@ -118,11 +112,14 @@ class KinematicBackend(RobotStateBackend):
     Each :meth:`step` integrates every robot's drive in closed form over one control
     step of ``1 / action_frequency`` seconds (an exact arc for differential drive; exact
     rotation of the body-frame velocity for holonomic drive). A motion that would make a
-    robot's disc overlap an OBSTACLE cell square or another robot on the same floor is
-    cut at the first contact, found exactly by sweeping the disc (no tunnelling at any
-    speed); then the robot slides along the contact (``"slide"``) or stops there for
-    the rest of the step (``"stop"``), and both parties' contact flags are set. No robot
-    ever ends a step overlapping an obstacle or another robot. A robot whose centre
+    robot's disc overlap an OBSTACLE cell square, an obstacle polygon of the floor plan
+    or another robot on the same floor is cut at the first contact, found exactly by
+    sweeping the discs (no tunnelling at any speed); then the robot slides along the
+    contact (``"slide"``) or stops there for the rest of the step (``"stop"``), and both
+    parties' contact flags are set. Robots move simultaneously: two that close on each
+    other stop where they first touch. A motion that does not go into an obstacle, such
+    as driving along a wall the disc touches, is not a contact. No robot ever ends a
+    step overlapping an obstacle or another robot. A robot whose centre
     moves over VOID (or off the map) stops moving in x, y and falls: its z drops by at
     least 0.05 m on that step, then under gravity.
 
@@ -309,9 +306,12 @@ class KinematicBackend(RobotStateBackend):
         Returns
         -------
         bool
-            True when the centre is on the map and not over VOID or an OBSTACLE cell, the
-            disc overlaps no OBSTACLE square by more than 1e-9 m (touching is fine), and it
-            overlaps no other present, placed, non-falling robot on that floor.
+            True when the disc misses the floor's blocked set (``tmap.collision``: every
+            OBSTACLE and VOID cell square, everything off the map and the floor plan's
+            obstacle polygons; touching within 1e-9 m is fine), exactly as the task and
+            the planner decide, and it overlaps no other present, placed, non-falling
+            robot on that floor by more than 1e-9 m. (Motion is more lenient about VOID: a
+            disc may overhang it, and a robot falls only once its centre is over it.)
         """
         rb = self._robot(idn)
         geom = rb.geom if floor is None else self._floor(floor)
@@ -320,14 +320,9 @@ class KinematicBackend(RobotStateBackend):
         if orientation is not None:
             parse_orientation(orientation)
         x, y = xy[0], xy[1]
-        cell = geom.cell_index(x, y)
-        if cell < 0 or geom.codes[cell] != FREE:  # VOID, OBSTACLE or off the map
-            return False
         r = rb.radius
-        limit = r - _TOUCH
-        for x0, y0, x1, y1 in geom.edge_squares(x - r, y - r, x + r, y + r):
-            if square_distance(x, y, x0, y0, x1, y1)[0] < limit:
-                return False
+        if not geom.collision.points_clear((x, y), r):
+            return False
         for other in self._robots:
             if other is rb or other.floor != fl or not other.solid():
                 continue
@@ -401,12 +396,13 @@ class KinematicBackend(RobotStateBackend):
             rb.yaw += w * dt
             rb.vel = (dx / dt, dy / dt, 0.0, w)
         if slow:
-            self._slow_step(slow, moving, dt)
+            self._slow_step(slow, dt)
 
-    def _slow_step(self, slow: list[_Robot], solid: list[_Robot], dt: float) -> None:
-        # All slow robots advance together in sub-steps, in index order within each, so
-        # that robots meeting head-on share the gap. Collisions are exact for any segment
-        # length; sub-steps keep the swept chord near the arc and the search boxes small.
+    def _slow_step(self, slow: list[_Robot], dt: float) -> None:
+        # All slow robots advance together in sub-steps; within each, contacts.advance moves
+        # them simultaneously, so robots meeting head-on share the gap by their speeds.
+        # Collisions are exact for any chord; sub-steps keep the chord near the arc and the
+        # search boxes small.
         n_sub = 1
         for rb in slow:
             res = rb.geom.res
@@ -420,17 +416,23 @@ class KinematicBackend(RobotStateBackend):
             rb.stopped = False
             if rb.geom.is_void(rb.x, rb.y):
                 rb.falling = True  # standing over nothing: falls without moving
+        stop = self._stop
         for _ in range(n_sub):
+            standing = []
             for rb in slow:
                 if rb.falling:
                     continue
                 vx, vy, w = rb.cmd
-                if not rb.stopped and (vx != 0.0 or vy != 0.0):
-                    dx, dy = _arc(rb.yaw, vx, vy, w, h)
-                    self._advance(rb, dx, dy, solid)
-                    if rb.geom.is_void(rb.x, rb.y):
-                        rb.falling = True
-                rb.yaw += w * h
+                if rb.stopped or (vx == 0.0 and vy == 0.0):
+                    rb.mx = rb.my = 0.0
+                else:
+                    rb.mx, rb.my = _arc(rb.yaw, vx, vy, w, h)
+                standing.append(rb)
+            advance(standing, stop)
+            for rb in standing:
+                if rb.geom.is_void(rb.x, rb.y):
+                    rb.falling = True
+                rb.yaw += rb.cmd[2] * h
         for rb, (x0, y0, yaw0) in zip(slow, start):
             if rb.falling:
                 vel_x, vel_y, wz = (rb.x - x0) / dt, (rb.y - y0) / dt, (rb.yaw - yaw0) / dt
@@ -438,134 +440,3 @@ class KinematicBackend(RobotStateBackend):
                 rb.vel = (vel_x, vel_y, rb.vel[2], wz)
             else:
                 rb.vel = ((rb.x - x0) / dt, (rb.y - y0) / dt, 0.0, (rb.yaw - yaw0) / dt)
-
-    def _advance(self, rb: _Robot, dx: float, dy: float, solid: list[_Robot]) -> None:
-        """Move robot ``rb`` by (dx, dy), resolving contacts; sets contact flags."""
-        r = rb.radius
-        geom = rb.geom
-        px, py = rb.x, rb.y
-        x_start, y_start = px, py
-        hit_any = False
-        for _ in range(_MAX_SLIDES):
-            length = math.hypot(dx, dy)
-            if length <= 1e-15:
-                break
-            reach = r + length + 2.0 * _ACTIVE
-            squares = geom.edge_squares(px - reach, py - reach, px + reach, py + reach)
-            others = [
-                o
-                for o in solid
-                if o is not rb
-                and o.floor == rb.floor
-                and not o.falling
-                and (o.x - px) ** 2 + (o.y - py) ** 2 < (reach + o.radius) ** 2
-            ]
-            # Constraints already touching: do not move into them.
-            active: list[tuple[float, float, _Robot | None]] = []
-            far_squares = []
-            for sq in squares:
-                dist, nx, ny = square_distance(px, py, *sq)
-                if dist <= r + _ACTIVE:
-                    active.append((nx, ny, None))
-                elif dist < reach:
-                    far_squares.append(sq)
-            far_others = []
-            for o in others:
-                ex, ey = px - o.x, py - o.y
-                d = math.hypot(ex, ey)
-                if d - r - o.radius <= _ACTIVE:
-                    active.append((ex / d, ey / d, o) if d > 0.0 else (1.0, 0.0, o))
-                else:
-                    far_others.append(o)
-            blocked = [c for c in active if dx * c[0] + dy * c[1] < 0.0]
-            if blocked:
-                hit_any = True
-                for _, _, o in blocked:
-                    if o is not None:
-                        o.contact = True
-                if self._stop:
-                    rb.stopped = True
-                    break
-                dx, dy = _slide(dx, dy, blocked, active)
-                if dx == 0.0 and dy == 0.0:
-                    break
-            # First contact along the (possibly projected) motion.
-            t_hit = 1.0
-            first: Any = None
-            for sq in far_squares:
-                t = enter_rounded_square(px, py, dx, dy, *sq, r + _HIT)
-                if t < t_hit:
-                    t_hit, first = t, sq
-            for o in far_others:
-                t = enter_disc(px, py, dx, dy, o.x, o.y, r + o.radius + _HIT)
-                if t < t_hit:
-                    t_hit, first = t, o
-            if first is None:
-                px += dx
-                py += dy
-                dx = dy = 0.0
-                break
-            hit_any = True
-            if isinstance(first, _Robot):
-                first.contact = True
-                t_stop = enter_disc(px, py, dx, dy, first.x, first.y, r + first.radius + _PLACE)
-            else:
-                t_stop = enter_rounded_square(px, py, dx, dy, *first, r + _PLACE)
-            t_stop = min(max(t_stop, 0.0), t_hit)
-            px += t_stop * dx
-            py += t_stop * dy
-            dx *= 1.0 - t_stop
-            dy *= 1.0 - t_stop
-            if self._stop:
-                rb.stopped = True
-                break
-        if hit_any:
-            rb.contact = True
-            # Safety net against rounding: never accept an overlap deeper than before.
-            if (px != x_start or py != y_start) and (
-                (depth := self._penetration(rb, px, py, solid)) > 0.0
-                and depth > self._penetration(rb, x_start, y_start, solid)
-            ):
-                px, py = x_start, y_start
-        rb.x, rb.y = px, py
-
-    def _penetration(self, rb: _Robot, x: float, y: float, solid: list[_Robot]) -> float:
-        """Deepest overlap (m) of robot ``rb``'s disc at (x, y) with obstacles and robots."""
-        r = rb.radius
-        deepest = -math.inf
-        for sq in rb.geom.edge_squares(x - r, y - r, x + r, y + r):
-            deepest = max(deepest, r - square_distance(x, y, *sq)[0])
-        geom = rb.geom
-        cell = geom.cell_index(x, y)
-        if cell >= 0 and geom.codes[cell] == OBSTACLE:  # centre inside, maybe an inner cell
-            row, col = divmod(cell, geom.width)
-            x0, y0 = geom.ox + col * geom.res, geom.oy + row * geom.res
-            sd = square_distance(x, y, x0, y0, x0 + geom.res, y0 + geom.res)[0]
-            deepest = max(deepest, r - sd)
-        for o in solid:
-            if o is not rb and o.floor == rb.floor and not o.falling:
-                deepest = max(deepest, r + o.radius - math.hypot(x - o.x, y - o.y))
-        return deepest
-
-
-def _slide(
-    dx: float,
-    dy: float,
-    blocked: list[tuple[float, float, Any]],
-    active: list[tuple[float, float, Any]],
-) -> tuple[float, float]:
-    """Project motion (dx, dy) onto the tangent of a blocking contact that keeps clear of all.
-
-    In 2D the best feasible motion lies on one constraint's tangent or is zero (a corner).
-    """
-    best = (0.0, 0.0)
-    best_len = 0.0
-    tol = 1e-12 * math.hypot(dx, dy)
-    for nx, ny, _ in blocked:
-        dot = dx * nx + dy * ny
-        tx, ty = dx - dot * nx, dy - dot * ny
-        if all(tx * mx + ty * my >= -tol for mx, my, _ in active):
-            length = tx * tx + ty * ty
-            if length > best_len:
-                best, best_len = (tx, ty), length
-    return best
