@@ -615,8 +615,9 @@ def check_valid_pose(factory: BackendFactory) -> None:
     """``is_valid_pose`` rejects overlap with obstacles and robots, VOID and off the map.
 
     Overlaps of 2 cm and more are rejected, a disc clear by 0.1 um is accepted (touching
-    is allowed); only present, placed robots on that floor block; a centre over VOID or
-    off the map is rejected but a disc overhanging VOID is not; ``floor=`` picks the floor.
+    is allowed); only present, placed robots on that floor block; a disc overhanging VOID
+    or the map's edge is rejected (SPEC 2: a robot stands where its disc misses both the
+    blocked set and VOID); ``floor=`` picks the floor.
     """
     scene = _room(60)
     backend = _loaded(factory, scene, [RobotSpec(), RobotSpec(radius=0.1)])
@@ -651,7 +652,8 @@ def check_valid_pose(factory: BackendFactory) -> None:
     scene = Scene.from_array([grid, blocked], 0.1)
     backend = _loaded(factory, scene, [RobotSpec(radius=0.05)])
     valid(0, (0.5, 0.5), True, "free floor")
-    valid(0, (0.69, 0.5), True, "the centre is on the floor; a disc overhanging VOID is fine")
+    valid(0, (0.64, 0.5), True, "the disc is 1 cm clear of the VOID cells")
+    valid(0, (0.69, 0.5), False, "the centre is on the floor but the disc overhangs VOID")
     valid(0, (0.75, 0.5), False, "the centre is over VOID")
     valid(0, (-0.01, 0.5), False, "the centre is off the map")
     valid(0, (0.5, 1.2), False, "the centre is off the map")
