@@ -30,17 +30,17 @@ __all__ = ["CONTACT_SLOP", "OVERLAP_TOLERANCE", "TOUCH_TOLERANCE", "PymunkBacken
 #: floor's blocked set, and overlaps another robot by at most :data:`TOUCH_TOLERANCE`.
 OVERLAP_TOLERANCE = 1e-3
 #: Overlap (m) that pymunk leaves in a resting contact (``Space.collision_slop``).
-CONTACT_SLOP = 1e-6
+CONTACT_SLOP = 1e-7
 #: Overlap (m) up to which two robots count as touching: deeper overlaps left at the end
 #: of a step are removed, and :meth:`PymunkBackend.is_valid_pose` accepts a robot that
 #: overlaps another by at most this much (so two robots resting in contact stand validly).
-#: Against walls it is the width of the skin the static shapes are grown by.
+#: The static shapes are grown by half of it (see ``_WALL_SKIN``).
 TOUCH_TOLERANCE = 10.0 * CONTACT_SLOP
 
 #: Metres by which every static shape is grown (a rounded polygon): a robot resting
 #: against it overlaps the grown shape by pymunk's slop at most, so it stays clear of the
 #: floor's true blocked set and its pose stays valid for ``is_valid_pose``.
-_WALL_SKIN = TOUCH_TOLERANCE
+_WALL_SKIN = 0.5 * TOUCH_TOLERANCE
 _SETTLE_DEPTH = 0.5 * _WALL_SKIN  # m: deeper overlaps at the end of a step are settled
 _MAX_SETTLE = 8  # settling sub-steps per control step, at most
 _MAX_SUBSTEPS = 4096
@@ -277,7 +277,7 @@ class PymunkBackend(RobotStateBackend):
     Each floor is one pymunk ``Space`` holding the floor's obstacles as static convex
     shapes (OBSTACLE cells merged into rectangles, and the floor plan's shapely obstacle
     polygons cut into convex pieces, so both stop a robot; see
-    :mod:`pointnav_pymunk.geometry`), grown by a skin of :data:`TOUCH_TOLERANCE`, and the
+    :mod:`pointnav_pymunk.geometry`), grown by a skin of half :data:`TOUCH_TOLERANCE`, and the
     robots standing on it. A robot is a dynamic disc of its spec's radius (frictionless, inelastic, never
     spun by contacts) pulled towards its commanded velocity by a velocity motor: a pivot
     joint to a kinematic control body with no position correction and a finite force, as
@@ -298,7 +298,7 @@ class PymunkBackend(RobotStateBackend):
     obstacle or another robot by more than :data:`OVERLAP_TOLERANCE` (1 mm); in practice
     a robot ends clear of the blocked set (it rests on the skin, overlapping it by pymunk's
     slop, :data:`CONTACT_SLOP`), and overlaps another robot by at most
-    :data:`TOUCH_TOLERANCE` (1e-5 m).
+    :data:`TOUCH_TOLERANCE` (1e-6 m).
 
     Parameters
     ----------
@@ -320,8 +320,8 @@ class PymunkBackend(RobotStateBackend):
     full speed within one sub-step, so a robot keeps to its command unless a contact stops
     it. A robot told to stand still is braked (its mass becomes 1e6 kg instead of 1 kg),
     so a robot that drives into it stops rather than shoving it: the braked robot moves by
-    micrometres at most. At the end of a step, overlaps deeper than half
-    of :data:`TOUCH_TOLERANCE` (left by a hit in the last sub-step) are removed by pymunk's own
+    micrometres at most. At the end of a step, overlaps deeper than a
+    quarter of :data:`TOUCH_TOLERANCE` (left by a hit in the last sub-step) are removed by pymunk's own
     position correction in extra sub-steps in which nothing moves. The step is
     deterministic: the same calls give the same results, and :meth:`reset` rebuilds every
     space, so an episode does not depend on earlier ones.
@@ -571,7 +571,7 @@ class PymunkBackend(RobotStateBackend):
             :data:`~pointnav_core.collision.TOUCH_TOL` is fine), and it overlaps no other
             present, placed, non-falling robot on that floor by more than
             :data:`TOUCH_TOLERANCE`. A robot resting against a wall stays valid: the static
-            shapes are grown by a skin of :data:`TOUCH_TOLERANCE`, so it rests clear.
+            shapes are grown by a skin of half :data:`TOUCH_TOLERANCE`, so it rests clear.
         """
         rb = self._robot(idn)
         fl = self._floors[rb.floor] if floor is None else self._floor(floor)
