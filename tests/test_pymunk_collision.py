@@ -223,7 +223,7 @@ def test_a_robot_on_a_movingai_map_collides_with_its_cells_and_its_frame(tmp_pat
     backend.land(1, 0, (3.5, 1.0), IDENTITY)  # drives +x into the map's edge
     for _ in range(25):  # 1.25 m at 0.5 m/s: far enough for both
         backend.step({0: [1.0, 0.0], 1: [1.0, 0.0]})
-    (x0, y0, z0), (x1, y1, z1) = backend.get_pose(0)[0], backend.get_pose(1)[0]
+    (x0, y0, _), (x1, y1, z1) = backend.get_pose(0)[0], backend.get_pose(1)[0]
     assert R <= block.distance(Point(x0, y0)) <= R + 2 * TOUCH_TOLERANCE
     assert R <= inside.exterior.distance(Point(x1, y1)) <= R + 2 * TOUCH_TOLERANCE
     assert inside.contains(Point(x1, y1)) and z1 == 0.0  # did not fall off
