@@ -108,8 +108,8 @@ def test_convex_pieces_are_convex_and_tile_the_polygon(polygon):
 
 @given(strategies.floor_plans())
 def test_generated_floor_plans_become_few_convex_pieces(plan):
-    tmap = TraversableMap(np.zeros((2, 2), np.uint8), 0.1)
-    pieces, thickness = floor_pieces(tmap, plan)
+    tmap = TraversableMap(np.zeros((2, 2), np.uint8), 0.1, geometry=plan)  # no OBSTACLE cell
+    pieces, thickness = floor_pieces(tmap)
     assert all(_is_convex(p) for p in pieces)
     union = shapely.union_all([Polygon(p) for p in pieces])
     obstacles = shapely.union_all(plan.obstacles)
@@ -127,38 +127,56 @@ def test_a_grid_wall_is_one_shape_not_one_per_cell():
 
 def test_a_generated_house_uses_its_polygons_and_few_shapes():
     scene = scenes.rooms(0)
+    tmap = scene.floors[0]
     backend = loaded(scene, [RobotSpec()])
     n_shapes = len(static_shapes(backend))
-    assert n_shapes == len(floor_pieces(scene.floors[0], scene.floor_plans[0])[0])
-    assert n_shapes <= 2 * len(scene.floor_plans[0].obstacles)
-    assert n_shapes < (scene.floors[0].codes == OBSTACLE).sum() / 20
+    assert n_shapes == len(floor_pieces(tmap)[0])
+    rects = len(merge_cells(tmap.codes == OBSTACLE))
+    assert n_shapes <= 2 * len(scene.floor_plans[0].obstacles) + rects
+    assert n_shapes < (tmap.codes == OBSTACLE).sum() / 20
 
 
-def test_polygon_scene_collides_with_the_polygon_not_its_raster():
-    # A disc obstacle on a coarse 0.25 m grid: its raster is a staircase; the robot must
-    # stop where the true circle is.
+def test_polygon_scene_collides_with_the_polygon_and_its_raster():
+    # A disc obstacle on a coarse 0.25 m grid: its raster squares stick out of the circle
+    # in a staircase. The blocked set is both, so the robot stops touching their union.
     outline = box(0, 0, 6, 6)
     pillar = Point(3.0, 3.0).buffer(0.5, quad_segs=64)
     scene = Scene.from_polygons(outline, [pillar], resolution=0.25)
+    tmap = scene.floors[0]
+    (ox, oy), res = tmap.origin, tmap.resolution
+    cells = [
+        box(ox + c * res, oy + r * res, ox + (c + 1) * res, oy + (r + 1) * res)
+        for r, c in zip(*np.nonzero(tmap.codes == OBSTACLE))
+    ]
+    blocked = shapely.union_all([pillar, *cells])
+    assert blocked.area > pillar.area + 0.02  # the raster does stick out
     spec = RobotSpec(radius=0.2)
     backend = loaded(scene, [spec])
-    for yaw in (0.0, 0.7, 2.0, -2.5):
+    corners = np.array(blocked.exterior.coords)
+    cx, cy = corners[np.argmax([pillar.distance(Point(c)) for c in corners])]
+    outermost = math.atan2(cy - 3.0, cx - 3.0)  # the square corner farthest out
+    beyond_the_circle = []
+    for yaw in (0.0, 0.7, 2.0, -2.5, outermost):
         start = (3.0 - 2.0 * math.cos(yaw), 3.0 - 2.0 * math.sin(yaw))
         backend.land(0, 0, start, quat(yaw))
         for _ in range(40):
             backend.step({0: [1.0, 0.0]})
         x, y, _ = position(backend)
-        assert pillar.exterior.distance(Point(x, y)) == pytest.approx(0.2, abs=2e-3)  # 64-gon
-        assert not pillar.contains(Point(x, y))
+        assert blocked.distance(Point(x, y)) == pytest.approx(0.2, abs=2 * TOUCH_TOLERANCE)
+        assert blocked.distance(Point(x, y)) >= 0.2
         assert backend.in_contact(0)
+        beyond_the_circle.append(pillar.distance(Point(x, y)) - 0.2)
+    assert beyond_the_circle[-1] > 0.01  # stopped by a square, not the circle
 
 
-def test_floor_geometry_falls_back_to_the_maps_own_polygons():
-    plan = floorplans.FloorPlan(outline=box(0, 0, 4, 4), obstacles=[Point(2, 2).buffer(0.5)])
+def test_floor_geometry_comes_from_the_maps_own_collision_geometry():
+    # A scene without floor_plans: the map's FloorCollision still brings its polygons.
+    plan = floorplans.FloorPlan(outline=box(0, 0, 4, 4), obstacles=[box(2.0, 0.0, 2.02, 4.0)])
     tmap = Scene.from_polygons(plan.outline, plan.obstacles, resolution=0.1).floors[0]
+    assert not (tmap.codes == OBSTACLE).any()  # too thin to cover a cell centre
     bare = types.SimpleNamespace(floors=[tmap], n_floors=1, get_floor_height=lambda f=0: 0.0)
     backend = loaded(bare, [RobotSpec()])
-    assert len(static_shapes(backend)) == 1  # the disc as one convex piece, not its raster
+    assert len(static_shapes(backend)) == 1
 
 
 # ----------------------------------------------------------------------- construction
@@ -293,7 +311,13 @@ def test_a_robot_driving_behind_a_slower_one_is_held_back_and_both_are_flagged()
 @pytest.mark.parametrize("kind", ["rooms", "maze", "clutter"])
 def test_stated_overlap_tolerance_holds_for_eight_robots_in_a_house(kind):
     scene = getattr(scenes, kind)(1)
-    obstacles = shapely.union_all(scene.floor_plans[0].obstacles)
+    tmap = scene.floors[0]
+    (ox, oy), res = tmap.origin, tmap.resolution
+    cells = [
+        box(ox + c * res, oy + r * res, ox + (c + 1) * res, oy + (r + 1) * res)
+        for r, c in zip(*np.nonzero(tmap.codes == OBSTACLE))
+    ]
+    obstacles = shapely.union_all([*scene.floor_plans[0].obstacles, *cells])
     specs = [RobotSpec(drive=("holonomic", "differential")[i % 2]) for i in range(8)]
     backend = loaded(scene, specs)
     rng = np.random.default_rng(1)
@@ -303,7 +327,7 @@ def test_stated_overlap_tolerance_holds_for_eight_robots_in_a_house(kind):
             if backend.is_valid_pose(idn, xyz):
                 break
         backend.land(idn, 0, xyz, quat(rng.uniform(-math.pi, math.pi)))
-    worst = 0.0
+    worst = worst_wall = 0.0
     hits = 0
     for step in range(150):
         forward = step % 30 < 24
@@ -318,10 +342,11 @@ def test_stated_overlap_tolerance_holds_for_eight_robots_in_a_house(kind):
         for i in range(8):
             p = Point(xy[i])
             depth = 0.18 - (obstacles.distance(p) if not obstacles.contains(p) else -1.0)
-            worst = max(worst, depth)
+            worst_wall = max(worst_wall, depth)
             for j in range(i + 1, 8):
                 worst = max(worst, 0.36 - float(np.linalg.norm(xy[i] - xy[j])))
     assert hits > 50  # the robots did run into things
+    assert worst_wall <= 1e-9  # clear of the walls: they rest on the skin
     assert worst <= TOUCH_TOLERANCE + 1e-9 <= OVERLAP_TOLERANCE
 
 

@@ -21,22 +21,22 @@ from pointnav_core.backend import (
     planar_quat,
 )
 from pointnav_core.maps import VOID
-from pointnav_pymunk.geometry import floor_pieces
+from pointnav_pymunk.floor import (
+    _ROBOT,
+    _WALL_SKIN,
+    CONTACT_SLOP,
+    TOUCH_TOLERANCE,
+    _Floor,
+)
 
 __all__ = ["CONTACT_SLOP", "OVERLAP_TOLERANCE", "TOUCH_TOLERANCE", "PymunkBackend"]
 
 #: Largest overlap (m) with an obstacle or another robot that a robot may have at the end
-#: of a control step (the conformance kit's bound). In practice it is at most
-#: :data:`TOUCH_TOLERANCE`.
+#: of a control step (the conformance kit's bound). In practice a robot ends clear of the
+#: floor's blocked set, and overlaps another robot by at most :data:`TOUCH_TOLERANCE`.
 OVERLAP_TOLERANCE = 1e-3
-#: Overlap (m) that pymunk leaves in a resting contact (``Space.collision_slop``).
-CONTACT_SLOP = 1e-6
-#: Overlap (m) up to which two shapes count as touching: deeper overlaps left at the end
-#: of a step are removed, and :meth:`PymunkBackend.is_valid_pose` accepts poses that
-#: overlap by at most this much (so a robot resting against a wall stands validly).
-TOUCH_TOLERANCE = 10.0 * CONTACT_SLOP
 
-_SETTLE_DEPTH = TOUCH_TOLERANCE  # m: deeper overlaps at the end of a step are settled
+_SETTLE_DEPTH = 0.5 * _WALL_SKIN  # m: deeper overlaps at the end of a step are settled
 _MAX_SETTLE = 8  # settling sub-steps per control step, at most
 _MAX_SUBSTEPS = 4096
 _SUBSTEP_FRACTION = 0.4  # of the thinnest wall / smallest robot pair, travel per sub-step
@@ -45,71 +45,6 @@ _PUSH_EPS = 1e-9  # m/s: a command into a contact faster than this is a hit
 _MASS = 1.0  # kg, a driving robot
 _HOLD_MASS = 1e6  # kg, a robot told to stand still (braked: it is not shoved)
 _MOTOR_MARGIN = 4.0  # motor force lets a robot reverse at full speed within a sub-step, x2
-
-_WALL, _ROBOT = 1, 2  # collision types, and shape-filter categories
-_WALLS_ONLY = pymunk.ShapeFilter(mask=_WALL)
-
-
-class _Floor:
-    """One floor: its grid for VOID checks and its pymunk Space of static obstacles."""
-
-    __slots__ = (
-        "index",
-        "height",
-        "codes",
-        "rows",
-        "width",
-        "res",
-        "inv_res",
-        "ox",
-        "oy",
-        "pieces",
-        "thickness",
-        "space",
-        "depth",
-    )
-
-    def __init__(self, index: int, tmap: Any, height: float, plan: Any) -> None:
-        codes = np.asarray(tmap.codes)
-        self.index = index
-        self.height = height
-        self.rows, self.width = (int(n) for n in codes.shape)
-        self.codes = codes.astype(np.uint8).tobytes()
-        self.res = float(tmap.resolution)
-        self.inv_res = 1.0 / self.res
-        self.ox, self.oy = (float(v) for v in tmap.origin)
-        self.pieces, self.thickness = floor_pieces(tmap, plan)
-        self.space: pymunk.Space = None  # type: ignore[assignment]  # set by build_space
-        self.depth = 0.0  # deepest overlap seen while measuring (m)
-
-    def build_space(self, hit_wall: Any, hit_robot: Any) -> None:
-        """A fresh space holding this floor's obstacles as static convex shapes."""
-        space = pymunk.Space()
-        space.collision_slop = CONTACT_SLOP
-        space.collision_bias = 0.0  # correct an overlap fully in the next sub-step
-        space.iterations = 10
-        static = pymunk.Body(body_type=pymunk.Body.STATIC)  # ours, so it can be removed
-        shapes = []
-        for ring in self.pieces:
-            shape = pymunk.Poly(static, ring)
-            shape.collision_type = _WALL
-            shape.filter = pymunk.ShapeFilter(categories=_WALL)
-            shape.friction = 0.0
-            shape.elasticity = 0.0
-            shapes.append(shape)
-        space.add(static, *shapes)
-        space.on_collision(_ROBOT, _WALL, post_solve=hit_wall)
-        space.on_collision(_ROBOT, _ROBOT, post_solve=hit_robot)
-        self.space = space
-
-    def code(self, x: float, y: float) -> int:
-        """Cell code under world point (x, y); VOID off the map."""
-        col = math.floor((x - self.ox) * self.inv_res)
-        row = math.floor((y - self.oy) * self.inv_res)
-        if 0 <= col < self.width and 0 <= row < self.rows:
-            return self.codes[row * self.width + col]
-        return VOID
-
 
 class _Robot:
     """One robot: its spec, its pymunk parts and its per-step state."""
@@ -243,9 +178,10 @@ class PymunkBackend(RobotStateBackend):
     """2D rigid-body backend on pymunk: discs with real contacts against walls and robots.
 
     Each floor is one pymunk ``Space`` holding the floor's obstacles as static convex
-    shapes (OBSTACLE cells merged into rectangles, or the scene's shapely obstacle polygons
-    cut into convex pieces when the scene was built from polygons) and the robots standing
-    on it. A robot is a dynamic disc of its spec's radius (frictionless, inelastic, never
+    shapes (OBSTACLE cells merged into rectangles, and the floor plan's shapely obstacle
+    polygons cut into convex pieces, so both stop a robot; see
+    :mod:`pointnav_pymunk.geometry`), grown by a skin of half :data:`TOUCH_TOLERANCE`, and the
+    robots standing on it. A robot is a dynamic disc of its spec's radius (frictionless, inelastic, never
     spun by contacts) pulled towards its commanded velocity by a velocity motor: a pivot
     joint to a kinematic control body with no position correction and a finite force, as
     in pymunk's own examples, so the solver resolves motors and contacts together. One
@@ -263,7 +199,9 @@ class PymunkBackend(RobotStateBackend):
     step, then under gravity). :meth:`get_velocity` reports the effective velocities of
     the last step (displacement over its duration). No robot ends a step overlapping an
     obstacle or another robot by more than :data:`OVERLAP_TOLERANCE` (1 mm); in practice
-    by at most :data:`TOUCH_TOLERANCE` (1e-5 m).
+    a robot ends clear of the blocked set (it rests on the skin, overlapping it by pymunk's
+    slop, :data:`CONTACT_SLOP`), and overlaps another robot by at most
+    :data:`TOUCH_TOLERANCE` (1e-6 m).
 
     Parameters
     ----------
@@ -285,8 +223,8 @@ class PymunkBackend(RobotStateBackend):
     full speed within one sub-step, so a robot keeps to its command unless a contact stops
     it. A robot told to stand still is braked (its mass becomes 1e6 kg instead of 1 kg),
     so a robot that drives into it stops rather than shoving it: the braked robot moves by
-    micrometres at most. At the end of a step, overlaps deeper than
-    :data:`TOUCH_TOLERANCE` (left by a hit in the last sub-step) are removed by pymunk's own
+    micrometres at most. At the end of a step, overlaps deeper than a
+    quarter of :data:`TOUCH_TOLERANCE` (left by a hit in the last sub-step) are removed by pymunk's own
     position correction in extra sub-steps in which nothing moves. The step is
     deterministic: the same calls give the same results, and :meth:`reset` rebuilds every
     space, so an episode does not depend on earlier ones.
@@ -337,11 +275,10 @@ class PymunkBackend(RobotStateBackend):
         Parameters
         ----------
         scene : Scene
-            Uses ``floors`` (list of TraversableMap), ``n_floors``,
-            ``get_floor_height(floor)`` and, when present, ``floor_plans`` (the shapely
-            polygons each floor was built from, or None; a map's own ``geometry`` is
-            used otherwise): a floor with polygons collides with the polygons, any
-            other floor with its OBSTACLE cells.
+            Uses ``floors`` (list of TraversableMap), ``n_floors`` and
+            ``get_floor_height(floor)``. Robots collide with each floor's OBSTACLE cells
+            and with the obstacle polygons of its collision geometry (``tmap.collision``,
+            from the floor plan the map was built from, if any).
         robots : sequence of RobotSpec
             Robot ``idn`` is ``robots[idn]``.
         action_frequency : float
@@ -352,16 +289,8 @@ class PymunkBackend(RobotStateBackend):
         Robots start present, unplaced, at rest at x = y = 0 on floor 0.
         """
         specs, n_floors, dt = check_load(scene, robots, action_frequency)
-        plans = list(getattr(scene, "floor_plans", None) or ())
-        plans += [None] * (n_floors - len(plans))
         self._floors = [
-            _Floor(
-                f,
-                scene.floors[f],
-                float(scene.get_floor_height(f)),
-                plans[f] or getattr(scene.floors[f], "geometry", None),
-            )
-            for f in range(n_floors)
+            _Floor(f, scene.floors[f], float(scene.get_floor_height(f))) for f in range(n_floors)
         ]
         self._robots = [_Robot(spec) for spec in specs]
         for rb in self._robots:
@@ -539,12 +468,13 @@ class PymunkBackend(RobotStateBackend):
         Returns
         -------
         bool
-            True when the centre is on the map and not over VOID, the disc overlaps no
-            obstacle of the floor (the shapes the robots collide with: OBSTACLE cells, or
-            the obstacle polygons of a scene built from polygons) by more than
-            :data:`TOUCH_TOLERANCE` (touching is fine, and so is a resting contact), and
-            it overlaps no other present, placed, non-falling robot on that floor by more
-            than that.
+            True when the disc misses the floor's blocked set exactly as
+            ``tmap.collision.points_clear`` decides (every OBSTACLE and VOID cell square,
+            everything off the map, the floor plan's obstacle polygons; touching within
+            :data:`~pointnav_core.collision.TOUCH_TOL` is fine), and it overlaps no other
+            present, placed, non-falling robot on that floor by more than
+            :data:`TOUCH_TOLERANCE`. A robot resting against a wall stays valid: the static
+            shapes are grown by a skin of half :data:`TOUCH_TOLERANCE`, so it rests clear.
         """
         rb = self._robot(idn)
         fl = self._floors[rb.floor] if floor is None else self._floor(floor)
@@ -552,13 +482,9 @@ class PymunkBackend(RobotStateBackend):
         if orientation is not None:
             parse_orientation(orientation)
         x, y = xy[0], xy[1]
-        if fl.code(x, y) == VOID:
-            return False
         r = rb.radius
-        limit = r - TOUCH_TOLERANCE
-        for info in fl.space.point_query((x, y), r, _WALLS_ONLY):
-            if info.distance < limit:
-                return False
+        if not fl.clear(x, y, r):
+            return False
         for other in self._robots:
             if other is rb or other.floor != fl.index or not other.solid():
                 continue

@@ -1,15 +1,18 @@
 """Static geometry for the pymunk backend: obstacle grids and polygons as convex pieces.
 
-pymunk's polygon shapes are convex (it takes the hull of whatever it is given), and every
-shape costs a little in the broad phase, so a floor's obstacles are turned into as few
-convex pieces as practical:
+The shapes robots collide with are the floor's blocked set for motion
+(:class:`~pointnav_core.collision.FloorCollision`, less VOID): every OBSTACLE cell square
+plus the obstacle polygons the floor was built from, so a hand-edited OBSTACLE cell with no
+polygon under it and a polygon thinner than a cell both stop a robot. pymunk's polygon
+shapes are convex (it takes the hull of whatever it is given), and every shape costs a
+little in the broad phase, so both are turned into as few convex pieces as practical:
 
-- a grid floor: OBSTACLE cells merged into axis-aligned rectangles (:func:`merge_cells`,
-  greedy row-run merging: runs of cells along a row, stacked while the next row has the
-  same run);
-- a floor built from shapely polygons: each convex obstacle as it is, each other one cut
-  into convex pieces (:func:`convex_pieces`: horizontal slabs between vertex heights, where
-  every piece is a trapezoid, then neighbouring pieces glued back while they stay convex).
+- OBSTACLE cells merged into axis-aligned rectangles (:func:`merge_cells`, greedy row-run
+  merging: runs of cells along a row, stacked while the next row has the same run);
+  rectangles that lie inside one obstacle polygon add nothing and are dropped;
+- each convex obstacle polygon as it is, each other one cut into convex pieces
+  (:func:`convex_pieces`: horizontal slabs between vertex heights, where every piece is a
+  trapezoid, then neighbouring pieces glued back while they stay convex).
 
 VOID is no shape at all: a robot falls there (the backend checks the grid), it does not
 bump into anything.
@@ -174,26 +177,23 @@ def min_thickness(polygon: Polygon) -> float:
     return 2.0 * polygon.area / length if length > 0.0 else 0.0
 
 
-def floor_pieces(
-    tmap: TraversableMap, plan: object = None
-) -> tuple[list[list[tuple[float, float]]], float]:
-    """Convex obstacle pieces of one floor and the thickness of its thinnest obstacle.
+def floor_pieces(tmap: TraversableMap) -> tuple[list[list[tuple[float, float]]], float]:
+    """Convex pieces covering one floor's OBSTACLE cells and obstacle polygons.
 
     Parameters
     ----------
     tmap : TraversableMap
-        The floor's grid (used when there is no ``plan``).
-    plan : FloorPlan, optional
-        The polygons the floor was built from (anything with ``obstacles``); when given,
-        the obstacles are the polygons themselves rather than their raster.
+        The floor. Its OBSTACLE cells and the polygons of its collision geometry
+        (``tmap.collision.polygons``, the floor plan's obstacles) are both used.
 
     Returns
     -------
     pieces : list of list of (float, float)
-        Vertex rings in world metres.
+        Vertex rings in world metres; their union is the OBSTACLE cell squares and the
+        polygons.
     thickness : float
-        Metres: the cell size for a grid floor; for polygons, the smaller of the cell size
-        and the thinnest obstacle's :func:`min_thickness`.
+        Metres: the smaller of the cell size and the thinnest polygon's
+        :func:`min_thickness`.
 
     Examples
     --------
@@ -202,18 +202,19 @@ def floor_pieces(
     ([[(1.5, 0.0), (2.5, 0.0), (2.5, 1.0), (1.5, 1.0)]], 0.5)
     """
     res = float(tmap.resolution)
-    if plan is not None:
-        pieces: list[list[tuple[float, float]]] = []
-        thickness = res
-        for obstacle in plan.obstacles:  # type: ignore[attr-defined]
-            for part in _polygons(obstacle):
-                pieces.extend(convex_pieces(part))
-                thickness = min(thickness, min_thickness(part))
-        return pieces, thickness
     ox, oy = (float(v) for v in tmap.origin)
-    pieces = []
+    polygons = [part for obstacle in tmap.collision.polygons for part in _polygons(obstacle)]
+    tree = shapely.STRtree(polygons) if polygons else None
+    pieces: list[list[tuple[float, float]]] = []
+    thickness = res
     for r0, c0, r1, c1 in merge_cells(np.asarray(tmap.codes) == OBSTACLE):
         x0, x1 = ox + c0 * res, ox + c1 * res
         y0, y1 = oy + r0 * res, oy + r1 * res
+        rect = box(x0, y0, x1, y1)
+        if tree is not None and len(tree.query(rect, predicate="within")):
+            continue  # covered by a polygon's own pieces
         pieces.append([(x0, y0), (x1, y0), (x1, y1), (x0, y1)])
-    return pieces, res
+    for part in polygons:
+        pieces.extend(convex_pieces(part))
+        thickness = min(thickness, min_thickness(part))
+    return pieces, thickness
