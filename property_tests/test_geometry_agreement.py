@@ -17,12 +17,14 @@ import math
 
 import numpy as np
 import pytest
+import shapely
 from hypothesis import assume, given, note, settings
 from hypothesis import strategies as st
 
 from pointnav_core.backend import available_backends
 from pointnav_core.env import PointNavEnv
 from pointnav_core.errors import SamplingError
+from pointnav_core.maps import VOID
 from pointnav_core.policies import ShortestPathFollower
 from pointnav_core.testing.strategies import nav_scenes
 from pointnav_core.transforms import quat2yaw
@@ -86,6 +88,17 @@ def test_a_straight_contact_free_drive_bounds_the_planner_distance(backend, scen
         if info["collisions"] or terminated or truncated:
             return  # contact (or a fall): no claim
     end = env.task.get_current_pos(env)[:2]
+    # Backends let a disc hang over VOID until its centre is over it (then it falls); the
+    # planner never goes there. No claim when the disc came within r of a VOID cell.
+    tmap = env.scene.floors[0]
+    res = tmap.resolution
+    ox, oy = tmap.origin
+    void = [
+        shapely.box(ox + c * res, oy + r * res, ox + (c + 1) * res, oy + (r + 1) * res)
+        for r, c in zip(*np.nonzero(tmap.codes == VOID))
+    ]
+    if void and shapely.distance(shapely.union_all(void), shapely.LineString([start, end])) < radius:
+        return
     length = math.hypot(*(end - start))
     distance = env.scene.geodesic_distance(0, start, end, robot=radius)
     note(f"{start} -> {end}: driven {length}, planner {distance}")

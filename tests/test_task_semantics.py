@@ -717,3 +717,13 @@ def test_a_get_pose_patched_on_the_backend_instance_is_read_from_the_next_episod
     _, _, _, _, info = env.step(STOP)
     assert env.task.robot_xyz[0] == pytest.approx(2.0, abs=1e-12)  # the patched position
     assert info["distance_to_goal"] == pytest.approx(1.0, abs=1e-9)
+
+
+def test_info_distances_and_metrics_are_python_floats(backend):
+    env = make_env(backend, wall_with_gap(), initial_pos=(1.0, 1.0, 0.0), goal_pos=(3.0, 1.0, 0.0), reward_type="geodesic")
+    _, info = env.reset(seed=0)
+    for _ in range(3):
+        _, reward, _, _, info = env.step(FORWARD)
+        assert type(reward) is float
+        for key in ("distance_to_goal", "geodesic_dist", "spl", "soft_spl", "path_length"):
+            assert type(info[key]) is float, key

@@ -22,6 +22,10 @@ __all__ = ["ShortestPathFollower"]
 #: Heading error (rad) below which a differential robot drives instead of turning; float32
 #: actions round a turn to about 1e-7 of its size, so the robot faces the point to ~1e-7.
 _FACING = 1e-6
+#: Clearance (m) beyond the robot's radius the follower keeps where it can: far below any
+#: passage that matters (the planner opens passages 1 mm wider than the robot), far above a
+#: rigid-body solver's contact skin.
+_HAIR = 1e-4
 
 
 def _wrap(angle: float) -> float:
@@ -62,7 +66,8 @@ class ShortestPathFollower:
     -----
     Every step heads straight for the farthest of four points up to ``lookahead`` along the
     exact shortest path that the disc can reach in a straight line (checked against the
-    floor's blocked set), so the robot never cuts a corner the path wraps. The motion is
+    floor's blocked set), or else for the path's next vertex, so the robot never cuts a
+    corner the path wraps. The motion is
     exactly that straight line: a differential robot turns in place until it faces the
     point, then drives with no turn; a holonomic robot translates without turning. A robot
     whose disc overlaps something (a rigid-body solver's slop, a pose set by hand) heads for
@@ -102,7 +107,9 @@ class ShortestPathFollower:
         goal = np.asarray(task.get_goal_pos(), dtype=np.float64)[:2]
         tmap = env.scene.floors[task.floor]
         path = None
-        radii = (spec.radius + self.margin, spec.radius) if self.margin > 0 else (spec.radius,)
+        # Wider first; then a hair wider than the robot, so that the path never quite
+        # touches a wall (a rigid-body solver counts touching as contact); then exact.
+        radii = sorted({spec.radius + self.margin, spec.radius + _HAIR, spec.radius}, reverse=True)
         for radius in radii:
             path, _ = env.scene.goal_field(task.floor, goal, robot=radius).path(xy)
             if path is not None:
@@ -115,8 +122,12 @@ class ShortestPathFollower:
             if path is None:
                 return None
             return centre
-        ahead = resample_path(path, self.lookahead / 4, 5)[1:][::-1]
-        clear = tmap.collision.segments_clear(np.broadcast_to(xy, ahead.shape), ahead, spec.radius)
+        # Candidates, farthest first: points up to ``lookahead`` along the path, then the
+        # path's next vertex. The drawn path circumscribes its arcs, so the straight move to
+        # the next vertex is always clear, while a chord to a point further round an arc
+        # would cut it.
+        ahead = np.vstack([resample_path(path, self.lookahead / 4, 5)[1:][::-1], path[1]])
+        clear = tmap.collision.segments_clear(np.broadcast_to(xy, ahead.shape), ahead, radius)
         return ahead[int(np.argmax(clear))] if clear.any() else ahead[-1]
 
     def act(self) -> NDArray[np.float32]:

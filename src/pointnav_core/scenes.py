@@ -82,7 +82,10 @@ class FloorGoalField:
     def __init__(self, tmap: TraversableMap, field: GoalField) -> None:
         self.tmap = tmap
         self.field = field
-        self.distance = field.distance
+
+    def distance(self, x: float, y: float) -> float:
+        """Geodesic distance (m) from world point (x, y) to the goal; ``inf`` if unreachable."""
+        return float(self.field.distance(x, y))
 
     @property
     def goal_usable(self) -> bool:
