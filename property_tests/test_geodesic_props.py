@@ -116,3 +116,13 @@ def test_random_points_are_usable_and_stay_in_the_reference_component(case, seed
     _, q = scene.get_random_point(0, reference_point=ref, robot=radius, rng=rng)
     assert tmap.component_at(q[:2], radius) == tmap.component_at(ref, radius)
     assert scene.get_shortest_path(0, ref, q[:2], robot=radius)[1] is not None
+
+
+@given(traversable_maps(), st.floats(0.0, 3.0))
+def test_usable_cells_are_the_exact_clearance_test_at_every_centre(tmap, radius_cells):
+    # The distance-transform fast path of usable() against the exact test it shortcuts.
+    radius = radius_cells * tmap.resolution
+    h, w = tmap.shape
+    rows, cols = np.mgrid[0:h, 0:w]
+    centres = tmap.cell_to_world(np.stack([rows, cols], axis=-1))
+    assert (tmap.usable(radius) == tmap.collision.points_clear(centres, radius)).all()
