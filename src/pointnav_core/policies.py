@@ -26,6 +26,12 @@ _FACING = 1e-6
 #: passage that matters (the planner opens passages 1 mm wider than the robot), far above a
 #: rigid-body solver's contact skin.
 _HAIR = 1e-4
+#: Path points closer than this (m) are one point (the robot lands on a point to ~1e-10).
+_SAME = 1e-6
+#: Widest heading error (rad) a differential robot drives out on an arc instead of turning.
+_ARC_BEARING = 0.6
+#: Chords of a driven arc checked for clearance.
+_ARC_CHORDS = 4
 
 
 def _wrap(angle: float) -> float:
@@ -58,7 +64,8 @@ class ShortestPathFollower:
     margin : float
         Extra clearance (m) kept from obstacles where there is room: the follower plans for
         a robot this much wider and falls back to the true radius where the wider robot does
-        not fit. Default 0.05 m.
+        not fit. Default 0.02 m: a path that wraps a corner at a little more than the robot's
+        radius can be driven in a few straight chords that keep the true radius.
     lookahead : float
         How far (m) along the path the follower looks for the point to head for.
 
@@ -67,9 +74,9 @@ class ShortestPathFollower:
     Every step heads straight for the farthest of four points up to ``lookahead`` along the
     exact shortest path that the disc can reach in a straight line (checked against the
     floor's blocked set), or else for the path's next vertex, so the robot never cuts a
-    corner the path wraps. The motion is
-    exactly that straight line: a differential robot turns in place until it faces the
-    point, then drives with no turn; a holonomic robot translates without turning. A robot
+    corner the path wraps. A holonomic robot translates there without turning. A
+    differential robot drives the circular arc tangent to its heading that ends there,
+    when that arc is clear (checked), and turns in place first otherwise. A robot
     whose disc overlaps something (a rigid-body solver's slop, a pose set by hand) heads for
     the nearest cell centre it fits at.
 
@@ -88,7 +95,7 @@ class ShortestPathFollower:
         self,
         env: Any,
         task: Any = None,
-        margin: float = 0.05,
+        margin: float = 0.02,
         lookahead: float = 0.3,
     ) -> None:
         self.env = env
@@ -126,8 +133,13 @@ class ShortestPathFollower:
         # path's next vertex. The drawn path circumscribes its arcs, so the straight move to
         # the next vertex is always clear, while a chord to a point further round an arc
         # would cut it.
+        # A robot standing on a wrapped arc is its own first tangent point: skip repeats.
+        path = path[np.r_[True, np.hypot(*np.diff(path, axis=0).T) > _SAME]]
+        if len(path) < 2:
+            return None
         ahead = np.vstack([resample_path(path, self.lookahead / 4, 5)[1:][::-1], path[1]])
-        clear = tmap.collision.segments_clear(np.broadcast_to(xy, ahead.shape), ahead, radius)
+        reach = min(radius, spec.radius + _HAIR)
+        clear = tmap.collision.segments_clear(np.broadcast_to(xy, ahead.shape), ahead, reach)
         return ahead[int(np.argmax(clear))] if clear.any() else ahead[-1]
 
     def act(self) -> NDArray[np.float32]:
@@ -152,8 +164,40 @@ class ShortestPathFollower:
         if spec.drive == "holonomic":
             action[0] = speed * math.cos(bearing)
             action[1] = speed * math.sin(bearing)
-        elif abs(bearing) > _FACING:
-            action[1] = float(np.clip(bearing / (spec.max_angular_velocity * dt), -1.0, 1.0))
-        else:
+        elif abs(bearing) <= _FACING:
             action[0] = speed
+        elif (arc := self._arc_step(xy, yaw, dist, bearing, dt)) is not None:
+            action[0], action[1] = arc
+        else:
+            action[1] = float(np.clip(bearing / (spec.max_angular_velocity * dt), -1.0, 1.0))
         return action
+
+    def _arc_step(
+        self, xy: NDArray[np.float64], yaw: float, dist: float, bearing: float, dt: float
+    ) -> tuple[float, float] | None:
+        """(v, w) actions that drive one step along the circular arc from the pose to the
+        point ``dist`` m ahead at ``bearing`` rad, tangent to the heading; None when the
+        bearing is too wide, the turn too fast, or the arc not clear.
+        """
+        spec = self.env.robots[self.task.robot_idn]
+        if abs(bearing) > _ARC_BEARING:
+            return None
+        kappa = 2.0 * math.sin(bearing) / dist  # curvature (1/m) of the arc through both
+        length = dist * bearing / math.sin(bearing)
+        s = min(length, spec.max_linear_velocity * dt, spec.max_angular_velocity * dt / abs(kappa))
+        # The driven arc, as chords whose sagitta the clearance test adds to the radius.
+        u = np.linspace(0.0, s, _ARC_CHORDS + 1)
+        pts = np.stack(
+            [
+                xy[0] + (np.sin(yaw + kappa * u) - math.sin(yaw)) / kappa,
+                xy[1] - (np.cos(yaw + kappa * u) - math.cos(yaw)) / kappa,
+            ],
+            axis=1,
+        )
+        sagitta = (s / _ARC_CHORDS) ** 2 * abs(kappa) / 8.0
+        tmap = self.env.scene.floors[self.task.floor]
+        if not tmap.collision.segments_clear(pts[:-1], pts[1:], spec.radius + _HAIR + sagitta).all():
+            return None
+        v = s / (spec.max_linear_velocity * dt)
+        w = kappa * s / (spec.max_angular_velocity * dt)
+        return float(np.clip(v, 0.0, 1.0)), float(np.clip(w, -1.0, 1.0))

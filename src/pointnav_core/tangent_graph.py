@@ -47,7 +47,7 @@ from numpy.typing import ArrayLike, NDArray
 from scipy import ndimage
 from scipy.spatial import cKDTree
 
-from pointnav_core.collision import FloorCollision, convex_corners
+from pointnav_core.collision import TOUCH_TOL, FloorCollision, convex_corners
 from pointnav_core.paths import path_length, resample_path
 from pointnav_core.tangent_edges import build_edges, sight_radii
 
@@ -94,8 +94,10 @@ def _tangent_from_point(
     dx = cx - px
     dy = cy - py
     L = np.hypot(dx, dy)
-    ok = L >= r * (1 + 1e-12) if r > 0 else L > 0
-    safe = np.where(ok, L, 1.0)
+    # A point on the circle (within the touching tolerance: a robot following a path that
+    # wraps this corner stands there) is its own tangent point, at length 0.
+    ok = L >= r - TOUCH_TOL if r > 0 else L > 0
+    safe = np.where(ok, np.maximum(L, r), 1.0)
     theta = -s * np.arcsin(np.clip(r / safe, -1.0, 1.0))
     heading = np.arctan2(dy, dx) + theta
     ang = heading - s * (math.pi / 2)
