@@ -57,8 +57,12 @@ def test_paths_are_usable_free_and_as_long_as_reported(case):
     tmap, radius, (a, b) = case
     scene = scene_of(tmap)
     path, dist = scene.get_shortest_path(0, a, b, entire_path=True, robot=radius)
-    same_component = tmap.component_at(a, radius) == tmap.component_at(b, radius)
-    assert (path is not None) == bool(same_component)
+    # Components join cell centres the disc moves between straight, so they are truly
+    # connected; a passage no row of centres runs through may split one (the planner
+    # still finds the way), so only this direction holds.
+    same_component = tmap.component_at(a, radius) == tmap.component_at(b, radius) > 0
+    if same_component:
+        assert path is not None
     if path is None:
         return
     assert np.allclose(path[0], a) and np.allclose(path[-1], b)

@@ -274,7 +274,9 @@ class GoalField:
         n_cells = h * w
         flat = usable.ravel()
         idx = np.flatnonzero(flat)
-        kind = np.zeros(n_cells, dtype=np.int8)
+        # Usable cells start unsettled (3): the grid may not reach a cell the planner does
+        # (a passage no row of cell centres runs through), so only an exact query says 0.
+        kind = np.where(flat, 3, 0).astype(np.int8)
         label = np.full(n_cells, -1, dtype=np.int64)
         value = np.full(n_cells, np.inf)
         rows, cols = np.divmod(idx, w)
