@@ -114,10 +114,19 @@ def test_lookup_fast_path_equals_the_vectorised_root_check():
     planner = planner_for(tmap, 0.18)
     _, goal = scene.get_random_point(0, robot=0.18, rng=5)
     field = planner.goal_field(goal[:2])
-    field.distance(0.0, 0.0)  # builds the table
-    kind = np.asarray(field._table["kind"])
+    field.distance(0.0, 0.0)  # builds the table: proposals only, blocks unchecked
+    kind = field._table["kind"]
+    # A lookup checks the block it lands in: land once in every block (at a cell centre).
+    landed = []
+    while (kind == 4).any():
+        i = int(np.flatnonzero(kind == 4)[0])
+        r, c = divmod(i, tmap.shape[1])
+        field.distance(tmap.origin[0] + (c + 0.5) * tmap.resolution, tmap.origin[1] + (r + 0.5) * tmap.resolution)
+        assert kind[i] != 4
+        landed.append(i)
+    assert len(landed) > 4  # several blocks, each checked by its own first lookup
     labels = np.asarray(field._table["label"])
-    cells = np.flatnonzero(kind == 2)[::7]
+    cells = np.setdiff1d(np.flatnonzero(kind == 2), landed)[::7]
     rows, cols = np.divmod(cells, tmap.shape[1])
     px = tmap.origin[0] + (cols + 0.5) * tmap.resolution
     py = tmap.origin[1] + (rows + 0.5) * tmap.resolution

@@ -25,6 +25,12 @@ __all__ = ["GoalField"]
 
 #: Most neighbour-inheritance passes of the root table (each reaches one cell further).
 _ADOPT_PASSES = 64
+#: Side (cells) of the square blocks of the root table, each checked on its first lookup.
+_BLOCK = 16
+#: Table kind of a cell whose proposed root has not been checked yet (its block has not).
+_UNCHECKED = 4
+#: Cells (each side) around a block whose roots may flow into it while it is checked.
+_MARGIN = 8
 
 
 class GoalField:
@@ -59,7 +65,6 @@ class GoalField:
     def nbytes(self) -> int:
         """Approximate memory held by this field, in bytes."""
         table = 0 if self._table is None else sum(v.nbytes for v in self._table.values() if isinstance(v, np.ndarray))
-        table += 0 if self._table is None else 100 * len(self._table["fallback"])
         return self._search.nbytes + table
 
     # ------------------------------------------------------------- exact queries
@@ -121,12 +126,15 @@ class GoalField:
         if i < 0:
             return math.inf
         kind = t["kind"][i]
+        if kind == _UNCHECKED:
+            self._check_block(i)
+            kind = t["kind"][i]
         if kind == 0:
             return math.inf
         if kind == 1:  # straight to the goal
             return math.hypot(x - t["gx"], y - t["gy"])
         if kind == 3:
-            # No checked root was proposed here: find the cell centre's exact one, once.
+            # No checked root was found here: find the cell centre's exact one, once.
             kind = self._settle_cell(i)
             if kind == 1:
                 return math.hypot(x - t["gx"], y - t["gy"])
@@ -165,7 +173,6 @@ class GoalField:
         kind = 0 if lab == -2 else 1 if lab == -1 else 2
         t["kind"][i] = kind
         t["label"][i] = max(lab, -1)
-        t["fallback"].pop(i, None)
         return kind
 
     def _root_values(
@@ -191,81 +198,121 @@ class GoalField:
             out[sub] = lcost[sub] + p.radius * np.maximum(dep[sub] - lpos[sub], 0.0) + length[sub]
         return out
 
-    def _adopt_roots(self, kind, label, cx_all, cy_all, usable, gx, gy) -> None:  # type: ignore[no-untyped-def]
-        """Let cells try their neighbours' roots, and keep the best that checks out.
-
-        A neighbour's root is usually visible from a cell too (as Theta* inherits parents).
-        The first pass takes the cells whose proposal failed and the cells on the border
-        between two roots (where the grid metric may have picked the worse of two routes
-        that almost tie); each pass tests every distinct (cell, root) pair once, own root
-        included, and the next pass only cells next to a cell that changed.
-        """
+    def _key_values(self, cells: NDArray[np.int64], keys: NDArray[np.int64]) -> NDArray[np.float64]:
+        """Exact value of leaving cell centres by root ``keys`` (-1: the goal directly); inf if not valid."""
         p = self.planner
-        h, w = usable.shape
-        use = usable.ravel()
-        key = np.where(kind == 1, -1, np.where(kind == 2, label, -2))  # -2: no root
-        grid_key = key.reshape(h, w)
-        border = np.zeros((h, w), dtype=bool)
-        for dr, dc in ((0, 1), (1, 0), (1, 1), (1, -1)):
-            a = grid_key[0 : h - dr, max(0, -dc) : w - max(0, dc)]
-            b = grid_key[dr:, max(0, dc) : w - max(0, -dc)]
-            differ = (a != b) & (a > -2) & (b > -2)
-            border[0 : h - dr, max(0, -dc) : w - max(0, dc)] |= differ
-            border[dr:, max(0, dc) : w - max(0, -dc)] |= differ
-        todo_mask = use & ((key == -2) | border.ravel())
+        geo = p.geo
+        rows, cols = np.divmod(cells, geo.shape[1])
+        px = geo.origin[0] + (cols + 0.5) * geo.resolution
+        py = geo.origin[1] + (rows + 0.5) * geo.resolution
+        val = np.full(len(cells), np.inf)
+        direct = keys == -1
+        if direct.any():
+            gx, gy = float(self.goal[0]), float(self.goal[1])
+            d = np.flatnonzero(direct)
+            clear = geo.segments_clear(np.stack([px[d], py[d]], 1), np.array([gx, gy]), p.radius)
+            d = d[clear]
+            val[d] = np.hypot(px[d] - gx, py[d] - gy)
+        lab = np.flatnonzero(keys >= 0)
+        if len(lab):
+            val[lab] = self._root_values(cells[lab], keys[lab], px[lab], py[lab])
+        return val
+
+    def _check_block(self, i: int) -> None:
+        """Check the proposed roots of the block holding cell ``i``, then let its cells adopt.
+
+        Each proposal (the goal directly, or a label's tangent) is checked exactly at the cell
+        centre; a cell whose proposal fails gets kind 3, one with none kind 0. Then, as Theta*
+        inherits parents, the cells whose proposal failed and those on the border between two
+        roots try their neighbours' roots (a neighbour's root is usually visible too, and the
+        grid metric may have picked the worse of two routes that almost tie). Each pass tests
+        every distinct (cell, root) pair once, own root included, keeps each cell's best, and
+        the next pass takes only cells next to one that changed.
+
+        The passes run on the block and a margin of :data:`_MARGIN` cells around it, so that a
+        better root found next door can still flow in; only the block's cells are written.
+        Margin cells start from their table root where their block is checked, else from their
+        own proposal, checked here first: nothing unchecked is ever adopted.
+        """
+        t = self._table
+        assert t is not None
+        kind, label = t["kind"], t["label"]
+        h, w = self.planner.geo.shape
+        b, m = _BLOCK, _MARGIN
+        r0, c0 = (i // w) // b * b, (i % w) // b * b
+        t["done"][(r0 // b) * t["blocks_w"] + c0 // b] = True
+        # The working window: the block and its margin, clipped to the map.
+        wr0, wr1, wc0, wc1 = max(r0 - m, 0), min(r0 + b + m, h), max(c0 - m, 0), min(c0 + b + m, w)
+        wh, ww = wr1 - wr0, wc1 - wc0
+        ids = (np.arange(wr0, wr1)[:, None] * w + np.arange(wc0, wc1)[None, :]).ravel()
+        lr_all, lc_all = np.divmod(np.arange(len(ids)), ww)
+        mine = ((lr_all + wr0) // b == r0 // b) & ((lc_all + wc0) // b == c0 // b)
+        k = kind[ids]
+        key = np.where(k == 1, -1, np.where(k == 2, label[ids], -2)).astype(np.int64)
+        fresh = np.flatnonzero(k == _UNCHECKED)
+        prop = label[ids[fresh]].astype(np.int64)
+        has = prop > -2
+        ok = np.zeros(len(fresh), dtype=bool)
+        ok[has] = np.isfinite(self._key_values(ids[fresh[has]], prop[has]))
+        key[fresh[ok]] = prop[ok]
+        # The block's own cells take their checked proposals now; margin cells stay unchecked.
+        sel = mine[fresh]
+        # A cell with no proposal is not known unreachable: the grid cannot cross a passage
+        # no row of cell centres runs through, the planner can. It settles exactly (3).
+        kind[ids[fresh[sel]]] = np.where(ok, np.where(prop == -1, 1, 2), 3)[sel]
+        label[ids[fresh[sel]]] = np.where(ok, prop, -1)[sel]
+        # Roots of the window padded by one cell of none (-2), so that shifts stay inside.
+        pad = np.full((wh + 2, ww + 2), -2, dtype=np.int64)
+        pad[1:-1, 1:-1] = key.reshape(wh, ww)
+        grid = pad[1:-1, 1:-1]  # a view: updates show in the neighbour shifts below
+        use = self.planner.usable.ravel()[ids].reshape(wh, ww)
+        shifts = [(dr, dc) for dr in (-1, 0, 1) for dc in (-1, 0, 1) if dr or dc]
+        border = np.zeros((wh, ww), dtype=bool)
+        for dr, dc in shifts:
+            nk = pad[1 + dr : 1 + dr + wh, 1 + dc : 1 + dc + ww]
+            border |= (nk != grid) & (nk > -2) & (grid > -2)
+        todo_mask = use & ((grid == -2) | border)
+        changed = np.zeros(wh * ww, dtype=bool)
         for _ in range(_ADOPT_PASSES):
-            todo = np.flatnonzero(todo_mask)
-            if not len(todo):
-                return
-            rows, cols = np.divmod(todo, w)
-            cells, roots = [todo[key[todo] > -2]], [key[todo][key[todo] > -2]]
-            for dr in (-1, 0, 1):
-                for dc in (-1, 0, 1):
-                    if not (dr or dc):
-                        continue
-                    nr, nc = rows + dr, cols + dc
-                    inside = (nr >= 0) & (nr < h) & (nc >= 0) & (nc < w)
-                    nb = np.where(inside, nr * w + nc, 0)
-                    k = np.where(inside, key[nb], -2)
-                    sel = k > -2
-                    cells.append(todo[sel])
-                    roots.append(k[sel])
+            loc = np.flatnonzero(todo_mask)
+            if not len(loc):
+                break
+            lr, lc = lr_all[loc], lc_all[loc]
+            cells, roots = [loc], [grid.ravel()[loc]]
+            for dr, dc in shifts:
+                cells.append(loc)
+                roots.append(pad[1 + lr + dr, 1 + lc + dc])
             pair = np.unique(np.stack([np.concatenate(cells), np.concatenate(roots)], axis=1), axis=0)
+            pair = pair[pair[:, 1] > -2]
             if not len(pair):
-                return
-            pc, pr = pair[:, 0], pair[:, 1]
-            val = np.full(len(pair), np.inf)
-            direct = pr < 0
-            if direct.any():
-                c = pc[direct]
-                clear = p.geo.segments_clear(np.stack([cx_all[c], cy_all[c]], 1), np.array([gx, gy]), p.radius)
-                val[np.flatnonzero(direct)[clear]] = np.hypot(cx_all[c[clear]] - gx, cy_all[c[clear]] - gy)
-            if (~direct).any():
-                c = pc[~direct]
-                val[~direct] = self._root_values(c, pr[~direct], cx_all[c], cy_all[c])
-            ok = np.isfinite(val)
-            if not ok.any():
-                return
-            pc, pr, val = pc[ok], pr[ok], val[ok]
+                break
+            val = self._key_values(ids[pair[:, 0]], pair[:, 1])
+            good = np.isfinite(val)
+            if not good.any():
+                break
+            pl, pk, val = pair[good, 0], pair[good, 1], val[good]
             # The best pair of each cell: sort by value, keep the first of each cell.
-            order = np.lexsort((val, pc))
-            pc, pr = pc[order], pr[order]
-            first = np.concatenate([[True], pc[1:] != pc[:-1]])
-            cells, best = pc[first], pr[first]
-            moved = key[cells] != best
-            cells, best = cells[moved], best[moved]
-            if not len(cells):
-                return
-            key[cells] = best
-            kind[cells] = np.where(best < 0, 1, 2)
-            label[cells] = np.where(best < 0, -1, best)
+            order = np.lexsort((val, pl))
+            pl, pk = pl[order], pk[order]
+            first = np.concatenate([[True], pl[1:] != pl[:-1]])
+            pl, pk = pl[first], pk[first]
+            moved = grid.ravel()[pl] != pk
+            pl, pk = pl[moved], pk[moved]
+            if not len(pl):
+                break
+            grid[lr_all[pl], lc_all[pl]] = pk
+            changed[pl] = True
             # Only cells next to a cell that changed can gain a better root next pass.
-            fresh = np.zeros(h * w, dtype=bool)
-            fresh[cells] = True
-            near = ndimage.binary_dilation(fresh.reshape(h, w), structure=np.ones((3, 3), bool)).ravel()
-            todo_mask = near & use
+            now = np.zeros((wh, ww), dtype=bool)
+            now[lr_all[pl], lc_all[pl]] = True
+            todo_mask = use & ndimage.binary_dilation(now, structure=np.ones((3, 3), bool))
+        put = np.flatnonzero(changed & mine)
+        best = grid.ravel()[put]
+        kind[ids[put]] = np.where(best < 0, 1, 2)
+        label[ids[put]] = best
 
     def _build_table(self) -> dict[str, Any]:
+        """Propose every cell's root (one seeded grid Dijkstra); blocks are checked on first use."""
         p = self.planner
         geo = p.geo
         h, w = geo.shape
@@ -274,19 +321,11 @@ class GoalField:
         n_cells = h * w
         flat = usable.ravel()
         idx = np.flatnonzero(flat)
-        # Usable cells start unsettled (3): the grid may not reach a cell the planner does
-        # (a passage no row of cell centres runs through), so only an exact query says 0.
-        kind = np.where(flat, 3, 0).astype(np.int8)
-        label = np.full(n_cells, -1, dtype=np.int64)
-        value = np.full(n_cells, np.inf)
-        rows, cols = np.divmod(idx, w)
-        px = geo.origin[0] + (cols + 0.5) * res
-        py = geo.origin[1] + (rows + 0.5) * res
-        cx_all = np.full(n_cells, np.nan)
-        cy_all = np.full(n_cells, np.nan)
-        cx_all[idx], cy_all[idx] = px, py
+        kind = np.zeros(n_cells, dtype=np.int8)
+        label = np.full(n_cells, -2, dtype=np.int32)  # -1: the goal directly, -2: no proposal
         gx, gy = float(self.goal[0]), float(self.goal[1])
         if self.goal_usable and len(idx):
+            kind[idx] = _UNCHECKED
             # Seed each arrival at points along its arc ahead of it, so that a cell behind the
             # corner is proposed the arc point it leaves from; the goal is seed 0.
             search = self._search
@@ -305,15 +344,16 @@ class GoalField:
                 ys.append((p.cy[a_node] + p.radius * np.sin(ang))[ok])
                 costs.append((search.cost[arr_lab] + p.radius * (q - a_pos))[ok])
                 owner.append(arr_lab[ok] + 1)
-            xs, ys, costs, owner = (np.concatenate(v) for v in (xs, ys, costs, owner))
-            seed_x, seed_y, seed_cost, seed_owner = xs, ys, costs, owner
+            seed_x, seed_y, seed_cost, seed_owner = (np.concatenate(v) for v in (xs, ys, costs, owner))
             scol = np.floor((seed_x - geo.origin[0]) / res).astype(np.int64)
             srow = np.floor((seed_y - geo.origin[1]) / res).astype(np.int64)
             inside = (scol >= 0) & (scol < w) & (srow >= 0) & (srow < h)
             scell = np.where(inside, srow * w + scol, 0)
-            ok = inside & flat[scell]
-            seeds = np.flatnonzero(ok)
-            seed_val = seed_cost[seeds] + np.hypot(cx_all[scell[seeds]] - seed_x[seeds], cy_all[scell[seeds]] - seed_y[seeds])
+            seeds = np.flatnonzero(inside & flat[scell])
+            sc = scell[seeds]
+            seed_val = seed_cost[seeds] + np.hypot(
+                geo.origin[0] + (sc % w + 0.5) * res - seed_x[seeds], geo.origin[1] + (sc // w + 0.5) * res - seed_y[seeds]
+            )
             graph = p.cell_graph
             # A super-source (index n_cells) joined to each seed's cell, weighted by its cost.
             n = n_cells + 1 + len(seeds)
@@ -322,7 +362,7 @@ class GoalField:
             extra = sparse.csr_matrix(
                 (
                     np.concatenate([seed_val + 1e-300, np.full(len(seeds), 1e-300)]),
-                    (np.concatenate([np.full(len(seeds), n_cells), virt]), np.concatenate([virt, scell[seeds]])),
+                    (np.concatenate([np.full(len(seeds), n_cells), virt]), np.concatenate([virt, sc])),
                 ),
                 shape=(n, n),
             )
@@ -342,30 +382,16 @@ class GoalField:
             top = anc[:n_cells]
             cell_seed = np.where(top > n_cells, top - (n_cells + 1), -1)
             reach = np.isfinite(dist) & (cell_seed >= 0)
-            value[reach] = dist[reach]
-            kind[reach] = 3
-            seed_of = np.where(reach, seed_owner[seeds[np.maximum(cell_seed, 0)]], -1)
-            # Check each proposal: the straight segment from the cell centre to the goal, or
-            # the tangent from the seed's node, must be clear and leave the arc forward.
-            cells = np.flatnonzero(reach)
-            direct = seed_of[cells] == 0
-            if direct.any():
-                c = cells[direct]
-                clear = geo.segments_clear(np.stack([cx_all[c], cy_all[c]], 1), np.array([gx, gy]), p.radius)
-                kind[c[clear]] = 1
-            c = cells[~direct]
-            if len(c):
-                lab = seed_of[c] - 1
-                good = np.isfinite(self._root_values(c, lab, cx_all[c], cy_all[c]))
-                kind[c[good]] = 2
-                label[c[good]] = lab[good]
-            self._adopt_roots(kind, label, cx_all, cy_all, usable, gx, gy)
-        # Compact: one byte of kind and an int32 root per cell; grid fallback values are few.
-        fb = np.flatnonzero(kind == 3)
+            # The proposal, checked with its block: seed owner 0 is the goal (-1), else label + 1.
+            label[reach] = seed_owner[seeds[cell_seed[reach]]] - 1
+        b = _BLOCK
+        blocks_w = -(-w // b)
         table = {
             "kind": kind,
-            "label": label.astype(np.int32),
-            "fallback": dict(zip(fb.tolist(), value[fb].tolist())),
+            "label": label,
+            # Whether each block (row-major, _BLOCK cells square) has been checked.
+            "done": np.zeros(-(-h // b) * blocks_w, dtype=bool),
+            "blocks_w": blocks_w,
             "gx": gx,
             "gy": gy,
         }
