@@ -3,10 +3,12 @@
 A :class:`GoalField` is one Dijkstra run of :mod:`pointnav_core.tangent_graph` from a goal:
 the exact distance of every node it reaches. :meth:`GoalField.point_distance` and
 :meth:`GoalField.path` are exact for any point (the tangents the point sees, then the
-settled labels). :meth:`GoalField.distance` is the per-step lookup through a root table
-built on first use: a seeded multi-source Dijkstra on the grid proposes each cell's root
-label, each proposal is checked exactly, and cells whose proposal fails try their
-neighbours' roots. Everything is in world metres.
+settled labels). :meth:`GoalField.distance` is the per-step lookup through a root table:
+on the first lookup a seeded multi-source Dijkstra on the grid proposes every cell's root
+label (cheap); the exact checks are made one block of cells at a time, when a lookup first
+lands in the block: each proposal is checked, cells whose proposal fails and cells on the
+border of two roots try their neighbours' roots, and a cell left without one takes its
+centre's exact root on its own first lookup. Everything is in world metres.
 """
 
 from __future__ import annotations
