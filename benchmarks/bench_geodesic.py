@@ -4,8 +4,8 @@ Three modes; each prints the figures of one run, so that ratios are meaningful o
 machine.
 
 Speed (default): for generated houses on 200x200, 400x400 and 1000x1000 grids, the time to
-build the per-floor planner of :mod:`pointnav_core.geodesic` (erosion, corners, corner
-graph), to build one goal field, to query a cached field (a distance lookup and a whole
+build the per-floor planner of :mod:`pointnav_core.tangent_graph` (erosion, corners and
+their arcs), to build one goal field, to query a cached field (a distance lookup and a whole
 any-angle path), and, for the same start/goal pairs, one query of pyastar2d's C++ A* and of
 networkx A* on an 8-connected grid graph (how iGibson planned).
 
@@ -165,8 +165,8 @@ def speed(args):
     for name, tp, tf, tl, tq, ta, tn in rows:
         print(f"{name:26} {tp*1e3:8.1f}ms {tf*1e3:8.2f}ms {tl*1e6:8.2f}us {tq*1e6:8.1f}us "
               f"{ta*1e3:9.2f}ms {tn*1e3:9.1f}ms {ta/tl:13.0f} {ta/tq:11.1f} {tn/tq:9.0f}")
-    print("planner: per floor and radius (erosion, corners, corner graph, cell graph), cached;"
-          " field: per goal (corner distances + root table), cached; lookup:"
+    print("planner: per floor and radius (erosion, corners, arcs), cached;"
+          " field: per goal (arc-vertex distances + root table), cached; lookup:"
           " FloorGoalField.distance (the per-step query); path: get_shortest_path to a cached"
           " goal (checked, entire any-angle path); medians over pairs.")
 

@@ -1,8 +1,7 @@
 """Exact geodesics of a disc robot in a floor's collision geometry (the tangent graph).
 
-This planner replaces the corner graph of :mod:`pointnav_core.geodesic`, whose usable
-cells are decided at their centres (see ``docs/geodesic.md``); it is tested on its own
-and not yet what :class:`~pointnav_core.scenes.Scene` calls.
+This is the planner behind :class:`~pointnav_core.scenes.Scene`'s shortest paths, geodesic
+distances and goal fields (the model, its accuracy and cost: ``docs/geodesic.md``).
 
 The robot's centre may go wherever its disc of radius ``r`` misses the blocked set of
 :class:`~pointnav_core.collision.FloorCollision`. A shortest path in that space is taut: a
