@@ -149,3 +149,21 @@ def test_field_lookup_matches_exact_queries_in_a_generated_house():
     rel = np.array(rel)
     assert np.quantile(rel, 0.95) <= 1e-3
     assert rel.max() <= 0.01
+
+
+@pytest.mark.parametrize("max_length", [0.05, 1.0, 6.0, 1e9])
+def test_field_path_with_max_length_draws_the_whole_paths_beginning(max_length):
+    """A follower asks only for the path's beginning: a prefix of the whole path, long enough."""
+    scene = wall_scene()
+    start, goal = (2.5, 12.5), (28.5, 2.5)
+    field = scene.goal_field(0, goal, robot=0.3)
+    whole, length = field.path(start)
+    part, part_length = field.path(start, max_length=max_length)
+    assert part_length == length  # the length is always the whole path's
+    assert np.array_equal(part, whole[: len(part)])
+    # It reaches max_length along the path, or it is the whole path.
+    steps = np.hypot(*np.diff(part, axis=0).T)
+    assert steps.sum() >= max_length or len(part) == len(whole)
+    # And stops at the first arc that gets there: dropping that arc falls short.
+    if len(part) < len(whole):
+        assert steps.sum() - steps[-1] < max_length + 2 * math.pi * 0.3

@@ -185,19 +185,35 @@ class FieldLabels:
         along = (par >= 0) & (self.group[np.maximum(par, 0)] == self.group[reached])
         return reached[~along]
 
-    def trace(self, label: int, dep: float) -> list[NDArray[np.float64]]:
-        """Points from the departure at ``dep`` on ``label``'s arc back to the source."""
+    def trace(
+        self, label: int, dep: float, start: tuple[float, float] | None = None, max_length: float = math.inf
+    ) -> tuple[list[NDArray[np.float64]], bool]:
+        """Points from the departure at ``dep`` on ``label``'s arc back to the source.
+
+        With ``start`` (the point the path leaves from) and a finite ``max_length`` (m),
+        tracing stops at the first arc whose end lies ``max_length`` or more along the
+        path from ``start``. Returns the points and whether the trace reached the source.
+        """
         from pointnav_core.tangent_graph import _arc_points
 
         p = self.graph.p
         pts: list[NDArray[np.float64]] = []
         grp, par = self.group, self.parent
+        last = None if start is None else np.asarray(start, dtype=np.float64)
+        walked = 0.0
         while label >= 0:
             # Follow the arc back to where the path arrived on it.
             while par[label] >= 0 and grp[par[label]] == grp[label]:
                 label = int(par[label])
-            pts += _arc_points(p, int(self.node[label]), int(self.side[label]), dep, float(self.pos[label]))
+            arc = _arc_points(p, int(self.node[label]), int(self.side[label]), dep, float(self.pos[label]))
+            pts += arc
             label = int(par[label])
             if label >= 0:
                 dep = float(self.pos[label])
-        return pts
+            if last is not None and math.isfinite(max_length):
+                for q in arc:
+                    walked += math.hypot(q[0] - last[0], q[1] - last[1])
+                    last = q
+                if walked >= max_length and label >= 0:
+                    return pts, False
+        return pts, True

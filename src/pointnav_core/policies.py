@@ -118,7 +118,7 @@ class ShortestPathFollower:
         # touches a wall (a rigid-body solver counts touching as contact); then exact.
         radii = sorted({spec.radius + self.margin, spec.radius + _HAIR, spec.radius}, reverse=True)
         for radius in radii:
-            path, _ = env.scene.goal_field(task.floor, goal, robot=radius).path(xy)
+            path, _ = env.scene.goal_field(task.floor, goal, robot=radius).path(xy, max_length=self.lookahead)
             if path is not None:
                 break
         if path is None:

@@ -97,13 +97,15 @@ class FloorGoalField:
         return float(self.field.point_distance(_as_xy(source_xy, "source_xy")))
 
     def path(
-        self, source_xy: ArrayLike, exact: bool = True
+        self, source_xy: ArrayLike, exact: bool = True, max_length: float = math.inf
     ) -> tuple[NDArray[np.float64], float] | tuple[None, None]:
         """Shortest path (N, 2) in world metres from ``source_xy`` to the goal, and its length.
 
-        Every path is exact; ``exact`` is accepted for compatibility.
+        Every path is exact; ``exact`` is accepted for compatibility. A finite
+        ``max_length`` (m) draws only the path's beginning, to its first vertex at least
+        that far along; the length is still the whole path's.
         """
-        points, length = self.field.path(_as_xy(source_xy, "source_xy"))
+        points, length = self.field.path(_as_xy(source_xy, "source_xy"), max_length=max_length)
         if points is None:
             return None, None
         return points, float(length)

@@ -97,19 +97,27 @@ class GoalField:
         x, y = (float(v) for v in np.asarray(xy, dtype=np.float64).reshape(-1)[:2])
         return self._best(x, y)[0]
 
-    def path(self, xy: ArrayLike, exact: bool = True) -> tuple[NDArray[np.float64], float] | tuple[None, None]:
+    def path(
+        self, xy: ArrayLike, exact: bool = True, max_length: float = math.inf
+    ) -> tuple[NDArray[np.float64], float] | tuple[None, None]:
         """Shortest path (N, 2) from world point ``xy`` to the goal and its length (m).
 
-        ``exact`` is kept for compatibility: every path is exact.
+        ``exact`` is kept for compatibility: every path is exact. With a finite
+        ``max_length`` (m) only the path's beginning is drawn: it ends at the first vertex
+        ``max_length`` or more along it (a follower needs no more); the length returned is
+        still the whole path's.
         """
         x, y = (float(v) for v in np.asarray(xy, dtype=np.float64).reshape(-1)[:2])
         cost, label, dep = self._best(x, y)
         if label == -2:
             return None, None
         pts = [np.array([x, y])]
+        whole = True
         if label >= 0:
-            pts += self._search.trace(label, dep)
-        pts.append(self.goal.copy())
+            traced, whole = self._search.trace(label, dep, (x, y), max_length)
+            pts += traced
+        if whole:
+            pts.append(self.goal.copy())
         return np.array(pts), cost
 
     # ------------------------------------------------------------- lookup table

@@ -132,6 +132,7 @@ class Planner:
         # (node, side) -> departure positions, targets, target sides, arrivals, lengths.
         self._edges: dict[tuple[int, int], tuple[list[float], list[int], list[int], list[float], list[float]]] = {}
         self._sights = np.full(self.n_nodes, np.nan)
+        self._cell_sights: dict[tuple[int, int], float] = {}
         self._arc_graph: ArcGraph | None = None
         self._fb_edt: NDArray[np.float64] | None = None
         self._fb_mask: NDArray[np.bool_] | None = None
@@ -248,8 +249,20 @@ class Planner:
 
         Cast as :data:`_SIGHT_RAYS` rays marched through cells no disc can use; the bound
         is the longest ray plus two cells (see :func:`~pointnav_core.tangent_edges.sight_radii`).
+        Rays are cast once per cell, from its centre, and the bound is widened by the half
+        diagonal of a cell; point queries (every step of a follower) then cost a lookup.
         """
-        return float(self._sight_radii(np.array([x]), np.array([y]))[0])
+        geo = self.geo
+        res = geo.resolution
+        col = math.floor((x - geo.origin[0]) / res)
+        row = math.floor((y - geo.origin[1]) / res)
+        key = (row, col)
+        sight = self._cell_sights.get(key)
+        if sight is None:
+            cx, cy = geo.origin[0] + (col + 0.5) * res, geo.origin[1] + (row + 0.5) * res
+            sight = float(self._sight_radii(np.array([cx]), np.array([cy]))[0]) + res * math.sqrt(0.5)
+            self._cell_sights[key] = sight
+        return sight
 
     def _sight_radii(self, xs: NDArray[np.float64], ys: NDArray[np.float64]) -> NDArray[np.float64]:
         geo = self.geo
