@@ -1,15 +1,18 @@
 """pointnav-core: physics-free point-goal navigation on 2D floor maps.
 
-Importing the package registers the Gymnasium env ``pointnav_core/PointNav-v0`` and the
-PettingZoo env ``pointnav_core/MultiPointNav-v0`` (parallel and AEC registries).
+The core (maps, scenes, geodesics, transforms, the task, metrics, backends) imports neither
+Gymnasium, PettingZoo nor Pillow. The envs ``PointNavEnv`` and ``MultiPointNavEnv`` load on
+first use, and the ids ``pointnav_core/PointNav-v0`` (Gymnasium) and
+``pointnav_core/MultiPointNav-v0`` (PettingZoo, parallel and AEC) are registered with each
+library as soon as both it and this package are imported (see ``registration``).
 """
 
-from pointnav_core.env import PointNavEnv
+from typing import Any
+
 from pointnav_core.errors import BackendError, PointNavError, SamplingError
 from pointnav_core.maps import FREE, OBSTACLE, VOID, TraversableMap
 from pointnav_core.metrics import soft_spl, spl
-from pointnav_core.parallel import MultiPointNavEnv
-from pointnav_core.registration import register_envs
+from pointnav_core.registration import register_envs, register_when_imported
 from pointnav_core.scenes import Scene
 from pointnav_core.task import PointNavigationTask, TaskState, TaskStateError
 
@@ -35,4 +38,22 @@ __all__ = [
     "spl",
 ]
 
-register_envs()
+#: Exports that load Gymnasium or PettingZoo, imported on first access.
+_LAZY = {"PointNavEnv": "pointnav_core.env", "MultiPointNavEnv": "pointnav_core.parallel"}
+
+
+def __getattr__(name: str) -> Any:
+    if name in _LAZY:
+        import importlib
+
+        value = getattr(importlib.import_module(_LAZY[name]), name)
+        globals()[name] = value
+        return value
+    raise AttributeError(f"module 'pointnav_core' has no attribute {name!r}")
+
+
+def __dir__() -> list[str]:
+    return sorted(set(globals()) | set(_LAZY))
+
+
+register_when_imported()

@@ -17,7 +17,6 @@ import re
 
 import numpy as np
 from numpy.typing import NDArray
-from PIL import Image, UnidentifiedImageError
 
 from pointnav_core.maps import FREE, OBSTACLE
 
@@ -128,6 +127,8 @@ def read_trav_png(
     resolution = _check_resolution(resolution, "resolution")
     source_resolution = _check_resolution(source_resolution, "source_resolution")
     where = f"path {os.fspath(path)!r}"
+    from PIL import Image, UnidentifiedImageError  # only this reader needs Pillow
+
     try:
         with Image.open(path) as image:
             image.load()

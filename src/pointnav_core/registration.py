@@ -2,21 +2,28 @@
 
 Neither library discovers plugins (Gymnasium 1.x removed the ``gymnasium.envs`` entry-point
 group of gym 0.2x; PettingZoo 1.27's registry is filled only by ``pettingzoo.register``
-calls), so the ids exist once :func:`register_envs` has run. Importing ``pointnav_core``
-runs it. ``gymnasium.make("pointnav_core:pointnav_core/PointNav-v0")`` imports the package
-by itself; PettingZoo's ``make`` has no such ``module:`` prefix, so import ``pointnav_core``
-before ``pettingzoo.make("parallel", "pointnav_core/MultiPointNav-v0")``.
+calls), so the ids exist once :func:`register_envs` has run. The core of the package
+imports neither library, so importing ``pointnav_core`` does not register anything by
+itself; it calls :func:`register_when_imported`, which registers the ids with each library
+as soon as that library is imported (at once, if it already is). Hence, in either order,
+
+>>> import pointnav_core, gymnasium                                   # doctest: +SKIP
+>>> gymnasium.make("pointnav_core/PointNav-v0")                        # doctest: +SKIP
+
+works, and so does ``gymnasium.make("pointnav_core:pointnav_core/PointNav-v0")`` without
+importing the package first. Calling :func:`register_envs` registers explicitly.
 """
 
 from __future__ import annotations
 
-from collections.abc import Mapping
-from types import MappingProxyType
+import importlib.abc
+import importlib.machinery
+import sys
+from collections.abc import Callable, Mapping, Sequence
+from types import MappingProxyType, ModuleType
+from typing import Any
 
-import gymnasium
-import pettingzoo
-
-__all__ = ["ENV_IDS", "PARALLEL_ENV_IDS", "AEC_ENV_IDS", "register_envs"]
+__all__ = ["ENV_IDS", "PARALLEL_ENV_IDS", "AEC_ENV_IDS", "register_envs", "register_when_imported"]
 
 #: The Gymnasium (single-robot) ids, each with its lazy ``"module:Class"`` entry point.
 ENV_IDS: Mapping[str, str] = MappingProxyType(
@@ -34,26 +41,23 @@ AEC_ENV_IDS: Mapping[str, str] = MappingProxyType(
 )
 
 
-def register_envs() -> None:
-    """Register every pointnav-core env with Gymnasium and PettingZoo; ids already
-    registered are kept.
+def register_gymnasium() -> None:
+    """Register the Gymnasium ids (``max_episode_steps=None``: the task's ``timeout`` owns truncation)."""
+    import gymnasium
 
-    Gymnasium: ``max_episode_steps`` is None, since the task's ``timeout`` condition owns
-    truncation, so no ``TimeLimit`` wrapper is added. PettingZoo: the multi-robot env is
-    registered in both the ``"parallel"`` and the ``"aec"`` registry with no registry
-    ``max_cycles``, so the env's own default (500) applies unless ``make`` is given one.
-
-    Examples
-    --------
-    >>> register_envs(); register_envs()  # idempotent
-    >>> "pointnav_core/PointNav-v0" in gymnasium.registry
-    True
-    >>> "pointnav_core/MultiPointNav-v0" in pettingzoo.parallel_registry
-    True
-    """
     for env_id, entry_point in ENV_IDS.items():
         if env_id not in gymnasium.registry:
             gymnasium.register(id=env_id, entry_point=entry_point, max_episode_steps=None)
+
+
+def register_pettingzoo() -> None:
+    """Register the multi-robot env in PettingZoo's ``"parallel"`` and ``"aec"`` registries.
+
+    No registry ``max_cycles`` is set, so the env's own default (500) applies unless
+    ``make`` is given one.
+    """
+    import pettingzoo
+
     # pettingzoo.register warns when it overrides an id, so register each one only once.
     for env_type, ids, registry in (
         ("parallel", PARALLEL_ENV_IDS, pettingzoo.parallel_registry),
@@ -62,3 +66,75 @@ def register_envs() -> None:
         for env_id, entry_point in ids.items():
             if env_id not in registry:
                 pettingzoo.register(env_type, env_id, entry_point=entry_point)
+
+
+def register_envs() -> None:
+    """Register every pointnav-core env with Gymnasium and PettingZoo; ids already
+    registered are kept.
+
+    Examples
+    --------
+    >>> register_envs(); register_envs()  # idempotent
+    >>> import gymnasium, pettingzoo
+    >>> "pointnav_core/PointNav-v0" in gymnasium.registry
+    True
+    >>> "pointnav_core/MultiPointNav-v0" in pettingzoo.parallel_registry
+    True
+    """
+    register_gymnasium()
+    register_pettingzoo()
+
+
+#: What to run once each library has been imported.
+_REGISTRARS: dict[str, Callable[[], None]] = {"gymnasium": register_gymnasium, "pettingzoo": register_pettingzoo}
+
+
+def register_when_imported() -> None:
+    """Register with each library now if it is imported, else right after its import."""
+    waiting = []
+    for name, registrar in _REGISTRARS.items():
+        if name in sys.modules:
+            registrar()
+        else:
+            waiting.append(name)
+    if waiting and not any(isinstance(f, _AfterImport) for f in sys.meta_path):
+        sys.meta_path.insert(0, _AfterImport())
+
+
+class _AfterImport(importlib.abc.MetaPathFinder):
+    """Finds nothing itself; wraps the loader of a waiting library to register after it runs."""
+
+    def find_spec(
+        self, fullname: str, path: Sequence[str] | None, target: ModuleType | None = None
+    ) -> importlib.machinery.ModuleSpec | None:
+        if fullname not in _REGISTRARS:
+            return None
+        for finder in sys.meta_path:
+            if finder is self or not hasattr(finder, "find_spec"):
+                continue
+            spec = finder.find_spec(fullname, path, target)
+            if spec is not None:
+                if spec.loader is not None and hasattr(spec.loader, "exec_module"):
+                    spec.loader = _RegisteringLoader(spec.loader, _REGISTRARS[fullname])
+                return spec
+        return None
+
+
+class _RegisteringLoader(importlib.abc.Loader):
+    """A library's own loader, then its registrar."""
+
+    def __init__(self, loader: Any, registrar: Callable[[], None]) -> None:
+        self.loader = loader
+        self.registrar = registrar
+
+    def create_module(self, spec: importlib.machinery.ModuleSpec) -> ModuleType | None:
+        return self.loader.create_module(spec)
+
+    def exec_module(self, module: ModuleType) -> None:
+        self.loader.exec_module(module)
+        self.registrar()
+        if all(name in sys.modules for name in _REGISTRARS):  # nothing left to wait for
+            sys.meta_path[:] = [f for f in sys.meta_path if not isinstance(f, _AfterImport)]
+
+    def __getattr__(self, name: str) -> Any:  # get_resource_reader, is_package, ...
+        return getattr(self.loader, name)
