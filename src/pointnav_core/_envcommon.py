@@ -9,6 +9,7 @@ so both build them here. ``name`` arguments say what to call the value in an err
 
 from __future__ import annotations
 
+import copy
 import dataclasses
 import inspect
 import math
@@ -36,6 +37,8 @@ __all__ = [
 
 #: Keyword arguments of :class:`PointNavigationTask`, in signature order.
 TASK_KEYS = tuple(inspect.signature(PointNavigationTask).parameters)
+#: Task arguments holding term objects (copied for every task built from a dict).
+TERM_KEYS = ("termination_conditions", "reward_functions", "observation_terms")
 #: Fields of :class:`RobotSpec`, in declaration order.
 ROBOT_KEYS = tuple(f.name for f in dataclasses.fields(RobotSpec))
 
@@ -120,7 +123,10 @@ def make_task(
                     f"{name} sets {key}={task[key]!r}, but the environment sets "
                     f"{key}={value!r} for it"
                 )
-        return PointNavigationTask(**{**task, **fixed})
+        # Terms keep per-episode state: every task built from a dict gets its own copies
+        # (a multi-robot env builds one task per robot from the same dict).
+        args = {k: copy.deepcopy(v) if k in TERM_KEYS else v for k, v in task.items()}
+        return PointNavigationTask(**{**args, **fixed})
     raise ValueError(
         f"{name} must be a PointNavigationTask, a dict of its arguments, or None, got {task!r}"
     )
@@ -164,21 +170,19 @@ def action_space(robot: RobotSpec) -> spaces.Box:
 
 
 def observation_space(task: PointNavigationTask, flatten: bool) -> spaces.Space[Any]:
-    """The task's observation space: a ``Dict`` of its three arrays, or the flat ``(8,)`` Box.
+    """The task's observation space: a ``Dict`` of one ``Box`` per observation term, or
+    the flat Box of them all end to end.
 
     ``task`` must have met its environment (:meth:`PointNavigationTask.load`).
     """
+    layout = task.observation_layout
     low, high = task.observation_bounds
     if flatten:
         return spaces.Box(low, high, dtype=np.float32)
-    # An OrderedDict keeps this order (a plain dict would be sorted by key), so that
-    # FlattenObservation gives OmniGibson's low_dim order too.
+    # An OrderedDict keeps the terms' order (a plain dict would be sorted by key), so that
+    # FlattenObservation gives the flat order too.
     return spaces.Dict(
-        OrderedDict(
-            xy_pos_to_goal=spaces.Box(low[0:2], high[0:2], dtype=np.float32),
-            robot_lin_vel=spaces.Box(low[2:5], high[2:5], dtype=np.float32),
-            robot_ang_vel=spaces.Box(low[5:8], high[5:8], dtype=np.float32),
-        )
+        OrderedDict((name, spaces.Box(low[s], high[s], dtype=np.float32)) for name, s in layout.slices.items())
     )
 
 

@@ -44,20 +44,21 @@ class PointNavEnv(gym.Env[Any, np.ndarray]):
 
     ## Observation Space
 
-    A `Dict` of three `float32` arrays, in the robot's frame (+x ahead, +y to the left).
+    A `Dict` of one `float32` array per observation term (`pointnav_core.observations`;
+    the table is generated from the terms), in the robot's frame (+x ahead, +y to the left).
     `D` is the diagonal of the task's floor plus 1 m, `v` is `sqrt(2)` times the robot's
     `max_linear_velocity` and `w` its `max_angular_velocity`:
 
-    | Num | Key              | Observation                                   | Min  | Max |
-    |-----|------------------|-----------------------------------------------|------|-----|
-    | 0   | `xy_pos_to_goal` | goal x relative to the robot (m)              | -D   | D   |
-    | 1   | `xy_pos_to_goal` | goal y relative to the robot (m)              | -D   | D   |
-    | 2   | `robot_lin_vel`  | linear velocity x (m/s)                       | -v   | v   |
-    | 3   | `robot_lin_vel`  | linear velocity y (m/s)                       | -v   | v   |
-    | 4   | `robot_lin_vel`  | linear velocity z (m/s, negative when falling)| -v   | v   |
-    | 5   | `robot_ang_vel`  | angular velocity x (rad/s)                    | -w   | w   |
-    | 6   | `robot_ang_vel`  | angular velocity y (rad/s)                    | -w   | w   |
-    | 7   | `robot_ang_vel`  | angular velocity z, the yaw rate (rad/s)      | -w   | w   |
+    | Num | Key              | Observation                                    | Min | Max |
+    |-----|------------------|------------------------------------------------|-----|-----|
+    | 0   | `xy_pos_to_goal` | goal x relative to the robot (m)               | -D  | D   |
+    | 1   | `xy_pos_to_goal` | goal y relative to the robot (m)               | -D  | D   |
+    | 2   | `robot_lin_vel`  | linear velocity x (m/s)                        | -v  | v   |
+    | 3   | `robot_lin_vel`  | linear velocity y (m/s)                        | -v  | v   |
+    | 4   | `robot_lin_vel`  | linear velocity z (m/s, negative when falling) | -v  | v   |
+    | 5   | `robot_ang_vel`  | angular velocity x (rad/s)                     | -w  | w   |
+    | 6   | `robot_ang_vel`  | angular velocity y (rad/s)                     | -w  | w   |
+    | 7   | `robot_ang_vel`  | angular velocity z, the yaw rate (rad/s)       | -w  | w   |
 
     With `goal_in_polar=True` in the task, indices 0 and 1 are the distance `rho` in
     `[0, D]` m and the bearing `phi` in `[-pi, pi]` rad (0 dead ahead, positive to the

@@ -609,8 +609,8 @@ class MultiPointNavEnv(ParallelEnv[str, Any, np.ndarray]):
 
     def _finish(self, i: int) -> None:
         self._active[i] = False
-        fell = self.tasks[i].termination_results.get("falling", (False, False))[0]
-        if self.finished == "remove" or fell:
+        gone = any(c.removes_robot and c.done for c in self.tasks[i].termination_conditions.values())
+        if self.finished == "remove" or gone:
             self.backend.set_present(i, False)
 
     def _no_agents(self) -> NoReturn:

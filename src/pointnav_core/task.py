@@ -39,6 +39,7 @@ from numpy.typing import ArrayLike, NDArray
 from pointnav_core.errors import PointNavError, SamplingError
 from pointnav_core.markers import VisualMarker, _waypoints_along
 from pointnav_core.metrics import _soft_spl, _spl
+from pointnav_core.observations import Frame, ObservationLayout, ObservationTerm, default_observation_terms
 from pointnav_core.rewards import CollisionReward, PointGoalReward, PotentialReward, RewardFunction
 from pointnav_core.terminations import (
     Falling,
@@ -266,6 +267,28 @@ def _merge_config(
     return MappingProxyType(merged)
 
 
+def _compose(kind: str, base: type, defaults: Sequence[Any], extra: Any) -> dict[str, Any]:
+    """Defaults plus ``extra`` terms by name: a term named like a default replaces it in
+    place, any other is appended. ``kind`` names the argument in errors."""
+    terms = {t.name: t for t in defaults}
+    if extra is None:
+        return terms
+    if isinstance(extra, (str, bytes, Mapping)) or not isinstance(extra, Sequence):
+        raise ValueError(f"{kind} must be None or a sequence of {base.__name__} objects, got {extra!r}")
+    seen: set[str] = set()
+    for term in extra:
+        if not isinstance(term, base):
+            raise ValueError(f"{kind} must hold {base.__name__} objects, got {term!r}")
+        name = term.name
+        if not isinstance(name, str) or not name:
+            raise ValueError(f"{kind}: {term!r} must have a non-empty str name, got {name!r}")
+        if name in seen:
+            raise ValueError(f"{kind} has two terms named {name!r}")
+        seen.add(name)
+        terms[name] = term
+    return terms
+
+
 # ------------------------------------------------------------------------------ the task
 
 
@@ -317,6 +340,12 @@ class PointNavigationTask:
         Overrides of :attr:`default_termination_config`.
     reward_config : dict, optional
         Overrides of :attr:`default_reward_config`.
+    termination_conditions, reward_functions, observation_terms : sequence, optional
+        Extra :class:`~pointnav_core.terminations.TerminationCondition`,
+        :class:`~pointnav_core.rewards.RewardFunction` and
+        :class:`~pointnav_core.observations.ObservationTerm` objects. One named like a
+        built-in term replaces it in place; any other is added after the built-in ones
+        (evaluated, summed and observed in that order).
 
     Raises
     ------
@@ -386,6 +415,9 @@ class PointNavigationTask:
         reward_type: str = "l2",
         termination_config: Mapping[str, Any] | None = None,
         reward_config: Mapping[str, Any] | None = None,
+        termination_conditions: Sequence[TerminationCondition] | None = None,
+        reward_functions: Sequence[RewardFunction] | None = None,
+        observation_terms: Sequence[ObservationTerm] | None = None,
     ) -> None:
         self._robot_idn = _check_index("robot_idn", robot_idn)
         self._floor = _check_index("floor", floor)
@@ -424,6 +456,14 @@ class PointNavigationTask:
             rewards = dict(self._create_reward_functions())
         except ValueError as err:
             raise ValueError(f"reward_config: {err}") from None
+        terminations = _compose("termination_conditions", TerminationCondition, list(terminations.values()), termination_conditions)
+        rewards = _compose("reward_functions", RewardFunction, list(rewards.values()), reward_functions)
+        observations = _compose(
+            "observation_terms", ObservationTerm, default_observation_terms(self._goal_in_polar), observation_terms
+        )
+        self._observations: Mapping[str, ObservationTerm] = MappingProxyType(observations)
+        self._obs_layout: ObservationLayout | None = None
+        self._frame = Frame()
         self._terminations: Mapping[str, TerminationCondition] = MappingProxyType(terminations)
         self._rewards: Mapping[str, RewardFunction] = MappingProxyType(rewards)
         # The same, as tuples of (name, object) pairs for the per-step loops (both
@@ -441,8 +481,6 @@ class PointNavigationTask:
         self._pose_floats: Any = None
         self._velocity_floats: Any = None
         self._floor_height = 0.0
-        self._obs_low: tuple[float, ...] = ()
-        self._obs_high: tuple[float, ...] = ()
         # The episode (valid from the first successful reset).
         self._start_xy: tuple[float, float] | None = None
         self._start_quat: tuple[float, float, float, float] | None = None
@@ -736,19 +774,9 @@ class PointNavigationTask:
         self._spec = spec
         self._floor_height = float(scene.get_floor_height(self._floor))
         self._waypoint_spacing = float(scene.waypoint_spacing)
-        # Observation bounds (finite, so that Gymnasium's checker accepts the spaces): the
-        # goal is on the floor, so within its diagonal (+1 m for a robot falling off an
-        # edge); velocities within the robot's limits (sqrt(2) for a holonomic diagonal).
-        xmin, xmax, ymin, ymax = scene.floors[self._floor].extent
-        reach = math.hypot(xmax - xmin, ymax - ymin) + 1.0
-        v = math.sqrt(2.0) * spec.max_linear_velocity
-        w = spec.max_angular_velocity
-        if self._goal_in_polar:
-            goal_low, goal_high = (0.0, -math.pi), (reach, math.pi)
-        else:
-            goal_low, goal_high = (-reach, -reach), (reach, reach)
-        self._obs_low = (*goal_low, -v, -v, -v, -w, -w, -w)
-        self._obs_high = (*goal_high, v, v, v, w, w, w)
+        # Observation bounds are finite, so that Gymnasium's checker accepts the spaces.
+        self._obs_layout = ObservationLayout.from_terms(tuple(self._observations.values()), self, env)
+        self._frame.task, self._frame.env = self, env
         self._env = env
 
     def reset(self, env: TaskEnv) -> dict[str, Any]:
@@ -796,6 +824,8 @@ class PointNavigationTask:
                 condition.reset(self, env)
             for reward in self._rewards.values():
                 reward.reset(self, env)
+            for term in self._observations.values():
+                term.reset(self, env)
             if self._visualize_goal or self._visualize_path:
                 self._place_markers(x, y)
         except BaseException:
@@ -1078,94 +1108,76 @@ class PointNavigationTask:
             )
 
     def _obs_values(self, env: TaskEnv) -> list[float]:
-        """Goal (2), linear velocity (3), angular velocity (3), all in the robot frame."""
+        """Every observation term's values at this step, in order, clipped to the bounds."""
         backend = env.backend
         if backend is not self._backend:
             self._bind(backend)
+        frame = self._frame
         if self._velocity_floats is not None:
             vx, vy, vz, wx, wy, wz = self._velocity_floats(self._robot_idn)
+            frame.lin_vel, frame.ang_vel = (vx, vy, vz), (wx, wy, wz)
         else:
             lin, ang = backend.get_velocity(self._robot_idn)
-            vx, vy, vz = lin.tolist()
-            wx, wy, wz = ang.tolist()
+            frame.lin_vel, frame.ang_vel = tuple(lin.tolist()), tuple(ang.tolist())
         # The pose recorded at the last reset or step: the one the metrics saw.
-        x, y, _ = self._robot_xyz
-        qx, qy, qz, qw = self._robot_quat
-        # Rotation matrix R (robot -> world) of the normalised quaternion; R^T maps world
-        # vectors into the robot frame. Plain floats: this runs on every step.
-        s = 2.0 / (qx * qx + qy * qy + qz * qz + qw * qw)
-        r00 = 1.0 - s * (qy * qy + qz * qz)
-        r01 = s * (qx * qy - qz * qw)
-        r02 = s * (qx * qz + qy * qw)
-        r10 = s * (qx * qy + qz * qw)
-        r11 = 1.0 - s * (qx * qx + qz * qz)
-        r12 = s * (qy * qz - qx * qw)
-        r20 = s * (qx * qz - qy * qw)
-        r21 = s * (qy * qz + qx * qw)
-        r22 = 1.0 - s * (qx * qx + qy * qy)
-        # The goal in the heading frame: rotate by -yaw, yaw = atan2(R10, R00).
-        gx, gy = self._goal_xy  # type: ignore[misc]
-        dx, dy = gx - x, gy - y
-        h = math.hypot(r00, r10)
-        if h > 1e-12:
-            c, sn = r00 / h, r10 / h
-        else:  # +x points straight up or down: take the heading from the +y axis
-            yaw = math.atan2(-r01, r11)
-            c, sn = math.cos(yaw), math.sin(yaw)
-        lx, ly = c * dx + sn * dy, c * dy - sn * dx
-        if self._goal_in_polar:
-            rho = math.hypot(lx, ly)
-            phi = math.atan2(ly, lx) if rho > 0.0 else 0.0
-            lx, ly = rho, (math.pi if phi == -math.pi else phi)
-        values = (
-            lx,
-            ly,
-            r00 * vx + r10 * vy + r20 * vz,
-            r01 * vx + r11 * vy + r21 * vz,
-            r02 * vx + r12 * vy + r22 * vz,
-            r00 * wx + r10 * wy + r20 * wz,
-            r01 * wx + r11 * wy + r21 * wz,
-            r02 * wx + r12 * wy + r22 * wz,
-        )
-        # Keep inside the observation space (e.g. the vertical speed of a fall).
-        return [
-            lo if value < lo else hi if value > hi else value
-            for value, lo, hi in zip(values, self._obs_low, self._obs_high)
-        ]
+        x, y, z = self._robot_xyz
+        frame.set_pose(x, y, z, self._robot_quat)
+        frame.goal_x, frame.goal_y = self._goal_xy  # type: ignore[misc]
+        frame.env = env
+        return self._obs_layout.values(frame)  # type: ignore[union-attr]
 
     @property
-    def observation_bounds(self) -> tuple[NDArray[np.float32], NDArray[np.float32]]:
-        """``(low, high)`` of the 8 low-dimensional observation values, float32 arrays.
+    def observation_terms(self) -> Mapping[str, ObservationTerm]:
+        """Name -> observation term, in observation order (read-only mapping)."""
+        return self._observations
 
-        In the order of :meth:`get_low_dim_obs`. The goal lies within the floor's diagonal
-        plus 1 m (``rho`` in ``[0, that]`` and ``phi`` in ``[-pi, pi]`` when polar); linear
-        velocities within ``sqrt(2) * max_linear_velocity`` and angular ones within
-        ``max_angular_velocity``. Observations are clipped to these bounds (a falling
-        robot's vertical speed can exceed them).
+    @property
+    def observation_layout(self) -> ObservationLayout:
+        """Slices and bounds of the terms in the flat observation (after :meth:`load`).
 
         Raises
         ------
         TaskStateError
             Before the task has met an environment (:meth:`load`).
         """
-        if self._env is None:
+        if self._obs_layout is None:
+            raise TaskStateError("observation_layout needs an environment: call load(env) first")
+        return self._obs_layout
+
+    @property
+    def observation_bounds(self) -> tuple[NDArray[np.float32], NDArray[np.float32]]:
+        """``(low, high)`` of every observation value in flat order, float32 arrays.
+
+        With the built-in terms (see :mod:`~pointnav_core.observations`): the goal lies
+        within the floor's diagonal plus 1 m (``rho`` in ``[0, that]`` and ``phi`` in
+        ``[-pi, pi]`` when polar); linear velocities within ``sqrt(2) * max_linear_velocity``
+        and angular ones within ``max_angular_velocity``. Observations are clipped to these
+        bounds (a falling robot's vertical speed can exceed them).
+
+        Raises
+        ------
+        TaskStateError
+            Before the task has met an environment (:meth:`load`).
+        """
+        if self._obs_layout is None:
             raise TaskStateError("observation_bounds needs an environment: call load(env) first")
         return (
-            np.array(self._obs_low, dtype=np.float32),
-            np.array(self._obs_high, dtype=np.float32),
+            np.array(self._obs_layout.low, dtype=np.float32),
+            np.array(self._obs_layout.high, dtype=np.float32),
         )
 
     def get_obs(self, env: TaskEnv) -> dict[str, NDArray[np.float32]]:
-        """Return the task's low-dimensional observation, fresh float32 arrays.
+        """Return the task's observation: one fresh float32 array per term, by name.
 
         Returns
         -------
         dict
-            ``xy_pos_to_goal`` (2,): the goal minus the robot's position in the robot's
-            heading frame (+x ahead, +y left), in metres; or ``(rho, phi)`` (m, rad in
-            (-pi, pi]) when ``goal_in_polar``. ``robot_lin_vel`` (3,) m/s and
-            ``robot_ang_vel`` (3,) rad/s: world velocities rotated into the robot frame.
-            Values are clipped to :attr:`observation_bounds`.
+            With the built-in terms: ``xy_pos_to_goal`` (2,): the goal minus the robot's
+            position in the robot's heading frame (+x ahead, +y left), in metres; or
+            ``(rho, phi)`` (m, rad in (-pi, pi]) when ``goal_in_polar``. ``robot_lin_vel``
+            (3,) m/s and ``robot_ang_vel`` (3,) rad/s: world velocities rotated into the
+            robot frame. Then any added terms. Values are clipped to
+            :attr:`observation_bounds`.
 
         Notes
         -----
@@ -1179,18 +1191,14 @@ class PointNavigationTask:
             Before the first reset (there is no goal yet).
         """
         self._require_episode("get_obs()")
-        # One fresh buffer per call, split three ways (cheaper than three arrays).
+        # One fresh buffer per call, split by term (cheaper than one array per term).
         flat = np.array(self._obs_values(env), dtype=np.float32)
-        return {
-            "xy_pos_to_goal": flat[0:2],
-            "robot_lin_vel": flat[2:5],
-            "robot_ang_vel": flat[5:8],
-        }
+        return self._obs_layout.split(flat)  # type: ignore[union-attr]
 
     def get_low_dim_obs(self, env: TaskEnv) -> NDArray[np.float32]:
-        """Return OmniGibson's flat ``low_dim`` observation: :meth:`get_obs`'s three arrays
-        concatenated in the order ``xy_pos_to_goal``, ``robot_lin_vel``, ``robot_ang_vel``
-        (8 float32 values, fresh array)."""
+        """Return OmniGibson's flat ``low_dim`` observation: :meth:`get_obs`'s arrays
+        concatenated in term order (with the built-in terms ``xy_pos_to_goal``,
+        ``robot_lin_vel``, ``robot_ang_vel``: 8 float32 values), a fresh array."""
         self._require_episode("get_low_dim_obs()")
         return np.array(self._obs_values(env), dtype=np.float32)
 

@@ -113,6 +113,10 @@ class TerminationCondition:
     is_truncation : bool
         Whether ending the episode here is a *truncation* (a time limit, not a terminal
         state of the task): it sets Gymnasium's ``truncated`` instead of ``terminated``.
+    removes_robot : bool
+        Whether the robot leaves the world when this condition ends its episode (it fell):
+        a multi-robot env then takes it out of the backend even when finished robots
+        otherwise stay as obstacles.
     done, success : bool
         This condition's result at the last step (False after :meth:`reset`).
     """
@@ -120,6 +124,7 @@ class TerminationCondition:
     name: ClassVar[str] = "termination"
     is_success: ClassVar[bool] = False
     is_truncation: ClassVar[bool] = False
+    removes_robot: ClassVar[bool] = False
 
     def __init__(self) -> None:
         self.done = False
@@ -245,6 +250,7 @@ class Falling(TerminationCondition):
     """
 
     name = "falling"
+    removes_robot = True
 
     def __init__(self, fall_height: float = 0.03) -> None:
         super().__init__()
