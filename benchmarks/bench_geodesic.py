@@ -44,10 +44,18 @@ running after ``--limit`` seconds (default 600) is killed and shown as ``> limit
   ``Scene.from_movingai`` at 0.5 m, start and goal near opposite corners of the largest
   free region; skipped with a note when the files are absent (they are optional).
 
+Breakdown (``--breakdown``, alone): where the tangent planner's time goes on smaller
+versions of cases A and B (``--sizes``, default 500 and 1000 cells a side), in one
+process: the 8-connected scipy Dijkstra as above (graph and search, from the goal cell),
+then the planner's nodes, every tangent edge (``build_all_edges``), the arc-split graph,
+the goal field's ``csgraph.dijkstra`` over it and one exact query; each as a multiple of
+the grid Dijkstra.
+
 Run::
 
     python benchmarks/bench_geodesic.py [--pairs 30] [--accuracy]
     python benchmarks/bench_geodesic.py --scale [--cases A B movingai] [--limit 600]
+    python benchmarks/bench_geodesic.py --breakdown [--sizes 500 1000]
 
 (needs the ``bench`` extra: ``pip install -e ".[bench]"``).
 """
@@ -411,6 +419,43 @@ def job_tangent(case: dict[str, Any], lap: Any) -> float:
 JOBS = (("scipy Dijkstra", job_dijkstra), ("pyastar2d", job_astar), ("tangent", job_tangent))
 
 
+# --------------------------------------------------------------------------- breakdown
+def breakdown(sizes: list[int]) -> None:
+    """Time each stage of a goal field on cases A and B beside one grid Dijkstra."""
+    from scipy.sparse import csgraph
+
+    from pointnav_core.tangent_graph import Planner
+
+    print(f"machine: {machine()}")
+    print(f"radius {RADIUS} m; times in s, and as multiples of the grid Dijkstra (x)")
+    print(f"{'case':28} {'grid':>7} {'nodes':>14} {'edges':>14} {'arc graph':>14} {'field':>13} {'query':>7} {'all':>8}")
+    for size in sizes:
+        for case in (clutter_case(size), maze_case(size)):
+            h, w = case.blocked.shape
+            gr = int((case.goal[1] - case.origin[1]) // case.resolution)
+            gc = int((case.goal[0] - case.origin[0]) // case.resolution)
+            t0 = time.perf_counter()
+            csgraph.dijkstra(grid_graph(~case.blocked), directed=True, indices=gr * w + gc)
+            grid = time.perf_counter() - t0
+            laps = [time.perf_counter()]
+            planner = Planner(FloorCollision(case.blocked, case.resolution, case.origin), RADIUS)
+            laps.append(time.perf_counter())
+            planner.build_all_edges()
+            laps.append(time.perf_counter())
+            graph = planner.arc_graph()
+            laps.append(time.perf_counter())
+            field = planner.goal_field(case.goal)
+            laps.append(time.perf_counter())
+            field.point_distance(case.start)
+            laps.append(time.perf_counter())
+            cells = [f"{b - a:6.2f} {(b - a) / grid:5.0f}x" for a, b in zip(laps, laps[1:])]
+            cells[3] = f"{laps[4] - laps[3]:5.3f} {(laps[4] - laps[3]) / grid:5.1f}x"
+            cells[4] = f"{laps[5] - laps[4]:7.3f}"
+            print(f"{case.name:28} {grid:7.3f} {cells[0]:>14} {cells[1]:>14} {cells[2]:>14} {cells[3]:>13} "
+                  f"{cells[4]:>7} {(laps[-1] - laps[0]) / grid:7.0f}x   ({planner.n_nodes:,} nodes, "
+                  f"{graph.n_vertices:,} arc vertices)", flush=True)
+
+
 # --------------------------------------------------------------------------- scale: driver
 def _fmt_time(m: Measurement, key: str, limit: float) -> str:
     if key in m.laps:
@@ -476,6 +521,8 @@ def main():
     parser.add_argument("--plans", type=int, default=3)
     parser.add_argument("--acc-pairs", type=int, default=70)
     parser.add_argument("--scale", action="store_true", help="run the scale benchmark only")
+    parser.add_argument("--breakdown", action="store_true", help="time the planner's stages only")
+    parser.add_argument("--sizes", nargs="+", type=int, default=[500, 1000], help="cells a side (--breakdown)")
     parser.add_argument("--cases", nargs="+", choices=("A", "B", "movingai"), default=["A", "B", "movingai"])
     parser.add_argument("--limit", type=float, default=600.0, help="seconds per scale job (default 600)")
     parser.add_argument("--movingai", type=Path, default=MOVINGAI_DIR, help="folder of the MovingAI maps")
@@ -484,6 +531,9 @@ def main():
         parser.error(f"--limit must be > 0 seconds, got {args.limit}")
     if args.scale:
         scale(args.cases, args.limit, args.movingai)
+        return
+    if args.breakdown:
+        breakdown(args.sizes)
         return
     speed(args)
     if args.accuracy:
