@@ -9,14 +9,10 @@ never moves anything itself: the environment steps the backend, then calls
 
 Lifecycle
 ---------
-The task is a small state machine (h11 style). Its states are :class:`TaskState`; the legal
-moves are the table ``_TRANSITIONS`` below, and the diagram is drawn from that table::
-
-    IDLE --reset--> RUNNING --step--> RUNNING --step (a condition fires)--> DONE
-      any state --reset--> RUNNING        any state --reset or step raises--> ERROR
-
-``step`` is legal only while RUNNING. Calling it in any other state raises
-:class:`TaskStateError` and changes nothing. ``reset`` is legal in every state.
+The task is a small state machine (h11 style, :mod:`~pointnav_core.lifecycle`): its states
+are :class:`TaskState` and its legal moves the table ``lifecycle.TRANSITIONS``, drawn in
+``docs/lifecycle.md``. ``step`` is legal only while RUNNING. Calling it in any other state
+raises :class:`TaskStateError` and changes nothing. ``reset`` is legal in every state.
 
 The environment
 ---------------
@@ -27,7 +23,6 @@ multi-robot env). The task reads only the four members of :class:`TaskEnv`.
 
 from __future__ import annotations
 
-import enum
 import math
 from collections.abc import Mapping, Sequence
 from types import MappingProxyType
@@ -36,7 +31,17 @@ from typing import TYPE_CHECKING, Any, ClassVar, Protocol
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from pointnav_core.errors import PointNavError, SamplingError
+from pointnav_core.errors import SamplingError
+from pointnav_core.lifecycle import (
+    ERROR,
+    IDLE,
+    ILLEGAL_HINT,
+    TaskState,
+    TaskStateError,
+    allows,
+    move,
+)
+from pointnav_core.lifecycle import Event as _Event
 from pointnav_core.markers import VisualMarker, _waypoints_along
 from pointnav_core.metrics import _soft_spl, _spl
 from pointnav_core.observations import Frame, ObservationLayout, ObservationTerm, default_observation_terms
@@ -69,64 +74,6 @@ REWARD_TYPES = ("l2", "geodesic")
 _TWO_PI = 2.0 * math.pi
 # How far from 1 the norm of a fixed initial_quat may be (it is then normalised).
 _QUAT_NORM_TOL = 1e-3
-
-
-class TaskStateError(PointNavError, RuntimeError):
-    """A task method was called in a state that does not allow it (e.g. step before reset).
-
-    The task's state is unchanged when this is raised.
-    """
-
-
-class TaskState(enum.Enum):
-    """States of a task's episode lifecycle."""
-
-    #: Built, no episode yet: call ``reset(env)``.
-    IDLE = "idle"
-    #: An episode is in progress: ``step`` is legal.
-    RUNNING = "running"
-    #: The episode ended (terminated or truncated): call ``reset(env)`` to start another.
-    DONE = "done"
-    #: A reset or a step raised half-way; no valid episode: call ``reset(env)``.
-    ERROR = "error"
-
-    # Members are singletons compared by identity: hash them so too (Enum's default hash
-    # is a Python-level function, and the transition table is consulted on every step).
-    __hash__ = object.__hash__
-
-
-class _Event(enum.Enum):
-    RESET = "reset"  # a reset succeeded
-    STEP = "step"  # a step ended with no condition done
-    END = "end"  # a step ended with some condition done
-    FAIL = "fail"  # a reset or a step raised
-
-    __hash__ = object.__hash__
-
-
-IDLE, RUNNING, DONE, ERROR = TaskState.IDLE, TaskState.RUNNING, TaskState.DONE, TaskState.ERROR
-
-# The lifecycle, (state, event) -> next state. Rules: a reset may start an episode from any
-# state, and a reset or step that raises leaves the task in ERROR from any state; a step
-# happens only in RUNNING and stays there, or moves to DONE when a termination condition
-# fires. A pair missing from the table is an illegal move: it raises TaskStateError and
-# leaves the state unchanged.
-_TRANSITIONS: Mapping[tuple[TaskState, _Event], TaskState] = MappingProxyType(
-    {
-        **{(state, _Event.RESET): RUNNING for state in TaskState},
-        **{(state, _Event.FAIL): ERROR for state in TaskState},
-        (RUNNING, _Event.STEP): RUNNING,
-        (RUNNING, _Event.END): DONE,
-    }
-)
-
-_ILLEGAL_HINT: Mapping[TaskState, str] = MappingProxyType(
-    {
-        IDLE: "no episode has started: call reset(env) first",
-        DONE: "the episode has ended (terminated or truncated): call reset(env) to start another",
-        ERROR: "the last reset or step failed, so there is no valid episode: call reset(env)",
-    }
-)
 
 
 class TaskEnv(Protocol):
@@ -723,7 +670,7 @@ class PointNavigationTask:
 
     # ------------------------------------------------------------------ lifecycle
     def _move(self, event: _Event) -> None:
-        self._state = _TRANSITIONS[(self._state, event)]
+        self._state = move(self._state, event)
 
     def check_step(self) -> None:
         """Raise :class:`TaskStateError` unless :meth:`step` is legal now (nothing changes).
@@ -731,11 +678,8 @@ class PointNavigationTask:
         Environments call this before stepping the backend, so that an illegal step moves
         nothing in the world either.
         """
-        if (self._state, _Event.STEP) not in _TRANSITIONS:
-            raise TaskStateError(
-                f"step() is not allowed while the task is {self._state.name}: "
-                f"{_ILLEGAL_HINT[self._state]}"
-            )
+        if not allows(self._state, _Event.STEP):
+            move(self._state, _Event.STEP)  # raises, naming the state and what to do
 
     def load(self, env: TaskEnv) -> None:
         """Meet an environment: check this task fits it, and cache what steps need.
@@ -971,7 +915,7 @@ class PointNavigationTask:
             If no episode is running (before reset, or after the episode ended); the task
             is then unchanged.
         """
-        if (self._state, _Event.STEP) not in _TRANSITIONS:
+        if not allows(self._state, _Event.STEP):
             self.check_step()
         try:
             backend = env.backend
@@ -1027,7 +971,7 @@ class PointNavigationTask:
         except BaseException:
             self._move(_Event.FAIL)
             raise
-        self._state = _TRANSITIONS[(self._state, _Event.END if done else _Event.STEP)]
+        self._state = move(self._state, _Event.END if done else _Event.STEP)
         return reward, terminated, truncated, info
 
     def _bind(self, backend: Any) -> None:
@@ -1104,7 +1048,7 @@ class PointNavigationTask:
         if self._state is IDLE or self._state is ERROR:
             raise TaskStateError(
                 f"{what} needs an episode, but the task is {self._state.name}: "
-                f"{_ILLEGAL_HINT[self._state]}"
+                f"{ILLEGAL_HINT[self._state]}"
             )
 
     def _obs_values(self, env: TaskEnv) -> list[float]:
