@@ -169,7 +169,6 @@ from pettingzoo.utils.conversions import parallel_to_aec, parallel_to_aec_wrappe
 
 from pointnav_core import _envcommon, scenes
 from pointnav_core.backend import Backend, RobotSpec, make_backend
-from pointnav_core.errors import SamplingError
 from pointnav_core.task import PointNavigationTask, TaskStateError
 
 __all__ = [
@@ -495,11 +494,10 @@ class MultiPointNavEnv(ParallelEnv[str, Any, np.ndarray]):
         return observations, {agent: infos[i] for i, agent in enumerate(self.agents)}
 
     def _reset_robot(self, i: int, placed: list[int]) -> dict[str, Any]:
-        """Reset task ``i`` until its goal is distinct from the goals decided so far."""
+        """Reset task ``i`` with its goal kept apart from the goals decided so far."""
         task, tasks = self.tasks[i], self.tasks
-        if task.goal_pos is not None:  # fixed goals were checked against each other
-            return task.reset(self)
-        # Goals to keep clear of: those placed, and the fixed goals of robots still to come.
+        # Goals to keep clear of: those placed, and the fixed goals of robots still to come
+        # (fixed goals were checked against each other at construction).
         others = [
             j
             for j in range(len(tasks))
@@ -508,24 +506,20 @@ class MultiPointNavEnv(ParallelEnv[str, Any, np.ndarray]):
             and (j in placed or tasks[j].goal_pos is not None)
         ]
         separation = self._separation[i]
-        clash = -1
-        for _ in range(PointNavigationTask.max_trials):
-            info = task.reset(self)
-            gx, gy = task.goal_xy  # type: ignore[misc]
+
+        def apart(gx: float, gy: float) -> str | None:
             for j in others:
                 ox, oy = tasks[j].goal_xy  # type: ignore[misc]
                 if math.hypot(gx - ox, gy - oy) < separation[j]:
-                    clash = j
-                    break
-            else:
-                return info
-        raise SamplingError(
-            f"could not sample a goal for robot {i} distinct from the other robots' goals in "
-            f"{PointNavigationTask.max_trials} trials: goals must be at least max(sum of goal "
-            f"tolerances, sum of radii, one cell) apart (last clash: robot {clash}, "
-            f"{separation[clash]:.3g} m); use fewer robots, smaller goal_tolerance or a "
-            f"larger scene"
-        )
+                    return (
+                        f"the goal must be distinct from the other robots' goals, at least max(sum "
+                        f"of goal tolerances, sum of radii, one cell) apart ({separation[j]:.3g} m "
+                        f"from robot {j}'s); use fewer robots, a smaller goal_tolerance or a "
+                        f"larger scene"
+                    )
+            return None
+
+        return task.reset(self, goal_constraint=apart if others else None)
 
     def step(
         self, actions: Mapping[str, Any]

@@ -31,7 +31,6 @@ from typing import TYPE_CHECKING, Any, ClassVar, Protocol
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from pointnav_core.errors import SamplingError
 from pointnav_core.lifecycle import (
     ERROR,
     IDLE,
@@ -45,6 +44,7 @@ from pointnav_core.lifecycle import Event as _Event
 from pointnav_core.markers import VisualMarker, _waypoints_along
 from pointnav_core.metrics import _soft_spl, _spl
 from pointnav_core.observations import Frame, ObservationLayout, ObservationTerm, default_observation_terms
+from pointnav_core.sampling import GoalConstraint, sample_episode
 from pointnav_core.rewards import CollisionReward, PointGoalReward, PotentialReward, RewardFunction
 from pointnav_core.terminations import (
     Falling,
@@ -71,7 +71,6 @@ __all__ = [
 #: Valid values of ``reward_type``: the distance the potential reward is measured in.
 REWARD_TYPES = ("l2", "geodesic")
 
-_TWO_PI = 2.0 * math.pi
 # How far from 1 the norm of a fixed initial_quat may be (it is then normalised).
 _QUAT_NORM_TOL = 1e-3
 
@@ -723,7 +722,7 @@ class PointNavigationTask:
         self._frame.task, self._frame.env = self, env
         self._env = env
 
-    def reset(self, env: TaskEnv) -> dict[str, Any]:
+    def reset(self, env: TaskEnv, goal_constraint: GoalConstraint | None = None) -> dict[str, Any]:
         """Start a new episode: sample (or take) a start and a goal, land the robot.
 
         Parameters
@@ -731,6 +730,11 @@ class PointNavigationTask:
         env : TaskEnv
             The environment (its backend already reset). Randomness comes from
             ``env.np_random`` only, so a seeded env gives the same episode.
+        goal_constraint : callable, optional
+            ``goal_constraint(gx, gy)`` returns None to accept a sampled goal, else the
+            constraint it breaks (named in a :class:`SamplingError`); a multi-robot env
+            keeps goals apart with it. Not applied to a fixed ``goal_pos``. See
+            :mod:`~pointnav_core.sampling`.
 
         Returns
         -------
@@ -751,7 +755,7 @@ class PointNavigationTask:
             if env is not self._env:
                 self.load(env)
             self._bind(env.backend)  # every episode: a backend patched since is seen
-            self._sample_episode(env)
+            self._sample_episode(env, goal_constraint)
             pos, quat = env.backend.get_pose(self._robot_idn)
             x, y, z = pos.tolist()
             self._robot_xyz = (x, y, z)
@@ -783,88 +787,31 @@ class PointNavigationTask:
             {name: {"done": False, "success": False} for name in self._terminations},
         )
 
-    def _sample_episode(self, env: TaskEnv) -> None:
-        scene, backend, rng = env.scene, env.backend, env.np_random
-        spec, idn, floor, h = self._spec, self._robot_idn, self._floor, self._floor_height
-        fixed_start, fixed_goal = self._initial_pos, self._goal_pos
-        both_fixed = fixed_start is not None and fixed_goal is not None
-        path_range = None if both_fixed else self._path_range
-        goal_field = None if fixed_goal is None else scene.goal_field(floor, fixed_goal, robot=spec)
-        failures: dict[str, int] = {}
-
-        def fail(constraint: str) -> None:
-            failures[constraint] = failures.get(constraint, 0) + 1
-
-        for _ in range(1 if both_fixed else self.max_trials):
-            # 1. The start, in the fixed goal's component when there is one.
-            if fixed_start is not None:
-                sx, sy = fixed_start
-            else:
-                _, point = scene.get_random_point(
-                    floor=floor, reference_point=fixed_goal, robot=spec, rng=rng
-                )
-                sx, sy = float(point[0]), float(point[1])
-            if self._initial_quat is not None:
-                quat = self._initial_quat
-            else:
-                half = 0.5 * float(rng.uniform(0.0, _TWO_PI))
-                quat = (0.0, 0.0, math.sin(half), math.cos(half))
-            # Land first: validity is checked on the robot's floor, and other robots that
-            # are already placed (multi-robot resets place robots one by one) count.
-            backend.land(idn, floor, (sx, sy, h), quat)
-            if not backend.is_valid_pose(idn, (sx, sy, h), quat):
-                if fixed_start is not None:
-                    raise ValueError(
-                        f"initial_pos {[sx, sy]} is not a valid pose for robot {idn}: its disc "
-                        f"overlaps an obstacle or another robot"
-                    )
-                fail("the start must be a valid pose (clear of obstacles and other robots)")
-                continue
-            # 2. The goal, in the start's component.
-            if fixed_goal is not None:
-                gx, gy = fixed_goal
-            else:
-                _, point = scene.get_random_point(
-                    floor=floor, reference_point=(sx, sy), robot=spec, rng=rng
-                )
-                gx, gy = float(point[0]), float(point[1])
-                if not backend.is_valid_pose(idn, (gx, gy, h), quat):
-                    fail("the goal must be a valid pose (clear of obstacles and other robots)")
-                    continue
-            # A sampled start or goal never lands within success distance of the other,
-            # or the episode would be won before it starts.
-            if not both_fixed and math.hypot(gx - sx, gy - sy) < self._goal_tolerance:
-                fail(
-                    f"the goal must be at least goal_tolerance ({self._goal_tolerance} m) "
-                    f"from the start"
-                )
-                continue
-            # 3. The exact geodesic. A new goal costs only its corner solve here; the
-            # per-cell table is built on the episode's first lookup, for the goal kept.
-            field = goal_field if goal_field is not None else scene.goal_field(floor, (gx, gy), robot=spec)
-            geodesic = field.exact_distance((sx, sy))
-            constraint = f"the geodesic must lie in path_range {self._path_range} m"
-            if path_range is not None and not path_range[0] < geodesic < path_range[1]:
-                fail(constraint)
-                continue
-            break
-        else:  # a fixed pair never gets here: it either breaks or raises
-            worst = max(failures, key=failures.__getitem__)
-            detail = "; ".join(f"{c}: failed {n} time(s)" for c, n in failures.items())
-            raise SamplingError(
-                f"could not sample an episode for robot {idn} on floor {floor} in "
-                f"{self.max_trials} trials: {worst} ({detail})"
-            )
-        self._start_xy = (sx, sy)
-        self._start_quat = quat
-        self._goal_xy = (gx, gy)
-        self._goal_field = field
-        self._field_distance = field.distance
-        self._geodesic_dist = geodesic
+    def _sample_episode(self, env: TaskEnv, goal_constraint: GoalConstraint | None) -> None:
+        episode = sample_episode(
+            env,
+            robot_idn=self._robot_idn,
+            floor=self._floor,
+            spec=self._spec,
+            floor_height=self._floor_height,
+            initial_pos=self._initial_pos,
+            initial_quat=self._initial_quat,
+            goal_pos=self._goal_pos,
+            goal_tolerance=self._goal_tolerance,
+            path_range=self._path_range,
+            max_trials=self.max_trials,
+            goal_constraint=goal_constraint,
+        )
+        # The robot stands at the start: it was landed there in the accepted trial.
+        self._start_xy = episode.start_xy
+        self._start_quat = episode.start_quat
+        self._goal_xy = episode.goal_xy
+        self._goal_field = episode.field
+        self._field_distance = episode.field.distance
+        self._geodesic_dist = geodesic = episode.geodesic
         # Decided once per episode, so the potential never jumps between metrics.
         geodesic_metric = self._reward_type == "geodesic" and geodesic < math.inf
         self._metric = "geodesic" if geodesic_metric else "l2"
-        # The robot stands at the start: it was landed there in the accepted trial.
 
     # ------------------------------------------------------------------ per step
     def _geodesic_at(self, x: float, y: float) -> float:
