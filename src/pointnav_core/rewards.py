@@ -19,10 +19,12 @@ telescope: they sum to ``r_potential * (potential at reset - potential at the en
 What a reward function may read
 -------------------------------
 The task's per-step snapshot, refreshed before any reward runs: ``task.robot_idn``,
-``task.potential`` (float, m: the potential this step), ``task.in_contact``
-(``env.backend.in_contact(task.robot_idn)`` for this step) and
-``task.termination_results`` (name -> ``(done, success)`` of this step's termination
-conditions); and ``env.backend``. Subclass :class:`RewardFunction` to write your own.
+``task.potential`` (float, m: the potential this step), ``task.distance_to_goal`` (m,
+geodesic), ``task.robot_xyz``, ``task.goal_xy``, ``task.in_contact``
+(``env.backend.in_contact(task.robot_idn)`` for this step), ``task.episode_length``,
+``task.collisions`` and ``task.termination_results`` (name -> ``(done, success)`` of this
+step's termination conditions); and ``env.backend``. Subclass :class:`RewardFunction` to
+write your own and pass it as ``reward_functions`` (``docs/extending.md``).
 
 Examples
 --------

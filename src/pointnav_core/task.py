@@ -633,6 +633,12 @@ class PointNavigationTask:
         return self._potential
 
     @property
+    def distance_to_goal(self) -> float:
+        """Geodesic distance (m) from the robot to the goal at the last reset or step
+        (``inf`` where none is defined, e.g. over void); ``info["distance_to_goal"]``."""
+        return self._distance_to_goal
+
+    @property
     def potential_metric(self) -> str:
         """``"l2"`` or ``"geodesic"``: the potential's metric this episode (fixed at reset)."""
         return self._metric
