@@ -559,7 +559,9 @@ def test_render_before_reset_shows_the_floor_only():
 def test_render_returns_a_fresh_frame_each_call_from_a_cached_renderer(monkeypatch):
     env = make_env(visualize_goal=True)
     env.reset(seed=0)
+    attributes = dict(vars(env))
     first = env.render()
+    assert vars(env) == attributes  # the env owns its renderers; drawing sets nothing on it
     reference = first.copy()
     first[:] = 0
     built = []
@@ -568,7 +570,10 @@ def test_render_returns_a_fresh_frame_each_call_from_a_cached_renderer(monkeypat
     np.testing.assert_array_equal(env.render(), reference)
     assert built == []  # the floor picture was prepared once, at the first frame
     render_env(env, pixels_per_meter=10)
-    assert built == [1]  # another scale: another renderer
+    assert built == [1]  # no renderers given: the floor is drawn anew
+    env.scene = Scene.from_array(np.zeros((30, 40), np.uint8), 0.5)
+    env.render()
+    assert built == [1, 1]  # a new floor: a new renderer, not the old floor's picture
 
 
 def test_default_scale_and_the_pixels_per_meter_options():

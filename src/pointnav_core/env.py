@@ -11,6 +11,7 @@ from numpy.typing import NDArray
 
 from pointnav_core import _envcommon, scenes
 from pointnav_core.backend import Backend, RobotSpec, make_backend
+from pointnav_core.maps import BoundedCache
 from pointnav_core.task import PointNavigationTask
 
 __all__ = ["PointNavEnv"]
@@ -161,6 +162,7 @@ class PointNavEnv(gym.Env[Any, np.ndarray]):
         self.scene = scene
         self.robots = (self.robot,)
         self.render_mode = render_mode
+        self._renderers = BoundedCache(2)  # floor pictures prepared for render()
         self.flatten_obs = bool(flatten_obs)
         self.action_frequency = frequency
         self.backend = make_backend(backend, **dict(backend_kwargs or {}))
@@ -208,7 +210,7 @@ class PointNavEnv(gym.Env[Any, np.ndarray]):
         # Imported here: drawing is only needed when rendering.
         from pointnav_core.render import render_env
 
-        return render_env(self)
+        return render_env(self, renderers=self._renderers)
 
     def close(self) -> None:
         """Release the backend's resources (if it holds any)."""

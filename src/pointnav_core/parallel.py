@@ -169,6 +169,7 @@ from pettingzoo.utils.conversions import parallel_to_aec, parallel_to_aec_wrappe
 
 from pointnav_core import _envcommon, scenes
 from pointnav_core.backend import Backend, RobotSpec, make_backend
+from pointnav_core.maps import BoundedCache
 from pointnav_core.task import PointNavigationTask, TaskStateError
 
 __all__ = [
@@ -342,6 +343,7 @@ class MultiPointNavEnv(ParallelEnv[str, Any, np.ndarray]):
 
         self.scene = scene
         self.render_mode = render_mode
+        self._renderers = BoundedCache(2)  # floor pictures prepared for render()
         self.flatten_obs = bool(flatten_obs)
         self.finished = finished
         self.action_frequency = frequency
@@ -686,7 +688,7 @@ class MultiPointNavEnv(ParallelEnv[str, Any, np.ndarray]):
         # Imported here: drawing is only needed when rendering.
         from pointnav_core.render import render_env
 
-        return render_env(self)
+        return render_env(self, renderers=self._renderers)
 
     def close(self) -> None:
         """Release the backend's resources (if it holds any)."""

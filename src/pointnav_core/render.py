@@ -62,7 +62,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from PIL import Image
 
-from pointnav_core.maps import FREE, OBSTACLE, VOID, TraversableMap
+from pointnav_core.maps import FREE, OBSTACLE, VOID, BoundedCache, TraversableMap
 from pointnav_core.task import TaskState
 from pointnav_core.transforms import quat2yaw
 
@@ -562,11 +562,6 @@ def save_gif(frames: Iterable[ArrayLike], path: PathArg, fps: float = 10) -> Non
 
 
 # ------------------------------------------------------------------------------ environments
-# The attribute in which render_env caches an environment's renderers, keyed by
-# (floor, pixels_per_meter).
-_CACHE_ATTR = "_pointnav_renderers"
-
-
 def _env_tasks(env: Any) -> list[Any]:
     tasks = getattr(env, "tasks", None)
     if tasks is None:
@@ -577,21 +572,24 @@ def _env_tasks(env: Any) -> list[Any]:
     return list(tasks)
 
 
-def _renderer_for(env: Any, floor: int, pixels_per_meter: float) -> TopDownRenderer:
-    """The renderer of ``floor`` at this scale, built once per environment."""
-    tmap = env.scene.floors[floor]
-    cache = getattr(env, _CACHE_ATTR, None)
-    if cache is None:
-        cache = {}
-        setattr(env, _CACHE_ATTR, cache)
-    key = (floor, pixels_per_meter)
-    renderer = cache.get(key)
-    if renderer is None or renderer.tmap is not tmap:  # a new scene: draw its floor anew
-        renderer = cache[key] = TopDownRenderer(tmap, pixels_per_meter)
+def _renderer_for(
+    tmap: TraversableMap, pixels_per_meter: float, renderers: BoundedCache | None
+) -> TopDownRenderer:
+    """The renderer of ``tmap`` at this scale, taken from ``renderers`` when it has one."""
+    if renderers is None:
+        return TopDownRenderer(tmap, pixels_per_meter)
+    # Keyed by the floor's identity and checked, so a new scene is drawn anew.
+    key = (id(tmap), pixels_per_meter)
+    renderer = renderers.get_or_create(key, lambda: TopDownRenderer(tmap, pixels_per_meter))
+    if renderer.tmap is not tmap:
+        renderers.clear()
+        renderer = renderers.get_or_create(key, lambda: TopDownRenderer(tmap, pixels_per_meter))
     return renderer
 
 
-def render_env(env: Any, pixels_per_meter: float | None = None) -> NDArray[np.uint8]:
+def render_env(
+    env: Any, pixels_per_meter: float | None = None, *, renderers: BoundedCache | None = None
+) -> NDArray[np.uint8]:
     """Draw an environment from above: one floor, its robots and the tasks' markers.
 
     Parameters
@@ -602,6 +600,9 @@ def render_env(env: Any, pixels_per_meter: float | None = None) -> NDArray[np.ui
     pixels_per_meter : float, optional
         Picture scale (> 0). Default: ``env.render_pixels_per_meter`` when the environment
         has that attribute, else :data:`DEFAULT_PIXELS_PER_METER`.
+    renderers : BoundedCache, optional
+        Where the caller keeps the prepared floor pictures between frames (the envs own one
+        each). Without it every call draws the floor anew.
 
     Returns
     -------
@@ -615,9 +616,8 @@ def render_env(env: Any, pixels_per_meter: float | None = None) -> NDArray[np.ui
 
     Notes
     -----
-    The floor picture is prepared once per floor and scale and cached on ``env`` (in the
-    attribute ``_pointnav_renderers``); a frame then costs a copy of it and a few
-    disc masks.
+    With ``renderers``, the floor picture is prepared once per floor and scale; a frame then
+    costs a copy of it and a few disc masks.
 
     Examples
     --------
@@ -637,7 +637,7 @@ def render_env(env: Any, pixels_per_meter: float | None = None) -> NDArray[np.ui
     ppm = _check_number(pixels_per_meter, "pixels_per_meter", " (px/m)", low=0.0, strict=True)
     tasks = _env_tasks(env)
     floor = tasks[0].floor if tasks else 0
-    renderer = _renderer_for(env, floor, ppm)
+    renderer = _renderer_for(env.scene.floors[floor], ppm, renderers)
 
     markers = []
     for task in tasks:
@@ -717,14 +717,15 @@ def record_episode(
         raise ValueError(f"every must be an integer >= 1, got {every!r}")
     every = int(every)
     obs, _ = env.reset(seed=seed)
-    frames = [render_env(env, pixels_per_meter)]
+    renderers = BoundedCache(1)
+    frames = [render_env(env, pixels_per_meter, renderers=renderers)]
     steps, done = 0, False
     while not done:
         obs, _, terminated, truncated, _ = env.step(policy(obs))
         steps += 1
         done = bool(terminated or truncated)
         if done or steps % every == 0:
-            frames.append(render_env(env, pixels_per_meter))
+            frames.append(render_env(env, pixels_per_meter, renderers=renderers))
     if path is not None:
         fps = float(getattr(env, "metadata", {}).get("render_fps", 10)) / every
         save_gif(frames, path, fps=fps)
