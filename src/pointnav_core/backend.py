@@ -41,8 +41,9 @@ Float twin                        mirrors           returns
 ``get_velocity_floats(idn)``      ``get_velocity``  ``(vx, vy, vz, wx, wy, wz)``
 ================================  ================  ================================
 
-A twin must give exactly the numbers of its method. The task reads a twin only where
-:func:`float_twin` binds it: when it is defined at least as far down the class hierarchy as the method it mirrors
+A twin must give exactly the numbers of its method (the conformance check
+``fast_paths`` compares them). The task reads a twin only where :func:`float_twin` binds
+it: when it is defined at least as far down the class hierarchy as the method it mirrors
 (so a subclass that overrides ``get_pose`` alone is still read through ``get_pose``) and
 neither is set on the instance. Both shipped backends have both twins.
 

@@ -42,6 +42,9 @@ Check                       What it asks of a backend
 ``absent_robots``           an absent robot is not moved and collides with nothing
 ``reset``                   ``reset`` zeroes velocities and flags; robots block nothing until
                             placed again
+``fast_paths``              the optional float twins (``get_pose_floats``,
+                            ``get_velocity_floats``) give exactly the numbers of the methods
+                            they mirror, wherever the task would read them
 ``determinism``             the same actions from the same state give the same result, also
                             after ``reset``
 ==========================  ===================================================================

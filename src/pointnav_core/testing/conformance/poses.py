@@ -7,7 +7,7 @@ from typing import Any
 
 import numpy as np
 
-from pointnav_core.backend import RobotSpec, check_backend
+from pointnav_core.backend import FLOAT_TWINS, RobotSpec, check_backend, float_twin
 from pointnav_core.errors import BackendError
 from pointnav_core.maps import OBSTACLE, VOID
 from pointnav_core.scenes import Scene
@@ -31,6 +31,7 @@ from pointnav_core.testing.conformance.common import (
 
 __all__ = [
     "check_absent_robots",
+    "check_fast_paths",
     "check_landing",
     "check_pose_round_trip",
     "check_protocol",
@@ -326,3 +327,67 @@ def check_reset(factory: BackendFactory) -> None:
         np.array_equal(_xyz(backend, 0), before),
         "after reset() a robot that is not placed again moved on step()",
     )
+
+
+def check_fast_paths(factory: BackendFactory) -> None:
+    """Float twins the task reads give exactly the numbers of ``get_pose``/``get_velocity``.
+
+    The twins ``get_pose_floats`` and ``get_velocity_floats`` are optional (see
+    :data:`~pointnav_core.backend.FLOAT_TWINS`); a backend without them passes. Each twin
+    that :func:`~pointnav_core.backend.float_twin` binds (the ones the task reads instead
+    of their methods) must return a flat tuple of Python floats equal, value for value, to
+    the arrays of the method it mirrors: after ``land`` and ``set_pose`` at random headings
+    and after each of 60 steps of random actions (held 10 steps each) by three robots, in a
+    room with a pillar and a hole: with contacts, a fall and an absent robot.
+    """
+    backend = factory()
+    twins = {twin: float_twin(backend, twin) for twin in FLOAT_TWINS}
+    twins = {twin: read for twin, read in twins.items() if read is not None}
+    if not twins:
+        return
+    grid = np.zeros((30, 30), np.uint8)
+    grid[0, :] = grid[-1, :] = grid[:, 0] = grid[:, -1] = OBSTACLE
+    grid[12:16, 14:17] = OBSTACLE
+    grid[22:28, 3:27] = VOID
+    specs = [RobotSpec(), RobotSpec(radius=0.3, drive="holonomic"), RobotSpec(radius=0.1)]
+    backend.load(Scene.from_array(grid, 0.1), specs, action_frequency=10.0)
+    rng = np.random.default_rng(0)
+
+    def compare(when: str) -> None:
+        for idn in range(len(specs)):
+            for twin, read in twins.items():
+                method = FLOAT_TWINS[twin]
+                got = read(idn)
+                want = tuple(float(v) for part in getattr(backend, method)(idn) for v in part)
+                _expect(
+                    isinstance(got, tuple) and all(type(v) is float for v in got),
+                    f"{twin}({idn}) must return a tuple of Python floats, got {got!r}",
+                )
+                _expect(
+                    len(got) == len(want),
+                    f"{twin}({idn}) {when} returned {len(got)} numbers, but {method}({idn}) "
+                    f"gives {len(want)}",
+                )
+                wrong = [k for k, (a, b) in enumerate(zip(got, want)) if a != b]
+                _expect(
+                    not wrong,
+                    f"{twin}({idn}) {when} returned {got!r}, but {method}({idn}) gives "
+                    f"{want!r} (they differ at entries {wrong}); a float twin must give "
+                    "exactly the numbers of the method it mirrors",
+                )
+
+    for idn, xy in enumerate([(0.6, 0.6), (1.4, 0.7)]):
+        backend.land(idn, 0, xy, _quat(rng.uniform(-4.0, 4.0)))
+    backend.land(2, 0, (0.8, 1.9), _quat(math.pi / 2))  # facing the hole
+    compare("after land")
+    backend.set_pose(0, (0.7, 0.5, 0.0), _quat(rng.uniform(-4.0, 4.0)))
+    compare("after set_pose")
+    actions: dict[int, Any] = {}
+    for step in range(60):
+        if step % 10 == 0:  # held for 10 steps, mostly ahead: robots reach walls
+            actions = {i: rng.uniform(-0.5, 1.5, spec.action_dim) for i, spec in enumerate(specs)}
+            actions[2] = (1.0, 0.1)  # into the hole
+        if step == 45:
+            backend.set_present(1, False)
+        backend.step(actions)
+        compare(f"after step {step + 1}")

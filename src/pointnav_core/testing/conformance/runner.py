@@ -22,6 +22,7 @@ from pointnav_core.testing.conformance.motion import (
 )
 from pointnav_core.testing.conformance.poses import (
     check_absent_robots,
+    check_fast_paths,
     check_landing,
     check_pose_round_trip,
     check_protocol,
@@ -94,6 +95,7 @@ CHECKS: tuple[Check, ...] = tuple(
         ("falling", check_falling),
         ("absent_robots", check_absent_robots),
         ("reset", check_reset),
+        ("fast_paths", check_fast_paths),
         ("determinism", check_determinism),
     )
 )
