@@ -223,9 +223,8 @@ class KinematicBackend(RobotStateBackend):
                     rb.falling = True
                 rb.yaw += rb.cmd[2] * h
         for rb, (x0, y0, yaw0) in zip(slow, start):
+            planar = ((rb.x - x0) / dt, (rb.y - y0) / dt, (rb.yaw - yaw0) / dt)
             if rb.falling:
-                vel_x, vel_y, wz = (rb.x - x0) / dt, (rb.y - y0) / dt, (rb.yaw - yaw0) / dt
-                self._fall(rb, first=True)
-                rb.vel = (vel_x, vel_y, rb.vel[2], wz)
+                self._fall(rb, first=True, planar=planar)
             else:
-                rb.vel = ((rb.x - x0) / dt, (rb.y - y0) / dt, 0.0, (rb.yaw - yaw0) / dt)
+                rb.vel = (planar[0], planar[1], 0.0, planar[2])

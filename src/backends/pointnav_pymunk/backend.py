@@ -495,5 +495,5 @@ class PymunkBackend(RobotStateBackend):
         rb.body.velocity = (0.0, 0.0)
         rb.body.angular_velocity = 0.0
         dt = self._dt
-        self._fall(rb, first=True)
-        rb.vel = ((x - x0) / dt, (y - y0) / dt, rb.vel[2], (rb.body.angle - yaw0) / dt)
+        planar = ((x - x0) / dt, (y - y0) / dt, (rb.body.angle - yaw0) / dt)
+        self._fall(rb, first=True, planar=planar)

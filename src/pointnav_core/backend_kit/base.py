@@ -45,7 +45,7 @@ class RobotStateBackend:
         checked and turned into each robot's ``cmd`` and ``travel``, falls advanced), move
         the robots in
         ``free`` and set each one's ``vel`` (and ``contact``); call
-        ``self._fall(rb, first=True)`` for one whose centre went over VOID.
+        ``self._fall(rb, first=True, planar=...)`` for one whose centre went over VOID.
     ``_pose(rb)`` and ``_place(rb, x, y, yaw)``
         Read and write a robot's planar pose, wherever the backend keeps it (attributes of
         its state, a physics body).
@@ -108,7 +108,7 @@ class RobotStateBackend:
     ...             rb.x, rb.y, rb.yaw = rb.x + dx, rb.y + dy, rb.yaw + w * dt
     ...             rb.vel = (dx / dt, dy / dt, 0.0, w)
     ...             if self._floors[rb.floor].is_void(rb.x, rb.y):
-    ...                 self._fall(rb, first=True)
+    ...                 self._fall(rb, first=True, planar=(dx / dt, dy / dt, w))
     >>> from pointnav_core.backend import RobotSpec
     >>> from pointnav_core.scenes import Scene
     >>> backend = Ghosts()
@@ -360,11 +360,15 @@ class RobotStateBackend:
         """Whether robot ``idn`` is in the world."""
         return self._robot(idn).present
 
-    def _fall(self, rb: Any, *, first: bool) -> None:
+    def _fall(
+        self, rb: Any, *, first: bool, planar: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    ) -> None:
         """Advance robot ``rb``'s fall by one control step: z drops, ``vel`` is the drop's.
 
         On the ``first`` step the robot starts falling at ``fall_speed`` and drops at
         least 0.05 m (so the fall shows at any rate); then gravity accelerates it.
+        ``planar`` is the step's ``(vx, vy, wz)`` before the fall began (zero on the later
+        steps of a fall), kept in ``vel`` beside the drop's vz.
         """
         dt = self._dt
         if first:
@@ -376,4 +380,4 @@ class RobotStateBackend:
             drop = _MIN_FIRST_DROP
         rb.fall_speed = v0 + _GRAVITY * dt
         rb.z -= drop
-        rb.vel = (0.0, 0.0, -drop / dt, 0.0)
+        rb.vel = (planar[0], planar[1], -drop / dt, planar[2])
