@@ -35,12 +35,14 @@ Writing a backend with :class:`RobotStateBackend`
      0's height;
    - ``_pose(rb)`` returning ``(x, y, yaw)`` and ``_place(rb, x, y, yaw)``: where the
      pose lives;
-   - ``step(actions)``: ``for rb in self._start_step(actions)``, move the robot by its
-     ``rb.cmd`` over ``self._dt`` seconds (:func:`drive_arc` is the exact motion in open
-     space), resolve contacts (setting ``rb.contact`` on both parties), set ``rb.vel``
-     to the step's displacement over its duration, and call
-     ``self._fall(rb, first=True)`` for a robot whose centre ended over VOID
-     (``FloorGrid.is_void``).
+   - ``step(actions)``: ``for rb in self._start_step(actions)`` (the robots free to
+     move, each with its checked, scaled body-frame ``rb.cmd`` and its ``rb.travel``),
+     move the robot over ``self._dt`` seconds (:func:`drive_arc` is the exact motion in
+     open space), resolve contacts (setting ``rb.contact`` on both parties), set
+     ``rb.vel`` to the step's displacement and yaw change over its duration, and call
+     ``self._fall(rb, first=True, planar=...)`` for a robot whose centre ended over
+     VOID (``FloorGrid.is_void``); robots that are absent, unplaced or already falling
+     are handled by ``_start_step``.
 
    The base class then gives ``reset``, ``land``, ``set_pose``, ``get_pose``,
    ``get_velocity``, ``in_contact``, ``is_valid_pose`` (the floor's ``clear`` and
@@ -52,10 +54,12 @@ Writing a backend with :class:`RobotStateBackend`
    conformance kit on it: ``python -m pointnav_core.testing NAME``, or
    :func:`pointnav_core.testing.conformance.assert_conforms` from a test.
 
-Every helper works on plain Python floats: a backend's ``step`` runs once per control
-step for every robot, and the kit adds no array work to it. The example backend of
-:class:`RobotStateBackend` (robots that drive through walls) is the smallest complete one;
-``pointnav_kinematic`` and ``pointnav_pymunk`` are the full ones.
+The helpers work on plain Python floats: a backend's ``step`` runs for every robot on
+every control step, and for two or three numbers numpy's per-call overhead costs more
+than the arithmetic. The example backend of :class:`RobotStateBackend` (robots that
+drive through walls and fall into holes) is the smallest complete one; it passes every
+conformance check but those of contacts. ``pointnav_kinematic`` and ``pointnav_pymunk``
+are the full ones.
 
 >>> from pointnav_core.backend import RobotSpec
 >>> body_command(RobotSpec(drive="holonomic"), [0.5, -0.5, 1.0])
