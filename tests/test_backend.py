@@ -145,20 +145,20 @@ def test_scale_action_of_an_array_is_that_of_its_float64_values(drive, dtype):
     values = np.array([0.3, -1.7, 0.55, 2.0, -0.123456789], dtype=np.float64)
     for action in (values[: spec.action_dim], values[::2][: spec.action_dim]):
         action = action.astype(dtype)
-        expected = spec._scaled(np.asarray(action, dtype=np.float64).tolist())
-        scaled = spec._scaled(action)
+        expected = spec.scale_action_floats(np.asarray(action, dtype=np.float64).tolist())
+        scaled = spec.scale_action_floats(action)
         assert scaled == expected and all(type(v) is float for v in scaled)
     n = spec.action_dim
     for wrong in (values[: n + 1], values[: n - 1], values[:4].reshape(2, 2)):
         with pytest.raises(ValueError) as from_array:
-            spec._scaled(wrong.astype(dtype))
+            spec.scale_action_floats(wrong.astype(dtype))
         with pytest.raises(ValueError) as from_list:
-            spec._scaled(wrong.astype(np.float64).tolist())
+            spec.scale_action_floats(wrong.astype(np.float64).tolist())
         assert str(from_array.value) == str(from_list.value)
     if np.dtype(dtype).kind == "f":
         bad = np.full(spec.action_dim, np.nan, dtype=dtype)
         with pytest.raises(ValueError, match=r"action must be finite, got \[nan, nan"):
-            spec._scaled(bad)
+            spec.scale_action_floats(bad)
 
 
 @pytest.mark.parametrize("bad", [float("nan"), float("inf"), -float("inf")])

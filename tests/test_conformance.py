@@ -12,10 +12,13 @@ from hypothesis import given, reject
 from hypothesis import strategies as st
 
 from pointnav_core.backend import (
+    FLOAT_TWINS,
     RobotSpec,
     UnknownBackendError,
     available_backends,
     check_backend,
+    float_twin,
+    get_backend,
     make_backend,
 )
 from pointnav_core.errors import BackendError
@@ -122,6 +125,14 @@ class Clingy(KinematicBackend):
             rb.vel = (0.0, 0.0, 0.0, 0.0)
 
 
+class Shifted(KinematicBackend):
+    """Its float twin of get_pose reports x 1 m off (get_pose itself is right)."""
+
+    def get_pose_floats(self, idn):
+        x, *rest = super().get_pose_floats(idn)
+        return (x + 1.0, *rest)
+
+
 class Partial:
     """Implements only part of the protocol."""
 
@@ -142,6 +153,7 @@ class Partial:
         (Jittery, {"open_space_motion", "determinism"}, "diverged at step 1"),
         (Boastful, {"velocity_matches_motion"}, "but the robot moved"),
         (Clingy, {"reset"}, "still blocks is_valid_pose"),
+        (Shifted, {"fast_paths"}, "get_pose_floats(0) after land returned"),
     ],
     ids=lambda v: v.__name__ if isinstance(v, type) else None,
 )
@@ -157,6 +169,37 @@ def test_kit_reports_what_a_broken_backend_gets_wrong(backend, failing, message)
         assert_conforms(backend)
     assert message in str(info.value)
     assert isinstance(info.value, BackendError) and isinstance(info.value, AssertionError)
+
+
+@pytest.mark.parametrize("backend", BACKENDS)
+def test_a_wrong_float_twin_fails_the_fast_path_check(backend):
+    # A third-party subclass whose fast path lies: the task would read its numbers on
+    # every step, so the kit must refuse it, naming the twin and the entries that differ.
+    class SlowVelocity(get_backend(backend)):
+        def get_velocity_floats(self, idn):
+            vx, *rest = super().get_velocity_floats(idn)
+            return (vx * 0.5, *rest)
+
+    check = get_check("fast_paths")
+    check(backend_factory(backend))  # the shipped backend passes
+    with pytest.raises(AssertionError, match=r"get_velocity_floats\(0\) after step 1 returned"):
+        check(SlowVelocity)
+    with pytest.raises(AssertionError, match=r"differ at entries \[0\]"):
+        check(Shifted)
+
+
+def test_the_fast_path_check_skips_twins_the_task_does_not_read():
+    # Boastful overrides get_velocity but inherits get_velocity_floats: the task reads
+    # get_velocity then (see backend.float_twin), so the stale twin is not its business.
+    class ArraysOnly(Boastful):  # overrides get_pose too: the task reads no twin at all
+        def get_pose(self, idn):
+            return super().get_pose(idn)
+
+    assert float_twin(Boastful(), "get_velocity_floats") is None
+    assert float_twin(Boastful(), "get_pose_floats") is not None
+    assert [float_twin(ArraysOnly(), twin) for twin in FLOAT_TWINS] == [None, None]
+    results = run_checks(Boastful, ["fast_paths"]) + run_checks(ArraysOnly, ["fast_paths"])
+    assert [r.passed for r in results] == [True, True]
 
 
 def test_wrong_shapes_are_named_by_the_protocol_check():
@@ -200,7 +243,7 @@ def test_an_unexpected_exception_fails_the_check_and_says_where():
 
 def test_checks_have_unique_names_and_summaries():
     names = [c.name for c in CHECKS]
-    assert len(set(names)) == len(names) == 13
+    assert len(set(names)) == len(names) == 14
     assert all(isinstance(c, Check) and c.summary and str(c) == c.name for c in CHECKS)
 
 

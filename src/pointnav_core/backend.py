@@ -28,18 +28,33 @@ Units are metres, seconds and radians; the world frame has x, y on the floor and
 quaternions are ``(x, y, z, w)``. Actions are in ``[-1, 1]`` and are turned into velocities
 by :meth:`RobotSpec.scale_action`.
 
-Outside the protocol, a backend may offer a fast path for the task's per-step reads:
-``get_pose_floats(idn)`` and ``get_velocity_floats(idn)``, the numbers of ``get_pose`` and
-``get_velocity`` as one flat tuple of Python floats (no arrays). The task uses such a *float
-twin* only if it is defined at least as far down the class hierarchy as the method it
-mirrors (so a subclass that overrides ``get_pose`` alone is still read through it), and
-falls back to the protocol method otherwise. Both shipped backends have them.
+Float twins
+-----------
+Beside the protocol, a backend may offer a fast path for the task's per-step reads: a
+*float twin* of a protocol method returns that method's numbers as one flat tuple of
+Python floats, without building arrays (:data:`FLOAT_TWINS`, :class:`FloatTwinBackend`):
 
-For backend authors, the module also holds what the shipped backends share and a new one
-may reuse: :class:`RobotStateBackend` (a base class with the robot index checks, the
-simple accessors, presence and the fall of a robot over VOID), and the argument checks
-:func:`check_load`, :func:`check_index`, :func:`parse_position` and
-:func:`parse_orientation`, and :func:`planar_quat`, whose errors name the parameter.
+================================  ================  ================================
+Float twin                        mirrors           returns
+================================  ================  ================================
+``get_pose_floats(idn)``          ``get_pose``      ``(x, y, z, qx, qy, qz, qw)``
+``get_velocity_floats(idn)``      ``get_velocity``  ``(vx, vy, vz, wx, wy, wz)``
+================================  ================  ================================
+
+A twin must give exactly the numbers of its method (the conformance check
+``fast_paths`` compares them). The task reads a twin only where :func:`float_twin` binds
+it: when it is defined at least as far down the class hierarchy as the method it mirrors
+(so a subclass that overrides ``get_pose`` alone is still read through ``get_pose``) and
+neither is set on the instance. Both shipped backends have both twins.
+
+Writing a backend
+-----------------
+:mod:`pointnav_core.backend_kit` is the author's kit: :class:`RobotStateBackend` (a base
+class that implements every method but ``load`` and ``step``, the twins included), the
+robot state, the exact drive motion, the floor grid and the argument checks, with a guide.
+The kit's names that used to live here (``RobotStateBackend``, ``check_index``,
+``check_load``, ``parse_position``, ``parse_orientation``, ``planar_quat``) can still be
+imported from this module.
 """
 
 from __future__ import annotations
@@ -47,7 +62,7 @@ from __future__ import annotations
 import inspect
 import math
 import types
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 from importlib.metadata import entry_points
 from typing import TYPE_CHECKING, Any, Protocol, runtime_checkable
@@ -60,7 +75,9 @@ from pointnav_core.errors import BackendError
 __all__ = [
     "DRIVES",
     "ENTRY_POINT_GROUP",
+    "FLOAT_TWINS",
     "Backend",
+    "FloatTwinBackend",
     "RobotSpec",
     "RobotStateBackend",
     "UnknownBackendError",
@@ -68,6 +85,7 @@ __all__ = [
     "check_backend",
     "check_index",
     "check_load",
+    "float_twin",
     "get_backend",
     "make_backend",
     "parse_orientation",
@@ -201,10 +219,19 @@ class RobotSpec:
         ...
         ValueError: action must be finite, got [nan, 0.0]
         """
-        return np.array(self._scaled(action))
+        return np.array(self.scale_action_floats(action))
 
-    def _scaled(self, action: ArrayLike) -> tuple[float, ...]:
-        # Hot path (once per robot per step): plain floats beat numpy for 2-3 numbers.
+    def scale_action_floats(self, action: ArrayLike) -> tuple[float, ...]:
+        """:meth:`scale_action` as a tuple of Python floats, without an output array.
+
+        Same checks, clipping and errors; for a backend's ``step``, which scales every
+        robot's action on every control step (plain floats beat numpy for 2 or 3 numbers).
+
+        Examples
+        --------
+        >>> RobotSpec().scale_action_floats(np.array([0.5, -1.0], np.float32))
+        (0.25, -1.5)
+        """
         maxima = self._maxima
         if type(action) is np.ndarray and action.ndim == 1 and action.dtype in _FLOAT_DTYPES:
             # What env.step passes: tolist gives the float64 values, without a copy first.
@@ -358,6 +385,61 @@ class Backend(Protocol):
         ...
 
 
+#: The optional float twins of protocol methods: twin name -> the method it mirrors.
+FLOAT_TWINS = types.MappingProxyType(
+    {"get_pose_floats": "get_pose", "get_velocity_floats": "get_velocity"}
+)
+
+
+@runtime_checkable
+class FloatTwinBackend(Backend, Protocol):
+    """A :class:`Backend` with both float twins (:data:`FLOAT_TWINS`), the task's fast path.
+
+    Each twin returns the numbers of the method it mirrors, the same values, as one flat
+    tuple of Python floats.
+    """
+
+    def get_pose_floats(self, idn: int) -> tuple[float, ...]:
+        """``get_pose(idn)``'s position and quaternion: ``(x, y, z, qx, qy, qz, qw)``."""
+        ...
+
+    def get_velocity_floats(self, idn: int) -> tuple[float, ...]:
+        """``get_velocity(idn)``'s linear and angular parts: ``(vx, vy, vz, wx, wy, wz)``."""
+        ...
+
+
+def float_twin(backend: Any, twin: str) -> Callable[[int], tuple[float, ...]] | None:
+    """Return ``backend``'s bound float ``twin``, or None where the task must not use it.
+
+    A twin (a key of :data:`FLOAT_TWINS`) stands in for its method only if the class that
+    defines it is the class that defines the method or a subclass of it, and neither is
+    set on the instance: a subclass or a patch that changes ``get_pose`` but not
+    ``get_pose_floats`` is read through ``get_pose``.
+
+    Examples
+    --------
+    >>> backend = make_backend("kinematic")
+    >>> float_twin(backend, "get_pose_floats") is not None
+    True
+    >>> class Shifted(type(backend)):
+    ...     def get_pose(self, idn):
+    ...         position, orientation = super().get_pose(idn)
+    ...         return position + 1.0, orientation
+    >>> float_twin(Shifted(), "get_pose_floats") is None  # its twin is inherited: stale
+    True
+    """
+    method = FLOAT_TWINS[twin]
+    patched = getattr(backend, "__dict__", ())
+    if twin in patched or method in patched:
+        return None
+    mro = type(backend).__mro__
+    twin_owner = next((cls for cls in mro if twin in vars(cls)), None)
+    method_owner = next((cls for cls in mro if method in vars(cls)), None)
+    if twin_owner is None or method_owner is None or not issubclass(twin_owner, method_owner):
+        return None
+    return getattr(backend, twin)
+
+
 def _protocol_members() -> tuple[str, ...]:
     return tuple(
         name
@@ -497,394 +579,33 @@ def make_backend(backend: str | type | Backend = "kinematic", **kwargs: Any) -> 
     return backend
 
 
-# ----------------------------------------------------------------- for backend authors
+# The author's kit moved to pointnav_core.backend_kit, which builds on this module; its
+# names stay importable from here, loaded on first use (PEP 562).
+_KIT_NAMES = frozenset(
+    {
+        "RobotStateBackend",
+        "check_index",
+        "check_load",
+        "parse_orientation",
+        "parse_position",
+        "planar_quat",
+    }
+)
 
-_GRAVITY = 9.81  # m/s^2
-_MIN_FIRST_DROP = 0.05  # m: a fall must be visible on the step it starts, at any rate
-
-
-def _is_index(value: Any) -> bool:
-    return isinstance(value, (int, np.integer)) and not isinstance(value, (bool, np.bool_))
-
-
-def check_index(value: Any, count: int, *, name: str, what: str) -> int:
-    """Return ``value`` as an index into ``count`` things, or raise naming the parameter.
-
-    Parameters
-    ----------
-    value : int
-        The index given by the caller; a Python or numpy integer, not a bool.
-    count : int
-        How many things there are; valid indices are ``0 .. count - 1``.
-    name : str
-        The parameter's name, for the error message (``"idn"``, ``"floor"``).
-    what : str
-        What it indexes, for the error message (``"robot"``, ``"floor"``).
-
-    Returns
-    -------
-    int
-        ``value`` as a Python int.
-
-    Raises
-    ------
-    TypeError
-        If ``value`` is not an integer (bools are not).
-    ValueError
-        If ``value`` is outside ``[0, count)``.
-
-    Examples
-    --------
-    >>> check_index(1, 2, name="floor", what="floor")
-    1
-    >>> check_index(2, 2, name="floor", what="floor")
-    Traceback (most recent call last):
-    ...
-    ValueError: floor must be in [0, 2), got 2
-    >>> check_index(True, 2, name="idn", what="robot")
-    Traceback (most recent call last):
-    ...
-    TypeError: idn must be an int robot index, got True
-    """
-    if not _is_index(value):
-        raise TypeError(f"{name} must be an int {what} index, got {value!r}")
-    if not 0 <= value < count:
-        raise ValueError(f"{name} must be in [0, {count}), got {value}")
-    return int(value)
+if TYPE_CHECKING:
+    from pointnav_core.backend_kit import (
+        RobotStateBackend,
+        check_index,
+        check_load,
+        parse_orientation,
+        parse_position,
+        planar_quat,
+    )
 
 
-def check_load(
-    scene: Any, robots: Sequence[RobotSpec], action_frequency: Any
-) -> tuple[list[RobotSpec], int, float]:
-    """Check the arguments of :meth:`Backend.load` and return what a backend builds from.
+def __getattr__(name: str) -> Any:
+    if name in _KIT_NAMES:
+        from pointnav_core import backend_kit
 
-    Parameters
-    ----------
-    scene : Scene
-        Must have ``n_floors >= 1`` and as many ``floors``.
-    robots : sequence of RobotSpec
-        One spec per robot.
-    action_frequency : float
-        Control steps per second (Hz), finite and > 0.
-
-    Returns
-    -------
-    specs : list of RobotSpec
-        ``robots`` as a list.
-    n_floors : int
-        The scene's number of floors.
-    dt : float
-        Duration of one control step in seconds, ``1 / action_frequency``.
-
-    Raises
-    ------
-    ValueError
-        If ``action_frequency`` is not a finite number > 0, or the scene has no floors or
-        a floor count that does not match its maps.
-    TypeError
-        If an item of ``robots`` is not a :class:`RobotSpec`.
-
-    Examples
-    --------
-    >>> scene = types.SimpleNamespace(floors=["map"], n_floors=1)
-    >>> check_load(scene, (RobotSpec(),), 4.0)[1:]
-    (1, 0.25)
-    >>> check_load(scene, [RobotSpec(), "robot"], 10.0)
-    Traceback (most recent call last):
-    ...
-    TypeError: robots[1] must be a RobotSpec, got str
-    """
-    freq = float(action_frequency)
-    if not math.isfinite(freq) or freq <= 0.0:
-        raise ValueError(
-            f"action_frequency must be a finite number > 0 (Hz), got {action_frequency!r}"
-        )
-    specs = list(robots)
-    for i, spec in enumerate(specs):
-        if not isinstance(spec, RobotSpec):
-            raise TypeError(f"robots[{i}] must be a RobotSpec, got {type(spec).__name__}")
-    n_floors = int(scene.n_floors)
-    if n_floors < 1 or len(scene.floors) != n_floors:
-        raise ValueError(
-            f"scene must have n_floors >= 1 floors, got n_floors={n_floors} "
-            f"and {len(scene.floors)} maps"
-        )
-    return specs, n_floors, 1.0 / freq
-
-
-def parse_position(
-    position: ArrayLike, *, allow_2d: bool = False, name: str = "position"
-) -> tuple[float, ...]:
-    """Check a world position and return its coordinates as floats.
-
-    Parameters
-    ----------
-    position : array_like, shape (3,), or (2,) when ``allow_2d``
-        World ``(x, y, z)`` (or ``(x, y)``) in metres, finite.
-    allow_2d : bool
-        Whether ``(x, y)`` without a z is accepted.
-    name : str
-        The parameter's name, for the error message.
-
-    Returns
-    -------
-    tuple of float
-        The coordinates, 2 or 3 of them as given.
-
-    Raises
-    ------
-    ValueError
-        If ``position`` has another shape or holds NaN or infinity.
-
-    Examples
-    --------
-    >>> parse_position(np.array([1.0, 2.0]), allow_2d=True)
-    (1.0, 2.0)
-    >>> parse_position([1.0, 2.0])
-    Traceback (most recent call last):
-    ...
-    ValueError: position must be finite (x, y, z) in metres, got [1.0, 2.0]
-    """
-    p = np.asarray(position, dtype=np.float64)
-    shapes = ((2,), (3,)) if allow_2d else ((3,),)
-    if p.shape not in shapes or not np.isfinite(p).all():
-        want = "(x, y) or (x, y, z)" if allow_2d else "(x, y, z)"
-        raise ValueError(f"{name} must be finite {want} in metres, got {position!r}")
-    return tuple(p.tolist())
-
-
-def parse_orientation(orientation: ArrayLike, *, name: str = "orientation") -> float:
-    """Check an ``(x, y, z, w)`` quaternion and return its heading (yaw) in radians.
-
-    The heading is that of the rotated +x axis, ``atan2(2 (w z + x y), w² + x² - y² - z²)``;
-    it does not depend on the quaternion's scale, so a non-unit quaternion is fine.
-
-    Parameters
-    ----------
-    orientation : array_like, shape (4,)
-        A finite, non-zero quaternion ``(x, y, z, w)``.
-    name : str
-        The parameter's name, for the error message.
-
-    Returns
-    -------
-    float
-        The yaw in ``[-pi, pi]``.
-
-    Raises
-    ------
-    ValueError
-        If ``orientation`` has another shape, holds NaN or infinity, or is zero.
-
-    See Also
-    --------
-    pointnav_core.transforms.quat2yaw : The same heading for arrays of quaternions.
-    planar_quat : The inverse, for a planar robot.
-
-    Examples
-    --------
-    >>> round(parse_orientation([0.0, 0.0, 1.0, 1.0]), 6)  # not unit: still 90 degrees
-    1.570796
-    >>> parse_orientation((0.0, 0.0, 0.0, 0.0))
-    Traceback (most recent call last):
-    ...
-    ValueError: orientation must be a non-zero quaternion, got (0.0, 0.0, 0.0, 0.0)
-    """
-    q = np.asarray(orientation, dtype=np.float64)
-    if q.shape != (4,) or not np.isfinite(q).all():
-        raise ValueError(
-            f"{name} must be a finite (x, y, z, w) quaternion of shape (4,), "
-            f"got {orientation!r}"
-        )
-    x, y, z, w = q.tolist()
-    if x * x + y * y + z * z + w * w < 1e-12:
-        raise ValueError(f"{name} must be a non-zero quaternion, got {orientation!r}")
-    return math.atan2(2.0 * (w * z + x * y), w * w + x * x - y * y - z * z)
-
-
-def planar_quat(yaw: float) -> NDArray[np.float64]:
-    """Return the quaternion of a heading, with the heading wrapped so that ``w >= 0``.
-
-    Parameters
-    ----------
-    yaw : float
-        Heading about +z in radians, any finite value.
-
-    Returns
-    -------
-    ndarray of float64, shape (4,)
-        ``(0, 0, sin(a / 2), cos(a / 2))`` with ``a`` = ``yaw`` wrapped into
-        ``[-pi, pi]``: what :meth:`Backend.get_pose` returns for a planar robot.
-
-    See Also
-    --------
-    pointnav_core.transforms.yaw2quat : The same for arrays, without the wrapping (its
-        ``w`` is negative for ``|yaw| > pi``) and with ``-0.0`` made ``+0.0``.
-    parse_orientation : The inverse.
-
-    Examples
-    --------
-    >>> planar_quat(math.pi / 2).round(6).tolist()
-    [0.0, 0.0, 0.707107, 0.707107]
-    >>> planar_quat(2 * math.pi).tolist()  # a full turn: the identity, w = +1
-    [0.0, 0.0, 0.0, 1.0]
-    """
-    return np.array(_planar_quat_floats(yaw))
-
-
-def _planar_quat_floats(yaw: float) -> tuple[float, float, float, float]:
-    """:func:`planar_quat` as a tuple of floats (for ``get_pose_floats``)."""
-    half = 0.5 * math.remainder(yaw, 2.0 * math.pi)
-    return 0.0, 0.0, math.sin(half), math.cos(half)
-
-
-class RobotStateBackend:
-    """Base class for a backend that keeps one state object per robot.
-
-    It holds what the shipped backends share and a new backend may reuse: the robot and
-    floor index checks, the :attr:`n_robots` and :attr:`action_frequency` properties, the
-    accessors :meth:`get_velocity`, :meth:`get_robot_floor`, :meth:`in_contact` and
-    :meth:`is_present`, :meth:`set_present`, and the fall of a robot whose centre is over
-    VOID (:meth:`_fall`). A subclass implements the rest of the :class:`Backend` protocol
-    (``load``, ``reset``, ``land``, ``set_pose``, ``get_pose``, ``step``,
-    ``is_valid_pose``); :func:`check_backend` still checks that it does.
-
-    Parameters
-    ----------
-    fall_speed : float
-        Downward speed in m/s with which a fall starts, > 0; gravity (9.81 m/s^2) then
-        accelerates it.
-
-    Notes
-    -----
-    The subclass's ``load`` fills these attributes (empty, and ``0.1`` s, until then):
-
-    ``_robots`` : list
-        One state object per robot, index ``idn``, with the attributes ``floor`` (int),
-        ``present``, ``falling`` and ``contact`` (bool), ``z`` (m), ``fall_speed`` (m/s)
-        and ``vel``, the world velocity of the last step ``(vx, vy, vz, wz)`` in m/s and
-        rad/s, as a tuple of floats.
-    ``_floors`` : list
-        One object per floor, index ``floor``.
-    ``_dt`` : float
-        Duration of one control step in seconds.
-
-    Examples
-    --------
-    >>> class Points(RobotStateBackend):
-    ...     def load(self, scene, robots, action_frequency=10.0):
-    ...         specs, n_floors, self._dt = check_load(scene, robots, action_frequency)
-    ...         self._floors = list(range(n_floors))
-    ...         self._robots = [
-    ...             types.SimpleNamespace(floor=0, present=True, falling=False, contact=False,
-    ...                                   z=0.0, fall_speed=0.0, vel=(0.0, 0.0, 0.0, 0.0))
-    ...             for _ in specs
-    ...         ]
-    >>> backend = Points()
-    >>> backend.load(types.SimpleNamespace(floors=["map"], n_floors=1), [RobotSpec()])
-    >>> backend.n_robots, backend.is_present(0), backend.get_velocity(0)[0].tolist()
-    (1, True, [0.0, 0.0, 0.0])
-    >>> backend.in_contact(1)
-    Traceback (most recent call last):
-    ...
-    ValueError: idn must be in [0, 1), got 1
-    """
-
-    _robots: list[Any]
-    _floors: list[Any]
-    _dt: float
-
-    def __init__(self, *, fall_speed: float = 1.0) -> None:
-        fall_speed_f = float(fall_speed)
-        if not math.isfinite(fall_speed_f) or fall_speed_f <= 0.0:
-            raise ValueError(f"fall_speed must be a finite number > 0 (m/s), got {fall_speed!r}")
-        self.fall_speed = fall_speed_f
-        self._floors = []
-        self._robots = []
-        self._dt = 0.1
-
-    @property
-    def n_robots(self) -> int:
-        """Number of robots loaded (0 before :meth:`load`)."""
-        return len(self._robots)
-
-    @property
-    def action_frequency(self) -> float:
-        """Control steps per second (Hz)."""
-        return 1.0 / self._dt
-
-    def _robot(self, idn: int) -> Any:
-        """Robot ``idn``'s state; raises naming ``idn`` (RuntimeError before :meth:`load`)."""
-        robots = self._robots
-        if type(idn) is int and 0 <= idn < len(robots):
-            return robots[idn]  # the common case, checked without a call
-        if not robots and _is_index(idn):
-            raise RuntimeError("no robots: call load(scene, robots) first")
-        return robots[check_index(idn, len(robots), name="idn", what="robot")]
-
-    def _floor(self, floor: int) -> Any:
-        """Floor ``floor``'s object from ``_floors``; raises naming ``floor``."""
-        return self._floors[check_index(floor, len(self._floors), name="floor", what="floor")]
-
-    def get_velocity(self, idn: int) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-        """Return robot ``idn``'s world linear (3,) m/s and angular (3,) rad/s velocity.
-
-        These are the effective velocities of the last step: displacement and yaw change
-        divided by the step's duration (zero after load, reset, land and set_pose).
-        """
-        rb = self._robot(idn)
-        vx, vy, vz, wz = rb.vel
-        return np.array((vx, vy, vz)), np.array((0.0, 0.0, wz))
-
-    def get_velocity_floats(self, idn: int) -> tuple[float, ...]:
-        """Return :meth:`get_velocity`'s six numbers as a tuple of floats, without arrays.
-
-        ``(vx, vy, vz, wx, wy, wz)``. Not part of the :class:`Backend` protocol: an optional
-        fast path that the task reads on every step instead of :meth:`get_velocity`, only
-        when no subclass has overridden ``get_velocity`` below this class.
-        """
-        vx, vy, vz, wz = self._robot(idn).vel
-        return vx, vy, vz, 0.0, 0.0, wz
-
-    def get_robot_floor(self, idn: int) -> int:
-        """The floor robot ``idn`` was last landed on (0 until then)."""
-        return self._robot(idn).floor
-
-    def in_contact(self, idn: int) -> bool:
-        """Whether robot ``idn`` hit or pushed against an obstacle or robot in the last step."""
-        return self._robot(idn).contact
-
-    def set_present(self, idn: int, present: bool) -> None:
-        """Take robot ``idn`` out of the world (``False``) or bring it back (``True``).
-
-        An absent robot keeps its pose (and a fall in progress) but is not moved by
-        :meth:`step`, has no velocity and collides with nothing; bringing it back does not
-        check whether its pose is still free.
-        """
-        rb = self._robot(idn)
-        rb.present = bool(present)
-        if not rb.present:
-            rb.contact = False
-            rb.vel = (0.0, 0.0, 0.0, 0.0)
-
-    def is_present(self, idn: int) -> bool:
-        """Whether robot ``idn`` is in the world."""
-        return self._robot(idn).present
-
-    def _fall(self, rb: Any, *, first: bool) -> None:
-        """Advance robot ``rb``'s fall by one control step: z drops, ``vel`` is the drop's.
-
-        On the ``first`` step the robot starts falling at ``fall_speed`` and drops at
-        least 0.05 m (so the fall shows at any rate); then gravity accelerates it.
-        """
-        dt = self._dt
-        if first:
-            rb.falling = True
-            rb.fall_speed = self.fall_speed
-        v0 = rb.fall_speed
-        drop = v0 * dt + 0.5 * _GRAVITY * dt * dt
-        if first and drop < _MIN_FIRST_DROP:
-            drop = _MIN_FIRST_DROP
-        rb.fall_speed = v0 + _GRAVITY * dt
-        rb.z -= drop
-        rb.vel = (0.0, 0.0, -drop / dt, 0.0)
+        return getattr(backend_kit, name)
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

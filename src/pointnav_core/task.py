@@ -31,6 +31,7 @@ from typing import TYPE_CHECKING, Any, ClassVar, Protocol
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from pointnav_core.backend import float_twin
 from pointnav_core.lifecycle import (
     ERROR,
     IDLE,
@@ -168,32 +169,6 @@ def _check_index(name: str, value: Any) -> int:
     if value < 0:
         raise ValueError(f"{name} must be an integer >= 0, got {value!r}")
     return int(value)
-
-
-def _owner(cls: type, name: str) -> type | None:
-    """The class in ``cls``'s MRO that defines attribute ``name`` (None if none does)."""
-    for klass in cls.__mro__:
-        if name in vars(klass):
-            return klass
-    return None
-
-
-def _float_twin(backend: Any, twin: str, method: str) -> Any:
-    """``backend``'s bound ``twin`` of protocol ``method``, or None to call ``method`` itself.
-
-    A backend may offer ``get_pose_floats(idn)`` and ``get_velocity_floats(idn)``: the
-    numbers of ``get_pose(idn)`` and ``get_velocity(idn)`` as one flat tuple of Python
-    floats, without building arrays (the task reads them on every step). They are optional;
-    a twin is used only if it is defined at least as far down the class hierarchy as the
-    method it mirrors and neither is set on the instance, so that a subclass or a patch
-    that changes ``get_pose`` but not its twin is still read through ``get_pose``.
-    """
-    if twin in getattr(backend, "__dict__", ()) or method in getattr(backend, "__dict__", ()):
-        return None
-    twin_owner, method_owner = _owner(type(backend), twin), _owner(type(backend), method)
-    if twin_owner is None or method_owner is None or not issubclass(twin_owner, method_owner):
-        return None
-    return getattr(backend, twin)
 
 
 def _merge_config(
@@ -422,7 +397,7 @@ class PointNavigationTask:
         self._env: Any = None
         self._spec: Any = None
         # The backend last stepped with, and its float twins of get_pose / get_velocity
-        # (None: read the protocol methods); see _float_twin.
+        # (None: read the protocol methods); see backend.float_twin.
         self._backend: Any = None
         self._pose_floats: Any = None
         self._velocity_floats: Any = None
@@ -932,8 +907,8 @@ class PointNavigationTask:
 
         Done at every reset, and by a step or an observation that meets another backend.
         """
-        self._pose_floats = _float_twin(backend, "get_pose_floats", "get_pose")
-        self._velocity_floats = _float_twin(backend, "get_velocity_floats", "get_velocity")
+        self._pose_floats = float_twin(backend, "get_pose_floats")
+        self._velocity_floats = float_twin(backend, "get_velocity_floats")
         self._backend = backend
 
     # ------------------------------------------------------------------ markers

@@ -19,6 +19,7 @@ import math
 import numpy as np
 from scipy import ndimage
 
+from pointnav_core.backend_kit import FloorGrid
 from pointnav_core.maps import OBSTACLE, VOID, TraversableMap
 from pointnav_kinematic.polygons import EdgeIndex, Segment
 
@@ -236,8 +237,11 @@ def square_distance(
     return -depth, nx, ny
 
 
-class FloorGeometry:
+class FloorGeometry(FloorGrid):
     """One floor's blocked set, preprocessed for fast motion queries.
+
+    A :class:`~pointnav_core.backend_kit.FloorGrid` (cell lookups, the exact disc test)
+    with the clearance tables and wall indices of the kinematic backend's motion.
 
     Parameters
     ----------
@@ -249,10 +253,6 @@ class FloorGeometry:
 
     Attributes
     ----------
-    collision : FloorCollision
-        The floor's one collision geometry (``tmap.collision``), for exact pose queries.
-    codes : bytes
-        Row-major cell codes; cell ``(row, col)`` is ``codes[row * width + col]``.
     edge : bytes
         Row-major flags of *edge* obstacle cells: obstacles with a side neighbour that is
         not an obstacle (or off the map). A disc approaching from free space meets an edge
@@ -262,14 +262,8 @@ class FloorGeometry:
     """
 
     def __init__(self, tmap: TraversableMap, height: float) -> None:
+        super().__init__(tmap, height)
         codes = np.asarray(tmap.codes)
-        self.height = float(height)
-        self.rows, self.width = (int(n) for n in codes.shape)
-        self.res = float(tmap.resolution)
-        self.inv_res = 1.0 / self.res
-        self.ox, self.oy = (float(v) for v in tmap.origin)
-        self.codes = codes.astype(np.uint8).tobytes()
-        self.collision = tmap.collision
         # Buckets of a few cells: one step's search box spans one to four of them.
         self.edges = EdgeIndex(self.collision.polygons, bucket=4.0 * self.res)
         obstacle = codes == OBSTACLE
@@ -319,19 +313,6 @@ class FloorGeometry:
             grid = memoryview(np.ascontiguousarray(budget, dtype=np.float64).ravel())
             self._fast[radius] = grid
         return grid
-
-    def cell_index(self, x: float, y: float) -> int:
-        """Row-major index of the cell holding world point ``(x, y)``, or -1 off the map."""
-        col = math.floor((x - self.ox) * self.inv_res)
-        row = math.floor((y - self.oy) * self.inv_res)
-        if 0 <= col < self.width and 0 <= row < self.rows:
-            return row * self.width + col
-        return -1
-
-    def is_void(self, x: float, y: float) -> bool:
-        """Whether world point ``(x, y)`` is over VOID or off the map."""
-        i = self.cell_index(x, y)
-        return i < 0 or self.codes[i] == VOID
 
     def edge_squares(
         self, xmin: float, ymin: float, xmax: float, ymax: float

@@ -6,18 +6,14 @@ import math
 from collections.abc import Mapping, Sequence
 from typing import Any
 
-import numpy as np
-from numpy.typing import ArrayLike, NDArray
+from numpy.typing import ArrayLike
 
-from pointnav_core.collision import TOUCH_TOL
-from pointnav_core.backend import (
-    RobotSpec,
+from pointnav_core.backend import RobotSpec
+from pointnav_core.backend_kit import (
+    RobotState,
     RobotStateBackend,
-    _planar_quat_floats,
     check_load,
-    parse_orientation,
-    parse_position,
-    planar_quat,
+    drive_arc,
 )
 from pointnav_kinematic.contacts import advance
 from pointnav_kinematic.geometry import FloorGeometry
@@ -27,83 +23,29 @@ __all__ = ["COLLISION_MODES", "KinematicBackend"]
 #: Valid values of ``collision_mode``.
 COLLISION_MODES = ("slide", "stop")
 
-# Accepted overlap between robots in is_valid_pose (touching is allowed), as for walls.
-_TOUCH = TOUCH_TOL
 _MAX_TURN = 0.25  # rad per sub-step: the chord stays close to the arc
 _MAX_SUBSTEPS = 1024  # beyond this, segments grow; collisions stay exact regardless
 
 
-class _Robot:
-    """Mutable state of one robot, as plain floats for the per-step hot path."""
+class _Robot(RobotState):
+    """One robot: the shared state, its pose and what a step needs, as plain floats."""
 
-    __slots__ = (
-        "spec",
-        "radius",
-        "holonomic",
-        "x",
-        "y",
-        "z",
-        "yaw",
-        "floor",
-        "geom",
-        "fast",
-        "present",
-        "placed",
-        "falling",
-        "fall_speed",
-        "contact",
-        "vel",
-        "cmd",
-        "travel",
-        "stopped",
-        "mx",
-        "my",
-        "walls",
-    )
+    __slots__ = ("x", "y", "yaw", "geom", "fast", "stopped", "mx", "my", "walls")
 
     def __init__(self, spec: RobotSpec, geom: FloorGeometry) -> None:
-        self.spec = spec
-        self.radius = spec.radius
-        self.holonomic = spec.drive == "holonomic"
+        super().__init__(spec)
         self.x = self.y = self.yaw = 0.0
         self.z = geom.height
-        self.floor = 0
         self.geom = geom
         self.fast = geom.fast_clearance(spec.radius)
-        self.present = True
-        self.placed = False
-        self.falling = False
-        self.fall_speed = 0.0
-        self.contact = False
-        # World velocity of the last step: (vx, vy, vz) in m/s and yaw rate in rad/s.
-        self.vel = (0.0, 0.0, 0.0, 0.0)
-        # Commanded body-frame velocity (vx, vy, w) for the current step.
-        self.cmd = (0.0, 0.0, 0.0)
-        self.travel = 0.0
         self.stopped = False
         # This sub-step's chord (m) and the walls near it, for contacts.advance.
         self.mx = self.my = 0.0
         self.walls: list[tuple[float, ...]] = []
 
-    def solid(self) -> bool:
-        """Whether other robots can collide with this one."""
-        return self.present and self.placed and not self.falling
-
-
-def _arc(
-    yaw: float, vx: float, vy: float, w: float, h: float
-) -> tuple[float, float]:
-    """World displacement over ``h`` s of body velocity (vx, vy) turning at ``w`` rad/s.
-
-    Exact for a constant command: the integral of R(yaw + w t) (vx, vy) over [0, h].
-    Written with sin(a)/a, a = w h / 2, so it stays accurate as w -> 0 (straight line).
-    """
-    a = 0.5 * w * h
-    s = h * (math.sin(a) / a if a != 0.0 else 1.0)
-    mid = yaw + a
-    c = math.cos(mid)
-    sn = math.sin(mid)
-    return s * (vx * c - vy * sn), s * (vx * sn + vy * c)
+    def at_rest(self) -> None:
+        super().at_rest()
+        self.stopped = False
 
 
 class KinematicBackend(RobotStateBackend):
@@ -142,6 +84,7 @@ class KinematicBackend(RobotStateBackend):
     Examples
     --------
     >>> import types
+    >>> import numpy as np
     >>> from pointnav_core.maps import TraversableMap
     >>> floor = TraversableMap([[0, 0, 0, 0, 1]], resolution=1.0)
     >>> scene = types.SimpleNamespace(floors=[floor], n_floors=1, get_floor_height=lambda f=0: 0.0)
@@ -172,20 +115,9 @@ class KinematicBackend(RobotStateBackend):
     def load(
         self, scene: Any, robots: Sequence[RobotSpec], action_frequency: float = 10.0
     ) -> None:
-        """Build the world from ``scene.floors`` and one robot per spec.
+        """Build the world (see :meth:`Backend.load`): the floors' geometry, the robots.
 
-        Parameters
-        ----------
-        scene : Scene
-            Uses only ``floors`` (list of TraversableMap), ``n_floors`` and
-            ``get_floor_height(floor)``.
-        robots : sequence of RobotSpec
-            Robot ``idn`` is ``robots[idn]``.
-        action_frequency : float
-            Control steps per second (Hz), > 0.
-
-        Notes
-        -----
+        Uses only the scene's ``floors``, ``n_floors`` and ``get_floor_height(floor)``.
         Robots start present, unplaced, at rest at x = y = 0 on floor 0.
         """
         specs, n_floors, dt = check_load(scene, robots, action_frequency)
@@ -196,173 +128,30 @@ class KinematicBackend(RobotStateBackend):
         self._robots = [_Robot(spec, self._floors[0]) for spec in specs]
         self._dt = dt
 
-    def reset(self) -> None:
-        """Return every robot to its state after :meth:`load`, keeping its pose.
-
-        Velocities and contact flags become zero, falls end, and every robot is present
-        again but unplaced: it takes part in no collision until :meth:`land` or
-        :meth:`set_pose` places it, so that the task can place robots one by one.
-        """
-        for rb in self._robots:
-            rb.present = True
-            rb.placed = False
-            self._at_rest(rb)
-
-    @staticmethod
-    def _at_rest(rb: _Robot) -> None:
-        rb.falling = False
-        rb.fall_speed = 0.0
-        rb.contact = False
-        rb.stopped = False
-        rb.vel = (0.0, 0.0, 0.0, 0.0)
-        rb.cmd = (0.0, 0.0, 0.0)
-
     # ------------------------------------------------------------------ poses
-    def land(self, idn: int, floor: int, position: ArrayLike, orientation: ArrayLike) -> None:
-        """Place robot ``idn`` at rest on ``floor``: x, y from ``position``, z = floor height.
+    def _pose(self, rb: _Robot) -> tuple[float, float, float]:
+        return rb.x, rb.y, rb.yaw
 
-        Parameters
-        ----------
-        idn : int
-            Robot index.
-        floor : int
-            Floor index.
-        position : array_like, shape (2,) or (3,)
-            World x, y in metres; a z is ignored.
-        orientation : array_like, shape (4,)
-            ``(x, y, z, w)`` quaternion; only its yaw matters.
-        """
-        rb = self._robot(idn)
-        geom = self._floor(floor)
-        xy = parse_position(position, allow_2d=True)
-        yaw = parse_orientation(orientation)
-        rb.floor = int(floor)
-        rb.geom = geom
-        rb.fast = geom.fast_clearance(rb.radius)
-        rb.x, rb.y, rb.z, rb.yaw = xy[0], xy[1], geom.height, yaw
-        rb.placed = True
-        self._at_rest(rb)
-
-    def set_pose(self, idn: int, position: ArrayLike, orientation: ArrayLike) -> None:
-        """Teleport robot ``idn`` (at rest) to world ``position`` and ``orientation``.
-
-        Parameters
-        ----------
-        idn : int
-            Robot index.
-        position : array_like, shape (3,)
-            World x, y, z in metres. The robot stays on its floor (use :meth:`land` to
-            change floors).
-        orientation : array_like, shape (4,)
-            ``(x, y, z, w)`` quaternion; the backend is planar, so only its yaw is kept.
-        """
-        rb = self._robot(idn)
-        x, y, z = parse_position(position)
-        yaw = parse_orientation(orientation)
-        rb.x, rb.y, rb.z, rb.yaw = x, y, z, yaw
-        rb.placed = True
-        self._at_rest(rb)
-
-    def get_pose(self, idn: int) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-        """Return robot ``idn``'s world position (3,) in metres and orientation (4,).
-
-        The orientation is the planar quaternion ``(0, 0, sin(yaw/2), cos(yaw/2))`` with
-        yaw in [-pi, pi], so its w is >= 0.
-        """
-        rb = self._robot(idn)
-        return np.array((rb.x, rb.y, rb.z)), planar_quat(rb.yaw)
-
-    def get_pose_floats(self, idn: int) -> tuple[float, ...]:
-        """Return :meth:`get_pose`'s seven numbers as a tuple of floats, without arrays.
-
-        ``(x, y, z, qx, qy, qz, qw)``. Not part of the :class:`~pointnav_core.backend.Backend`
-        protocol: an optional fast path that the task reads on every step instead of
-        :meth:`get_pose`, only when no subclass has overridden ``get_pose``.
-        """
-        rb = self._robot(idn)
-        return (rb.x, rb.y, rb.z, *_planar_quat_floats(rb.yaw))
-
-    def is_valid_pose(
-        self,
-        idn: int,
-        position: ArrayLike,
-        orientation: ArrayLike | None = None,
-        *,
-        floor: int | None = None,
-    ) -> bool:
-        """Whether robot ``idn`` could stand at ``position``.
-
-        Parameters
-        ----------
-        idn : int
-            Robot index.
-        position : array_like, shape (2,) or (3,)
-            World x, y (and an ignored z) in metres.
-        orientation : array_like, shape (4,), optional
-            Ignored (a disc looks the same in every heading); validated when given.
-        floor : int, optional
-            Floor to test on; default: the robot's floor (:meth:`get_robot_floor`).
-
-        Returns
-        -------
-        bool
-            True when the disc misses the floor's blocked set (``tmap.collision``: every
-            OBSTACLE and VOID cell square, everything off the map and the floor plan's
-            obstacle polygons; touching within 1e-9 m is fine), exactly as the task and
-            the planner decide, and it overlaps no other present, placed, non-falling
-            robot on that floor by more than 1e-9 m. (Motion is more lenient about VOID: a
-            disc may overhang it, and a robot falls only once its centre is over it.)
-        """
-        rb = self._robot(idn)
-        geom = rb.geom if floor is None else self._floor(floor)
-        fl = rb.floor if floor is None else int(floor)
-        xy = parse_position(position, allow_2d=True)
-        if orientation is not None:
-            parse_orientation(orientation)
-        x, y = xy[0], xy[1]
-        r = rb.radius
-        if not geom.collision.points_clear((x, y), r):
-            return False
-        for other in self._robots:
-            if other is rb or other.floor != fl or not other.solid():
-                continue
-            reach = r + other.radius - _TOUCH
-            if (x - other.x) ** 2 + (y - other.y) ** 2 < reach * reach and reach > 0.0:
-                return False
-        return True
+    def _place(self, rb: _Robot, x: float, y: float, yaw: float) -> None:
+        rb.x, rb.y, rb.yaw = x, y, yaw
+        geom = self._floors[rb.floor]
+        if rb.geom is not geom:  # landed on another floor
+            rb.geom = geom
+            rb.fast = geom.fast_clearance(rb.radius)
 
     # ------------------------------------------------------------------ stepping
     def step(self, actions: Mapping[int, ArrayLike]) -> None:
         """Apply each given robot's action and advance one control step for all robots.
 
-        Parameters
-        ----------
-        actions : mapping of int to array_like
-            Robot index -> action in ``[-1, 1]`` (see :meth:`RobotSpec.scale_action`).
-            Robots without an entry get a zero command.
+        See :meth:`Backend.step`. A robot with nothing within reach of its step (the
+        clearance grid says so in one lookup) moves by its exact arc; the others advance
+        together in sub-steps with exact, swept contacts (:func:`contacts.advance`). A
+        bad action or robot index raises (ValueError) before any robot has moved.
         """
-        robots = self._robots
-        zero = (0.0, 0.0, 0.0)
-        for rb in robots:
-            rb.cmd = zero
-        for idn, action in actions.items():
-            rb = self._robot(idn)
-            cmd = rb.spec._scaled(action)
-            rb.cmd = cmd if rb.holonomic else (cmd[0], 0.0, cmd[1])
-        dt = self._dt
-        moving = []
-        for rb in robots:
-            rb.contact = False
-            if not (rb.present and rb.placed):
-                rb.vel = (0.0, 0.0, 0.0, 0.0)
-            elif rb.falling:
-                self._fall(rb, first=False)
-            else:
-                vx, vy, _ = rb.cmd
-                rb.travel = (math.hypot(vx, vy) if vy else abs(vx)) * dt
-                moving.append(rb)
+        moving = self._start_step(actions)
         if not moving:
             return
+        dt = self._dt
         slow = []
         for rb in moving:
             # Fast path: the clearance grid vouches for everything within reach.
@@ -390,7 +179,7 @@ class KinematicBackend(RobotStateBackend):
             fast = moving
         for rb in fast:
             vx, vy, w = rb.cmd
-            dx, dy = _arc(rb.yaw, vx, vy, w, dt)
+            dx, dy = drive_arc(rb.yaw, vx, vy, w, dt)
             rb.x += dx
             rb.y += dy
             rb.yaw += w * dt
@@ -426,7 +215,7 @@ class KinematicBackend(RobotStateBackend):
                 if rb.stopped or (vx == 0.0 and vy == 0.0):
                     rb.mx = rb.my = 0.0
                 else:
-                    rb.mx, rb.my = _arc(rb.yaw, vx, vy, w, h)
+                    rb.mx, rb.my = drive_arc(rb.yaw, vx, vy, w, h)
                 standing.append(rb)
             advance(standing, stop)
             for rb in standing:
@@ -434,9 +223,8 @@ class KinematicBackend(RobotStateBackend):
                     rb.falling = True
                 rb.yaw += rb.cmd[2] * h
         for rb, (x0, y0, yaw0) in zip(slow, start):
+            planar = ((rb.x - x0) / dt, (rb.y - y0) / dt, (rb.yaw - yaw0) / dt)
             if rb.falling:
-                vel_x, vel_y, wz = (rb.x - x0) / dt, (rb.y - y0) / dt, (rb.yaw - yaw0) / dt
-                self._fall(rb, first=True)
-                rb.vel = (vel_x, vel_y, rb.vel[2], wz)
+                self._fall(rb, first=True, planar=planar)
             else:
-                rb.vel = ((rb.x - x0) / dt, (rb.y - y0) / dt, 0.0, (rb.yaw - yaw0) / dt)
+                rb.vel = (planar[0], planar[1], 0.0, planar[2])

@@ -9,16 +9,14 @@ from typing import Any
 
 import numpy as np
 import pymunk
-from numpy.typing import ArrayLike, NDArray
+from numpy.typing import ArrayLike
 
-from pointnav_core.backend import (
-    RobotSpec,
+from pointnav_core.backend import RobotSpec
+from pointnav_core.backend_kit import (
+    RobotState,
     RobotStateBackend,
-    _planar_quat_floats,
     check_load,
-    parse_orientation,
-    parse_position,
-    planar_quat,
+    drive_arc,
 )
 from pointnav_core.maps import VOID
 from pointnav_pymunk.floor import (
@@ -46,45 +44,14 @@ _MASS = 1.0  # kg, a driving robot
 _HOLD_MASS = 1e6  # kg, a robot told to stand still (braked: it is not shoved)
 _MOTOR_MARGIN = 4.0  # motor force lets a robot reverse at full speed within a sub-step, x2
 
-class _Robot:
-    """One robot: its spec, its pymunk parts and its per-step state."""
+class _Robot(RobotState):
+    """One robot: the shared state, its pymunk parts and what a step needs."""
 
-    __slots__ = (
-        "spec",
-        "radius",
-        "holonomic",
-        "floor",
-        "z",
-        "body",
-        "shape",
-        "control",
-        "joint",
-        "space",
-        "present",
-        "placed",
-        "falling",
-        "fall_speed",
-        "contact",
-        "vel",
-        "cmd",
-        "touching",
-        "start",
-    )
+    __slots__ = ("body", "shape", "control", "joint", "space", "touching", "start")
 
     def __init__(self, spec: RobotSpec) -> None:
-        self.spec = spec
-        self.radius = spec.radius
-        self.holonomic = spec.drive == "holonomic"
-        self.floor = 0
-        self.z = 0.0
+        super().__init__(spec)
         self.space: pymunk.Space | None = None
-        self.present = True
-        self.placed = False
-        self.falling = False
-        self.fall_speed = 0.0
-        self.contact = False
-        self.vel = (0.0, 0.0, 0.0, 0.0)  # world (vx, vy, vz) m/s and yaw rate rad/s
-        self.cmd = (0.0, 0.0, 0.0)  # body-frame (vx, vy, w) of the current step
         # Contacts found by the last pymunk step: (nx, ny, other robot or None), the
         # normal pointing from the obstacle towards this robot.
         self.touching: list[tuple[float, float, Any]] = []
@@ -109,9 +76,11 @@ class _Robot:
         self.body, self.shape, self.control, self.joint = body, shape, control, joint
         self.space = None
 
-    def solid(self) -> bool:
-        """Whether the robot is in the world's physics (others can touch it)."""
-        return self.present and self.placed and not self.falling
+    def at_rest(self) -> None:
+        super().at_rest()
+        self.touching = []
+        self.body.velocity = (0.0, 0.0)
+        self.body.angular_velocity = 0.0
 
 
 def _empty_spaces(spaces: list[pymunk.Space]) -> None:
@@ -124,19 +93,6 @@ def _empty_spaces(spaces: list[pymunk.Space]) -> None:
     for space in spaces:
         space.remove(*space.constraints, *space.shapes, *space.bodies)
     spaces.clear()
-
-
-def _chord(yaw: float, vx: float, vy: float, w: float, h: float) -> tuple[float, float]:
-    """World velocity whose straight motion over ``h`` s ends where the exact arc ends.
-
-    The arc of body velocity (vx, vy) turning at ``w`` rad/s from heading ``yaw``; written
-    with sin(a)/a, a = w h / 2, so it stays accurate as w -> 0.
-    """
-    a = 0.5 * w * h
-    s = math.sin(a) / a if a != 0.0 else 1.0
-    mid = yaw + a
-    c, sn = math.cos(mid), math.sin(mid)
-    return s * (vx * c - vy * sn), s * (vx * sn + vy * c)
 
 
 def _project(
@@ -201,7 +157,10 @@ class PymunkBackend(RobotStateBackend):
     obstacle or another robot by more than :data:`OVERLAP_TOLERANCE` (1 mm); in practice
     a robot ends clear of the blocked set (it rests on the skin, overlapping it by pymunk's
     slop, :data:`CONTACT_SLOP`), and overlaps another robot by at most
-    :data:`TOUCH_TOLERANCE` (1e-6 m).
+    :data:`TOUCH_TOLERANCE` (1e-6 m). :meth:`is_valid_pose` accepts a robot that overlaps
+    another by up to :data:`TOUCH_TOLERANCE`, so two robots resting in contact stand
+    validly, and a robot resting against a wall stays valid: the static shapes are grown
+    by a skin of half :data:`TOUCH_TOLERANCE`, so it rests clear of the blocked set.
 
     Parameters
     ----------
@@ -247,6 +206,8 @@ class PymunkBackend(RobotStateBackend):
     (3.75, True)
     """
 
+    touch_tolerance = TOUCH_TOLERANCE
+
     def __init__(self, min_substeps: int = 1, fall_speed: float = 1.0) -> None:
         if (
             isinstance(min_substeps, bool)
@@ -272,25 +233,14 @@ class PymunkBackend(RobotStateBackend):
     ) -> None:
         """Build one pymunk space per floor of ``scene`` and one robot per spec.
 
-        Parameters
-        ----------
-        scene : Scene
-            Uses ``floors`` (list of TraversableMap), ``n_floors`` and
-            ``get_floor_height(floor)``. Robots collide with each floor's OBSTACLE cells
-            and with the obstacle polygons of its collision geometry (``tmap.collision``,
-            from the floor plan the map was built from, if any).
-        robots : sequence of RobotSpec
-            Robot ``idn`` is ``robots[idn]``.
-        action_frequency : float
-            Control steps per second (Hz), > 0.
-
-        Notes
-        -----
-        Robots start present, unplaced, at rest at x = y = 0 on floor 0.
+        See :meth:`Backend.load`. Robots collide with each floor's OBSTACLE cells and with
+        the obstacle polygons of its collision geometry (``tmap.collision``, from the
+        floor plan the map was built from, if any); they start present, unplaced, at rest
+        at x = y = 0 on floor 0.
         """
         specs, n_floors, dt = check_load(scene, robots, action_frequency)
         self._floors = [
-            _Floor(f, scene.floors[f], float(scene.get_floor_height(f))) for f in range(n_floors)
+            _Floor(scene.floors[f], float(scene.get_floor_height(f))) for f in range(n_floors)
         ]
         self._robots = [_Robot(spec) for spec in specs]
         for rb in self._robots:
@@ -311,29 +261,12 @@ class PymunkBackend(RobotStateBackend):
             self._by_shape[rb.shape] = rb
 
     def reset(self) -> None:
-        """Return every robot to its state after :meth:`load`, keeping its pose.
+        """As :meth:`RobotStateBackend.reset`, and every space is rebuilt.
 
-        Velocities and contact flags become zero, falls end, and every robot is present
-        again but unplaced: it takes part in no collision until :meth:`land` or
-        :meth:`set_pose` places it. Every space is rebuilt, so what happens next does not
-        depend on what happened before.
+        So what happens next does not depend on what happened before.
         """
-        for rb in self._robots:
-            rb.present = True
-            rb.placed = False
-            self._at_rest(rb)
+        super().reset()
         self._rebuild()
-
-    @staticmethod
-    def _at_rest(rb: _Robot) -> None:
-        rb.falling = False
-        rb.fall_speed = 0.0
-        rb.contact = False
-        rb.vel = (0.0, 0.0, 0.0, 0.0)
-        rb.cmd = (0.0, 0.0, 0.0)
-        rb.touching = []
-        rb.body.velocity = (0.0, 0.0)
-        rb.body.angular_velocity = 0.0
 
     # ------------------------------------------------------------------ membership
     def _sync_space(self, rb: _Robot) -> None:
@@ -365,73 +298,13 @@ class PymunkBackend(RobotStateBackend):
         self._forget(rb)
 
     # ------------------------------------------------------------------ poses
-    def land(self, idn: int, floor: int, position: ArrayLike, orientation: ArrayLike) -> None:
-        """Place robot ``idn`` at rest on ``floor``: x, y from ``position``, z = floor height.
+    def _pose(self, rb: _Robot) -> tuple[float, float, float]:
+        x, y = rb.body.position
+        return x, y, rb.body.angle
 
-        Parameters
-        ----------
-        idn : int
-            Robot index.
-        floor : int
-            Floor index.
-        position : array_like, shape (2,) or (3,)
-            World x, y in metres; a z is ignored.
-        orientation : array_like, shape (4,)
-            ``(x, y, z, w)`` quaternion; only its yaw matters.
-        """
-        rb = self._robot(idn)
-        fl = self._floor(floor)
-        xy = parse_position(position, allow_2d=True)
-        yaw = parse_orientation(orientation)
-        self._at_rest(rb)
-        rb.floor = fl.index
-        rb.z = fl.height
-        rb.placed = True
-        self._teleport(rb, xy[0], xy[1], yaw)
-        self._sync_space(rb)
-
-    def set_pose(self, idn: int, position: ArrayLike, orientation: ArrayLike) -> None:
-        """Teleport robot ``idn`` (at rest) to world ``position`` and ``orientation``.
-
-        Parameters
-        ----------
-        idn : int
-            Robot index.
-        position : array_like, shape (3,)
-            World x, y, z in metres. The robot stays on its floor (use :meth:`land` to
-            change floors).
-        orientation : array_like, shape (4,)
-            ``(x, y, z, w)`` quaternion; the backend is planar, so only its yaw is kept.
-        """
-        rb = self._robot(idn)
-        x, y, z = parse_position(position)
-        yaw = parse_orientation(orientation)
-        self._at_rest(rb)
-        rb.z = z
-        rb.placed = True
+    def _place(self, rb: _Robot, x: float, y: float, yaw: float) -> None:
         self._teleport(rb, x, y, yaw)
         self._sync_space(rb)
-
-    def get_pose(self, idn: int) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-        """Return robot ``idn``'s world position (3,) in metres and orientation (4,).
-
-        The orientation is the planar quaternion ``(0, 0, sin(yaw/2), cos(yaw/2))`` with
-        yaw in [-pi, pi], so its w is >= 0.
-        """
-        rb = self._robot(idn)
-        x, y = rb.body.position
-        return np.array((x, y, rb.z)), planar_quat(rb.body.angle)
-
-    def get_pose_floats(self, idn: int) -> tuple[float, ...]:
-        """Return :meth:`get_pose`'s seven numbers as a tuple of floats, without arrays.
-
-        ``(x, y, z, qx, qy, qz, qw)``. Not part of the :class:`~pointnav_core.backend.Backend`
-        protocol: an optional fast path that the task reads on every step instead of
-        :meth:`get_pose`, only when no subclass has overridden ``get_pose``.
-        """
-        rb = self._robot(idn)
-        x, y = rb.body.position
-        return (x, y, rb.z, *_planar_quat_floats(rb.body.angle))
 
     def set_present(self, idn: int, present: bool) -> None:
         """Take robot ``idn`` out of the world (``False``) or bring it back (``True``).
@@ -443,56 +316,6 @@ class PymunkBackend(RobotStateBackend):
         rb = self._robots[idn]
         rb.body.velocity = (0.0, 0.0)
         self._sync_space(rb)
-
-    def is_valid_pose(
-        self,
-        idn: int,
-        position: ArrayLike,
-        orientation: ArrayLike | None = None,
-        *,
-        floor: int | None = None,
-    ) -> bool:
-        """Whether robot ``idn`` could stand at ``position``.
-
-        Parameters
-        ----------
-        idn : int
-            Robot index.
-        position : array_like, shape (2,) or (3,)
-            World x, y (and an ignored z) in metres.
-        orientation : array_like, shape (4,), optional
-            Ignored (a disc looks the same in every heading); validated when given.
-        floor : int, optional
-            Floor to test on; default: the robot's floor (:meth:`get_robot_floor`).
-
-        Returns
-        -------
-        bool
-            True when the disc misses the floor's blocked set exactly as
-            ``tmap.collision.points_clear`` decides (every OBSTACLE and VOID cell square,
-            everything off the map, the floor plan's obstacle polygons; touching within
-            :data:`~pointnav_core.collision.TOUCH_TOL` is fine), and it overlaps no other
-            present, placed, non-falling robot on that floor by more than
-            :data:`TOUCH_TOLERANCE`. A robot resting against a wall stays valid: the static
-            shapes are grown by a skin of half :data:`TOUCH_TOLERANCE`, so it rests clear.
-        """
-        rb = self._robot(idn)
-        fl = self._floors[rb.floor] if floor is None else self._floor(floor)
-        xy = parse_position(position, allow_2d=True)
-        if orientation is not None:
-            parse_orientation(orientation)
-        x, y = xy[0], xy[1]
-        r = rb.radius
-        if not fl.clear(x, y, r):
-            return False
-        for other in self._robots:
-            if other is rb or other.floor != fl.index or not other.solid():
-                continue
-            reach = r + other.radius - TOUCH_TOLERANCE
-            ox, oy = other.body.position
-            if reach > 0.0 and (x - ox) ** 2 + (y - oy) ** 2 < reach * reach:
-                return False
-        return True
 
     # ------------------------------------------------------------------ contacts
     def _hit_wall(self, arbiter: pymunk.Arbiter, space: pymunk.Space, data: Any) -> None:
@@ -533,44 +356,22 @@ class PymunkBackend(RobotStateBackend):
     def step(self, actions: Mapping[int, ArrayLike]) -> None:
         """Apply each given robot's action and advance one control step for all robots.
 
-        Parameters
-        ----------
-        actions : mapping of int to array_like
-            Robot index -> action in ``[-1, 1]`` (see :meth:`RobotSpec.scale_action`).
-            Robots without an entry get a zero command.
-
-        Raises
-        ------
-        ValueError
-            If an action has the wrong shape or is not finite, or an index is out of
-            range; no robot has moved then.
+        See :meth:`Backend.step`; how a step runs is told in the class's notes. A bad
+        action or robot index raises (ValueError) before any robot has moved.
         """
-        commands = {}
-        for idn, action in actions.items():
-            rb = self._robot(idn)
-            cmd = rb.spec._scaled(action)
-            commands[id(rb)] = cmd if rb.holonomic else (cmd[0], 0.0, cmd[1])
+        free = self._start_step(actions)
         dt = self._dt
-        zero = (0.0, 0.0, 0.0)
         moving: list[_Robot] = []
-        travel = 0.0
+        travel = 0.0  # the most sub-steps' worth of travel of any robot
         reach = self._reach()
-        for rb in self._robots:
-            rb.cmd = commands.get(id(rb), zero)
-            rb.contact = False
-            if not (rb.present and rb.placed):
-                rb.vel = (0.0, 0.0, 0.0, 0.0)
-            elif rb.falling:
-                self._fall(rb, first=False)
-            else:
-                x, y = rb.body.position
-                rb.start = (x, y, rb.body.angle)
-                if self._floors[rb.floor].code(x, y) == VOID:
-                    self._start_fall(rb)  # standing over nothing: falls without moving
-                    continue
-                vx, vy, _ = rb.cmd
-                travel = max(travel, math.hypot(vx, vy) * dt / reach[rb.floor])
-                moving.append(rb)
+        for rb in free:
+            x, y = rb.body.position
+            rb.start = (x, y, rb.body.angle)
+            if self._floors[rb.floor].code(x, y) == VOID:
+                self._start_fall(rb)  # standing over nothing: falls without moving
+                continue
+            travel = max(travel, rb.travel / reach[rb.floor])
+            moving.append(rb)
         if not moving:
             return
         n_sub = min(max(self.min_substeps, math.ceil(travel)), _MAX_SUBSTEPS)
@@ -626,7 +427,7 @@ class PymunkBackend(RobotStateBackend):
                     velocities.append(None)
                     continue
                 vx, vy, w = rb.cmd
-                u = _chord(rb.body.angle, vx, vy, w, h)
+                u = drive_arc(rb.body.angle, vx, vy, w, h, True)
                 rb.control.velocity = u
                 velocities.append(u)
             for rb, u in zip(moving, velocities):
@@ -694,5 +495,5 @@ class PymunkBackend(RobotStateBackend):
         rb.body.velocity = (0.0, 0.0)
         rb.body.angular_velocity = 0.0
         dt = self._dt
-        self._fall(rb, first=True)
-        rb.vel = ((x - x0) / dt, (y - y0) / dt, rb.vel[2], (rb.body.angle - yaw0) / dt)
+        planar = ((x - x0) / dt, (y - y0) / dt, (rb.body.angle - yaw0) / dt)
+        self._fall(rb, first=True, planar=planar)

@@ -15,7 +15,7 @@ from typing import Any
 import numpy as np
 import pymunk
 
-from pointnav_core.maps import VOID
+from pointnav_core.backend_kit import FloorGrid
 from pointnav_pymunk.geometry import floor_pieces
 
 __all__ = ["CONTACT_SLOP", "TOUCH_TOLERANCE"]
@@ -37,39 +37,15 @@ _WALL, _ROBOT = 1, 2  # collision types, and shape-filter categories
 _WALLS_ONLY = pymunk.ShapeFilter(mask=_WALL)
 
 
-class _Floor:
+class _Floor(FloorGrid):
     """One floor: its grid, its pymunk Space of static obstacles, its standing test."""
 
-    __slots__ = (
-        "index",
-        "height",
-        "codes",
-        "rows",
-        "width",
-        "res",
-        "inv_res",
-        "ox",
-        "oy",
-        "pieces",
-        "thickness",
-        "collision",
-        "grid",
-        "space",
-        "depth",
-    )
+    __slots__ = ("pieces", "thickness", "grid", "space", "depth")
 
-    def __init__(self, index: int, tmap: Any, height: float) -> None:
-        codes = np.asarray(tmap.codes)
-        self.index = index
-        self.height = height
-        self.rows, self.width = (int(n) for n in codes.shape)
-        self.codes = codes.astype(np.uint8).tobytes()
-        self.res = float(tmap.resolution)
-        self.inv_res = 1.0 / self.res
-        self.ox, self.oy = (float(v) for v in tmap.origin)
+    def __init__(self, tmap: Any, height: float) -> None:
+        super().__init__(tmap, height)
         self.pieces, self.thickness = floor_pieces(tmap)
-        self.collision = tmap.collision  # the one blocked set, for is_valid_pose
-        self.grid = codes
+        self.grid = np.asarray(tmap.codes)
         self.space: pymunk.Space = None  # type: ignore[assignment]  # set by build_space
         self.depth = 0.0  # deepest overlap seen while measuring (m)
 
@@ -96,11 +72,11 @@ class _Floor:
     def clear(self, x: float, y: float, r: float) -> bool:
         """Whether a disc of radius ``r`` m at world (x, y) misses the floor's blocked set.
 
-        Exactly ``collision.points_clear``: every non-FREE cell, off the map, the polygons.
+        Exactly ``FloorGrid.clear``: every non-FREE cell, off the map, the polygons.
         """
         if self._far_from_walls(x, y, r):
             return True
-        return bool(self.collision.points_clear((x, y), r))
+        return super().clear(x, y, r)
 
     def _far_from_walls(self, x: float, y: float, r: float) -> bool:
         # A quick yes, about 20 times cheaper than the exact test, for the usual disc in
@@ -115,11 +91,3 @@ class _Floor:
         if self.grid[r0 : r1 + 1, c0 : c1 + 1].any():  # FREE is 0
             return False
         return not self.space.point_query((x, y), r + 2.0 * _WALL_SKIN, _WALLS_ONLY)
-
-    def code(self, x: float, y: float) -> int:
-        """Cell code under world point (x, y); VOID off the map."""
-        col = math.floor((x - self.ox) * self.inv_res)
-        row = math.floor((y - self.oy) * self.inv_res)
-        if 0 <= col < self.width and 0 <= row < self.rows:
-            return self.codes[row * self.width + col]
-        return VOID
