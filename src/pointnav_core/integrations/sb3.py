@@ -1,10 +1,11 @@
 """Stable-Baselines3 adapters: the multi-robot env as a ``VecEnv``, and a metrics callback.
 
-SuperSuit's ``pettingzoo_env_to_vec_env_v1`` does not fit ``MultiPointNav-v0``: it takes
-a world as finished only when every robot is both terminated *and* truncated, so it steps
-a world whose robots all ended and the env raises ``TaskStateError``; its auto-reset puts
-the reset infos over the final ones (the logged success rate is the reset's); and its
-``ConcatVecEnv`` cannot be seeded. :class:`MultiRobotVecEnv` does this directly.
+SuperSuit (3.11) does not fit ``MultiPointNav-v0``: its ``black_death_v3``, which
+``pettingzoo_env_to_vec_env_v1`` needs as robots leave at different steps, ends a world
+only when every robot is both terminated *and* truncated, so the vec env steps a world
+whose robots all ended and the env raises ``TaskStateError``; the vec env's auto-reset puts
+the reset infos over the final ones (a logged success rate is not the episodes'); and
+``concat_vec_envs_v1`` cannot be seeded. :class:`MultiRobotVecEnv` does this directly.
 
 Slots
 -----
