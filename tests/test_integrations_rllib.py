@@ -11,6 +11,7 @@ import ray
 from ray.rllib.algorithms.ppo import PPOConfig
 from ray.rllib.core.rl_module.default_model_config import DefaultModelConfig
 from ray.rllib.env.multi_agent_episode import MultiAgentEpisode
+from ray.rllib.env.single_agent_episode import SingleAgentEpisode
 from ray.rllib.env.wrappers.pettingzoo_env import ParallelPettingZooEnv
 from ray.rllib.utils.metrics.metrics_logger import MetricsLogger
 from ray.rllib.utils.pre_checks.env import check_multiagent_environments
@@ -137,6 +138,21 @@ def test_rllib_episode_takes_the_mixed_end_and_is_done_only_at_its_end():
     for key, expected in rl_cases.EXPECTED_MEANS.items():
         assert logger.peek(("pointnav", key)) == pytest.approx(expected)
     assert logger.peek(("pointnav", "success")) == pytest.approx(2 / 3)
+
+
+def test_callback_reads_single_robot_episodes_too():
+    # robot_2 of rl_cases alone: its goal is inside the tolerance, success on step 1.
+    task = rl_cases.TASKS[2]
+    env = make_single_env({"scene": rl_cases.open_room(), "task": task})
+    episode = SingleAgentEpisode()
+    logger = MetricsLogger()
+    obs, info = env.reset(seed=0)
+    episode.add_env_reset(obs, info)
+    obs, reward, terminated, truncated, info = env.step(rl_cases.ACTIONS["robot_2"])
+    episode.add_env_step(obs, rl_cases.ACTIONS["robot_2"], reward, info, terminated=terminated, truncated=truncated)
+    PointNavMetricsCallbacks().on_episode_end(episode=episode, metrics_logger=logger, env_index=0)
+    for key, expected in rl_cases.EXPECTED["robot_2"].items():
+        assert logger.peek(("pointnav", key)) == pytest.approx(expected)
 
 
 def test_render_takes_no_argument_and_rllibs_own_wrapper_can_render():

@@ -142,6 +142,7 @@ def test_callback_logs_the_success_rate_of_the_final_infos():
     assert logged["pointnav/spl"] == pytest.approx(expected["spl"])
     assert logged["pointnav/soft_spl"] == pytest.approx(expected["soft_spl"])
     assert logged["pointnav/collisions"] == pytest.approx(expected["collisions"])
+    assert callback.summary().startswith("last 3 of 3 episodes: success rate 0.67, SPL 0.67")
 
 
 def test_ppo_learns_on_the_vec_env_across_world_resets():

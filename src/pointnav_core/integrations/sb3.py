@@ -313,6 +313,17 @@ class PointNavMetricsCallback(BaseCallback):
         """The metrics' means over the last ``window`` episodes (empty before the first)."""
         return {key: float(np.mean(values)) for key, values in self._recent.items() if values}
 
+    def summary(self) -> str:
+        """One line on the recent episodes: their count and the metrics' means."""
+        if not self.episodes:
+            return "no episode has ended yet"
+        means = self.means()
+        return (
+            f"last {min(self.episodes, self.window)} of {self.episodes} episodes: success rate "
+            f"{means['success']:.2f}, SPL {means['spl']:.2f}, SoftSPL {means['soft_spl']:.2f}, "
+            f"collisions {means['collisions']:.1f}"
+        )
+
     def record(self) -> None:
         """Record the current means (and the episode count) in the logger."""
         for key, value in self.means().items():
