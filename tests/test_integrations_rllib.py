@@ -105,7 +105,9 @@ def test_all_is_in_truncateds_when_max_cycles_cuts_every_robot():
     env = PointNavMultiAgentEnv({"scene": small_house(), "n_robots": 2, "max_cycles": 3})
     env.reset(seed=0)
     for t in range(1, 4):
-        _, _, terminateds, truncateds, _ = env.step({a: np.zeros(2, np.float32) for a in env.agents})
+        _, _, terminateds, truncateds, _ = env.step(
+            {a: np.zeros(2, np.float32) for a in env.agents}
+        )
         assert terminateds["__all__"] is False
         assert truncateds["__all__"] is (t == 3)
 
@@ -149,7 +151,9 @@ def test_callback_reads_single_robot_episodes_too():
     obs, info = env.reset(seed=0)
     episode.add_env_reset(obs, info)
     obs, reward, terminated, truncated, info = env.step(rl_cases.ACTIONS["robot_2"])
-    episode.add_env_step(obs, rl_cases.ACTIONS["robot_2"], reward, info, terminated=terminated, truncated=truncated)
+    episode.add_env_step(
+        obs, rl_cases.ACTIONS["robot_2"], reward, info, terminated=terminated, truncated=truncated
+    )
     PointNavMetricsCallbacks().on_episode_end(episode=episode, metrics_logger=logger, env_index=0)
     for key, expected in rl_cases.EXPECTED["robot_2"].items():
         assert logger.peek(("pointnav", key)) == pytest.approx(expected)

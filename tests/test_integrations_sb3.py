@@ -62,7 +62,14 @@ def test_sb3_check_env_passes_on_the_registered_env(kwargs):
 
 def test_callback_logs_the_final_infos_of_single_robot_episodes():
     venv = DummyVecEnv(
-        [lambda: gym.make(ENV_ID, scene=small_house(), flatten_obs=True, task={"termination_config": {"max_steps": 8}})]
+        [
+            lambda: gym.make(
+                ENV_ID,
+                scene=small_house(),
+                flatten_obs=True,
+                task={"termination_config": {"max_steps": 8}},
+            )
+        ]
     )
     model = PPO("MlpPolicy", venv, n_steps=16, batch_size=16, n_epochs=1, seed=0)
     logger, capture = capture_logger()
@@ -108,7 +115,9 @@ def test_vec_env_keeps_final_infos_through_a_mixed_termination_and_truncation():
     assert infos[2] == {"idle": True}
     for k, agent in enumerate(rl_cases.AGENTS[:2]):
         assert infos[k]["episode_length"] == 5
-        assert infos[k]["TimeLimit.truncated"] is (rl_cases.TRUNCATED[agent] and not rl_cases.TERMINATED[agent])
+        assert infos[k]["TimeLimit.truncated"] is (
+            rl_cases.TRUNCATED[agent] and not rl_cases.TERMINATED[agent]
+        )
     # robot_0's final observation: its goal 0.47 m ahead (the new episode's: 0.72 m).
     assert infos[0]["terminal_observation"][0] == pytest.approx(0.47)
     assert first[0][0] == pytest.approx(0.72)
@@ -146,7 +155,9 @@ def test_callback_logs_the_success_rate_of_the_final_infos():
 
 
 def test_ppo_learns_on_the_vec_env_across_world_resets():
-    venv = VecMonitor(make_vec_env(n_worlds=2, n_robots=2, scene=small_house(), max_cycles=6, seed=0))
+    venv = VecMonitor(
+        make_vec_env(n_worlds=2, n_robots=2, scene=small_house(), max_cycles=6, seed=0)
+    )
     model = PPO("MlpPolicy", venv, n_steps=12, batch_size=48, n_epochs=1, seed=0)
     logger, capture = capture_logger()
     model.set_logger(logger)

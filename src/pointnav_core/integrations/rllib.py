@@ -199,7 +199,9 @@ class PointNavMetricsCallbacks(RLlibCallback):
             return
         for metrics in finished.values():
             for key, value in metrics.items():
-                metrics_logger.log_value(("pointnav", key), value, reduce="mean", window=self.WINDOW)
+                metrics_logger.log_value(
+                    ("pointnav", key), value, reduce="mean", window=self.WINDOW
+                )
 
 
 def _stash_finished(episode: Any, stash_key: str) -> dict[Any, dict[str, float]]:

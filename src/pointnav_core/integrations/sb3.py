@@ -38,6 +38,7 @@ from __future__ import annotations
 from collections import deque
 from collections.abc import Callable, Iterable, Mapping, Sequence
 from copy import deepcopy
+from types import MappingProxyType
 from typing import Any
 
 import numpy as np
@@ -103,8 +104,9 @@ class MultiRobotVecEnv(VecEnv):
         for w, agent in self.slots:
             if self.worlds[w].observation_space(agent) != obs_space:
                 raise ValueError(
-                    f"every robot must have the same observation space: world {w}'s {agent} has "
-                    f"{self.worlds[w].observation_space(agent)}, world 0's {first_agent} {obs_space}"
+                    f"every robot must have the same observation space: world {w}'s {agent} "
+                    f"has {self.worlds[w].observation_space(agent)}, world 0's {first_agent} "
+                    f"{obs_space}"
                 )
             if self.worlds[w].action_space(agent) != act_space:
                 raise ValueError(
@@ -184,7 +186,9 @@ class MultiRobotVecEnv(VecEnv):
 
     def get_attr(self, attr_name: str, indices: VecEnvIndices = None) -> list[Any]:
         """The attribute of each slot's world."""
-        return [getattr(self.worlds[self.slots[k][0]], attr_name) for k in self._get_indices(indices)]
+        return [
+            getattr(self.worlds[self.slots[k][0]], attr_name) for k in self._get_indices(indices)
+        ]
 
     def set_attr(self, attr_name: str, value: Any, indices: VecEnvIndices = None) -> None:
         """Set the attribute on each world named by the slots (once per world)."""
@@ -192,7 +196,11 @@ class MultiRobotVecEnv(VecEnv):
             setattr(self.worlds[w], attr_name, value)
 
     def env_method(
-        self, method_name: str, *method_args: Any, indices: VecEnvIndices = None, **method_kwargs: Any
+        self,
+        method_name: str,
+        *method_args: Any,
+        indices: VecEnvIndices = None,
+        **method_kwargs: Any,
     ) -> list[Any]:
         """Call the method once per world named by the slots; each slot gets its world's result."""
         slots = list(self._get_indices(indices))
@@ -204,11 +212,15 @@ class MultiRobotVecEnv(VecEnv):
 
     def env_is_wrapped(self, wrapper_class: type, indices: VecEnvIndices = None) -> list[bool]:
         """Whether each slot's world is (or is wrapped by) an instance of ``wrapper_class``."""
-        return [_is_wrapped(self.worlds[self.slots[k][0]], wrapper_class) for k in self._get_indices(indices)]
+        return [
+            _is_wrapped(self.worlds[self.slots[k][0]], wrapper_class)
+            for k in self._get_indices(indices)
+        ]
 
     # ------------------------------------------------------------------ helpers
     def _worlds_of(self, indices: VecEnvIndices | Iterable[int]) -> list[int]:
-        return list(dict.fromkeys(self.slots[k][0] for k in self._get_indices(indices)))  # type: ignore[arg-type]
+        slots = self._get_indices(indices)  # type: ignore[arg-type]
+        return list(dict.fromkeys(self.slots[k][0] for k in slots))
 
     def _reset_world(
         self, w: int, seed: int | None = None, options: Mapping[str, Any] | None = None
@@ -276,12 +288,14 @@ class PointNavMetricsCallback(BaseCallback):
     """
 
     #: Logger key of each metric.
-    KEYS = {
-        "success": "pointnav/success_rate",
-        "spl": "pointnav/spl",
-        "soft_spl": "pointnav/soft_spl",
-        "collisions": "pointnav/collisions",
-    }
+    KEYS = MappingProxyType(
+        {
+            "success": "pointnav/success_rate",
+            "spl": "pointnav/spl",
+            "soft_spl": "pointnav/soft_spl",
+            "collisions": "pointnav/collisions",
+        }
+    )
 
     def __init__(self, window: int = 100, verbose: int = 0) -> None:
         super().__init__(verbose)
