@@ -126,12 +126,14 @@ next ``reset``.
 
 Rendering
 ---------
-``render()`` (no arguments) returns a top-down ``(H, W, 3)`` uint8 image when
+``render()`` returns a top-down ``(H, W, 3)`` uint8 image when
 ``render_mode="rgb_array"`` (:func:`pointnav_core.render.render_env`): the first task's
 floor, every robot present on it (parked ones too) and, with ``visualize_goal`` /
 ``visualize_path``, each task's markers. PettingZoo's ``render_test`` builds every env with
 ``render_mode="human"`` first, so ``"human"`` is accepted at construction; it is not
 supported (there is no window), and ``render()`` then raises ``NotImplementedError``.
+``render(mode)`` also works when ``mode`` is None or the ``render_mode`` (RLlib's
+PettingZoo wrapper passes it); another mode is a ``ValueError``.
 
 Examples
 --------
@@ -670,8 +672,16 @@ class MultiPointNavEnv(ParallelEnv[str, Any, np.ndarray]):
         state = np.clip(np.array(values), self._state_low, self._state_high)
         return state.astype(np.float32)
 
-    def render(self) -> NDArray[np.uint8] | None:
-        """Return a top-down RGB image (H, W, 3) uint8 when ``render_mode="rgb_array"``."""
+    def render(self, mode: str | None = None) -> NDArray[np.uint8] | None:
+        """Return a top-down RGB image (H, W, 3) uint8 when ``render_mode="rgb_array"``.
+
+        ``mode``, if given, must be the ``render_mode`` chosen at construction.
+        """
+        if mode is not None and mode != self.render_mode:
+            raise ValueError(
+                f"render() draws in the render_mode given at construction "
+                f"({self.render_mode!r}), got mode={mode!r}"
+            )
         if self.render_mode is None:
             gymnasium.logger.warn(
                 "You are calling render method without specifying any render mode. "
