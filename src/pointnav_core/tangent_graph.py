@@ -47,6 +47,7 @@ from scipy import ndimage
 from scipy.spatial import cKDTree
 
 from pointnav_core.collision import TOUCH_TOL, FloorCollision, convex_corners
+from pointnav_core.frozen import thaw
 from pointnav_core.paths import path_length, resample_path
 from pointnav_core.tangent_edges import build_edges, sight_radii
 
@@ -141,6 +142,11 @@ class Planner:
         self._cell_graph: Any = None
         self._fields: dict[tuple[float, float], GoalField] = {}
         self._field_bytes = 0
+
+    def __setstate__(self, state: dict[str, Any]) -> None:
+        # The sight bounds is filled in place as queries arrive; a copy unpickled from read-only
+        # buffers (another process, Ray's object store) gets writable arrays.
+        self.__dict__.update(thaw(state))
 
     # ------------------------------------------------------------------ nodes
     def _build_nodes(self) -> None:

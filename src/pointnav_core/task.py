@@ -25,13 +25,13 @@ from __future__ import annotations
 
 import math
 from collections.abc import Mapping, Sequence
-from types import MappingProxyType
 from typing import TYPE_CHECKING, Any, ClassVar, Protocol
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from pointnav_core.backend import float_twin
+from pointnav_core.frozen import FrozenMapping
 from pointnav_core.lifecycle import (
     ERROR,
     IDLE,
@@ -176,7 +176,7 @@ def _merge_config(
 ) -> Mapping[str, Any]:
     merged = dict(defaults)
     if overrides is None:
-        return MappingProxyType(merged)
+        return FrozenMapping(merged)
     if not isinstance(overrides, Mapping):
         raise ValueError(f"{name} must be None or a dict, got {overrides!r}")
     for key in overrides:
@@ -185,7 +185,7 @@ def _merge_config(
                 f"{name} has an unknown key {key!r}; valid keys are {list(defaults)}"
             )
     merged.update(overrides)
-    return MappingProxyType(merged)
+    return FrozenMapping(merged)
 
 
 def _compose(kind: str, base: type, defaults: Sequence[Any], extra: Any) -> dict[str, Any]:
@@ -309,11 +309,11 @@ class PointNavigationTask:
     max_trials: ClassVar[int] = 100
 
     #: Termination defaults (read-only; pass ``termination_config`` to override).
-    default_termination_config: ClassVar[Mapping[str, Any]] = MappingProxyType(
+    default_termination_config: ClassVar[Mapping[str, Any]] = FrozenMapping(
         {"max_collisions": 500, "max_steps": 500, "fall_height": 0.03}
     )
     #: Reward defaults (read-only; pass ``reward_config`` to override).
-    default_reward_config: ClassVar[Mapping[str, Any]] = MappingProxyType(
+    default_reward_config: ClassVar[Mapping[str, Any]] = FrozenMapping(
         {"r_potential": 1.0, "r_collision": 0.1, "r_pointgoal": 10.0}
     )
 
@@ -382,11 +382,11 @@ class PointNavigationTask:
         observations = _compose(
             "observation_terms", ObservationTerm, default_observation_terms(self._goal_in_polar), observation_terms
         )
-        self._observations: Mapping[str, ObservationTerm] = MappingProxyType(observations)
+        self._observations: Mapping[str, ObservationTerm] = FrozenMapping(observations)
         self._obs_layout: ObservationLayout | None = None
         self._frame = Frame()
-        self._terminations: Mapping[str, TerminationCondition] = MappingProxyType(terminations)
-        self._rewards: Mapping[str, RewardFunction] = MappingProxyType(rewards)
+        self._terminations: Mapping[str, TerminationCondition] = FrozenMapping(terminations)
+        self._rewards: Mapping[str, RewardFunction] = FrozenMapping(rewards)
         # The same, as tuples of (name, object) pairs for the per-step loops (both
         # mappings are read-only, so these never go stale).
         self._termination_items = tuple(terminations.items())

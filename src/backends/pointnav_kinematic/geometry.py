@@ -14,6 +14,7 @@ touches the obstacle when its centre enters that region.
 
 from __future__ import annotations
 
+import array
 import math
 
 import numpy as np
@@ -294,9 +295,9 @@ class FloorGeometry(FloorGrid):
         void = np.pad(codes == VOID, 1, constant_values=True)  # off the map is VOID
         edt_void = np.asarray(ndimage.distance_transform_edt(~void))[1:-1, 1:-1]
         self._clear_void = (edt_void - slack) * self.res
-        self._fast: dict[float, memoryview] = {}
+        self._fast: dict[float, array.array[float]] = {}
 
-    def fast_clearance(self, radius: float) -> memoryview:
+    def fast_clearance(self, radius: float) -> array.array[float]:
         """Per-cell travel budget (m) within which a disc of ``radius`` meets nothing.
 
         A disc of ``radius`` whose centre starts anywhere in cell ``i`` and moves less
@@ -310,7 +311,9 @@ class FloorGeometry(FloorGrid):
             if self._polygon_off_map:  # the disc may reach a polygon beyond the map's edge
                 void = void - radius
             budget = np.minimum(self._clear_obstacle - radius, void)
-            grid = memoryview(np.ascontiguousarray(budget, dtype=np.float64).ravel())
+            # A plain array of doubles: indexing it gives Python floats as fast as a
+            # memoryview does, and unlike a memoryview it pickles (as its values).
+            grid = array.array("d", np.ascontiguousarray(budget, dtype=np.float64).ravel().tobytes())
             self._fast[radius] = grid
         return grid
 
