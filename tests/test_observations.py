@@ -129,7 +129,9 @@ def test_added_reward_and_termination_take_part_in_every_step():
 
 
 def test_every_robot_gets_its_own_copy_of_the_terms():
-    env = MultiPointNavEnv(scene=small_scene(), n_robots=2, task={"observation_terms": [Heading()]})
+    env = MultiPointNavEnv(
+        scene=small_scene(), n_robots=2, task={"observation_terms": [Heading()]}, flatten_obs=False
+    )
     env.reset(seed=0)
     a, b = (t.observation_terms["heading"] for t in env.tasks)
     assert a is not b and a.resets == b.resets == 1

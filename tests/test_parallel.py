@@ -39,8 +39,8 @@ with warnings.catch_warnings():
 
 ENV_ID = "pointnav_core/MultiPointNav-v0"
 BACKENDS = available_backends()
-# api_test's advice for Dict observations (it prefers Box); the flat-observation run below
-# passes with every warning an error.
+# api_test's advice for Dict observations (it prefers Box); the default flat observations
+# pass with every warning an error.
 DICT_OBS_ADVICE = (
     "Observation space for each agent probably should be gymnasium.spaces.box",
     "Observation is not a NumPy array",
@@ -113,8 +113,16 @@ def test_aec_api_test_passes_with_flat_observations(backend):
     api_test(parallel_to_aec(env), num_cycles=300)
 
 
+def test_api_tests_pass_in_the_default_configuration_with_warnings_as_errors():
+    # The registered env exactly as users get it: the default house, robots and tasks.
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        parallel_api_test(pettingzoo.make("parallel", ENV_ID), num_cycles=200)
+        api_test(pettingzoo.make("aec", ENV_ID), num_cycles=200)
+
+
 def test_aec_api_test_passes_with_dict_observations_apart_from_its_box_advice():
-    env = parallel.parallel_env(scene=small_scene(), n_robots=3)
+    env = parallel.parallel_env(scene=small_scene(), n_robots=3, flatten_obs=False)
     with warnings.catch_warnings():
         for message in DICT_OBS_ADVICE:
             warnings.filterwarnings("ignore", message=message, category=UserWarning)
@@ -173,6 +181,9 @@ def test_same_seed_gives_identical_runs_over_many_steps(backend):
                     for key in a:
                         assert a[key].dtype == b[key].dtype == np.float32
                         np.testing.assert_array_equal(a[key], b[key])
+                elif isinstance(a, np.ndarray):  # the default flat observation
+                    assert a.dtype == b.dtype == np.float32
+                    np.testing.assert_array_equal(a, b)
                 else:
                     assert a == b and type(a) is type(b)
         assert env1.agents == env2.agents
@@ -221,9 +232,13 @@ def test_metadata_name_matches_the_id_and_the_module_functions_agree():
 # ------------------------------------------------------------------------------ spaces, API
 
 
-def test_spaces_are_cached_per_agent_and_match_the_single_robot_env():
+@pytest.mark.parametrize("flat", [True, False])
+def test_spaces_are_cached_per_agent_and_match_the_single_robot_env(flat):
     env = parallel.parallel_env(
-        scene=small_scene(), n_robots=2, robot=[{}, {"drive": "holonomic", "radius": 0.15}]
+        scene=small_scene(),
+        n_robots=2,
+        robot=[{}, {"drive": "holonomic", "radius": 0.15}],
+        flatten_obs=flat,
     )
     for agent in env.possible_agents:
         assert env.observation_space(agent) is env.observation_space(agent)
@@ -231,7 +246,7 @@ def test_spaces_are_cached_per_agent_and_match_the_single_robot_env():
     assert env.action_space("robot_0").shape == (2,)
     assert env.action_space("robot_1").shape == (3,)
     assert env.action_space("robot_0") is not env.action_space("robot_1")
-    single = pointnav_core.PointNavEnv(scene=small_scene())
+    single = pointnav_core.PointNavEnv(scene=small_scene(), flatten_obs=flat)
     assert env.observation_space("robot_0") == single.observation_space
     with pytest.raises(KeyError, match="unknown agent 'robot_9'"):
         env.observation_space("robot_9")
@@ -330,7 +345,11 @@ def test_robots_with_fixed_starts_are_placed_first():
     env = parallel.parallel_env(
         scene=Scene.from_array(grid, 0.1),
         n_robots=2,
-        task=[{"goal_tolerance": 0.1}, {"goal_tolerance": 0.1, "initial_pos": (0.7, 0.7, 0.0)}],
+        # No path_range: the default one starts at 1 m, more than this room offers.
+        task=[
+            {"goal_tolerance": 0.1, "path_range": None},
+            {"goal_tolerance": 0.1, "path_range": None, "initial_pos": (0.7, 0.7, 0.0)},
+        ],
     )
     for seed in range(30):
         env.reset(seed=seed)

@@ -243,7 +243,8 @@ def test_observation_bounds_need_an_env():
 
 
 def test_impossible_path_range_is_a_sampling_error_naming_it():
-    env = PointNavEnv(scene=small_scene(), robot=ROBOT, task={"path_range": (50.0, 60.0)})
+    with pytest.warns(UserWarning, match=r"path_range=\(50.0, 60.0\).*cannot be solved"):
+        env = PointNavEnv(scene=small_scene(), robot=ROBOT, task={"path_range": (50.0, 60.0)})
     with pytest.raises(SamplingError, match="path_range") as excinfo:
         env.reset(seed=0)
     assert "100 trials" in str(excinfo.value)

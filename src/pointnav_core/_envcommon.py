@@ -13,6 +13,8 @@ import copy
 import dataclasses
 import inspect
 import math
+import sys
+import warnings
 from collections import OrderedDict
 from collections.abc import Mapping
 from typing import Any
@@ -30,6 +32,8 @@ __all__ = [
     "action_space",
     "check_action",
     "check_action_frequency",
+    "derives_path_range",
+    "fit_path_range",
     "make_robot",
     "make_task",
     "observation_space",
@@ -154,7 +158,7 @@ def check_world_args(
 def check_action_frequency(action_frequency: Any) -> float:
     """Return ``action_frequency`` (Hz) as a float, or raise ValueError unless finite and > 0."""
     try:
-        frequency = float(action_frequency)
+        frequency = math.nan if isinstance(action_frequency, (str, bytes)) else float(action_frequency)
     except (TypeError, ValueError):
         frequency = math.nan
     if isinstance(action_frequency, bool) or not (math.isfinite(frequency) and frequency > 0):
@@ -162,6 +166,69 @@ def check_action_frequency(action_frequency: Any) -> float:
             f"action_frequency must be a finite number > 0 (Hz), got {action_frequency!r}"
         )
     return frequency
+
+
+#: Share of the robot's reach (the distance it covers driving straight at full speed for the
+#: whole step limit) that a default episode's geodesic may take. The oracle needs more
+#: time than the geodesic at full speed: it turns in place where no clear arc reaches its
+#: next point, and it slows near the goal. On the registered defaults it used up to 2.1x
+#: the geodesic's driving time on episodes over 10 m, and up to 3.7x on short ones
+#: (``benchmarks/bench_default_episodes.py``), so half the reach leaves nearly every
+#: default episode solvable while keeping most of the house's distances.
+SOLVABLE_SHARE = 0.5
+
+
+#: Shortest default episode (m of geodesic), Habitat's minimum: shorter ones teach little
+#: and are often won by chance in a few steps.
+MIN_GEODESIC = 1.0
+
+
+def derives_path_range(task: Any) -> bool:
+    """Whether the env chooses the task's ``path_range``: the task was not given as an
+    object and its dict (if any) sets no ``path_range``."""
+    return task is None or (isinstance(task, Mapping) and "path_range" not in task)
+
+
+def fit_path_range(
+    task: PointNavigationTask,
+    robot: RobotSpec,
+    frequency: float,
+    steps: int,
+    derive: bool,
+    name: str = "task",
+) -> None:
+    """Make the task's episodes drivable within ``steps`` control steps.
+
+    The robot's reach is ``steps * robot.max_linear_velocity / frequency`` metres. With
+    ``derive``, the task's ``path_range`` becomes ``(MIN_GEODESIC, max(SOLVABLE_SHARE *
+    reach, MIN_GEODESIC + 1))``; otherwise a ``path_range`` whose maximum exceeds the reach
+    gets a ``UserWarning``, as some of its episodes cannot be finished in time.
+    """
+    reach = steps * robot.max_linear_velocity / frequency
+    if derive:
+        task.path_range = (MIN_GEODESIC, max(SOLVABLE_SHARE * reach, MIN_GEODESIC + 1.0))
+        return
+    if task.path_range is not None and task.path_range[1] > reach:
+        warnings.warn(
+            f"{name}: path_range={task.path_range} allows start-goal geodesics up to "
+            f"{task.path_range[1]:g} m, but in max_steps={steps} steps at "
+            f"{frequency:g} Hz the robot drives at most {reach:.4g} m, so some episodes "
+            f"cannot be solved; lower path_range or raise max_steps",
+            UserWarning,
+            stacklevel=_stacklevel_outside_package(),
+        )
+
+
+def _stacklevel_outside_package() -> int:
+    """The ``stacklevel`` that points a warning at the first caller outside this package
+    and the env libraries (``gymnasium.make`` may sit in between)."""
+    frame, level = sys._getframe(1), 1
+    while frame is not None and frame.f_globals.get("__name__", "").partition(".")[0] in _SKIPPED:
+        frame, level = frame.f_back, level + 1
+    return level
+
+
+_SKIPPED = frozenset({"pointnav_core", "gymnasium", "pettingzoo"})
 
 
 def action_space(robot: RobotSpec) -> spaces.Box:

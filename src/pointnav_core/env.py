@@ -14,7 +14,7 @@ from pointnav_core.backend import Backend, RobotSpec, make_backend
 from pointnav_core.maps import BoundedCache
 from pointnav_core.task import PointNavigationTask
 
-__all__ = ["PointNavEnv"]
+__all__ = ["PointNavEnv", "TaskStepLimit"]
 
 
 class PointNavEnv(gym.Env[Any, np.ndarray]):
@@ -81,10 +81,17 @@ class PointNavEnv(gym.Env[Any, np.ndarray]):
 
     The robot starts at rest at a point drawn uniformly from the free space its disc fits
     in, with a heading uniform in `[0, 2 pi)`; the goal is drawn uniformly from the part of
-    the floor connected to the start, at least `goal_tolerance` away (within `path_range`
-    of geodesic distance, if given). Both can be fixed instead (`initial_pos`,
+    the floor connected to the start, at least `goal_tolerance` away and within the task's
+    `path_range` of geodesic distance. Both can be fixed instead (`initial_pos`,
     `initial_quat`, `goal_pos` in the task). All of it comes from the seed passed to
     `reset`.
+
+    Every default episode can be finished in time: unless the task is given as an object
+    or its dict sets `path_range`, the env sets `path_range = (1, R / 2)` m, where the reach
+    `R = max_steps * max_linear_velocity / action_frequency` is the distance the robot
+    drives straight at full speed in the step limit (25 m by default, so geodesics from
+    1 m, as in Habitat, up to 12.5 m); the other half is time to turn. An explicit
+    `path_range` beyond `R` warns.
 
     ## Episode End
 
@@ -96,7 +103,8 @@ class PointNavEnv(gym.Env[Any, np.ndarray]):
        steps.
     3. Termination: the robot fell: its height dropped more than `fall_height` (0.03 m)
        below its floor (it drove over void).
-    4. Truncation: the episode reached `max_steps` (500) steps.
+    4. Truncation: the episode reached `max_steps` (500) steps; `gymnasium.make(...,
+       max_episode_steps=N)` sets it to `N` (as does setting `env.max_episode_steps`).
 
     When the step limit coincides with another end, both `terminated` and `truncated` are
     True. Stepping after the end raises `TaskStateError`: call `reset`.
@@ -158,6 +166,7 @@ class PointNavEnv(gym.Env[Any, np.ndarray]):
             scene, flatten_obs, action_frequency, backend_kwargs
         )
         self.robot = _envcommon.make_robot(robot)
+        self._derive_path_range = _envcommon.derives_path_range(task)
         self.task = _envcommon.make_task(task)
         self.scene = scene
         self.robots = (self.robot,)
@@ -165,6 +174,7 @@ class PointNavEnv(gym.Env[Any, np.ndarray]):
         self._renderers = BoundedCache(2)  # floor pictures prepared for render()
         self.flatten_obs = bool(flatten_obs)
         self.action_frequency = frequency
+        self._fit_path_range()
         self.backend = make_backend(backend, **dict(backend_kwargs or {}))
         self.backend.load(scene, self.robots, frequency)
         # Fails here, naming the parameter, if the task does not fit this scene and robot.
@@ -218,7 +228,23 @@ class PointNavEnv(gym.Env[Any, np.ndarray]):
         if callable(close):
             close()
 
+    @property
+    def max_episode_steps(self) -> int:
+        """The task's step limit (``max_steps``); setting it also refits a derived
+        ``path_range``. ``gymnasium.make(..., max_episode_steps=N)`` sets it to ``N``."""
+        return self.task.max_steps
+
+    @max_episode_steps.setter
+    def max_episode_steps(self, value: int) -> None:
+        self.task.max_steps = value
+        self._fit_path_range()
+
     # ------------------------------------------------------------------ helpers
+    def _fit_path_range(self) -> None:
+        _envcommon.fit_path_range(
+            self.task, self.robot, self.action_frequency, self.task.max_steps, self._derive_path_range
+        )
+
     def _check_action(self, action: Any) -> Any:
         return _envcommon.check_action(action, self._action_shape, self.robot.drive)
 
@@ -227,3 +253,23 @@ class PointNavEnv(gym.Env[Any, np.ndarray]):
             return self.task.get_low_dim_obs(self)
         return self.task.get_obs(self)
 
+
+
+class TaskStepLimit(gym.Wrapper[Any, np.ndarray, Any, np.ndarray], gym.utils.RecordConstructorArgs):
+    """Hands the step limit of a ``TimeLimit`` below it to the :class:`PointNavEnv` it wraps.
+
+    The registered ids add it after ``gymnasium.make``'s ``TimeLimit``, so that
+    ``gymnasium.make("pointnav_core/PointNav-v0", max_episode_steps=1000)`` sets the task's
+    own ``max_steps`` (and the derived ``path_range``) rather than leaving the task to end
+    episodes at its default 500. Without a ``TimeLimit`` below it, it changes nothing.
+    """
+
+    def __init__(self, env: gym.Env[Any, np.ndarray]) -> None:
+        gym.utils.RecordConstructorArgs.__init__(self)
+        gym.Wrapper.__init__(self, env)
+        inner: Any = env
+        while isinstance(inner, gym.Wrapper):
+            if isinstance(inner, gym.wrappers.TimeLimit):
+                env.unwrapped.max_episode_steps = inner._max_episode_steps
+                break
+            inner = inner.env

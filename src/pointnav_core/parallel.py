@@ -9,8 +9,8 @@
 | Number of Agents   | `n_robots` (default 2)                                               |
 | Action Shape       | `(2,)` differential drive, `(3,)` holonomic                          |
 | Action Values      | `[-1, 1]`, float32                                                   |
-| Observation Shape  | `Dict` of `xy_pos_to_goal (2,)`, `robot_lin_vel (3,)`,               |
-|                    | `robot_ang_vel (3,)`; `(8,)` with `flatten_obs=True`                 |
+| Observation Shape  | `(8,)`; with `flatten_obs=False` a `Dict` of `xy_pos_to_goal (2,)`,  |
+|                    | `robot_lin_vel (3,)`, `robot_ang_vel (3,)`                           |
 | Observation Values | bounded, float32 (as in `PointNavEnv`)                               |
 | State Shape        | `(8 * n_robots,)`                                                    |
 | State Values       | bounded, float32                                                     |
@@ -33,7 +33,7 @@ and ``max_collision`` counter).
 Arguments
 ---------
 ``parallel_env(scene=None, n_robots=2, robot=None, task=None, backend="kinematic",
-backend_kwargs=None, max_cycles=500, render_mode=None, flatten_obs=False, finished="park",
+backend_kwargs=None, max_cycles=500, render_mode=None, flatten_obs=True, finished="park",
 action_frequency=10.0)``
 
 | Argument           | Type                        | Default           | Description            |
@@ -48,7 +48,8 @@ action_frequency=10.0)``
 | `max_cycles`       | **int** >= 1                | `500`             | steps, then all agents |
 |                    |                             |                   | are truncated          |
 | `render_mode`      | **str** or `None`           | `None`            | `"rgb_array"` or None  |
-| `flatten_obs`      | **bool**                    | `False`           | flat `(8,)` `low_dim`  |
+| `flatten_obs`      | **bool**                    | `True`            | flat `(8,)` `low_dim`, |
+|                    |                             |                   | or a `Dict` if False   |
 | `finished`         | `"park"` or `"remove"`      | `"park"`          | a finished robot stays,|
 |                    |                             |                   | or leaves the world    |
 | `action_frequency` | **float**                   | `10.0`            | control rate (Hz)      |
@@ -62,7 +63,7 @@ Observation and action spaces
 Per agent, the same as ``PointNavEnv`` for that robot: the action is ``(v, w)`` (or
 ``(vx, vy, w)`` for a holonomic robot) in ``[-1, 1]``, scaled by the robot's maxima and held
 for one control step; the observation is the robot's own goal in its own frame and its own
-velocities (a ``Dict``, or OmniGibson's flat 8-vector with ``flatten_obs=True``). Agents do
+velocities (OmniGibson's flat 8-vector, or a ``Dict`` with ``flatten_obs=False``). Agents do
 not observe each other: :meth:`MultiPointNavEnv.state` is the global view.
 ``observation_space(agent)`` and ``action_space(agent)`` return the same object every call.
 
@@ -141,8 +142,8 @@ Examples
 >>> from pointnav_core import parallel
 >>> env = parallel.parallel_env(n_robots=3, task={"goal_tolerance": 0.3})
 >>> observations, infos = env.reset(seed=0)
->>> env.agents, sorted(observations["robot_0"])
-(['robot_0', 'robot_1', 'robot_2'], ['robot_ang_vel', 'robot_lin_vel', 'xy_pos_to_goal'])
+>>> env.agents, observations["robot_0"].shape, observations["robot_0"].dtype
+(['robot_0', 'robot_1', 'robot_2'], (8,), dtype('float32'))
 >>> actions = {agent: np.array([1.0, 0.0], dtype=np.float32) for agent in env.agents}
 >>> observations, rewards, terminations, truncations, infos = env.step(actions)
 >>> type(rewards["robot_1"]), terminations["robot_1"], infos["robot_1"]["episode_length"]
@@ -254,6 +255,14 @@ def _make_tasks(task: Any, n: int) -> list[PointNavigationTask]:
     return tasks
 
 
+def _derived_path_ranges(task: Any, n: int) -> list[bool]:
+    """For each robot, whether the env chooses its task's ``path_range``."""
+    entries = _per_robot(task, n, "task")
+    if entries is None:
+        return [_envcommon.derives_path_range(task)] * n
+    return [_envcommon.derives_path_range(entry) for entry in entries]
+
+
 def _goal_separation(
     scene: scenes.Scene, tasks: Sequence[PointNavigationTask], robots: Sequence[RobotSpec]
 ) -> list[list[float]]:
@@ -299,7 +308,8 @@ class MultiPointNavEnv(ParallelEnv[str, Any, np.ndarray]):
     render_mode : {None, "rgb_array"}
         ``"human"`` is accepted for PettingZoo's ``render_test`` but cannot render.
     flatten_obs : bool
-        Flat ``(8,)`` observations instead of the ``Dict``.
+        Flat ``(8,)`` observations (the default: PettingZoo's ``api_test`` and RLlib's
+        default encoders expect arrays); False gives the ``Dict`` of ``PointNavEnv``.
     finished : {"park", "remove"}
         A finished robot stays as an obstacle, or leaves the world.
     action_frequency : float
@@ -324,7 +334,7 @@ class MultiPointNavEnv(ParallelEnv[str, Any, np.ndarray]):
         max_cycles: int = 500,
         render_mode: str | None = None,
         *,
-        flatten_obs: bool = False,
+        flatten_obs: bool = True,
         finished: str = "park",
         action_frequency: float = 10.0,
     ) -> None:
@@ -341,6 +351,7 @@ class MultiPointNavEnv(ParallelEnv[str, Any, np.ndarray]):
             scene, flatten_obs, action_frequency, backend_kwargs
         )
         self.robots = _make_robots(robot, n)
+        derive = _derived_path_ranges(task, n)
         tasks = _make_tasks(task, n)
 
         self.scene = scene
@@ -349,6 +360,10 @@ class MultiPointNavEnv(ParallelEnv[str, Any, np.ndarray]):
         self.flatten_obs = bool(flatten_obs)
         self.finished = finished
         self.action_frequency = frequency
+        # A robot has min(its task's max_steps, max_cycles) steps to reach its goal.
+        for i, (t, rb) in enumerate(zip(tasks, self.robots)):
+            steps = min(t.max_steps, self.max_cycles)
+            _envcommon.fit_path_range(t, rb, frequency, steps, derive[i], name=f"task[{i}]")
         self.backend = make_backend(backend, **dict(backend_kwargs or {}))
         self.backend.load(scene, self.robots, frequency)
         for i, t in enumerate(tasks):

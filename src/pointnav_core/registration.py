@@ -42,12 +42,24 @@ AEC_ENV_IDS: Mapping[str, str] = MappingProxyType(
 
 
 def register_gymnasium() -> None:
-    """Register the Gymnasium ids (``max_episode_steps=None``: the task's ``timeout`` owns truncation)."""
-    import gymnasium
+    """Register the Gymnasium ids.
 
+    ``max_episode_steps=None``: the task's ``timeout`` owns truncation. A
+    ``max_episode_steps`` given to ``gymnasium.make`` reaches the task through the
+    :class:`~pointnav_core.env.TaskStepLimit` wrapper each id adds after the ``TimeLimit``.
+    """
+    import gymnasium
+    from gymnasium.envs.registration import WrapperSpec
+
+    step_limit = WrapperSpec("TaskStepLimit", "pointnav_core.env:TaskStepLimit", kwargs={})
     for env_id, entry_point in ENV_IDS.items():
         if env_id not in gymnasium.registry:
-            gymnasium.register(id=env_id, entry_point=entry_point, max_episode_steps=None)
+            gymnasium.register(
+                id=env_id,
+                entry_point=entry_point,
+                max_episode_steps=None,
+                additional_wrappers=(step_limit,),
+            )
 
 
 def register_pettingzoo() -> None:

@@ -91,6 +91,10 @@ def sample_episode(
         path_range = None
     fixed_field = None if goal_pos is None else scene.goal_field(floor, goal_pos, robot=spec)
     failures: dict[str, int] = {}
+    # A geodesic is never shorter than the straight line, so a point farther than the
+    # range's maximum can never pass: draw only among nearer ones (the accepted pairs
+    # keep their distribution, and a short range no longer fails by rejection).
+    reach = None if path_range is None or not math.isfinite(path_range[1]) else path_range[1]
 
     def fail(constraint: str) -> None:
         failures[constraint] = failures.get(constraint, 0) + 1
@@ -99,7 +103,13 @@ def sample_episode(
         if initial_pos is not None:
             sx, sy = initial_pos
         else:
-            _, point = scene.get_random_point(floor=floor, reference_point=goal_pos, robot=spec, rng=rng)
+            _, point = scene.get_random_point(
+                floor=floor,
+                reference_point=goal_pos,
+                robot=spec,
+                rng=rng,
+                max_distance=None if goal_pos is None else reach,
+            )
             sx, sy = float(point[0]), float(point[1])
         if initial_quat is not None:
             quat = initial_quat
@@ -120,7 +130,9 @@ def sample_episode(
         if goal_pos is not None:
             gx, gy = goal_pos
         else:
-            _, point = scene.get_random_point(floor=floor, reference_point=(sx, sy), robot=spec, rng=rng)
+            _, point = scene.get_random_point(
+                floor=floor, reference_point=(sx, sy), robot=spec, rng=rng, max_distance=reach
+            )
             gx, gy = float(point[0]), float(point[1])
             if not backend.is_valid_pose(robot_idn, (gx, gy, floor_height), quat):
                 fail("the goal must be a valid pose (clear of obstacles and other robots)")

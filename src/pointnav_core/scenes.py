@@ -292,6 +292,7 @@ class Scene:
         reference_point: ArrayLike | None = None,
         robot: Any = None,
         rng: np.random.Generator | int | None = None,
+        max_distance: float | None = None,
     ) -> tuple[int, NDArray[np.float64]]:
         """Sample a usable point uniformly over the robot-eroded free space.
 
@@ -305,6 +306,10 @@ class Scene:
         robot : RobotSpec, float or None
             Whose radius erodes the free space.
         rng : numpy Generator, int seed, or None
+        max_distance : float, optional
+            With ``reference_point``: draw only among points at most this far (m, xy) from
+            it. A geodesic is never shorter, so a sampler that wants geodesics below a
+            bound loses no candidate and rejects far fewer.
 
         Returns
         -------
@@ -319,6 +324,11 @@ class Scene:
         """
         rng = _as_rng(rng)
         radius = robot_radius(robot)
+        if max_distance is not None:
+            if reference_point is None:
+                raise ValueError("max_distance needs a reference_point to measure from")
+            if isinstance(max_distance, bool) or not isinstance(max_distance, (int, float, np.integer, np.floating)) or not max_distance >= 0:
+                raise ValueError(f"max_distance must be None or a number >= 0 (m), got {max_distance!r}")
         if floor is None:
             candidates = [i for i, f in enumerate(self.floors) if f.usable(radius).any()]
             if not candidates:
@@ -337,10 +347,11 @@ class Scene:
                     f"reference_point {ref.tolist()} is not usable on floor {floor} for a robot "
                     f"of radius {radius} m (blocked, too close to an obstacle, or off the map)"
                 )
-            cells = np.flatnonzero(tmap.components(radius) == label)
+            cells = _cells_of(tmap.components(radius), label, tmap, ref, max_distance)
         if len(cells) == 0:
+            within = "" if max_distance is None else f" within {max_distance} m of the reference point"
             raise SamplingError(
-                f"floor {floor} has no usable cell for a robot of radius {radius} m"
+                f"floor {floor} has no usable cell{within} for a robot of radius {radius} m"
             )
         cell = np.unravel_index(cells[int(rng.integers(len(cells)))], tmap.shape)
         x, y = tmap.cell_to_world(np.array(cell))
@@ -432,3 +443,24 @@ def clutter(seed: int | None = None, resolution: float = 0.1, **kwargs: Any) -> 
     """A generated open space cluttered with obstacles (see ``floorplans.clutter``)."""
     plan = floorplans.clutter(seed, **kwargs)
     return Scene.from_polygons(plan.outline, plan.obstacles, resolution=resolution)
+
+
+def _cells_of(
+    labels: NDArray[np.integer], label: int, tmap: TraversableMap, ref: NDArray[np.float64], max_distance: float | None
+) -> NDArray[np.intp]:
+    """Flat indices of the cells labelled ``label``, with centres within ``max_distance``
+    (m) of ``ref`` if given (only the window around ``ref`` is scanned)."""
+    if max_distance is None or not math.isfinite(max_distance):
+        return np.flatnonzero(labels == label)
+    rows, cols = labels.shape
+    corners = tmap.world_to_cell(np.array([ref - max_distance, ref + max_distance]))
+    lo, hi = corners.min(axis=0), corners.max(axis=0)  # whichever way rows run
+    r0, r1 = max(int(lo[0]), 0), min(int(hi[0]) + 1, rows)
+    c0, c1 = max(int(lo[1]), 0), min(int(hi[1]) + 1, cols)
+    if r0 >= r1 or c0 >= c1:
+        return np.zeros(0, dtype=np.intp)
+    rr, cc = np.nonzero(labels[r0:r1, c0:c1] == label)
+    rr, cc = rr + r0, cc + c0
+    xy = tmap.cell_to_world(np.stack([rr, cc], axis=-1))
+    near = np.hypot(xy[:, 0] - ref[0], xy[:, 1] - ref[1]) <= max_distance
+    return np.ravel_multi_index((rr[near], cc[near]), labels.shape)

@@ -147,10 +147,17 @@ def _check_quat(name: str, value: Any) -> tuple[float, float, float, float] | No
     return x, y, z, w
 
 
+def _is_real(value: Any) -> bool:
+    """A real number, not a bool or a string."""
+    return isinstance(value, (int, float, np.integer, np.floating)) and not isinstance(value, (bool, np.bool_))
+
+
 def _check_path_range(value: Any) -> tuple[float, float] | None:
     if value is None:
         return None
     try:
+        if isinstance(value, (str, bytes)) or not all(_is_real(v) for v in value):
+            raise TypeError("not two numbers")  # '12' is not (1.0, 2.0), nor True 1.0
         lo, hi = (float(v) for v in value)
     except (TypeError, ValueError):
         raise ValueError(
@@ -491,8 +498,29 @@ class PointNavigationTask:
 
     @property
     def path_range(self) -> tuple[float, float] | None:
-        """(min, max) geodesic of sampled start/goal pairs (m), or None."""
+        """(min, max) geodesic of sampled start/goal pairs (m), or None; settable, used
+        from the next reset (the envs set it to what the robot can drive in time)."""
         return self._path_range
+
+    @path_range.setter
+    def path_range(self, value: tuple[float, float] | None) -> None:
+        self._path_range = _check_path_range(value)
+
+    @property
+    def max_steps(self) -> int:
+        """Steps after which the episode is truncated (``termination_config["max_steps"]``);
+        settable, used from the next step (``gymnasium.make(max_episode_steps=...)`` sets it)."""
+        return int(self._termination_config["max_steps"])
+
+    @max_steps.setter
+    def max_steps(self, value: int) -> None:
+        timeout = Timeout(max_steps=value)  # checks the value, naming max_steps
+        config = dict(self._termination_config)
+        config["max_steps"] = timeout.max_steps
+        self._termination_config = FrozenMapping(config)
+        current = self._terminations.get("timeout")
+        if isinstance(current, Timeout):
+            current.max_steps = timeout.max_steps
 
     @property
     def visualize_goal(self) -> bool:
