@@ -595,7 +595,7 @@ def finished_robot_0_env() -> MultiPointNavEnv:
         ({"robot_1": GO, "robot_7": GO}, "unknown agent 'robot_7'"),
         ({"robot_1": np.array([np.nan, 0.0])}, "robot_1: action must be finite"),
         ({"robot_1": np.zeros(3)}, r"robot_1: action must have shape \(2,\)"),
-        ({"robot_1": "fast"}, "robot_1: action must be an array of 2 numbers"),
+        ({"robot_1": "fast"}, "robot_1: action must be an array of 2 real numbers"),
         ([GO], "actions must be a dict"),
     ],
     ids=[

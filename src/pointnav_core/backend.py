@@ -70,6 +70,7 @@ from typing import TYPE_CHECKING, Any, Protocol, runtime_checkable
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from pointnav_core import validation
 from pointnav_core.errors import BackendError
 
 __all__ = [
@@ -113,15 +114,7 @@ _FLOAT_DTYPES = frozenset((np.dtype(np.float32), np.dtype(np.float64)))
 
 
 def _positive(name: str, value: Any, *, strict: bool, unit: str) -> float:
-    try:
-        number = float(value)
-    except (TypeError, ValueError):
-        raise ValueError(f"{name} must be a number ({unit}), got {value!r}") from None
-    bound_ok = number > 0.0 if strict else number >= 0.0
-    if not math.isfinite(number) or not bound_ok:
-        relation = "> 0" if strict else ">= 0"
-        raise ValueError(f"{name} must be a finite number {relation} ({unit}), got {value!r}")
-    return number
+    return validation.real(name, value, minimum=0.0, strict=strict, unit=unit)
 
 
 @dataclass(frozen=True, kw_only=True)

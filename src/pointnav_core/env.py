@@ -87,10 +87,10 @@ class PointNavEnv(gym.Env[Any, np.ndarray]):
     `reset`.
 
     Every default episode can be finished in time: unless the task is given as an object
-    or its dict sets `path_range`, the env sets `path_range = (1, R / 2)` m, where the reach
+    or its dict sets `path_range`, the env sets `path_range = (1, 0.4 R)` m, where the reach
     `R = max_steps * max_linear_velocity / action_frequency` is the distance the robot
     drives straight at full speed in the step limit (25 m by default, so geodesics from
-    1 m, as in Habitat, up to 12.5 m); the other half is time to turn. An explicit
+    1 m, as in Habitat, up to 10 m); the rest is time to turn. An explicit
     `path_range` beyond `R` warns.
 
     ## Episode End
@@ -137,7 +137,7 @@ class PointNavEnv(gym.Env[Any, np.ndarray]):
     | `backend_kwargs`   | **dict** or `None`           | `None`            | backend's arguments  |
     | `render_mode`      | **str** or `None`            | `None`            | `"rgb_array"` or None|
     | `flatten_obs`      | **bool**                     | `False`           | flat `(8,)` `low_dim`|
-    | `action_frequency` | **float**                    | `10.0`            | control rate (Hz)    |
+    | `action_frequency` | **float**                    | `10.0`            | 0.1 to 10,000 Hz     |
 
     ## Version History
 

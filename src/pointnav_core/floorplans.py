@@ -33,6 +33,7 @@ from numpy.typing import NDArray
 from shapely import affinity
 from shapely.geometry import MultiPolygon, Point, Polygon, box
 
+from pointnav_core import validation
 from pointnav_core.maps import FREE, OBSTACLE, VOID
 
 __all__ = ["FloorPlan", "clutter", "maze", "rasterize", "rooms"]
@@ -121,23 +122,17 @@ def _check_polygon(geom: object, name: str) -> None:
 
 
 def _check_positive(value: float, name: str, unit: str = "m") -> float:
-    try:
-        value = float(value)
-    except (TypeError, ValueError):
-        raise ValueError(f"{name} must be a finite number > 0 ({unit}), got {value!r}") from None
-    if not math.isfinite(value) or value <= 0.0:
-        raise ValueError(f"{name} must be a finite number > 0 ({unit}), got {value!r}")
-    return value
+    return validation.real(name, value, minimum=0.0, strict=True, unit=unit)
 
 
 def _check_pair(value: Sequence[float], name: str, meaning: str) -> tuple[float, float]:
     try:
-        a, b = (float(v) for v in value)
-    except (TypeError, ValueError):
+        a, b = validation.vector(name, value, sizes=(2,))
+    except ValueError:
         raise ValueError(f"{name} must be two numbers {meaning}, got {value!r}") from None
-    if not (math.isfinite(a) and math.isfinite(b) and a > 0.0 and b > 0.0):
+    if not (a > 0.0 and b > 0.0):
         raise ValueError(f"{name} must be two finite numbers > 0 {meaning}, got {value!r}")
-    return a, b
+    return float(a), float(b)
 
 
 def _check_range(value: Sequence[float], name: str) -> tuple[float, float]:
@@ -147,14 +142,17 @@ def _check_range(value: Sequence[float], name: str) -> tuple[float, float]:
     return lo, hi
 
 
+def _rng(seed: object) -> np.random.Generator:
+    """A Generator from ``seed``: None, an int >= 0, a SeedSequence or a Generator."""
+    if seed is None or isinstance(seed, (np.random.SeedSequence, np.random.Generator)):
+        return np.random.default_rng(seed)
+    return np.random.default_rng(validation.integer("seed", seed, minimum=0))
+
+
 def _check_probability(value: float, name: str) -> float:
-    try:
-        value = float(value)
-    except (TypeError, ValueError):
-        raise ValueError(f"{name} must be a probability in [0, 1], got {value!r}") from None
-    if not 0.0 <= value <= 1.0:
+    if not (validation.is_real(value) and 0.0 <= value <= 1.0):
         raise ValueError(f"{name} must be a probability in [0, 1], got {value!r}")
-    return value
+    return float(value)
 
 
 # --------------------------------------------------------------------------- rasterize
@@ -352,7 +350,7 @@ def rooms(
     >>> plan == rooms(seed=0)
     True
     """
-    rng = np.random.default_rng(seed)
+    rng = _rng(seed)
     width, height = _check_pair(size, "size", "(width, height) in metres")
     wall = _check_positive(wall, "wall")
     outer_wall = _check_positive(outer_wall, "outer_wall")
@@ -667,7 +665,7 @@ def maze(
     >>> plan == maze(seed=1, size=(4.2, 2.2), corridor=0.8, wall=0.2)
     True
     """
-    rng = np.random.default_rng(seed)
+    rng = _rng(seed)
     width, height = _check_pair(size, "size", "(width, height) in metres")
     corridor = _check_positive(corridor, "corridor")
     wall = _check_positive(wall, "wall")
@@ -798,7 +796,7 @@ def clutter(
     >>> len(clutter(seed=3, n_obstacles=10, grouped=1.0).obstacles)  # all in one group
     2
     """
-    rng = np.random.default_rng(seed)
+    rng = _rng(seed)
     width, height = _check_pair(size, "size", "(width, height) in metres")
     if n_obstacles is None:
         n_obstacles = round(width * height / 8.0)

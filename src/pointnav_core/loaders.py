@@ -18,6 +18,7 @@ import re
 import numpy as np
 from numpy.typing import NDArray
 
+from pointnav_core import validation
 from pointnav_core.maps import FREE, OBSTACLE
 
 __all__ = ["MOVINGAI_CELLS", "read_movingai", "read_trav_png"]
@@ -39,13 +40,7 @@ MOVINGAI_CELLS: dict[str, int] = {
 
 
 def _check_resolution(value: float, name: str) -> float:
-    try:
-        value = float(value)
-    except (TypeError, ValueError):
-        raise ValueError(f"{name} must be a finite number > 0 (metres per cell), got {value!r}") from None
-    if not math.isfinite(value) or value <= 0.0:
-        raise ValueError(f"{name} must be a finite number > 0 (metres per cell), got {value!r}")
-    return value
+    return validation.real(name, value, minimum=0.0, strict=True, unit="metres per cell")
 
 
 def read_trav_png(

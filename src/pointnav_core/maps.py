@@ -31,6 +31,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy import ndimage
 
+from pointnav_core import validation
 from pointnav_core.collision import FloorCollision
 
 __all__ = ["FREE", "OBSTACLE", "VOID", "CELL_CLASSES", "TraversableMap", "BoundedCache"]
@@ -83,10 +84,7 @@ class BoundedCache:
 
 
 def _check_radius(radius: float) -> float:
-    radius = float(radius)
-    if not math.isfinite(radius) or radius < 0.0:
-        raise ValueError(f"radius must be a finite number >= 0 (metres), got {radius!r}")
-    return radius
+    return validation.real("radius", radius, minimum=0.0, unit="metres")
 
 
 class TraversableMap:
@@ -144,15 +142,9 @@ class TraversableMap:
                 "grid holds unknown cell codes "
                 f"{sorted(set(np.unique(codes[bad]).tolist()))[:5]}; valid: {CELL_CLASSES}"
             )
-        resolution = float(resolution)
-        if not math.isfinite(resolution) or resolution <= 0.0:
-            raise ValueError(f"resolution must be a finite number > 0 (m/cell), got {resolution!r}")
-        origin_arr = np.asarray(origin, dtype=np.float64)
-        if origin_arr.shape != (2,) or not np.isfinite(origin_arr).all():
-            raise ValueError(f"origin must be two finite numbers (x, y), got {origin!r}")
-        height = float(height)
-        if not math.isfinite(height):
-            raise ValueError(f"height must be finite, got {height!r}")
+        resolution = validation.real("resolution", resolution, minimum=0.0, strict=True, unit="m/cell")
+        origin_arr = validation.vector("origin", origin, sizes=(2,))
+        height = validation.real("height", height)
         self.codes: NDArray[np.uint8] = np.array(codes, dtype=np.uint8, order="C", copy=True)
         self.codes.flags.writeable = False
         self.resolution = resolution

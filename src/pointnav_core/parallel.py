@@ -52,7 +52,7 @@ action_frequency=10.0)``
 |                    |                             |                   | or a `Dict` if False   |
 | `finished`         | `"park"` or `"remove"`      | `"park"`          | a finished robot stays,|
 |                    |                             |                   | or leaves the world    |
-| `action_frequency` | **float**                   | `10.0`            | control rate (Hz)      |
+| `action_frequency` | **float**                   | `10.0`            | 0.1 to 10,000 Hz       |
 
 ``task`` entries are :class:`~pointnav_core.task.PointNavigationTask` keyword arguments
 (a list may also hold ready tasks); the env sets ``robot_idn`` (an entry that gives one must
@@ -313,7 +313,7 @@ class MultiPointNavEnv(ParallelEnv[str, Any, np.ndarray]):
     finished : {"park", "remove"}
         A finished robot stays as an obstacle, or leaves the world.
     action_frequency : float
-        Control rate (Hz), > 0.
+        Control rate (Hz), from 0.1 to 10,000.
 
     Raises
     ------

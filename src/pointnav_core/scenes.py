@@ -32,13 +32,13 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from pointnav_core import floorplans, loaders
+from pointnav_core import floorplans, loaders, validation
 from pointnav_core.errors import SamplingError
 from pointnav_core.floorplans import FloorPlan
+from pointnav_core.maps import OBSTACLE, TraversableMap
 from pointnav_core.paths import resample_path
 from pointnav_core.tangent_field import GoalField
 from pointnav_core.tangent_graph import Planner, planner_for
-from pointnav_core.maps import OBSTACLE, TraversableMap
 
 __all__ = ["Scene", "FloorGoalField", "robot_radius", "rooms", "maze", "clutter"]
 
@@ -48,22 +48,18 @@ def robot_radius(robot: Any) -> float:
     if robot is None:
         return 0.0
     radius = getattr(robot, "radius", robot)
-    try:
-        radius = float(radius)
-    except (TypeError, ValueError):
+    if not validation.is_real(radius):
         raise ValueError(
             f"robot must be a robot spec with a radius, a radius in metres, or None; got {robot!r}"
-        ) from None
-    if not math.isfinite(radius) or radius < 0.0:
-        raise ValueError(f"robot radius must be a finite number >= 0 (m), got {radius!r}")
-    return radius
+        )
+    return validation.real("robot radius", radius, minimum=0.0)
 
 
 def _as_xy(value: ArrayLike, name: str) -> NDArray[np.float64]:
-    arr = np.asarray(value, dtype=np.float64).reshape(-1)
-    if arr.shape not in ((2,), (3,)) or not np.isfinite(arr).all():
-        raise ValueError(f"{name} must be a finite (x, y) or (x, y, z) point in metres, got {value!r}")
-    return arr[:2]
+    try:
+        return validation.vector(name, value, sizes=(2, 3))[:2]
+    except ValueError:
+        raise ValueError(f"{name} must be a finite (x, y) or (x, y, z) point in metres, got {value!r}") from None
 
 
 def _as_rng(rng: np.random.Generator | int | None) -> np.random.Generator:
@@ -327,7 +323,7 @@ class Scene:
         if max_distance is not None:
             if reference_point is None:
                 raise ValueError("max_distance needs a reference_point to measure from")
-            if isinstance(max_distance, bool) or not isinstance(max_distance, (int, float, np.integer, np.floating)) or not max_distance >= 0:
+            if not (validation.is_real(max_distance) and max_distance >= 0):
                 raise ValueError(f"max_distance must be None or a number >= 0 (m), got {max_distance!r}")
         if floor is None:
             candidates = [i for i, f in enumerate(self.floors) if f.usable(radius).any()]

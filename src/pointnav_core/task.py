@@ -30,6 +30,7 @@ from typing import TYPE_CHECKING, Any, ClassVar, Protocol
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from pointnav_core import validation
 from pointnav_core.backend import float_twin
 from pointnav_core.frozen import FrozenMapping
 from pointnav_core.lifecycle import (
@@ -44,9 +45,19 @@ from pointnav_core.lifecycle import (
 from pointnav_core.lifecycle import Event as _Event
 from pointnav_core.markers import VisualMarker, _waypoints_along
 from pointnav_core.metrics import _soft_spl, _spl
-from pointnav_core.observations import Frame, ObservationLayout, ObservationTerm, default_observation_terms
+from pointnav_core.observations import (
+    Frame,
+    ObservationLayout,
+    ObservationTerm,
+    default_observation_terms,
+)
+from pointnav_core.rewards import (
+    CollisionReward,
+    PointGoalReward,
+    PotentialReward,
+    RewardFunction,
+)
 from pointnav_core.sampling import GoalConstraint, sample_episode
-from pointnav_core.rewards import CollisionReward, PointGoalReward, PotentialReward, RewardFunction
 from pointnav_core.terminations import (
     Falling,
     MaxCollision,
@@ -106,24 +117,19 @@ class TaskEnv(Protocol):
 # ------------------------------------------------------------------------------ validation
 
 
-def _check_bool(name: str, value: Any) -> bool:
-    if not isinstance(value, (bool, np.bool_)):
-        raise ValueError(f"{name} must be True or False, got {value!r}")
-    return bool(value)
+_check_bool = validation.boolean
 
 
 def _check_position(name: str, value: Any) -> tuple[float, float] | None:
     if value is None:
         return None
     try:
-        arr = np.asarray(value, dtype=np.float64)
-    except (TypeError, ValueError):
-        arr = None
-    if arr is None or arr.shape not in ((2,), (3,)) or not np.isfinite(arr).all():
+        arr = validation.vector(name, value, sizes=(2, 3))
+    except ValueError:
         raise ValueError(
             f"{name} must be None or a finite position (x, y, z) in metres (z is replaced by "
             f"the floor height), got {value!r}"
-        )
+        ) from None
     return float(arr[0]), float(arr[1])
 
 
@@ -131,13 +137,11 @@ def _check_quat(name: str, value: Any) -> tuple[float, float, float, float] | No
     if value is None:
         return None
     try:
-        arr = np.asarray(value, dtype=np.float64)
-    except (TypeError, ValueError):
-        arr = None
-    if arr is None or arr.shape != (4,) or not np.isfinite(arr).all():
+        arr = validation.vector(name, value, sizes=(4,))
+    except ValueError:
         raise ValueError(
             f"{name} must be None or a finite unit quaternion (x, y, z, w), got {value!r}"
-        )
+        ) from None
     norm = math.sqrt(float(arr @ arr))
     if abs(norm - 1.0) > _QUAT_NORM_TOL:
         raise ValueError(
@@ -147,18 +151,12 @@ def _check_quat(name: str, value: Any) -> tuple[float, float, float, float] | No
     return x, y, z, w
 
 
-def _is_real(value: Any) -> bool:
-    """A real number, not a bool or a string."""
-    return isinstance(value, (int, float, np.integer, np.floating)) and not isinstance(value, (bool, np.bool_))
-
-
 def _check_path_range(value: Any) -> tuple[float, float] | None:
     if value is None:
         return None
     try:
-        if isinstance(value, (str, bytes)) or not all(_is_real(v) for v in value):
-            raise TypeError("not two numbers")  # '12' is not (1.0, 2.0), nor True 1.0
-        lo, hi = (float(v) for v in value)
+        # Not finite-only: the maximum may be inf. '12' is not (1.0, 2.0), nor True 1.0.
+        lo, hi = validation.vector("path_range", value, sizes=(2,), finite=False)
     except (TypeError, ValueError):
         raise ValueError(
             f"path_range must be None or (min, max) geodesic distances in metres, got {value!r}"
@@ -167,15 +165,11 @@ def _check_path_range(value: Any) -> tuple[float, float] | None:
         raise ValueError(
             f"path_range must be (min, max) with 0 <= min < max (m), min finite, got {value!r}"
         )
-    return lo, hi
+    return float(lo), float(hi)
 
 
 def _check_index(name: str, value: Any) -> int:
-    if isinstance(value, (bool, np.bool_)) or not isinstance(value, (int, np.integer)):
-        raise ValueError(f"{name} must be an integer >= 0, got {value!r}")
-    if value < 0:
-        raise ValueError(f"{name} must be an integer >= 0, got {value!r}")
-    return int(value)
+    return validation.integer(name, value, minimum=0)
 
 
 def _merge_config(

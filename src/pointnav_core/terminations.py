@@ -40,8 +40,9 @@ Examples
 from __future__ import annotations
 
 import math
-import operator
 from typing import Any, ClassVar
+
+from pointnav_core import validation
 
 __all__ = [
     "TerminationCondition",
@@ -64,15 +65,7 @@ def _check_count(name: str, value: Any, minimum: int) -> int:
     ...
     ValueError: max_steps must be an integer >= 1, got 0
     """
-    if isinstance(value, bool):
-        raise ValueError(f"{name} must be an integer >= {minimum}, got {value!r}")
-    try:
-        number = operator.index(value)
-    except TypeError:
-        raise ValueError(f"{name} must be an integer >= {minimum}, got {value!r}") from None
-    if number < minimum:
-        raise ValueError(f"{name} must be an integer >= {minimum}, got {value!r}")
-    return int(number)
+    return validation.integer(name, value, minimum=minimum)
 
 
 def _check_length(name: str, value: Any, unit: str = "m") -> float:
@@ -85,15 +78,7 @@ def _check_length(name: str, value: Any, unit: str = "m") -> float:
     ...
     ValueError: fall_height must be a finite number >= 0 (m), got -1
     """
-    if isinstance(value, bool):
-        raise ValueError(f"{name} must be a finite number >= 0 ({unit}), got {value!r}")
-    try:
-        number = float(value)
-    except (TypeError, ValueError):
-        raise ValueError(f"{name} must be a finite number >= 0 ({unit}), got {value!r}") from None
-    if not (math.isfinite(number) and number >= 0.0):
-        raise ValueError(f"{name} must be a finite number >= 0 ({unit}), got {value!r}")
-    return number
+    return validation.real(name, value, minimum=0.0, unit=unit)
 
 
 class TerminationCondition:

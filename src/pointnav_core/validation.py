@@ -1,0 +1,133 @@
+"""Argument checks: one rule for what counts as a number, everywhere.
+
+Every public constructor and function checks its arguments with these helpers, so that
+the same value is accepted or refused the same way wherever it is passed. The rules:
+
+- a number is an ``int`` or ``float`` (or a numpy integer or floating scalar); a ``bool``
+  is not a number (``True`` is not a radius of 1 m), a string is not a number (``"0.2"``
+  is not 0.2 m), and a complex number is not a real one;
+- a sequence of numbers is a list, tuple or numeric array of such numbers; a string is
+  not a sequence of numbers (``"12"`` is not ``(1, 2)``);
+- a refusal is a ``ValueError`` whose message starts with the parameter's name and says
+  what was expected, with the unit.
+
+>>> real("radius", 0.2, minimum=0.0)
+0.2
+>>> real("radius", True, minimum=0.0)
+Traceback (most recent call last):
+...
+ValueError: radius must be a finite number >= 0 (m), got True
+>>> vector("goal_pos", "12", sizes=(2, 3))
+Traceback (most recent call last):
+...
+ValueError: goal_pos must be 2 or 3 finite numbers, got '12'
+"""
+
+from __future__ import annotations
+
+import math
+import operator
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+__all__ = ["boolean", "integer", "is_real", "real", "vector"]
+
+_REAL_KINDS = "biuf"  # numpy dtype kinds that hold real numbers (b: refused below)
+
+
+def is_real(value: Any) -> bool:
+    """Whether ``value`` is a real number: int, float or a numpy real scalar, not a bool."""
+    if isinstance(value, (bool, np.bool_)):
+        return False
+    return isinstance(value, (int, float, np.integer, np.floating))
+
+
+def _bound(minimum: float | None, strict: bool, maximum: float | None) -> str:
+    parts = []
+    if minimum is not None:
+        parts.append(f"{'>' if strict else '>='} {minimum:g}")
+    if maximum is not None:
+        parts.append(f"<= {maximum:g}")
+    return " " + " and ".join(parts) if parts else ""
+
+
+def real(
+    name: str,
+    value: Any,
+    *,
+    minimum: float | None = None,
+    strict: bool = False,
+    maximum: float | None = None,
+    finite: bool = True,
+    unit: str = "m",
+) -> float:
+    """``value`` as a float, or a ValueError naming ``name``.
+
+    Parameters
+    ----------
+    name : str
+        The parameter's name, for the message.
+    value : Any
+        A real number (see the module notes).
+    minimum, maximum : float, optional
+        Bounds; ``strict`` makes the minimum exclusive.
+    finite : bool
+        Refuse infinities (NaN is always refused).
+    unit : str
+        Unit named in the message.
+    """
+    number = float(value) if is_real(value) else math.nan
+    ok = not math.isnan(number) and (math.isfinite(number) or not finite)
+    if ok and minimum is not None:
+        ok = number > minimum if strict else number >= minimum
+    if ok and maximum is not None:
+        ok = number <= maximum
+    if not ok:
+        kind = "a finite number" if finite else "a number"
+        raise ValueError(f"{name} must be {kind}{_bound(minimum, strict, maximum)} ({unit}), got {value!r}")
+    return number
+
+
+def integer(name: str, value: Any, *, minimum: int | None = None) -> int:
+    """``value`` as an int, or a ValueError naming ``name`` (no bools, no 2.0)."""
+    number = None
+    if not isinstance(value, (bool, np.bool_)):
+        try:
+            number = operator.index(value)
+        except TypeError:
+            number = None
+    if number is None or (minimum is not None and number < minimum):
+        bound = "" if minimum is None else f" >= {minimum}"
+        raise ValueError(f"{name} must be an integer{bound}, got {value!r}")
+    return int(number)
+
+
+def boolean(name: str, value: Any) -> bool:
+    """``value`` as a bool: only ``True``/``False`` (and numpy's) are accepted."""
+    if not isinstance(value, (bool, np.bool_)):
+        raise ValueError(f"{name} must be True or False, got {value!r}")
+    return bool(value)
+
+
+def vector(name: str, value: Any, *, sizes: tuple[int, ...], finite: bool = True) -> NDArray[np.float64]:
+    """``value`` as a 1-D float64 array of one of ``sizes`` numbers, or a ValueError.
+
+    A list or tuple must hold real numbers (see :func:`is_real`); an array must have a
+    real, non-boolean dtype. Strings, bools and complex numbers are refused.
+    """
+    arr = None
+    if isinstance(value, np.ndarray):
+        if value.dtype.kind in _REAL_KINDS and value.dtype.kind != "b":
+            arr = value.astype(np.float64).reshape(-1) if value.ndim <= 1 else None
+    elif isinstance(value, (list, tuple)) and all(is_real(v) for v in value):
+        arr = np.array(value, dtype=np.float64)
+    ok = arr is not None and arr.shape[0] in sizes and not np.isnan(arr).any()
+    if ok and finite:
+        ok = bool(np.isfinite(arr).all())
+    if not ok:
+        count = " or ".join(str(s) for s in sizes)
+        kind = "finite numbers" if finite else "numbers"
+        raise ValueError(f"{name} must be {count} {kind}, got {value!r}")
+    return arr  # type: ignore[return-value]
