@@ -228,3 +228,28 @@ def test_a_robot_on_a_movingai_map_collides_with_its_cells_and_its_frame(tmp_pat
     assert R <= inside.exterior.distance(Point(x1, y1)) <= R + 2 * TOUCH_TOLERANCE
     assert inside.contains(Point(x1, y1)) and z1 == 0.0  # did not fall off
     assert backend.in_contact(0) and backend.in_contact(1)
+
+
+def test_a_step_that_ends_square_over_a_corner_it_ran_into_is_a_contact():
+    # A holonomic robot (r = 0.0546875 m) drives +x at 0.375 m/s along y = 0.55, 5 cm above
+    # the top face (y = 0.5) of a block whose left edge is x = 0.4: the disc reaches the
+    # block's corner at x = 0.4 - sqrt(r^2 - 0.05^2), and its fourth step ends with the
+    # centre exactly above the corner, where the contact normal is square to the motion.
+    grid = np.full((16, 16), FREE, dtype=np.uint8)
+    grid[0, :] = grid[-1, :] = grid[:, 0] = grid[:, -1] = OBSTACLE
+    grid[3:5, 4:6] = OBSTACLE
+    scene = Scene.from_array(grid, 0.1)
+    radius = 0.0546875
+    backend = loaded(scene, [RobotSpec(radius=radius, drive="holonomic")])
+    backend.land(0, 0, (0.25, 0.55, 0.0), IDENTITY)
+    block = box(0.4, 0.3, 0.6, 0.5)
+    flagged = []
+    for _ in range(4):
+        start = backend.get_pose(0)[0][:2].copy()
+        backend.step({0: np.array([0.75, 0.0, 0.0])})
+        end = backend.get_pose(0)[0][:2]
+        # The reference: the straight drive of this step comes within r of the block.
+        ran_into = shapely.LineString([start, (end[0], start[1])]).distance(block) < radius - 1e-9
+        flagged.append((backend.in_contact(0), ran_into))
+    assert flagged[:3] == [(False, False)] * 3
+    assert flagged[3] == (True, True)

@@ -95,6 +95,11 @@ def _empty_spaces(spaces: list[pymunk.Space]) -> None:
     spaces.clear()
 
 
+def _depth(arbiter: pymunk.Arbiter) -> float:
+    """How deep (m) the two shapes of ``arbiter`` overlap; 0 when they only touch."""
+    return max((-p.distance for p in arbiter.contact_point_set.points), default=0.0)
+
+
 def _project(
     ux: float, uy: float, limits: list[tuple[float, float, float]]
 ) -> tuple[float, float]:
@@ -324,7 +329,10 @@ class PymunkBackend(RobotStateBackend):
         nx, ny = -n.x, -n.y
         rb.touching.append((nx, ny, None))
         u = rb.control.velocity  # the commanded velocity of this sub-step
-        if u.x * nx + u.y * ny < -_PUSH_EPS:
+        # A hit: the command drives into the wall, or the sub-step ended deeper in it than
+        # a resting contact ever is (a sub-step that ends just past a corner can leave the
+        # normal square to the motion, though the robot ran into the corner on the way).
+        if u.x * nx + u.y * ny < -_PUSH_EPS or _depth(arbiter) > TOUCH_TOLERANCE:
             rb.contact = True
         if self._measuring:
             self._measure(rb, arbiter)
