@@ -12,7 +12,7 @@ def python_blocks(text: str) -> list[str]:
 
 def test_every_block_of_extending_md_runs_in_order():
     blocks = python_blocks(PAGE.read_text())
-    assert len(blocks) >= 4  # reward, termination, observation, multi-robot (and backend)
+    assert len(blocks) >= 6  # reward, termination, observation, multi-robot, backend, its checks
     namespace: dict = {"__name__": "extending_md"}
     for i, block in enumerate(blocks):
         try:
