@@ -119,6 +119,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     parser.add_argument("--drive", choices=("differential", "holonomic"), default="differential")
     parser.add_argument("--backends", nargs="+", default=None, help="default: kinematic and pymunk")
     parser.add_argument("--movingai", type=Path, default=MOVINGAI_DIR, help="folder of the MovingAI maps")
+    parser.add_argument("--maps", nargs="+", default=None, help=f"map files (default: {' '.join(MAPS)})")
     args = parser.parse_args(argv)
     if args.episodes < 1:
         parser.error(f"--episodes must be >= 1, got {args.episodes}")
@@ -126,7 +127,10 @@ def main(argv: Sequence[str] | None = None) -> int:
         parser.error(f"--max-steps must be >= 1, got {args.max_steps}")
     installed = available_backends()
     names = args.backends or [b for b in ("kinematic", "pymunk") if b in installed]
-    maps = movingai_maps(args.movingai, MAPS)
+    unknown = sorted(set(args.maps or ()) - set(MAPS))
+    if unknown:
+        parser.error(f"--maps: unknown map {unknown[0]!r}; known maps are {list(MAPS)}")
+    maps = movingai_maps(args.movingai, args.maps or MAPS)
     if not maps:
         print(f"no MovingAI maps in {args.movingai}: nothing to run")
         return 0

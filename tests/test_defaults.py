@@ -47,19 +47,19 @@ def steps_until_end(env: gym.Env, seed: int = 0) -> tuple[int, dict]:
 # ------------------------------------------------------------------------ the derived range
 
 
-def test_the_registered_ids_keep_episodes_within_half_the_reach():
+def test_the_registered_ids_keep_episodes_within_two_fifths_of_the_reach():
     single = gym.make(ENV_ID).unwrapped
-    assert single.task.path_range == (1.0, 0.5 * 500 * 0.5 / 10)
+    assert single.task.path_range == (1.0, 0.4 * 500 * 0.5 / 10)
     multi = pettingzoo.make("parallel", MULTI_ID)
-    assert all(t.path_range == (1.0, 12.5) for t in multi.tasks)
+    assert all(t.path_range == (1.0, 10.0) for t in multi.tasks)
 
 
 @pytest.mark.parametrize(
     ("kwargs", "expected_max"),
     [
-        ({"robot": {"max_linear_velocity": 1.0}}, 0.5 * 500 * 1.0 / 10),
-        ({"action_frequency": 20.0}, 0.5 * 500 * 0.5 / 20),
-        ({"task": {"termination_config": {"max_steps": 2000}}}, 0.5 * 2000 * 0.5 / 10),
+        ({"robot": {"max_linear_velocity": 1.0}}, 0.4 * 500 * 1.0 / 10),
+        ({"action_frequency": 20.0}, 0.4 * 500 * 0.5 / 20),
+        ({"task": {"termination_config": {"max_steps": 2000}}}, 0.4 * 2000 * 0.5 / 10),
         ({"task": {"termination_config": {"max_steps": 20}}}, 2.0),  # never under 1 m wide
     ],
 )
@@ -72,14 +72,14 @@ def test_sampled_default_episodes_lie_in_the_range():
     env = gym.make(ENV_ID)
     for seed in range(15):
         _, info = env.reset(seed=seed)
-        assert 1.0 < info["geodesic_dist"] < 12.5
+        assert 1.0 < info["geodesic_dist"] < 10.0
 
 
 def test_a_multi_robot_range_uses_the_shorter_of_max_steps_and_max_cycles():
     env = MultiPointNavEnv(max_cycles=100)
-    assert all(t.path_range == pytest.approx((1.0, 0.5 * 100 * 0.5 / 10)) for t in env.tasks)
+    assert all(t.path_range == pytest.approx((1.0, 0.4 * 100 * 0.5 / 10)) for t in env.tasks)
     mixed = MultiPointNavEnv(task=[{}, {"path_range": (2.0, 3.0)}])
-    assert mixed.tasks[0].path_range == (1.0, 12.5) and mixed.tasks[1].path_range == (2.0, 3.0)
+    assert mixed.tasks[0].path_range == (1.0, 10.0) and mixed.tasks[1].path_range == (2.0, 3.0)
 
 
 def test_explicit_ranges_and_task_objects_are_kept():
@@ -147,7 +147,7 @@ def test_task_step_limit_without_a_time_limit_changes_nothing():
 def test_max_episode_steps_property_checks_and_refits():
     env = PointNavEnv()
     env.max_episode_steps = 1000
-    assert env.task.max_steps == 1000 and env.task.path_range == (1.0, 25.0)
+    assert env.task.max_steps == 1000 and env.task.path_range == (1.0, 0.4 * 1000 * 0.5 / 10)
     assert env.task.termination_config["max_steps"] == 1000
     for bad in (0, True, 2.5, "100"):
         with pytest.raises(ValueError, match="max_steps must be an integer >= 1"):
@@ -170,7 +170,7 @@ def test_a_small_scene_that_cannot_hold_the_default_range_says_so():
     tiny = np.full((12, 12), FREE, dtype=np.uint8)
     tiny[0, :] = tiny[-1, :] = tiny[:, 0] = tiny[:, -1] = OBSTACLE
     env = PointNavEnv(scene=Scene.from_array(tiny, 0.1), task={"goal_tolerance": 0.1})
-    with pytest.raises(SamplingError, match=r"path_range \(1.0, 12.5\)"):
+    with pytest.raises(SamplingError, match=r"path_range \(1.0, 10.0\)"):
         env.reset(seed=0)
     ok = PointNavEnv(scene=small_scene(), task={"goal_tolerance": 0.1})
     ok.reset(seed=0)

@@ -22,7 +22,13 @@ from scipy import ndimage, sparse
 from scipy.sparse import csgraph
 
 from pointnav_core.frozen import thaw
-from pointnav_core.tangent_graph import _ANG_TOL, _TWO_PI, Planner, _ccw_pos, _tangent_from_point
+from pointnav_core.tangent_graph import (
+    _ANG_TOL,
+    _TWO_PI,
+    Planner,
+    _ccw_pos,
+    _tangent_from_point,
+)
 
 __all__ = ["GoalField"]
 
