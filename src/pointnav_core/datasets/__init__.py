@@ -1,0 +1,18 @@
+"""Episode datasets: Habitat's PointNav format, a generator with its rules, scene sets.
+
+=====================  ===================================================================
+module                 what it holds
+=====================  ===================================================================
+``format``             :class:`EpisodeDataset`, :class:`PointNavEpisode`: gzip JSON files
+``generator``          :func:`generate_episodes`: Habitat's sampling rules, seeded
+``scene_sets``         named scene sets with train / val / test splits, ``scene_id`` lookup
+``playback``           :class:`EpisodeSchedule`: a dataset's episodes in order or shuffled
+=====================  ===================================================================
+
+Nothing here imports Gymnasium, PettingZoo or a backend.
+"""
+
+from pointnav_core.datasets.format import EpisodeDataset, PointNavEpisode
+from pointnav_core.datasets.generator import GeneratorConfig, generate_episodes, island_radius
+
+__all__ = ["EpisodeDataset", "GeneratorConfig", "PointNavEpisode", "generate_episodes", "island_radius"]
