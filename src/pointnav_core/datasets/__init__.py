@@ -13,6 +13,18 @@ Nothing here imports Gymnasium, PettingZoo or a backend.
 """
 
 from pointnav_core.datasets.format import EpisodeDataset, PointNavEpisode
-from pointnav_core.datasets.generator import GeneratorConfig, generate_episodes, island_radius
+from pointnav_core.datasets.generator import GeneratorConfig, generate_episodes, generate_split, island_radius
+from pointnav_core.datasets.scene_sets import SCENE_SETS, SceneSet, load_scene, scene_set
 
-__all__ = ["EpisodeDataset", "GeneratorConfig", "PointNavEpisode", "generate_episodes", "island_radius"]
+__all__ = [
+    "SCENE_SETS",
+    "EpisodeDataset",
+    "GeneratorConfig",
+    "PointNavEpisode",
+    "SceneSet",
+    "generate_episodes",
+    "generate_split",
+    "island_radius",
+    "load_scene",
+    "scene_set",
+]

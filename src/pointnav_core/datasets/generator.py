@@ -20,20 +20,29 @@ The start heading is uniform in [0, 2 pi). Every random draw comes from one nump
 
 from __future__ import annotations
 
+import hashlib
 import math
 import weakref
-from collections.abc import Sequence
-from dataclasses import dataclass
+from collections.abc import Callable, Sequence
+from dataclasses import asdict, dataclass
 from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
 
-from pointnav_core.datasets.format import PointNavEpisode
+from pointnav_core.datasets.format import EpisodeDataset, PointNavEpisode
+from pointnav_core.datasets.scene_sets import SceneSet, load_scene
 from pointnav_core.errors import SamplingError
 from pointnav_core.scenes import Scene, robot_radius
 
-__all__ = ["GeneratorConfig", "generate_episodes", "island_radius", "ratio_keep_probability"]
+__all__ = [
+    "GeneratorConfig",
+    "generate_episodes",
+    "generate_split",
+    "island_radius",
+    "ratio_keep_probability",
+    "scene_seed",
+]
 
 
 def ratio_keep_probability(ratio: float) -> float:
@@ -264,3 +273,63 @@ def generate_episodes(
                 f"start for {config.max_goals_per_episode} goals in a row ({detail})"
             )
     return episodes
+
+
+def scene_seed(seed: int, scene_id: str) -> np.random.SeedSequence:
+    """The seed of one scene's episodes: from the run's ``seed`` and the scene's id only, so
+    a scene's episodes do not depend on which other scenes are generated."""
+    digest = hashlib.sha256(scene_id.encode("utf-8")).digest()
+    return np.random.SeedSequence([int(seed), int.from_bytes(digest[:8], "little")])
+
+
+def generate_split(
+    scene_set: SceneSet,
+    split: str,
+    n_episodes: int,
+    seed: int = 0,
+    config: GeneratorConfig | None = None,
+    root: str | None = None,
+    progress: Callable[[int], None] | None = None,
+) -> EpisodeDataset:
+    """Generate ``n_episodes`` episodes spread evenly over the scenes of one split.
+
+    Scene ``k`` of the split gets ``n_episodes // n_scenes`` episodes, one more for the
+    first ``n_episodes % n_scenes`` scenes; episode ids are ``"0"``, ``"1"``, ... in that
+    order. Each scene's episodes are seeded by :func:`scene_seed`.
+
+    Parameters
+    ----------
+    scene_set : SceneSet
+    split : str
+    n_episodes : int
+    seed : int
+    config : GeneratorConfig, optional
+    root : str, optional
+        Folder relative scene paths are read from.
+    progress : callable, optional
+        Called with the number of episodes generated for each scene.
+    """
+    config = config or GeneratorConfig()
+    ids = scene_set.scene_ids(split)
+    if not ids:
+        raise ValueError(f"split {split!r} of scene set {scene_set.name!r} has no scenes")
+    if isinstance(n_episodes, bool) or not isinstance(n_episodes, int) or n_episodes < 1:
+        raise ValueError(f"n_episodes must be an integer >= 1, got {n_episodes!r}")
+    episodes: list[PointNavEpisode] = []
+    for k, scene_id in enumerate(ids):
+        count = n_episodes // len(ids) + (k < n_episodes % len(ids))
+        if not count:
+            continue
+        scene = load_scene(scene_id, root)
+        episodes += generate_episodes(
+            scene, scene_id, count, seed=scene_seed(seed, scene_id), config=config, first_id=len(episodes)
+        )
+        if progress is not None:
+            progress(count)
+    metadata = {
+        "scene_set": scene_set.name,
+        "split": split,
+        "seed": int(seed),
+        "generator": {**asdict(config), "geodesic_range": list(config.geodesic_range)},
+    }
+    return EpisodeDataset(episodes, metadata)
