@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import hashlib
 
 import numpy as np
@@ -137,3 +138,25 @@ def test_generate_split_spreads_episodes_and_is_reproducible(scene_folder):
     alone = generate_split(SceneSet("one", {"train": (first,)}), "train", counts[0], seed=3, config=config)
     mine = [ep for ep in data if ep.scene_id == first]
     assert [(e.start_position, e.goal_position) for e in alone] == [(e.start_position, e.goal_position) for e in mine]
+
+
+def test_shipped_validation_dataset_regenerates_byte_identically():
+    from pointnav_core.datasets import SCENE_SETS, VALIDATION_DATASET, validation_dataset
+    from pointnav_core.datasets.generator import generate_split
+
+    shipped = validation_dataset()
+    assert len(shipped) == 300
+    assert set(shipped.scene_ids) == set(SCENE_SETS["houses"].scene_ids("val"))
+    assert not set(shipped.scene_ids) & set(SCENE_SETS["houses"].scene_ids("train") + SCENE_SETS["houses"].scene_ids("test"))
+    assert shipped.metadata == {
+        "scene_set": "houses",
+        "split": "val",
+        "seed": 0,
+        "generator": {**dataclasses.asdict(GeneratorConfig()), "geodesic_range": [1.0, 30.0]},
+    }
+    # Every scene's episodes depend on the seed and the scene only: regenerate the first
+    # house's 15 episodes (the whole file takes ~10 s; the README gives its command).
+    first = SCENE_SETS["houses"].scene_ids("val")[0]
+    part = generate_split(SceneSet("first", {"val": (first,)}), "val", 15, seed=0)
+    assert part.episodes == shipped.episodes[:15]
+    assert EpisodeDataset(shipped.episodes, shipped.metadata).to_bytes() == VALIDATION_DATASET.read_bytes()
