@@ -110,7 +110,7 @@ def test_bad_policy(spec, match):
         make_policy(spec)
 
 
-def test_unknown_scene_id_names_the_episode(dataset_file, tmp_path):
+def test_unknown_scene_id_names_the_episode(dataset_file, tmp_path, capsys):
     data = EpisodeDataset.load(dataset_file)
     bad = [dataclasses.replace(data[0], scene_id="castle:1")]
     with pytest.raises(ValueError, match=r"episode '0': field 'scene_id': unknown scene_id 'castle:1'"):
@@ -118,8 +118,12 @@ def test_unknown_scene_id_names_the_episode(dataset_file, tmp_path):
     raw = data.to_json()
     raw["episodes"][1]["goals"][0]["position"] = [1.0, "2.0", 0.0]
     (tmp_path / "bad.json").write_text(json.dumps(raw))
-    with pytest.raises(ValueError, match=r"episode '1' \(index 1 of bad.json\): field 'goals\[0\].position'"):
-        main(["eval", "--dataset", str(tmp_path / "bad.json"), "--quiet"])
+    assert main(["eval", "--dataset", str(tmp_path / "bad.json"), "--quiet"]) == 2
+    err = capsys.readouterr().err
+    assert "pointnav eval: error: episode '1' (index 1 of bad.json): field 'goals[0].position'" in err
+    assert main(["dataset", "generate", "--scenes", str(dataset_file.parent), "--split", "validation",
+                 "--episodes", "2", "--out", str(tmp_path / "x.json.gz"), "--quiet"]) == 2
+    assert "pointnav dataset generate: error: split must be one of ['train', 'val', 'test']" in capsys.readouterr().err
 
 
 def test_demo_on_a_scene_file(dataset_file, capsys):

@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import argparse
 import os
+import sys
 from collections.abc import Callable
 from typing import Any
 
@@ -83,6 +84,21 @@ def _eval(args: argparse.Namespace) -> int:
     return 0
 
 
+def _reporting(command: str, func: Callable[[argparse.Namespace], int]) -> Callable[[argparse.Namespace], int]:
+    """Run ``func``; bad input (a ValueError, a missing file, a sampling failure) is printed
+    as one line ``pointnav COMMAND: error: ...`` on stderr, with exit status 2."""
+    from pointnav_core.errors import SamplingError
+
+    def run(args: argparse.Namespace) -> int:
+        try:
+            return func(args)
+        except (ValueError, FileNotFoundError, SamplingError) as err:
+            print(f"pointnav {command}: error: {err}", file=sys.stderr)
+            return 2
+
+    return run
+
+
 def _number(text: str) -> float:
     try:
         return float(text)
@@ -106,7 +122,7 @@ def add_commands(sub: Any, positive_int: Callable[[str], int]) -> None:
     gen.add_argument("--goal-radius", type=_number, default=0.5, metavar="M")
     gen.add_argument("--habitat-frame", action="store_true", help="write Habitat's y-up frame")
     gen.add_argument("--quiet", action="store_true", help="no progress bar")
-    gen.set_defaults(func=_dataset_generate)
+    gen.set_defaults(func=_reporting("dataset generate", _dataset_generate))
 
     ev = sub.add_parser("eval", help="evaluate a policy on an episode dataset")
     ev.add_argument("--dataset", required=True, metavar="FILE")
@@ -120,4 +136,4 @@ def add_commands(sub: Any, positive_int: Callable[[str], int]) -> None:
     ev.add_argument("--results", default=None, metavar="FILE", help="per-episode results (.jsonl, or .csv)")
     ev.add_argument("--plot", default=None, metavar="FILE", help="PNG of SPL and success against geodesic distance")
     ev.add_argument("--quiet", action="store_true", help="no progress bar")
-    ev.set_defaults(func=_eval)
+    ev.set_defaults(func=_reporting("eval", _eval))
