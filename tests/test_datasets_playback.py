@@ -115,3 +115,47 @@ def test_datasets_load_no_env_library():
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
     assert out.returncode == 0, out.stderr
     assert out.stdout.strip() == "[]"
+
+
+def test_wrappers_play_the_schedule_at_every_reset(scene, dataset):
+    from pointnav_core.dataset_envs import DatasetEpisodes, ParallelDatasetEpisodes
+
+    env = DatasetEpisodes(PointNavEnv(scene=scene, flatten_obs=True), dataset, shuffle=True, seed=5)
+    expected = EpisodeSchedule(dataset, shuffle=True, seed=5).take(2 * len(dataset))
+    for ep in expected:
+        _, info = env.reset()
+        assert env.episode is ep
+        assert tuple(env.unwrapped.backend.get_pose(0)[0][:2]) == ep.start_xy
+        assert abs(info["geodesic_dist"] - ep.geodesic_distance) <= 1e-6
+    env.reset(options={"episode": dataset[1]})
+    assert tuple(env.unwrapped.task.get_goal_pos()[:2]) == dataset[1].goal_xy
+    obs, *_ = env.step(env.action_space.sample())
+    assert env.observation_space.contains(obs)
+
+    far = [dataset[0]] + [ep for ep in dataset if math.dist(ep.start_xy, dataset[0].start_xy) > 1.0][:1]
+    multi = ParallelDatasetEpisodes(MultiPointNavEnv(scene=scene, n_robots=2), far)
+    _, infos = multi.reset(seed=0)
+    assert [e.episode_id for e in multi.episodes] == [far[0].episode_id, far[1].episode_id]
+    assert abs(infos["robot_1"]["geodesic_dist"] - far[1].geodesic_distance) <= 1e-6
+    assert multi.agents == ["robot_0", "robot_1"]
+
+
+def test_dataset_env_builds_the_scene_robot_and_floor(tmp_path):
+    from pointnav_core.dataset_envs import dataset_env
+
+    map_path = tmp_path / "room.map"
+    map_path.write_text("type octile\nheight 8\nwidth 8\nmap\n" + "\n".join(["@" * 8] + ["@......@"] * 6 + ["@" * 8]) + "\n")
+    config = GeneratorConfig(geodesic_range=(1.0, 3.0), ratio_threshold=1.0, island_radius_limit=0.5, robot_radius=0.25)
+    scene_id = f"movingai:{map_path}"
+    from pointnav_core.datasets import load_scene
+
+    eps = generate_episodes(load_scene(scene_id), scene_id, 3, seed=0, config=config)
+    env = dataset_env(eps, scene_id)
+    assert env.unwrapped.robot.radius == 0.25
+    _, info = env.reset(seed=0)
+    assert env.episode is eps[0] and abs(info["geodesic_dist"] - eps[0].geodesic_distance) <= 1e-6
+    with pytest.raises(ValueError, match="no episode has scene_id 'rooms:1'"):
+        dataset_env(eps, "rooms:1")
+    mixed = [eps[0], dataclasses.replace(eps[1], robot_radius=0.1)]
+    with pytest.raises(ValueError, match=r"differ in field 'info.robot_radius' \(\[0.1, 0.25\]\)"):
+        dataset_env(mixed, scene_id)
