@@ -115,6 +115,10 @@ def test_unknown_scene_id_names_the_episode(dataset_file, tmp_path, capsys):
     bad = [dataclasses.replace(data[0], scene_id="castle:1")]
     with pytest.raises(ValueError, match=r"episode '0': field 'scene_id': unknown scene_id 'castle:1'"):
         evaluate(bad)
+    # (2.25, 2.25) is the pillar's square in the map: no robot stands there.
+    blocked = [dataclasses.replace(data[0], start_position=(2.25, 2.25, 0.0))]
+    with pytest.raises(ValueError, match=r"episode '0' \(scene 'movingai:.*\.map'\): field 'start_position' \[2.25, 2.25, 0.0\] is not valid for robot 0"):
+        evaluate(blocked)
     raw = data.to_json()
     raw["episodes"][1]["goals"][0]["position"] = [1.0, "2.0", 0.0]
     (tmp_path / "bad.json").write_text(json.dumps(raw))
