@@ -52,6 +52,21 @@ def dataset_file(tmp_path_factory):
     return out
 
 
+def test_generate_flags_reach_the_rules(tmp_path, dataset_file):
+    out = tmp_path / "loose.json.gz"
+    args = ["dataset", "generate", "--scenes", str(dataset_file.parent), "--split", "train", "--episodes", "3",
+            "--min-geodesic", "2", "--max-geodesic", "3", "--robot-radius", "0.2", "--goal-radius", "0.3",
+            "--ratio-threshold", "1.0", "--island-radius", "0.5", "--seed", "4", "--out", str(out), "--quiet"]
+    assert main(args) == 0
+    data = EpisodeDataset.load(out)
+    assert data.metadata["generator"] == {
+        "geodesic_range": [2.0, 3.0], "ratio_threshold": 1.0, "island_radius_limit": 0.5,
+        "retries_per_goal": 10, "robot_radius": 0.2, "goal_radius": 0.3, "max_goals_per_episode": 1000,
+    }
+    assert data.metadata["seed"] == 4
+    assert all(2.0 <= ep.geodesic_distance <= 3.0 and ep.robot_radius == 0.2 and ep.goal_radius == 0.3 for ep in data)
+
+
 def test_generated_file_loads(dataset_file):
     data = EpisodeDataset.load(dataset_file)
     assert len(data) == 6

@@ -29,6 +29,8 @@ def _dataset_generate(args: argparse.Namespace) -> int:
         geodesic_range=(args.min_geodesic, args.max_geodesic),
         robot_radius=args.robot_radius,
         goal_radius=args.goal_radius,
+        ratio_threshold=args.ratio_threshold,
+        island_radius_limit=args.island_radius,
     )
     scenes = scene_set(args.scenes, seed=args.seed)
     with tqdm(total=args.episodes, disable=args.quiet, desc="episodes", unit="ep") as bar:
@@ -120,6 +122,9 @@ def add_commands(sub: Any, positive_int: Callable[[str], int]) -> None:
     gen.add_argument("--max-geodesic", type=_number, default=30.0, metavar="M")
     gen.add_argument("--robot-radius", type=_number, default=0.18, metavar="M")
     gen.add_argument("--goal-radius", type=_number, default=0.5, metavar="M")
+    gen.add_argument("--ratio-threshold", type=_number, default=1.1, metavar="R",
+                     help="pairs with geodesic/euclidean below R are kept with probability 20 (ratio - 0.98)^2")
+    gen.add_argument("--island-radius", type=_number, default=1.5, metavar="M", help="reject starts on smaller islands")
     gen.add_argument("--habitat-frame", action="store_true", help="write Habitat's y-up frame")
     gen.add_argument("--quiet", action="store_true", help="no progress bar")
     gen.set_defaults(func=_reporting("dataset generate", _dataset_generate))
