@@ -8,7 +8,12 @@ import math
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from pointnav_core.datasets import EpisodeDataset, GeneratorConfig, PointNavEpisode, generate_episodes
+from pointnav_core.datasets import (
+    EpisodeDataset,
+    GeneratorConfig,
+    PointNavEpisode,
+    generate_episodes,
+)
 from pointnav_core.testing.strategies import nav_scenes, yaws
 
 coords = st.floats(-1e3, 1e3, allow_nan=False, allow_infinity=False)
@@ -35,7 +40,9 @@ def episodes(draw: st.DrawFn, episode_id: str) -> PointNavEpisode:
 @st.composite
 def datasets(draw: st.DrawFn) -> EpisodeDataset:
     n = draw(st.integers(0, 5))
-    return EpisodeDataset([draw(episodes(str(i))) for i in range(n)], {"note": draw(st.text(max_size=8))})
+    return EpisodeDataset(
+        [draw(episodes(str(i))) for i in range(n)], {"note": draw(st.text(max_size=8))}
+    )
 
 
 @given(datasets())
@@ -55,7 +62,12 @@ def test_habitat_frame_round_trips(data):
 @settings(max_examples=15)
 @given(nav_scenes(), st.integers(0, 2**32 - 1))
 def test_generated_episodes_obey_the_rules(scene, seed):
-    config = GeneratorConfig(geodesic_range=(0.3, 5.0), robot_radius=0.1, island_radius_limit=0.0, max_goals_per_episode=200)
+    config = GeneratorConfig(
+        geodesic_range=(0.3, 5.0),
+        robot_radius=0.1,
+        island_radius_limit=0.0,
+        max_goals_per_episode=200,
+    )
     for ep in generate_episodes(scene, "s", 3, seed=seed, config=config):
         assert 0.3 <= ep.geodesic_distance <= 5.0
         assert scene.is_usable(0, ep.start_xy, 0.1) and scene.is_usable(0, ep.goal_xy, 0.1)

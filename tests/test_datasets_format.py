@@ -60,7 +60,14 @@ def test_bytes_are_reproducible_gzip_without_mtime(dataset):
 def test_file_has_habitat_keys(dataset):
     raw = json.loads(gzip.decompress(dataset.to_bytes()))
     ep = raw["episodes"][0]
-    assert set(ep) == {"episode_id", "scene_id", "start_position", "start_rotation", "goals", "info"}
+    assert set(ep) == {
+        "episode_id",
+        "scene_id",
+        "start_position",
+        "start_rotation",
+        "goals",
+        "info",
+    }
     assert set(ep["goals"][0]) == {"position", "radius"}
     assert set(ep["info"]) == {"geodesic_distance", "floor", "robot_radius"}
     assert raw["pointnav_core"]["frame"] == "z-up"
@@ -145,7 +152,9 @@ def test_malformed_episode_names_episode_and_field(dataset, edit, field):
 def test_duplicate_ids_and_bad_files(tmp_path, dataset):
     raw = _raw(dataset)
     raw["episodes"][3]["episode_id"] = "1"
-    with pytest.raises(ValueError, match=r"episode '1' \(index 3\): field 'episode_id' must be unique"):
+    with pytest.raises(
+        ValueError, match=r"episode '1' \(index 3\): field 'episode_id' must be unique"
+    ):
         EpisodeDataset.from_json(raw)
     with pytest.raises(ValueError, match="'episodes' list"):
         EpisodeDataset.from_json({"episodes": {}})

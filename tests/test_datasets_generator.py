@@ -70,7 +70,12 @@ def _flood_islands(usable: np.ndarray) -> tuple[np.ndarray, dict[int, float]]:
             for dr in (-1, 0, 1):
                 for dc in (-1, 0, 1):
                     q = (r + dr, c + dc)
-                    if 0 <= q[0] < usable.shape[0] and 0 <= q[1] < usable.shape[1] and usable[q] and not labels[q]:
+                    if (
+                        0 <= q[0] < usable.shape[0]
+                        and 0 <= q[1] < usable.shape[1]
+                        and usable[q]
+                        and not labels[q]
+                    ):
                         labels[q] = n
                         queue.append(q)
                         cells.append(q)
@@ -91,14 +96,18 @@ def test_no_start_or_goal_on_a_small_island():
     assert len(small) == 1  # the pocket: the rule has something to reject
     scene = Scene.from_array(free, RES)
     # The ratio filter is off here (threshold 1): this test is about islands, and it is fast.
-    episodes = generate_episodes(scene, "islands", 60, seed=1, config=GeneratorConfig(ratio_threshold=1.0))
+    episodes = generate_episodes(
+        scene, "islands", 60, seed=1, config=GeneratorConfig(ratio_threshold=1.0)
+    )
     for ep in episodes:
         assert radii[labels[_cell(ep.start_xy)]] >= 1.5
         assert radii[labels[_cell(ep.goal_xy)]] >= 1.5
     # The library's island radius is the reference's, for both islands.
     for label, reference in radii.items():
         r, c = np.argwhere(labels == label)[0]
-        assert island_radius(scene, 0, ((c + 0.5) * RES, (r + 0.5) * RES), RADIUS) == pytest.approx(reference, abs=1e-9)
+        assert island_radius(scene, 0, ((c + 0.5) * RES, (r + 0.5) * RES), RADIUS) == pytest.approx(
+            reference, abs=1e-9
+        )
     # Without the rule, the pocket does get episodes (so the check above could fail).
     loose_rules = GeneratorConfig(island_radius_limit=0.0, ratio_threshold=1.0)
     loose = generate_episodes(scene, "islands", 60, seed=1, config=loose_rules)
@@ -112,7 +121,9 @@ def test_distances_in_range_and_equal_to_the_library_geodesic():
     fresh = Scene.from_array(free, RES)  # no caches shared with the generator's scene
     for ep in episodes:
         assert 2.0 <= ep.geodesic_distance <= 6.0
-        _, length = fresh.get_shortest_path(0, ep.start_xy, ep.goal_xy, entire_path=True, robot=RADIUS)
+        _, length = fresh.get_shortest_path(
+            0, ep.start_xy, ep.goal_xy, entire_path=True, robot=RADIUS
+        )
         assert abs(length - ep.geodesic_distance) <= 1e-6
         assert fresh.is_usable(0, ep.start_xy, RADIUS) and fresh.is_usable(0, ep.goal_xy, RADIUS)
         assert ep.robot_radius == RADIUS and ep.goal_radius == 0.5
@@ -139,7 +150,12 @@ def test_ratio_filter_keep_rate_matches_habitat_formula():
         p = np.minimum(20.0 * (ratios[sel] - 0.98) ** 2, 1.0)  # Habitat's _ratio_sample_rate
         expected = p.mean()
         sigma = math.sqrt((p * (1 - p)).sum()) / sel.sum()
-        assert abs(kept[sel].mean() - expected) <= 4 * sigma + 1e-3, (lo, hi, kept[sel].mean(), expected)
+        assert abs(kept[sel].mean() - expected) <= 4 * sigma + 1e-3, (
+            lo,
+            hi,
+            kept[sel].mean(),
+            expected,
+        )
     # Every kept low-ratio pair became an episode; the filter's counter adds up.
     assert stats["rejected"]["ratio filter"] == int((1 - kept).sum())
     low = [ep for ep in episodes if ep.geodesic_distance / math.dist(ep.start_xy, ep.goal_xy) < 1.1]
@@ -154,7 +170,9 @@ def test_same_floor_and_floor_recorded():
     for ep in episodes:
         height = 3.0 * ep.floor
         assert ep.start_position[2] == ep.goal_position[2] == height
-        assert math.isfinite(scene.geodesic_distance(ep.floor, ep.start_xy, ep.goal_xy, robot=RADIUS))
+        assert math.isfinite(
+            scene.geodesic_distance(ep.floor, ep.start_xy, ep.goal_xy, robot=RADIUS)
+        )
 
 
 def test_start_yaw_is_random():
@@ -178,7 +196,9 @@ def test_same_seed_same_bytes_other_seed_other_bytes():
 
 def test_stats_do_not_change_the_episodes():
     scene = Scene.from_array(_divided_grid(), RES)
-    assert generate_episodes(scene, "d", 10, seed=9) == generate_episodes(scene, "d", 10, seed=9, stats={})
+    assert generate_episodes(scene, "d", 10, seed=9) == generate_episodes(
+        scene, "d", 10, seed=9, stats={}
+    )
 
 
 def test_impossible_rules_raise_sampling_error():

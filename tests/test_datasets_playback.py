@@ -30,7 +30,9 @@ def scene() -> Scene:
 
 @pytest.fixture(scope="module")
 def dataset(scene) -> EpisodeDataset:
-    config = GeneratorConfig(geodesic_range=(1.0, 5.0), ratio_threshold=1.0, island_radius_limit=1.0)
+    config = GeneratorConfig(
+        geodesic_range=(1.0, 5.0), ratio_threshold=1.0, island_radius_limit=1.0
+    )
     return EpisodeDataset(generate_episodes(scene, "box", 12, seed=0, config=config))
 
 
@@ -51,8 +53,12 @@ def test_single_env_plays_the_episode(scene, dataset):
 def test_schedule_in_order_and_shuffled(dataset):
     ids = [ep.episode_id for ep in dataset]
     assert [ep.episode_id for ep in EpisodeSchedule(dataset).take(2 * len(ids))] == ids + ids
-    first = [ep.episode_id for ep in EpisodeSchedule(dataset, shuffle=True, seed=3).take(2 * len(ids))]
-    again = [ep.episode_id for ep in EpisodeSchedule(dataset, shuffle=True, seed=3).take(2 * len(ids))]
+    first = [
+        ep.episode_id for ep in EpisodeSchedule(dataset, shuffle=True, seed=3).take(2 * len(ids))
+    ]
+    again = [
+        ep.episode_id for ep in EpisodeSchedule(dataset, shuffle=True, seed=3).take(2 * len(ids))
+    ]
     assert first == again
     assert sorted(first[: len(ids)]) == sorted(ids) == sorted(first[len(ids) :])
     assert first[: len(ids)] != ids and first[: len(ids)] != first[len(ids) :]
@@ -65,23 +71,36 @@ def test_schedule_in_order_and_shuffled(dataset):
 def test_episode_seed_depends_on_the_episode_only(dataset):
     seeds = [episode_seed(ep) for ep in dataset]
     assert len(set(seeds)) == len(seeds)
-    assert episode_seed(dataset[3]) == episode_seed(dataclasses.replace(dataset[3], start_position=(0.0, 0.0, 0.0)))
+    assert episode_seed(dataset[3]) == episode_seed(
+        dataclasses.replace(dataset[3], start_position=(0.0, 0.0, 0.0))
+    )
     assert all(0 <= s < 2**63 for s in seeds)
 
 
 def test_start_not_valid_for_the_robot_names_episode_and_field(scene, dataset):
     env = PointNavEnv(scene=scene, robot={"radius": 0.6})
     bad = next(ep for ep in dataset if not scene.is_usable(0, ep.start_xy, 0.6))
-    with pytest.raises(ValueError, match=rf"episode '{bad.episode_id}' \(scene 'box'\): field 'start_position' .* not valid for robot 0 \(radius 0.6 m\)"):
+    with pytest.raises(
+        ValueError,
+        match=rf"episode '{bad.episode_id}' \(scene 'box'\): field 'start_position' .* not valid for robot 0 \(radius 0.6 m\)",
+    ):
         env.reset(options={"episode": bad})
     blocked_goal = dataclasses.replace(dataset[0], goal_position=(3.15, 2.5, 0.0))
     env = PointNavEnv(scene=scene)
     with pytest.raises(ValueError, match=r"field 'goals\[0\].position'"):
         env.reset(options={"episode": blocked_goal})
-    with pytest.raises(ValueError, match=r"field 'info.floor' is 1, but robot 0's task navigates floor 0"):
+    with pytest.raises(
+        ValueError, match=r"field 'info.floor' is 1, but robot 0's task navigates floor 0"
+    ):
         env.reset(options={"episode": dataclasses.replace(dataset[0], floor=1)})
     with pytest.raises(ValueError, match=r"field 'start_position' has z = 0.5 m"):
-        env.reset(options={"episode": dataclasses.replace(dataset[0], start_position=(*dataset[0].start_xy, 0.5))})
+        env.reset(
+            options={
+                "episode": dataclasses.replace(
+                    dataset[0], start_position=(*dataset[0].start_xy, 0.5)
+                )
+            }
+        )
     with pytest.raises(ValueError, match="episode must be a PointNavEpisode"):
         env.reset(options={"episode": {"start": (1, 1)}})
     # The env recovers: a good episode plays after a bad one.
@@ -90,7 +109,9 @@ def test_start_not_valid_for_the_robot_names_episode_and_field(scene, dataset):
 
 def test_multi_robot_env_plays_one_episode_per_robot(scene, dataset):
     env = MultiPointNavEnv(scene=scene, n_robots=2)
-    far_apart = [dataset[0]] + [ep for ep in dataset if math.dist(ep.start_xy, dataset[0].start_xy) > 1.0][:1]
+    far_apart = [dataset[0]] + [
+        ep for ep in dataset if math.dist(ep.start_xy, dataset[0].start_xy) > 1.0
+    ][:1]
     _, infos = env.reset(seed=0, options={"episodes": far_apart})
     for i, ep in enumerate(far_apart):
         assert tuple(env.backend.get_pose(i)[0][:2]) == ep.start_xy
@@ -132,7 +153,9 @@ def test_wrappers_play_the_schedule_at_every_reset(scene, dataset):
     obs, *_ = env.step(env.action_space.sample())
     assert env.observation_space.contains(obs)
 
-    far = [dataset[0]] + [ep for ep in dataset if math.dist(ep.start_xy, dataset[0].start_xy) > 1.0][:1]
+    far = [dataset[0]] + [
+        ep for ep in dataset if math.dist(ep.start_xy, dataset[0].start_xy) > 1.0
+    ][:1]
     multi = ParallelDatasetEpisodes(MultiPointNavEnv(scene=scene, n_robots=2), far)
     _, infos = multi.reset(seed=0)
     assert [e.episode_id for e in multi.episodes] == [far[0].episode_id, far[1].episode_id]
@@ -144,8 +167,14 @@ def test_dataset_env_builds_the_scene_robot_and_floor(tmp_path):
     from pointnav_core.dataset_envs import dataset_env
 
     map_path = tmp_path / "room.map"
-    map_path.write_text("type octile\nheight 8\nwidth 8\nmap\n" + "\n".join(["@" * 8] + ["@......@"] * 6 + ["@" * 8]) + "\n")
-    config = GeneratorConfig(geodesic_range=(1.0, 3.0), ratio_threshold=1.0, island_radius_limit=0.5, robot_radius=0.25)
+    map_path.write_text(
+        "type octile\nheight 8\nwidth 8\nmap\n"
+        + "\n".join(["@" * 8] + ["@......@"] * 6 + ["@" * 8])
+        + "\n"
+    )
+    config = GeneratorConfig(
+        geodesic_range=(1.0, 3.0), ratio_threshold=1.0, island_radius_limit=0.5, robot_radius=0.25
+    )
     scene_id = f"movingai:{map_path}"
     from pointnav_core.datasets import load_scene
 

@@ -48,7 +48,11 @@ def test_named_sets_never_share_a_scene_between_splits(name):
 
 def test_val_and_test_houses_are_different_houses():
     houses = SCENE_SETS["houses"]
-    picked = list(houses.scene_ids("val")[:2]) + list(houses.scene_ids("test")[:2]) + [houses.scene_ids("train")[-1]]
+    picked = (
+        list(houses.scene_ids("val")[:2])
+        + list(houses.scene_ids("test")[:2])
+        + [houses.scene_ids("train")[-1]]
+    )
     prints = {_fingerprint(load_scene(s)) for s in picked}
     assert len(prints) == len(picked)
     # A generated scene_id builds exactly the library's generated house.
@@ -80,7 +84,9 @@ def scene_folder(tmp_path):
 def test_folder_set_splits_maps_and_omnigibson_scenes(scene_folder):
     found = folder_scene_set(scene_folder, seed=0)
     ids = [s for split in found.splits.values() for s in split]
-    assert sorted(ids) == sorted([f"movingai:{scene_folder}/m{i}.map" for i in range(5)] + [f"trav:{scene_folder}/omni"])
+    assert sorted(ids) == sorted(
+        [f"movingai:{scene_folder}/m{i}.map" for i in range(5)] + [f"trav:{scene_folder}/omni"]
+    )
     assert len(found.splits["val"]) >= 1 and len(found.splits["test"]) >= 1
     assert folder_scene_set(scene_folder, seed=0) == found
     assert scene_set(str(scene_folder)).splits == found.splits
@@ -124,7 +130,9 @@ def test_unknown_set_and_bad_folder(tmp_path):
 
 def test_generate_split_spreads_episodes_and_is_reproducible(scene_folder):
     found = folder_scene_set(scene_folder, seed=0)
-    config = GeneratorConfig(geodesic_range=(1.0, 4.0), island_radius_limit=0.5, ratio_threshold=1.0)
+    config = GeneratorConfig(
+        geodesic_range=(1.0, 4.0), island_radius_limit=0.5, ratio_threshold=1.0
+    )
     data = generate_split(found, "train", 9, seed=3, config=config)
     assert [ep.episode_id for ep in data] == [str(i) for i in range(9)]
     counts = [sum(ep.scene_id == s for ep in data) for s in found.splits["train"]]
@@ -135,9 +143,13 @@ def test_generate_split_spreads_episodes_and_is_reproducible(scene_folder):
     assert EpisodeDataset.from_json(data.to_json()) == data
     # A scene's episodes depend on the seed and the scene only, not on the other scenes.
     first = found.splits["train"][0]
-    alone = generate_split(SceneSet("one", {"train": (first,)}), "train", counts[0], seed=3, config=config)
+    alone = generate_split(
+        SceneSet("one", {"train": (first,)}), "train", counts[0], seed=3, config=config
+    )
     mine = [ep for ep in data if ep.scene_id == first]
-    assert [(e.start_position, e.goal_position) for e in alone] == [(e.start_position, e.goal_position) for e in mine]
+    assert [(e.start_position, e.goal_position) for e in alone] == [
+        (e.start_position, e.goal_position) for e in mine
+    ]
 
 
 def test_shipped_validation_dataset_regenerates_byte_identically():
@@ -147,7 +159,9 @@ def test_shipped_validation_dataset_regenerates_byte_identically():
     shipped = validation_dataset()
     assert len(shipped) == 300
     assert set(shipped.scene_ids) == set(SCENE_SETS["houses"].scene_ids("val"))
-    assert not set(shipped.scene_ids) & set(SCENE_SETS["houses"].scene_ids("train") + SCENE_SETS["houses"].scene_ids("test"))
+    assert not set(shipped.scene_ids) & set(
+        SCENE_SETS["houses"].scene_ids("train") + SCENE_SETS["houses"].scene_ids("test")
+    )
     assert shipped.metadata == {
         "scene_set": "houses",
         "split": "val",
@@ -159,4 +173,7 @@ def test_shipped_validation_dataset_regenerates_byte_identically():
     first = SCENE_SETS["houses"].scene_ids("val")[0]
     part = generate_split(SceneSet("first", {"val": (first,)}), "val", 15, seed=0)
     assert part.episodes == shipped.episodes[:15]
-    assert EpisodeDataset(shipped.episodes, shipped.metadata).to_bytes() == VALIDATION_DATASET.read_bytes()
+    assert (
+        EpisodeDataset(shipped.episodes, shipped.metadata).to_bytes()
+        == VALIDATION_DATASET.read_bytes()
+    )

@@ -41,10 +41,25 @@ map
 def dataset_file(tmp_path_factory):
     folder = tmp_path_factory.mktemp("scenes")
     for name in ("a", "b", "c"):
-        (folder / f"{name}.map").write_text(MAP.replace("@@...", "@@..." if name != "b" else "@@.@."))
+        (folder / f"{name}.map").write_text(
+            MAP.replace("@@...", "@@..." if name != "b" else "@@.@.")
+        )
     out = folder / "val.json.gz"
-    args = ["dataset", "generate", "--scenes", str(folder), "--split", "train", "--episodes", "6",
-            "--max-geodesic", "4", "--out", str(out), "--quiet"]
+    args = [
+        "dataset",
+        "generate",
+        "--scenes",
+        str(folder),
+        "--split",
+        "train",
+        "--episodes",
+        "6",
+        "--max-geodesic",
+        "4",
+        "--out",
+        str(out),
+        "--quiet",
+    ]
     assert main(args) == 0
     again = folder / "again.json.gz"
     assert main([*args[:-2], str(again), "--quiet"]) == 0
@@ -54,17 +69,49 @@ def dataset_file(tmp_path_factory):
 
 def test_generate_flags_reach_the_rules(tmp_path, dataset_file):
     out = tmp_path / "loose.json.gz"
-    args = ["dataset", "generate", "--scenes", str(dataset_file.parent), "--split", "train", "--episodes", "3",
-            "--min-geodesic", "2", "--max-geodesic", "3", "--robot-radius", "0.2", "--goal-radius", "0.3",
-            "--ratio-threshold", "1.0", "--island-radius", "0.5", "--seed", "4", "--out", str(out), "--quiet"]
+    args = [
+        "dataset",
+        "generate",
+        "--scenes",
+        str(dataset_file.parent),
+        "--split",
+        "train",
+        "--episodes",
+        "3",
+        "--min-geodesic",
+        "2",
+        "--max-geodesic",
+        "3",
+        "--robot-radius",
+        "0.2",
+        "--goal-radius",
+        "0.3",
+        "--ratio-threshold",
+        "1.0",
+        "--island-radius",
+        "0.5",
+        "--seed",
+        "4",
+        "--out",
+        str(out),
+        "--quiet",
+    ]
     assert main(args) == 0
     data = EpisodeDataset.load(out)
     assert data.metadata["generator"] == {
-        "geodesic_range": [2.0, 3.0], "ratio_threshold": 1.0, "island_radius_limit": 0.5,
-        "retries_per_goal": 10, "robot_radius": 0.2, "goal_radius": 0.3, "max_goals_per_episode": 1000,
+        "geodesic_range": [2.0, 3.0],
+        "ratio_threshold": 1.0,
+        "island_radius_limit": 0.5,
+        "retries_per_goal": 10,
+        "robot_radius": 0.2,
+        "goal_radius": 0.3,
+        "max_goals_per_episode": 1000,
     }
     assert data.metadata["seed"] == 4
-    assert all(2.0 <= ep.geodesic_distance <= 3.0 and ep.robot_radius == 0.2 and ep.goal_radius == 0.3 for ep in data)
+    assert all(
+        2.0 <= ep.geodesic_distance <= 3.0 and ep.robot_radius == 0.2 and ep.goal_radius == 0.3
+        for ep in data
+    )
 
 
 def test_generated_file_loads(dataset_file):
@@ -87,7 +134,21 @@ def test_oracle_results_do_not_depend_on_order_or_workers(dataset_file):
 
 def test_cli_eval_prints_and_writes(dataset_file, tmp_path, capsys):
     results, plot = tmp_path / "r.jsonl", tmp_path / "r.png"
-    assert main(["eval", "--dataset", str(dataset_file), "--results", str(results), "--plot", str(plot), "--quiet"]) == 0
+    assert (
+        main(
+            [
+                "eval",
+                "--dataset",
+                str(dataset_file),
+                "--results",
+                str(results),
+                "--plot",
+                str(plot),
+                "--quiet",
+            ]
+        )
+        == 0
+    )
     out = capsys.readouterr().out
     for label in ("success", "SPL", "SoftSPL", "distance to goal", "collisions"):
         assert label in out
@@ -106,7 +167,9 @@ def test_cli_eval_prints_and_writes(dataset_file, tmp_path, capsys):
 def test_module_callable_policy(dataset_file):
     data = list(EpisodeDataset.load(dataset_file))[:2]
     results = evaluate(data, "eval_policies:standstill", max_steps=5)
-    assert [(r.success, r.steps, r.ended_by, r.path_length) for r in results] == [(False, 5, "timeout", 0.0)] * 2
+    assert [(r.success, r.steps, r.ended_by, r.path_length) for r in results] == [
+        (False, 5, "timeout", 0.0)
+    ] * 2
     assert all(r.distance_to_goal == pytest.approx(r.geodesic_distance, abs=1e-6) for r in results)
 
 
@@ -128,21 +191,47 @@ def test_bad_policy(spec, match):
 def test_unknown_scene_id_names_the_episode(dataset_file, tmp_path, capsys):
     data = EpisodeDataset.load(dataset_file)
     bad = [dataclasses.replace(data[0], scene_id="castle:1")]
-    with pytest.raises(ValueError, match=r"episode '0': field 'scene_id': unknown scene_id 'castle:1'"):
+    with pytest.raises(
+        ValueError, match=r"episode '0': field 'scene_id': unknown scene_id 'castle:1'"
+    ):
         evaluate(bad)
     # (2.25, 2.25) is the pillar's square in the map: no robot stands there.
     blocked = [dataclasses.replace(data[0], start_position=(2.25, 2.25, 0.0))]
-    with pytest.raises(ValueError, match=r"episode '0' \(scene 'movingai:.*\.map'\): field 'start_position' \[2.25, 2.25, 0.0\] is not valid for robot 0"):
+    with pytest.raises(
+        ValueError,
+        match=r"episode '0' \(scene 'movingai:.*\.map'\): field 'start_position' \[2.25, 2.25, 0.0\] is not valid for robot 0",
+    ):
         evaluate(blocked)
     raw = data.to_json()
     raw["episodes"][1]["goals"][0]["position"] = [1.0, "2.0", 0.0]
     (tmp_path / "bad.json").write_text(json.dumps(raw))
     assert main(["eval", "--dataset", str(tmp_path / "bad.json"), "--quiet"]) == 2
     err = capsys.readouterr().err
-    assert "pointnav eval: error: episode '1' (index 1 of bad.json): field 'goals[0].position'" in err
-    assert main(["dataset", "generate", "--scenes", str(dataset_file.parent), "--split", "validation",
-                 "--episodes", "2", "--out", str(tmp_path / "x.json.gz"), "--quiet"]) == 2
-    assert "pointnav dataset generate: error: split must be one of ['train', 'val', 'test']" in capsys.readouterr().err
+    assert (
+        "pointnav eval: error: episode '1' (index 1 of bad.json): field 'goals[0].position'" in err
+    )
+    assert (
+        main(
+            [
+                "dataset",
+                "generate",
+                "--scenes",
+                str(dataset_file.parent),
+                "--split",
+                "validation",
+                "--episodes",
+                "2",
+                "--out",
+                str(tmp_path / "x.json.gz"),
+                "--quiet",
+            ]
+        )
+        == 2
+    )
+    assert (
+        "pointnav dataset generate: error: split must be one of ['train', 'val', 'test']"
+        in capsys.readouterr().err
+    )
 
 
 def test_demo_on_a_scene_file(dataset_file, capsys):
@@ -156,7 +245,9 @@ def test_sb3_zip_policy(dataset_file, tmp_path):
     sb3 = pytest.importorskip("stable_baselines3")
     from pointnav_core.env import PointNavEnv
 
-    model = sb3.PPO("MlpPolicy", PointNavEnv(flatten_obs=True), n_steps=16, batch_size=16, device="cpu", seed=0)
+    model = sb3.PPO(
+        "MlpPolicy", PointNavEnv(flatten_obs=True), n_steps=16, batch_size=16, device="cpu", seed=0
+    )
     model.save(tmp_path / "ppo.zip")
     data = list(EpisodeDataset.load(dataset_file))[:2]
     first = evaluate(data, str(tmp_path / "ppo.zip"), max_steps=10)

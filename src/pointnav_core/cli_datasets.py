@@ -34,9 +34,13 @@ def _dataset_generate(args: argparse.Namespace) -> int:
     )
     scenes = scene_set(args.scenes, seed=args.seed)
     with tqdm(total=args.episodes, disable=args.quiet, desc="episodes", unit="ep") as bar:
-        dataset = generate_split(scenes, args.split, args.episodes, seed=args.seed, config=config, progress=bar.update)
+        dataset = generate_split(
+            scenes, args.split, args.episodes, seed=args.seed, config=config, progress=bar.update
+        )
     dataset.save(args.out, frame="habitat" if args.habitat_frame else "z-up")
-    print(f"wrote {args.out}: {len(dataset)} episodes on {len(dataset.scene_ids)} scenes of {args.scenes!r} ({args.split})")
+    print(
+        f"wrote {args.out}: {len(dataset)} episodes on {len(dataset.scene_ids)} scenes of {args.scenes!r} ({args.split})"
+    )
     return 0
 
 
@@ -86,7 +90,9 @@ def _eval(args: argparse.Namespace) -> int:
     return 0
 
 
-def _reporting(command: str, func: Callable[[argparse.Namespace], int]) -> Callable[[argparse.Namespace], int]:
+def _reporting(
+    command: str, func: Callable[[argparse.Namespace], int]
+) -> Callable[[argparse.Namespace], int]:
     """Run ``func``; bad input (a ValueError, a missing file, a sampling failure) is printed
     as one line ``pointnav COMMAND: error: ...`` on stderr, with exit status 2."""
     from pointnav_core.errors import SamplingError
@@ -113,7 +119,12 @@ def add_commands(sub: Any, positive_int: Callable[[str], int]) -> None:
     dataset = sub.add_parser("dataset", help="episode datasets")
     dsub = dataset.add_subparsers(dest="dataset_command", required=True)
     gen = dsub.add_parser("generate", help="generate an episode dataset with Habitat's rules")
-    gen.add_argument("--scenes", required=True, metavar="SET", help="a named set (houses, mazes, clutter) or a folder of scenes")
+    gen.add_argument(
+        "--scenes",
+        required=True,
+        metavar="SET",
+        help="a named set (houses, mazes, clutter) or a folder of scenes",
+    )
     gen.add_argument("--split", default="val", help="train, val or test (default val)")
     gen.add_argument("--episodes", type=positive_int, required=True, metavar="N")
     gen.add_argument("--out", required=True, metavar="FILE", help="output .json.gz")
@@ -122,23 +133,50 @@ def add_commands(sub: Any, positive_int: Callable[[str], int]) -> None:
     gen.add_argument("--max-geodesic", type=_number, default=30.0, metavar="M")
     gen.add_argument("--robot-radius", type=_number, default=0.18, metavar="M")
     gen.add_argument("--goal-radius", type=_number, default=0.5, metavar="M")
-    gen.add_argument("--ratio-threshold", type=_number, default=1.1, metavar="R",
-                     help="pairs with geodesic/euclidean below R are kept with probability 20 (ratio - 0.98)^2")
-    gen.add_argument("--island-radius", type=_number, default=1.5, metavar="M", help="reject starts on smaller islands")
+    gen.add_argument(
+        "--ratio-threshold",
+        type=_number,
+        default=1.1,
+        metavar="R",
+        help="pairs with geodesic/euclidean below R are kept with probability 20 (ratio - 0.98)^2",
+    )
+    gen.add_argument(
+        "--island-radius",
+        type=_number,
+        default=1.5,
+        metavar="M",
+        help="reject starts on smaller islands",
+    )
     gen.add_argument("--habitat-frame", action="store_true", help="write Habitat's y-up frame")
     gen.add_argument("--quiet", action="store_true", help="no progress bar")
     gen.set_defaults(func=_reporting("dataset generate", _dataset_generate))
 
     ev = sub.add_parser("eval", help="evaluate a policy on an episode dataset")
     ev.add_argument("--dataset", required=True, metavar="FILE")
-    ev.add_argument("--policy", default="oracle", help="oracle, MODULE:CALLABLE or a Stable-Baselines3 .zip")
-    ev.add_argument("--sb3-algo", default="PPO", help="algorithm class of an SB3 .zip (default PPO)")
+    ev.add_argument(
+        "--policy", default="oracle", help="oracle, MODULE:CALLABLE or a Stable-Baselines3 .zip"
+    )
+    ev.add_argument(
+        "--sb3-algo", default="PPO", help="algorithm class of an SB3 .zip (default PPO)"
+    )
     ev.add_argument("--backend", default="kinematic")
     ev.add_argument("--drive", choices=("differential", "holonomic"), default="differential")
     ev.add_argument("--workers", type=positive_int, default=1, metavar="N")
     ev.add_argument("--max-steps", type=positive_int, default=1000, metavar="N")
-    ev.add_argument("--scenes-dir", default=None, metavar="DIR", help="folder relative scene paths are read from")
-    ev.add_argument("--results", default=None, metavar="FILE", help="per-episode results (.jsonl, or .csv)")
-    ev.add_argument("--plot", default=None, metavar="FILE", help="PNG of SPL and success against geodesic distance")
+    ev.add_argument(
+        "--scenes-dir",
+        default=None,
+        metavar="DIR",
+        help="folder relative scene paths are read from",
+    )
+    ev.add_argument(
+        "--results", default=None, metavar="FILE", help="per-episode results (.jsonl, or .csv)"
+    )
+    ev.add_argument(
+        "--plot",
+        default=None,
+        metavar="FILE",
+        help="PNG of SPL and success against geodesic distance",
+    )
     ev.add_argument("--quiet", action="store_true", help="no progress bar")
     ev.set_defaults(func=_reporting("eval", _eval))

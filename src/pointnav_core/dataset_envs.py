@@ -41,12 +41,20 @@ class DatasetEpisodes(gym.Wrapper):
         Seed of the shuffling.
     """
 
-    def __init__(self, env: gym.Env, episodes: Iterable[PointNavEpisode], shuffle: bool = False, seed: int | None = None) -> None:
+    def __init__(
+        self,
+        env: gym.Env,
+        episodes: Iterable[PointNavEpisode],
+        shuffle: bool = False,
+        seed: int | None = None,
+    ) -> None:
         super().__init__(env)
         self.schedule = EpisodeSchedule(episodes, shuffle=shuffle, seed=seed)
         self.episode: PointNavEpisode | None = None
 
-    def reset(self, *, seed: int | None = None, options: dict[str, Any] | None = None) -> tuple[Any, dict[str, Any]]:
+    def reset(
+        self, *, seed: int | None = None, options: dict[str, Any] | None = None
+    ) -> tuple[Any, dict[str, Any]]:
         """Reset the env into the schedule's next episode (or ``options["episode"]``)."""
         options = dict(options or {})
         if options.get("episode") is None:
@@ -62,12 +70,20 @@ class ParallelDatasetEpisodes(BaseParallelWrapper):
     robot's raise ``ValueError`` naming the episode; goals are taken as given.
     """
 
-    def __init__(self, env: Any, episodes: Iterable[PointNavEpisode], shuffle: bool = False, seed: int | None = None) -> None:
+    def __init__(
+        self,
+        env: Any,
+        episodes: Iterable[PointNavEpisode],
+        shuffle: bool = False,
+        seed: int | None = None,
+    ) -> None:
         super().__init__(env)
         self.schedule = EpisodeSchedule(episodes, shuffle=shuffle, seed=seed)
         self.episodes: list[PointNavEpisode] = []
 
-    def reset(self, seed: int | None = None, options: dict[str, Any] | None = None) -> tuple[dict[str, Any], dict[str, dict[str, Any]]]:
+    def reset(
+        self, seed: int | None = None, options: dict[str, Any] | None = None
+    ) -> tuple[dict[str, Any], dict[str, dict[str, Any]]]:
         """Reset every robot into the schedule's next episodes (or ``options["episodes"]``)."""
         options = dict(options or {})
         if options.get("episodes") is None:
@@ -116,7 +132,10 @@ def dataset_env(
     mine = [ep for ep in episodes if ep.scene_id == scene_id]
     if not mine:
         raise ValueError(f"no episode has scene_id {scene_id!r}")
-    for field_name, values in (("info.floor", {ep.floor for ep in mine}), ("info.robot_radius", {ep.robot_radius for ep in mine})):
+    for field_name, values in (
+        ("info.floor", {ep.floor for ep in mine}),
+        ("info.robot_radius", {ep.robot_radius for ep in mine}),
+    ):
         if len(values) > 1:
             raise ValueError(
                 f"the episodes of scene {scene_id!r} differ in field '{field_name}' ({sorted(values)}); "
@@ -128,7 +147,9 @@ def dataset_env(
     if n_robots is None:
         from pointnav_core.env import PointNavEnv
 
-        return DatasetEpisodes(PointNavEnv(scene=scene, robot=robot, task=task, **env_kwargs), mine, shuffle, seed)
+        return DatasetEpisodes(
+            PointNavEnv(scene=scene, robot=robot, task=task, **env_kwargs), mine, shuffle, seed
+        )
     from pointnav_core.parallel import MultiPointNavEnv
 
     multi = MultiPointNavEnv(scene=scene, n_robots=n_robots, robot=robot, task=task, **env_kwargs)

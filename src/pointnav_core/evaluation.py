@@ -118,10 +118,14 @@ class _SB3Policy:
             try:
                 import stable_baselines3
             except ImportError:
-                raise ValueError("an SB3 .zip policy needs stable-baselines3 (pip install 'pointnav-core[rl]')") from None
+                raise ValueError(
+                    "an SB3 .zip policy needs stable-baselines3 (pip install 'pointnav-core[rl]')"
+                ) from None
             cls = getattr(stable_baselines3, self.algo, None)
             if cls is None:
-                raise ValueError(f"sb3_algo must name a Stable-Baselines3 algorithm (PPO, SAC, ...), got {self.algo!r}")
+                raise ValueError(
+                    f"sb3_algo must name a Stable-Baselines3 algorithm (PPO, SAC, ...), got {self.algo!r}"
+                )
             self._model = cls.load(self.path, device="cpu")
         return self._model
 
@@ -146,7 +150,9 @@ def make_policy(spec: str, sb3_algo: str = "PPO") -> PolicyFactory:
         ``.zip`` that does not exist.
     """
     if not isinstance(spec, str) or not spec:
-        raise ValueError(f"policy must be 'oracle', MODULE:CALLABLE or a path to an SB3 .zip, got {spec!r}")
+        raise ValueError(
+            f"policy must be 'oracle', MODULE:CALLABLE or a path to an SB3 .zip, got {spec!r}"
+        )
     if spec == "oracle":
         return _oracle
     if spec.endswith(".zip"):
@@ -155,7 +161,9 @@ def make_policy(spec: str, sb3_algo: str = "PPO") -> PolicyFactory:
         return _SB3Policy(spec, sb3_algo)
     module_name, sep, attr = spec.partition(":")
     if not sep or not module_name or not attr:
-        raise ValueError(f"policy must be 'oracle', MODULE:CALLABLE or a path to an SB3 .zip, got {spec!r}")
+        raise ValueError(
+            f"policy must be 'oracle', MODULE:CALLABLE or a path to an SB3 .zip, got {spec!r}"
+        )
     try:
         target: Any = importlib.import_module(module_name)
     except ImportError as err:
@@ -173,8 +181,15 @@ def make_policy(spec: str, sb3_algo: str = "PPO") -> PolicyFactory:
 class _Runner:
     """Plays episodes in one process, keeping one env per (scene, floor, robot, tolerance)."""
 
-    def __init__(self, policy: str | PolicyFactory, backend: str, max_steps: int, drive: str,
-                 scenes_root: str | None, sb3_algo: str) -> None:
+    def __init__(
+        self,
+        policy: str | PolicyFactory,
+        backend: str,
+        max_steps: int,
+        drive: str,
+        scenes_root: str | None,
+        sb3_algo: str,
+    ) -> None:
         self.factory = make_policy(policy, sb3_algo) if isinstance(policy, str) else policy
         self.backend, self.max_steps, self.drive = backend, max_steps, drive
         self.scenes_root, self.envs = scenes_root, {}
@@ -195,13 +210,19 @@ class _Runner:
                     f"episode {ep.episode_id!r}: field 'info.floor' is {ep.floor}, but scene "
                     f"{ep.scene_id!r} has {scene.n_floors} floor(s)"
                 )
-            task: dict[str, Any] = {"floor": ep.floor, "termination_config": {"max_steps": self.max_steps}}
+            task: dict[str, Any] = {
+                "floor": ep.floor,
+                "termination_config": {"max_steps": self.max_steps},
+            }
             if ep.goal_radius is not None:
                 task["goal_tolerance"] = ep.goal_radius
             flat = bool(getattr(self.factory, "flat", False))
             self.envs[key] = PointNavEnv(
-                scene=scene, robot={"radius": ep.robot_radius, "drive": self.drive}, task=task,
-                backend=self.backend, flatten_obs=flat,
+                scene=scene,
+                robot={"radius": ep.robot_radius, "drive": self.drive},
+                task=task,
+                backend=self.backend,
+                flatten_obs=flat,
             )
         return self.envs[key]
 
@@ -304,8 +325,14 @@ def evaluate(
             by_scene: dict[str, list[tuple[int, PointNavEpisode]]] = {}
             for i, ep in enumerate(episodes):
                 by_scene.setdefault(ep.scene_id, []).append((i, ep))
-            chunks = [group[k : k + _CHUNK] for group in by_scene.values() for k in range(0, len(group), _CHUNK)]
-            with ProcessPoolExecutor(workers, mp_context=get_context("spawn"), initializer=_init_worker, initargs=args) as pool:
+            chunks = [
+                group[k : k + _CHUNK]
+                for group in by_scene.values()
+                for k in range(0, len(group), _CHUNK)
+            ]
+            with ProcessPoolExecutor(
+                workers, mp_context=get_context("spawn"), initializer=_init_worker, initargs=args
+            ) as pool:
                 futures = [pool.submit(_play_chunk, chunk) for chunk in chunks]
                 for future in as_completed(futures):
                     for i, result in future.result():
@@ -337,7 +364,9 @@ def write_results(results: Iterable[EpisodeResult], path: str | os.PathLike[str]
             writer = csv.DictWriter(fh, fieldnames=names, lineterminator="\n")
             writer.writeheader()
             for r in results:
-                writer.writerow({k: repr(v) if isinstance(v, float) else v for k, v in asdict(r).items()})
+                writer.writerow(
+                    {k: repr(v) if isinstance(v, float) else v for k, v in asdict(r).items()}
+                )
         else:
             for r in results:
                 fh.write(json.dumps(asdict(r), sort_keys=False, allow_nan=True) + "\n")
@@ -349,7 +378,9 @@ def read_results(path: str | os.PathLike[str]) -> list[EpisodeResult]:
         return [EpisodeResult(**json.loads(line)) for line in fh if line.strip()]
 
 
-def plot_results(results: Sequence[EpisodeResult], path: str | os.PathLike[str], bin_width: float = 2.0) -> None:
+def plot_results(
+    results: Sequence[EpisodeResult], path: str | os.PathLike[str], bin_width: float = 2.0
+) -> None:
     """Draw SPL and success rate against geodesic distance as a PNG (Pillow).
 
     Each episode is a faint dot at its SPL; the lines join the means over bins of
@@ -388,7 +419,11 @@ def plot_results(results: Sequence[EpisodeResult], path: str | os.PathLike[str],
     edges = np.arange(0.0, x_max + bin_width / 2, bin_width)
     soft = np.array([r.soft_spl for r in results])
     # Success under the others, wider, so that equal curves stay visible.
-    for values, colour, line in ((success, (20, 150, 60), 5), (soft, (230, 140, 20), 2), (spl, (30, 70, 200), 2)):
+    for values, colour, line in (
+        (success, (20, 150, 60), 5),
+        (soft, (230, 140, 20), 2),
+        (spl, (30, 70, 200), 2),
+    ):
         points = []
         for lo, hi in zip(edges[:-1], edges[1:]):
             sel = (geo >= lo) & (geo < hi)
@@ -398,6 +433,10 @@ def plot_results(results: Sequence[EpisodeResult], path: str | os.PathLike[str],
             draw.line(points, fill=colour, width=line)
         for cx, cy in points:
             draw.ellipse([cx - 3, cy - 3, cx + 3, cy + 3], fill=colour)
-    draw.text((left, 12), f"success (green), SPL (blue) and SoftSPL (orange) vs geodesic distance, {len(results)} episodes", fill="black")
+    draw.text(
+        (left, 12),
+        f"success (green), SPL (blue) and SoftSPL (orange) vs geodesic distance, {len(results)} episodes",
+        fill="black",
+    )
     draw.text((left + pw / 2 - 60, height - 20), "geodesic distance (m)", fill="black")
     image.save(path)

@@ -24,7 +24,12 @@ which gives the same bytes again.
 from pathlib import Path
 
 from pointnav_core.datasets.format import EpisodeDataset, PointNavEpisode
-from pointnav_core.datasets.generator import GeneratorConfig, generate_episodes, generate_split, island_radius
+from pointnav_core.datasets.generator import (
+    GeneratorConfig,
+    generate_episodes,
+    generate_split,
+    island_radius,
+)
 from pointnav_core.datasets.scene_sets import SCENE_SETS, SceneSet, load_scene, scene_set
 
 #: The shipped validation dataset: 300 episodes on the ``val`` houses (see the module notes).

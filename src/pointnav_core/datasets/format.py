@@ -196,17 +196,25 @@ def _is_number(value: Any) -> bool:
     return isinstance(value, (int, float)) and not isinstance(value, bool)
 
 
-def _number(where: _Where, raw: Mapping[str, Any], key: str, name: str, minimum: float | None = None) -> float:
+def _number(
+    where: _Where, raw: Mapping[str, Any], key: str, name: str, minimum: float | None = None
+) -> float:
     if key not in raw:
         raise where.error(name, "present", "nothing")
     value = raw[key]
-    if not _is_number(value) or not math.isfinite(value) or (minimum is not None and value < minimum):
+    if (
+        not _is_number(value)
+        or not math.isfinite(value)
+        or (minimum is not None and value < minimum)
+    ):
         bound = "" if minimum is None else f" >= {minimum}"
         raise where.error(name, f"a finite number{bound}", value)
     return float(value)
 
 
-def _vector(where: _Where, raw: Mapping[str, Any], key: str, name: str, size: int) -> tuple[float, ...]:
+def _vector(
+    where: _Where, raw: Mapping[str, Any], key: str, name: str, size: int
+) -> tuple[float, ...]:
     if key not in raw:
         raise where.error(name, "present", "nothing")
     value = raw[key]
@@ -250,12 +258,16 @@ def _episode_from_json(raw: Any, index: int, source: str, frame: str) -> PointNa
         raise where.error("start_rotation", "a unit quaternion (x, y, z, w)", list(rotation))
     if frame == "habitat":
         if abs(rotation[0]) > _QUAT_TOL or abs(rotation[2]) > _QUAT_TOL:
-            raise where.error("start_rotation", "a rotation about Habitat's +y axis only", list(rotation))
+            raise where.error(
+                "start_rotation", "a rotation about Habitat's +y axis only", list(rotation)
+            )
         start, goal = from_habitat_position(start), from_habitat_position(goal)
         half = 0.5 * from_habitat_rotation(rotation)
         rotation = (0.0, 0.0, math.sin(half), math.cos(half))
     elif abs(rotation[0]) > _QUAT_TOL or abs(rotation[1]) > _QUAT_TOL:
-        raise where.error("start_rotation", "a yaw about +z (0, 0, sin(yaw/2), cos(yaw/2))", list(rotation))
+        raise where.error(
+            "start_rotation", "a yaw about +z (0, 0, sin(yaw/2), cos(yaw/2))", list(rotation)
+        )
     return PointNavEpisode(
         episode_id=raw["episode_id"],
         scene_id=raw["scene_id"],
@@ -292,7 +304,9 @@ class EpisodeDataset:
     episodes: tuple[PointNavEpisode, ...]
     metadata: Mapping[str, Any] = field(default_factory=dict)
 
-    def __init__(self, episodes: Iterable[PointNavEpisode], metadata: Mapping[str, Any] | None = None) -> None:
+    def __init__(
+        self, episodes: Iterable[PointNavEpisode], metadata: Mapping[str, Any] | None = None
+    ) -> None:
         episodes = tuple(episodes)
         seen: dict[str, int] = {}
         for i, ep in enumerate(episodes):
@@ -340,14 +354,20 @@ class EpisodeDataset:
             raise ValueError(f"field 'pointnav_core' must be an object{where}, got {meta!r}")
         frame = meta.get("frame", "z-up")
         if frame not in ("z-up", "habitat"):
-            raise ValueError(f"field 'pointnav_core.frame' must be 'z-up' or 'habitat'{where}, got {frame!r}")
-        episodes = [_episode_from_json(raw, i, source, frame) for i, raw in enumerate(data["episodes"])]
+            raise ValueError(
+                f"field 'pointnav_core.frame' must be 'z-up' or 'habitat'{where}, got {frame!r}"
+            )
+        episodes = [
+            _episode_from_json(raw, i, source, frame) for i, raw in enumerate(data["episodes"])
+        ]
         metadata = {k: v for k, v in meta.items() if k not in ("format_version", "frame")}
         return cls(episodes, metadata)
 
     def to_bytes(self, frame: str = "z-up") -> bytes:
         """The gzip file's bytes: sorted keys, compact JSON, gzip mtime 0 (reproducible)."""
-        text = json.dumps(self.to_json(frame), sort_keys=True, separators=(",", ":"), allow_nan=False)
+        text = json.dumps(
+            self.to_json(frame), sort_keys=True, separators=(",", ":"), allow_nan=False
+        )
         buffer = io.BytesIO()
         with gzip.GzipFile(filename="", mode="wb", fileobj=buffer, compresslevel=9, mtime=0) as gz:
             gz.write(text.encode("utf-8"))

@@ -74,7 +74,9 @@ def island_radius(scene: Scene, floor: int, xy: Sequence[float], robot: Any = No
 
 
 #: Island radii per map and robot radius (maps are immutable; entries die with the map).
-_RADII: weakref.WeakKeyDictionary[Any, dict[float, NDArray[np.float64]]] = weakref.WeakKeyDictionary()
+_RADII: weakref.WeakKeyDictionary[Any, dict[float, NDArray[np.float64]]] = (
+    weakref.WeakKeyDictionary()
+)
 
 
 def _island_radii(tmap: Any, radius: float) -> NDArray[np.float64]:
@@ -130,7 +132,12 @@ class GeneratorConfig:
 
     def __post_init__(self) -> None:
         def number(name: str, value: Any, minimum: float) -> None:
-            if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value) or value < minimum:
+            if (
+                isinstance(value, bool)
+                or not isinstance(value, (int, float))
+                or not math.isfinite(value)
+                or value < minimum
+            ):
                 raise ValueError(f"{name} must be a finite number >= {minimum}, got {value!r}")
 
         lo_hi = self.geodesic_range
@@ -206,15 +213,22 @@ def generate_episodes(
     near, far = config.geodesic_range
     areas = np.array([f.usable(radius).sum() for f in scene.floors], dtype=np.float64)
     if not areas.sum():
-        raise SamplingError(f"scene {scene_id!r} has no usable cell for a robot of radius {radius} m")
+        raise SamplingError(
+            f"scene {scene_id!r} has no usable cell for a robot of radius {radius} m"
+        )
     floor_p = areas / areas.sum()
     episodes: list[PointNavEpisode] = []
     stats = {} if stats is None else stats
     total: dict[str, int] = stats.setdefault("rejected", {})
     trials: list[tuple[float, bool]] = stats.setdefault("ratio_trials", [])
     while len(episodes) < n_episodes:
-        rejected = {"goal on a small island": 0, "no path": 0, "geodesic out of range": 0,
-                    "ratio filter": 0, "start on a small island": 0}
+        rejected = {
+            "goal on a small island": 0,
+            "no path": 0,
+            "geodesic out of range": 0,
+            "ratio filter": 0,
+            "start on a small island": 0,
+        }
         episode = None
         for _ in range(config.max_goals_per_episode):
             floor = int(rng.choice(len(areas), p=floor_p))
@@ -322,7 +336,12 @@ def generate_split(
             continue
         scene = load_scene(scene_id, root)
         episodes += generate_episodes(
-            scene, scene_id, count, seed=scene_seed(seed, scene_id), config=config, first_id=len(episodes)
+            scene,
+            scene_id,
+            count,
+            seed=scene_seed(seed, scene_id),
+            config=config,
+            first_id=len(episodes),
         )
         if progress is not None:
             progress(count)

@@ -133,12 +133,19 @@ def episode_poses(
             f"floor {floor}; build the env with task={{'floor': {episode.floor}}}"
         )
     if floor >= scene.n_floors:
-        raise ValueError(f"{name}: field 'info.floor' is {floor}, but the scene has {scene.n_floors} floor(s)")
+        raise ValueError(
+            f"{name}: field 'info.floor' is {floor}, but the scene has {scene.n_floors} floor(s)"
+        )
     height = scene.get_floor_height(floor)
     radius = getattr(robot, "radius", robot)
-    for field_name, xyz in (("start_position", episode.start_position), ("goals[0].position", episode.goal_position)):
+    for field_name, xyz in (
+        ("start_position", episode.start_position),
+        ("goals[0].position", episode.goal_position),
+    ):
         if abs(xyz[2] - height) > _HEIGHT_TOL:
-            raise ValueError(f"{name}: field '{field_name}' has z = {xyz[2]} m, but floor {floor} is at {height} m")
+            raise ValueError(
+                f"{name}: field '{field_name}' has z = {xyz[2]} m, but floor {floor} is at {height} m"
+            )
         if not scene.is_usable(floor, xyz[:2], robot):
             raise ValueError(
                 f"{name}: field '{field_name}' {list(xyz)} is not valid for robot {robot_idn} "

@@ -139,7 +139,11 @@ def folder_scene_set(
     folder = os.fspath(folder)
     if not os.path.isdir(folder):
         raise ValueError(f"scene folder {folder!r} does not exist or is not a folder")
-    if len(fractions) != 3 or any(f < 0 for f in fractions) or not math.isclose(sum(fractions), 1.0):
+    if (
+        len(fractions) != 3
+        or any(f < 0 for f in fractions)
+        or not math.isclose(sum(fractions), 1.0)
+    ):
         raise ValueError(f"fractions must be three numbers >= 0 summing to 1, got {fractions!r}")
     ids = []
     for name in sorted(os.listdir(folder)):
@@ -149,7 +153,9 @@ def folder_scene_set(
         elif os.path.isdir(path) and _trav_images(path):
             ids.append(f"trav:{path}")
     if not ids:
-        raise ValueError(f"scene folder {folder!r} holds no .map file and no folder with floor_trav_*.png")
+        raise ValueError(
+            f"scene folder {folder!r} holds no .map file and no folder with floor_trav_*.png"
+        )
     order = np.random.default_rng(seed).permutation(len(ids))
     n = len(ids)
     n_val = round(n * fractions[1])
@@ -172,7 +178,9 @@ def scene_set(spec: str, seed: int = 0) -> SceneSet:
         return SCENE_SETS[spec]
     if os.path.isdir(spec):
         return folder_scene_set(spec, seed=seed)
-    raise ValueError(f"scene set must be one of {sorted(SCENE_SETS)} or a folder of scenes, got {spec!r}")
+    raise ValueError(
+        f"scene set must be one of {sorted(SCENE_SETS)} or a folder of scenes, got {spec!r}"
+    )
 
 
 #: Scenes built by :func:`load_scene`, by (scene_id, root); a house takes ~0.5 s to build.
