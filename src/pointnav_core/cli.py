@@ -4,6 +4,9 @@
 (:class:`~pointnav_core.policies.ShortestPathFollower`) to sampled goals on the default
 kinematic backend, and prints success, SPL, SoftSPL, path length, collisions and speed.
 
+``pointnav demo --scene FILE`` drives on a MovingAI map or a traversability PNG instead.
+``pointnav dataset generate`` and ``pointnav eval`` are in :mod:`pointnav_core.cli_datasets`.
+
 ``--gif FILE`` writes the first episode as an animated GIF and ``--png FILE`` its last frame
 (top-down, :func:`pointnav_core.render.render_env`). When either is given, the demo's tasks
 show their markers (``visualize_goal`` and ``visualize_path``): the start in red, the goal in
@@ -39,6 +42,7 @@ def run_demo(
     frames: list | None = None,
     every: int = 1,
     pixels_per_meter: float | None = None,
+    scene: str | None = None,
 ) -> dict[str, float]:
     """Run the oracle for ``episodes`` episodes spread over ``houses`` generated houses.
 
@@ -68,6 +72,10 @@ def run_demo(
     pixels_per_meter : float, optional
         With ``frames``: the picture scale (default 20 px/m, see
         :func:`pointnav_core.render.render_env`).
+    scene : str, optional
+        A scene file instead of generated houses: a MovingAI ``.map``, an OmniGibson
+        ``floor_trav_<n>.png`` or a folder of them (any ``scene_id``, see
+        :func:`pointnav_core.datasets.load_scene`); ``houses`` is then ignored.
 
     Returns
     -------
@@ -84,9 +92,15 @@ def run_demo(
     task: dict = {"termination_config": {"max_steps": max_steps}}
     if frames is not None:
         task.update(visualize_goal=True, visualize_path=True)
+    if scene is not None:
+        from pointnav_core.datasets import load_scene
+
+        houses, loaded = 1, [load_scene(scene)]
+    else:
+        loaded = [scenes.rooms(seed=seed + h) for h in range(houses)]
     envs = [
         PointNavEnv(
-            scene=scenes.rooms(seed=seed + h),
+            scene=loaded[h],
             robot={"drive": drive},
             task=task,
             backend=backend,
@@ -140,6 +154,7 @@ def _demo(args: argparse.Namespace) -> int:
         frames=frames,
         every=args.every,
         pixels_per_meter=args.pixels_per_meter,
+        scene=args.scene,
     )
     rows = [
         ("episodes", f"{int(summary['episodes'])}"),
@@ -151,7 +166,8 @@ def _demo(args: argparse.Namespace) -> int:
         ("env steps / second", f"{summary['steps_per_second']:.0f} (oracle included)"),
     ]
     width = max(len(name) for name, _ in rows)
-    print(f"oracle on {args.houses} generated houses, {args.backend} backend, {args.drive} drive")
+    where = args.scene if args.scene else f"{args.houses} generated houses"
+    print(f"oracle on {where}, {args.backend} backend, {args.drive} drive")
     for name, value in rows:
         print(f"  {name:<{width}}  {value}")
     if frames:
@@ -198,8 +214,15 @@ def main(argv: Sequence[str] | None = None) -> int:
         "--pixels-per-meter", type=float, default=None, metavar="PPM",
         help="picture scale of --gif/--png (default 20: a 20 m house is 400 px wide)",
     )
+    demo.add_argument(
+        "--scene", metavar="FILE",
+        help="a MovingAI .map, an OmniGibson floor_trav_<n>.png or a folder of them, instead of generated houses",
+    )
     demo.add_argument("--quiet", action="store_true", help="no progress bar")
     demo.set_defaults(func=_demo)
+    from pointnav_core.cli_datasets import add_commands
+
+    add_commands(sub, _positive_int)
     args = parser.parse_args(argv)
     return int(args.func(args))
 

@@ -191,13 +191,14 @@ class PointNavEnv(gym.Env[Any, np.ndarray]):
     ) -> tuple[Any, dict[str, Any]]:
         """Start a new episode; the same ``seed`` gives the same episode.
 
-        ``options`` is accepted for API compatibility and not used.
+        ``options={"episode": episode}`` plays a dataset episode (its start, orientation and
+        goal; see :mod:`pointnav_core.datasets.playback`); other options are not used.
         """
         super().reset(seed=seed)
         if options is not None and not isinstance(options, Mapping):
             raise ValueError(f"options must be None or a dict, got {options!r}")
         self.backend.reset()
-        info = self.task.reset(self)
+        info = self.task.reset(self, episode=(options or {}).get("episode"))
         return self._get_obs(), info
 
     def step(self, action: Any) -> tuple[Any, float, bool, bool, dict[str, Any]]:

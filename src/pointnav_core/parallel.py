@@ -488,11 +488,14 @@ class MultiPointNavEnv(ParallelEnv[str, Any, np.ndarray]):
     ) -> tuple[dict[str, Any], dict[str, dict[str, Any]]]:
         """Start a new episode for every robot; the same ``seed`` gives the same episodes.
 
-        ``options`` is accepted for API compatibility and not used. Returns observations and
-        infos keyed by agent (each info is that robot's task info at step 0).
+        ``options={"episodes": [...]}`` plays dataset episodes, one per robot in robot
+        order (or a dict keyed by agent; see :mod:`pointnav_core.datasets.playback`); other
+        options are not used. Returns observations and infos keyed by agent (each info is
+        that robot's task info at step 0).
         """
         if options is not None and not isinstance(options, Mapping):
             raise ValueError(f"options must be None or a dict, got {options!r}")
+        given = self._given_episodes((options or {}).get("episodes"))
         if seed is not None or self._np_random is None:
             self._np_random, self._np_random_seed = seeding.np_random(seed)
         self.agents = []
@@ -502,7 +505,7 @@ class MultiPointNavEnv(ParallelEnv[str, Any, np.ndarray]):
         infos: list[dict[str, Any]] = [{}] * len(self.tasks)
         placed: list[int] = []
         for i in self._reset_order:
-            infos[i] = self._reset_robot(i, placed)
+            infos[i] = self._reset_robot(i, placed, given[i])
             placed.append(i)
         self._active = [True] * len(self.tasks)
         self._cycles = 0
@@ -512,7 +515,22 @@ class MultiPointNavEnv(ParallelEnv[str, Any, np.ndarray]):
         observations = {agent: observe[i](self) for i, agent in enumerate(self.agents)}
         return observations, {agent: infos[i] for i, agent in enumerate(self.agents)}
 
-    def _reset_robot(self, i: int, placed: list[int]) -> dict[str, Any]:
+    def _given_episodes(self, episodes: Any) -> list[Any]:
+        """One dataset episode (or None) per robot, from ``options["episodes"]``."""
+        n = len(self.tasks)
+        if episodes is None:
+            return [None] * n
+        if isinstance(episodes, Mapping):
+            unknown = [a for a in episodes if a not in self.possible_agents]
+            if unknown:
+                raise ValueError(f"options['episodes'] has unknown agent {unknown[0]!r}; agents are {self.possible_agents}")
+            return [episodes.get(agent) for agent in self.possible_agents]
+        episodes = list(episodes)
+        if len(episodes) != n:
+            raise ValueError(f"options['episodes'] must hold one episode per robot ({n}), got {len(episodes)}")
+        return episodes
+
+    def _reset_robot(self, i: int, placed: list[int], episode: Any = None) -> dict[str, Any]:
         """Reset task ``i`` with its goal kept apart from the goals decided so far."""
         task, tasks = self.tasks[i], self.tasks
         # Goals to keep clear of: those placed, and the fixed goals of robots still to come
@@ -538,7 +556,7 @@ class MultiPointNavEnv(ParallelEnv[str, Any, np.ndarray]):
                     )
             return None
 
-        return task.reset(self, goal_constraint=apart if others else None)
+        return task.reset(self, goal_constraint=apart if others else None, episode=episode)
 
     def step(
         self, actions: Mapping[str, Any]

@@ -725,7 +725,9 @@ class PointNavigationTask:
         self._frame.task, self._frame.env = self, env
         self._env = env
 
-    def reset(self, env: TaskEnv, goal_constraint: GoalConstraint | None = None) -> dict[str, Any]:
+    def reset(
+        self, env: TaskEnv, goal_constraint: GoalConstraint | None = None, episode: Any = None
+    ) -> dict[str, Any]:
         """Start a new episode: sample (or take) a start and a goal, land the robot.
 
         Parameters
@@ -738,6 +740,9 @@ class PointNavigationTask:
             constraint it breaks (named in a :class:`SamplingError`); a multi-robot env
             keeps goals apart with it. Not applied to a fixed ``goal_pos``. See
             :mod:`~pointnav_core.sampling`.
+        episode : PointNavEpisode, optional
+            Play this dataset episode (:mod:`pointnav_core.datasets`): its start, start
+            orientation and goal replace the task's fixed or sampled ones for this episode.
 
         Returns
         -------
@@ -758,7 +763,7 @@ class PointNavigationTask:
             if env is not self._env:
                 self.load(env)
             self._bind(env.backend)  # every episode: a backend patched since is seen
-            self._sample_episode(env, goal_constraint)
+            self._sample_episode(env, goal_constraint, episode)
             pos, quat = env.backend.get_pose(self._robot_idn)
             x, y, z = pos.tolist()
             self._robot_xyz = (x, y, z)
@@ -790,21 +795,31 @@ class PointNavigationTask:
             {name: {"done": False, "success": False} for name in self._terminations},
         )
 
-    def _sample_episode(self, env: TaskEnv, goal_constraint: GoalConstraint | None) -> None:
-        episode = sample_episode(
-            env,
-            robot_idn=self._robot_idn,
-            floor=self._floor,
-            spec=self._spec,
-            floor_height=self._floor_height,
-            initial_pos=self._initial_pos,
-            initial_quat=self._initial_quat,
-            goal_pos=self._goal_pos,
-            goal_tolerance=self._goal_tolerance,
-            path_range=self._path_range,
-            max_trials=self.max_trials,
-            goal_constraint=goal_constraint,
-        )
+    def _sample_episode(self, env: TaskEnv, goal_constraint: GoalConstraint | None, given: Any = None) -> None:
+        start, quat, goal = self._initial_pos, self._initial_quat, self._goal_pos
+        if given is not None:  # a dataset episode: checked here, named in every error
+            from pointnav_core.datasets.playback import episode_poses
+
+            start, quat, goal = episode_poses(given, env.scene, self._floor, self._spec, self._robot_idn)
+        try:
+            episode = sample_episode(
+                env,
+                robot_idn=self._robot_idn,
+                floor=self._floor,
+                spec=self._spec,
+                floor_height=self._floor_height,
+                initial_pos=start,
+                initial_quat=quat,
+                goal_pos=goal,
+                goal_tolerance=self._goal_tolerance,
+                path_range=self._path_range,
+                max_trials=self.max_trials,
+                goal_constraint=goal_constraint,
+            )
+        except ValueError as err:
+            if given is None:
+                raise
+            raise ValueError(f"episode {given.episode_id!r}: field 'start_position': {err}") from None
         # The robot stands at the start: it was landed there in the accepted trial.
         self._start_xy = episode.start_xy
         self._start_quat = episode.start_quat
