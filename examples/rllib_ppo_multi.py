@@ -9,17 +9,17 @@ ids in RLlib's registry, so the remote env runner, another process, builds the e
 Run: ``python examples/rllib_ppo_multi.py`` (needs the ``rl`` extra). Expected output:
 
     Ray node 127.0.0.1: alive=True, CPUs=2
-    iteration 1: 2000 env steps, 310 env steps/s, return 0.35, success 0.03, SPL 0.03
-    iteration 2: 4000 env steps, 311 env steps/s, return 1.45, success 0.07, SPL 0.04
-    iteration 3: 6000 env steps, 306 env steps/s, return 2.13, success 0.07, SPL 0.04
-    iteration 4: 8000 env steps, 308 env steps/s, return -1.63, success 0.00, SPL 0.00
-    iteration 5: 10000 env steps, 305 env steps/s, return 0.88, success 0.07, SPL 0.03
-    iteration 6: 12000 env steps, 301 env steps/s, return 1.80, success 0.03, SPL 0.03
-    iteration 7: 14000 env steps, 305 env steps/s, return -0.06, success 0.00, SPL 0.00
-    iteration 8: 16000 env steps, 302 env steps/s, return 1.87, success 0.03, SPL 0.01
+    iteration 1: 2000 env steps, 86 env steps/s, return 1.33, success 0.03, SPL 0.02
+    iteration 2: 4000 env steps, 84 env steps/s, return -0.34, success 0.00, SPL 0.00
+    iteration 3: 6000 env steps, 83 env steps/s, return 2.14, success 0.07, SPL 0.03
+    iteration 4: 8000 env steps, 85 env steps/s, return 1.65, success 0.03, SPL 0.02
+    iteration 5: 10000 env steps, 85 env steps/s, return -0.06, success 0.03, SPL 0.02
+    iteration 6: 12000 env steps, 94 env steps/s, return 1.82, success 0.03, SPL 0.02
+    iteration 7: 14000 env steps, 106 env steps/s, return -0.28, success 0.00, SPL 0.00
+    iteration 8: 16000 env steps, 116 env steps/s, return 1.99, success 0.07, SPL 0.03
 
-(On a 2-core x86_64 CPU machine that other jobs shared, 73 s, Ray's start and setup
-included. An env step moves all three robots. RLlib samples in another process, and the
+(On a 2-core x86_64 CPU machine that two other heavy jobs shared, 165 s, Ray's start and
+setup included; alone on it the same run gave about 300 env steps/s and 73 s. An env step moves all three robots. RLlib samples in another process, and the
 numbers may differ a little from run to run; Ray's own log lines go to stderr.)
 """
 

@@ -8,10 +8,10 @@ SPL and SoftSPL of each robot's episode.
 
 Run: ``python examples/sb3_ppo_multi.py`` (needs the ``rl`` extra). Expected output:
 
-    PPO on MultiPointNav-v0, 2 worlds x 3 robots = 6 slots: 1542 robot-steps/s (updates included)
-    last 100 of 120 robot-episodes: success rate 0.26, SPL 0.16, SoftSPL 0.21, collisions 19.7
+    PPO on MultiPointNav-v0, 2 worlds x 3 robots = 6 slots: 2724 robot-steps/s (updates included)
+    last 100 of 136 robot-episodes: success rate 0.56, SPL 0.38, SoftSPL 0.36, collisions 12.8
 
-(On a 2-core x86_64 CPU machine that other jobs shared, 21 s. The metrics repeat exactly
+(On a 2-core x86_64 CPU machine that other jobs shared, 12 s. The metrics repeat exactly
 run after run (seeded); the rate depends on the machine.)
 """
 

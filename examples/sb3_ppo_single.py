@@ -6,10 +6,10 @@ SoftSPL of the finished episodes to SB3's logger, printed here at the end.
 
 Run: ``python examples/sb3_ppo_single.py`` (needs the ``rl`` extra). Expected output:
 
-    PPO on PointNav-v0, 4 envs: 1223 steps/s (updates included)
-    last 100 of 128 episodes: success rate 0.11, SPL 0.05, SoftSPL 0.15, collisions 12.7
+    PPO on PointNav-v0, 4 envs: 2395 steps/s (updates included)
+    last 100 of 141 episodes: success rate 0.53, SPL 0.31, SoftSPL 0.33, collisions 12.6
 
-(On a 2-core x86_64 CPU machine that other jobs shared, 25 s. The metrics repeat exactly
+(On a 2-core x86_64 CPU machine that other jobs shared, 14 s. The metrics repeat exactly
 run after run (seeded); the rate depends on the machine.)
 """
 
