@@ -72,11 +72,15 @@ def _multi(episodes: int) -> list[tuple[float, int, bool, float]]:
             for agent in actions:
                 if terms[agent] or truncs[agent]:
                     info = infos[agent]
-                    out.append((start[agent], info["episode_length"], bool(info["success"]), info["spl"]))
+                    out.append(
+                        (start[agent], info["episode_length"], bool(info["success"]), info["spl"])
+                    )
     return out[:episodes]
 
 
-def _report(name: str, runs: list[tuple[float, int, bool, float]], step_m: float, wall: float) -> bool:
+def _report(
+    name: str, runs: list[tuple[float, int, bool, float]], step_m: float, wall: float
+) -> bool:
     geo = np.array([r[0] for r in runs])
     steps = np.array([r[1] for r in runs], dtype=float)
     success = np.array([r[2] for r in runs])
@@ -87,7 +91,9 @@ def _report(name: str, runs: list[tuple[float, int, bool, float]], step_m: float
         f"{'met' if rate >= TARGET else 'MISSED'}), SPL {spl.mean():.3f}, geodesic "
         f"{geo.min():.2f}-{geo.max():.2f} m, {wall:.0f} s"
     )
-    print(f"  {'geodesic m':<12} {'episodes':>8} {'success':>8} {'ratio median':>13} {'p95':>6} {'max':>6}")
+    print(
+        f"  {'geodesic m':<12} {'episodes':>8} {'success':>8} {'ratio median':>13} {'p95':>6} {'max':>6}"
+    )
     ratio = steps * step_m / np.maximum(geo, 1e-9)
     for lo, hi in zip(BANDS[:-1], BANDS[1:]):
         band = (geo >= lo) & (geo < hi)

@@ -49,7 +49,11 @@ def _same(a: Any, b: Any) -> bool:
     if isinstance(a, (list, tuple)):
         return len(a) == len(b) and all(_same(x, y) for x, y in zip(a, b))
     if isinstance(a, np.ndarray):
-        return isinstance(b, np.ndarray) and a.dtype == b.dtype and np.array_equal(a, b, equal_nan=True)
+        return (
+            isinstance(b, np.ndarray)
+            and a.dtype == b.dtype
+            and np.array_equal(a, b, equal_nan=True)
+        )
     if isinstance(a, float) and math.isnan(a):
         return isinstance(b, float) and math.isnan(b)
     return type(a) is type(b) and a == b
@@ -93,7 +97,9 @@ def _collisions(results: list[Any]) -> int:
 @pytest.mark.parametrize("copier", sorted(COPIERS))
 @pytest.mark.parametrize("backend", ["kinematic", "pymunk"])
 @pytest.mark.parametrize("when", ["before_reset", "after_reset"])
-def test_a_copied_single_robot_env_steps_exactly_like_the_original(copier: str, backend: str, when: str) -> None:
+def test_a_copied_single_robot_env_steps_exactly_like_the_original(
+    copier: str, backend: str, when: str
+) -> None:
     env = PointNavEnv(backend=backend, task={"reward_type": "geodesic"})
     if when == "after_reset":
         env.reset(seed=4)
@@ -110,7 +116,9 @@ def test_a_copied_single_robot_env_steps_exactly_like_the_original(copier: str, 
 @pytest.mark.parametrize("copier", sorted(COPIERS))
 @pytest.mark.parametrize("backend", ["kinematic", "pymunk"])
 @pytest.mark.parametrize("when", ["before_reset", "after_reset"])
-def test_a_copied_multi_robot_env_steps_exactly_like_the_original(copier: str, backend: str, when: str) -> None:
+def test_a_copied_multi_robot_env_steps_exactly_like_the_original(
+    copier: str, backend: str, when: str
+) -> None:
     env = MultiPointNavEnv(n_robots=3, backend=backend, task={"reward_type": "geodesic"})
     if when == "after_reset":
         env.reset(seed=2)

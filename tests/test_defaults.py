@@ -89,7 +89,9 @@ def test_explicit_ranges_and_task_objects_are_kept():
 
 
 def test_a_range_beyond_the_reach_warns_at_the_callers_line():
-    with pytest.warns(UserWarning, match=r"path_range=\(0.0, 30.0\).*max_steps=500.*25 m") as record:
+    with pytest.warns(
+        UserWarning, match=r"path_range=\(0.0, 30.0\).*max_steps=500.*25 m"
+    ) as record:
         PointNavEnv(task={"path_range": (0.0, 30.0)})
     assert record[0].filename == __file__
     with pytest.warns(UserWarning, match="cannot be solved") as record:
@@ -115,7 +117,9 @@ def test_get_random_point_with_max_distance_stays_within_it():
     scene = scenes.rooms(seed=0)
     _, anchor = scene.get_random_point(0, robot=0.18, rng=0)
     for seed in range(50):
-        _, p = scene.get_random_point(0, reference_point=anchor, robot=0.18, rng=seed, max_distance=1.2)
+        _, p = scene.get_random_point(
+            0, reference_point=anchor, robot=0.18, rng=seed, max_distance=1.2
+        )
         assert math.hypot(p[0] - anchor[0], p[1] - anchor[1]) <= 1.2
     with pytest.raises(ValueError, match="max_distance must be None or a number >= 0"):
         scene.get_random_point(0, reference_point=anchor, robot=0.18, max_distance=True)

@@ -41,8 +41,14 @@ CASES = [
     (lambda: PointNavigationTask(initial_quat=["0", "0", "0", "1"]), "initial_quat"),
     (lambda: PointNavigationTask(robot_idn=np.True_), "robot_idn"),
     (lambda: PointNavigationTask(floor=1.0), "floor"),
-    (lambda: PointNavigationTask(termination_config={"fall_height": "0.1"}), "termination_config: fall_height"),
-    (lambda: PointNavigationTask(termination_config={"max_steps": 2.0}), "termination_config: max_steps"),
+    (
+        lambda: PointNavigationTask(termination_config={"fall_height": "0.1"}),
+        "termination_config: fall_height",
+    ),
+    (
+        lambda: PointNavigationTask(termination_config={"max_steps": 2.0}),
+        "termination_config: max_steps",
+    ),
     (lambda: PointNavigationTask(reward_config={"r_collision": "1"}), "reward_config: r_collision"),
     (lambda: PointNavEnv(action_frequency=1e-9), "action_frequency"),
     (lambda: PointNavEnv(action_frequency="10"), "action_frequency"),
@@ -86,7 +92,11 @@ def test_actions_that_are_not_real_numbers_are_refused(action):
     assert env.task.episode_length == 0  # nothing moved
     penv = MultiPointNavEnv(scene=small_scene(), n_robots=2)
     penv.reset(seed=0)
-    expected = "^missing action for robot_0" if action is None else "^robot_0: action must be an array of 2 real"
+    expected = (
+        "^missing action for robot_0"
+        if action is None
+        else "^robot_0: action must be an array of 2 real"
+    )
     with pytest.raises(ValueError, match=expected):
         penv.step({"robot_0": action, "robot_1": np.zeros(2, np.float32)})
 
@@ -104,13 +114,25 @@ def test_real_numbers_of_every_kind_are_still_accepted():
 
 
 def test_the_helpers_follow_the_rules_by_hand():
-    assert [is_real(v) for v in (1, 1.5, np.int8(2), np.float32(1), True, np.bool_(1), "1", 1j, None)] == [
-        True, True, True, True, False, False, False, False, False,
+    assert [
+        is_real(v) for v in (1, 1.5, np.int8(2), np.float32(1), True, np.bool_(1), "1", 1j, None)
+    ] == [
+        True,
+        True,
+        True,
+        True,
+        False,
+        False,
+        False,
+        False,
+        False,
     ]
     assert real("x", 2, minimum=0.0, strict=True) == 2.0
     with pytest.raises(ValueError, match=r"^x must be a finite number > 0 \(m\), got 0"):
         real("x", 0, minimum=0.0, strict=True)
-    with pytest.raises(ValueError, match=r"^p must be a finite number >= 0 and <= 1 \(a probability\)"):
+    with pytest.raises(
+        ValueError, match=r"^p must be a finite number >= 0 and <= 1 \(a probability\)"
+    ):
         real("p", 1.5, minimum=0.0, maximum=1.0, unit="a probability")
     assert real("x", np.inf, finite=False) == np.inf
     with pytest.raises(ValueError, match="x must be a number"):
@@ -123,6 +145,14 @@ def test_the_helpers_follow_the_rules_by_hand():
     with pytest.raises(ValueError, match="^b must be True or False"):
         boolean("b", 1)
     assert vector("v", (1, 2.5), sizes=(2,)).tolist() == [1.0, 2.5]
-    for bad in ("12", (1, "2"), (1, True), np.array([1j, 2]), np.array([[1, 2]]), (1, 2, 3), (1, np.nan)):
+    for bad in (
+        "12",
+        (1, "2"),
+        (1, True),
+        np.array([1j, 2]),
+        np.array([[1, 2]]),
+        (1, 2, 3),
+        (1, np.nan),
+    ):
         with pytest.raises(ValueError, match=r"^v must be 2 finite numbers"):
             vector("v", bad, sizes=(2,))

@@ -86,7 +86,9 @@ def real(
         ok = number <= maximum
     if not ok:
         kind = "a finite number" if finite else "a number"
-        raise ValueError(f"{name} must be {kind}{_bound(minimum, strict, maximum)} ({unit}), got {value!r}")
+        raise ValueError(
+            f"{name} must be {kind}{_bound(minimum, strict, maximum)} ({unit}), got {value!r}"
+        )
     return number
 
 
@@ -111,7 +113,9 @@ def boolean(name: str, value: Any) -> bool:
     return bool(value)
 
 
-def vector(name: str, value: Any, *, sizes: tuple[int, ...], finite: bool = True) -> NDArray[np.float64]:
+def vector(
+    name: str, value: Any, *, sizes: tuple[int, ...], finite: bool = True
+) -> NDArray[np.float64]:
     """``value`` as a 1-D float64 array of one of ``sizes`` numbers, or a ValueError.
 
     A list or tuple must hold real numbers (see :func:`is_real`); an array must have a
