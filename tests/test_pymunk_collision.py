@@ -56,7 +56,7 @@ def edited(tmap: TraversableMap, cells: dict[tuple[int, int], int]) -> Scene:
     for (row, col), code in cells.items():
         codes[row, col] = code
     new = TraversableMap(codes, tmap.resolution, tmap.origin, geometry=tmap.geometry)
-    return Scene([new], floor_plans=[tmap.geometry])
+    return Scene([new])
 
 
 THIN_WALL = box(2.99, 0.0, 3.02, 3.0)

@@ -8,6 +8,7 @@ from PIL import Image
 from shapely.geometry import Point, box
 
 from pointnav_core.errors import SamplingError
+from pointnav_core.floorplans import FloorPlan
 from pointnav_core.maps import OBSTACLE, VOID
 from pointnav_core.scenes import Scene, clutter, maze, robot_radius, rooms
 
@@ -138,3 +139,13 @@ def test_generated_scenes_are_deterministic_and_navigable(generator):
     _, p = a.get_random_point(0, robot=0.18, rng=0)
     _, q = a.get_random_point(0, reference_point=p, robot=0.18, rng=1)
     assert a.get_shortest_path(0, p, q, robot=0.18)[1] is not None
+
+
+def test_a_floor_plan_lives_on_its_map_once():
+    plan = FloorPlan(outline=box(0, 0, 3, 2), obstacles=[box(1, 0.5, 1.5, 1.5)])
+    scene = Scene.from_polygons(plan.outline, plan.obstacles, resolution=0.1)
+    assert scene.floor_plans == (scene.floors[0].geometry,)
+    bare = Scene.from_array(np.ones((10, 10), bool), 0.1)
+    assert bare.floor_plans == (None,)
+    with pytest.raises(ValueError, match=r"floor_plans\[0\] is not floor 0's geometry"):
+        Scene(bare.floors, floor_plans=[plan])

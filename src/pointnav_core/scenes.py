@@ -119,7 +119,8 @@ class Scene:
     waypoint_spacing : float
         Spacing (m) of those waypoints along the path.
     floor_plans : sequence of FloorPlan or None, optional
-        The polygons each floor was rasterised from, when known (backends may use them).
+        Accepted for compatibility: a floor's plan is its map's ``geometry`` (give it to
+        :class:`TraversableMap`), so an entry must be None or that same plan.
 
     Examples
     --------
@@ -146,15 +147,27 @@ class Scene:
             raise ValueError(f"num_waypoints must be an integer >= 1, got {num_waypoints!r}")
         if not math.isfinite(waypoint_spacing) or waypoint_spacing <= 0:
             raise ValueError(f"waypoint_spacing must be > 0 (m), got {waypoint_spacing!r}")
-        plans = list(floor_plans) if floor_plans is not None else [None] * len(floors)
-        if len(plans) != len(floors):
-            raise ValueError(
-                f"floor_plans must have one entry per floor ({len(floors)}), got {len(plans)}"
-            )
+        if floor_plans is not None:
+            plans = list(floor_plans)
+            if len(plans) != len(floors):
+                raise ValueError(
+                    f"floor_plans must have one entry per floor ({len(floors)}), got {len(plans)}"
+                )
+            for i, (plan, tmap) in enumerate(zip(plans, floors)):
+                if plan is not None and plan is not tmap.geometry:
+                    raise ValueError(
+                        f"floor_plans[{i}] is not floor {i}'s geometry: a floor's plan lives on "
+                        f"its map, TraversableMap(..., geometry=plan)"
+                    )
         self.floors = floors
         self.num_waypoints = int(num_waypoints)
         self.waypoint_spacing = float(waypoint_spacing)
-        self.floor_plans = plans
+
+    @property
+    def floor_plans(self) -> tuple[FloorPlan | None, ...]:
+        """Each floor's plan (the polygons it was rasterised from) or None: its map's
+        ``geometry``, stored there once."""
+        return tuple(f.geometry for f in self.floors)
 
     # ------------------------------------------------------------- constructors
     @classmethod
@@ -209,7 +222,7 @@ class Scene:
         plan = FloorPlan(outline=floor, obstacles=tuple(obstacles))
         codes, origin = floorplans.rasterize(plan.outline, plan.obstacles, resolution)
         tmap = TraversableMap(codes, resolution, origin, height, geometry=plan)
-        return cls([tmap], floor_plans=[plan], **kwargs)
+        return cls([tmap], **kwargs)
 
     @classmethod
     def from_png(
