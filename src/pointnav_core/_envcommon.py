@@ -181,9 +181,11 @@ def observation_space(task: PointNavigationTask, flatten: bool) -> spaces.Space[
         return spaces.Box(low, high, dtype=np.float32)
     # An OrderedDict keeps the terms' order (a plain dict would be sorted by key), so that
     # FlattenObservation gives the flat order too.
-    return spaces.Dict(
-        OrderedDict((name, spaces.Box(low[s], high[s], dtype=np.float32)) for name, s in layout.slices.items())
-    )
+    boxes = OrderedDict()
+    for name in layout.slices:
+        lo, hi, shape, dtype = layout.space_bounds(name, low, high)
+        boxes[name] = spaces.Box(lo, hi, shape, dtype=dtype)
+    return spaces.Dict(boxes)
 
 
 def check_action(
