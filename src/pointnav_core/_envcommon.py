@@ -28,6 +28,7 @@ __all__ = [
     "ROBOT_KEYS",
     "TASK_KEYS",
     "action_space",
+    "add_sensors",
     "check_action",
     "check_action_frequency",
     "make_robot",
@@ -132,6 +133,44 @@ def make_task(
     )
 
 
+def add_sensors(task: Any, sensors: Mapping[str, Any] | None, name: str = "task") -> Any:
+    """``task`` (None, a dict of task arguments, a task, or a list of them) with the terms
+    of ``sensors`` (:func:`pointnav_core.sensors.make_sensors`) added to its
+    ``observation_terms``, before any given there.
+
+    Raises
+    ------
+    ValueError
+        For a bad ``sensors`` config (naming the sensor or key), for a ready
+        ``PointNavigationTask`` (its terms are fixed: pass a dict), or for a sensor the task
+        dict already has among its ``observation_terms``.
+    """
+    from pointnav_core.sensors import make_sensors
+
+    terms = make_sensors(sensors)
+    if not terms:
+        return task
+    if isinstance(task, (list, tuple)):
+        return [add_sensors(entry, sensors, f"{name}[{i}]") for i, entry in enumerate(task)]
+    if task is None:
+        task = {}
+    if isinstance(task, PointNavigationTask):
+        raise ValueError(
+            f"sensors cannot be added to a ready PointNavigationTask ({name}): pass the task "
+            f"as a dict of its arguments, or put the sensor terms in its observation_terms"
+        )
+    if not isinstance(task, Mapping):
+        return task  # make_task names the problem
+    given = list(task.get("observation_terms") or ())
+    names = {getattr(term, "name", None) for term in given}
+    for term in terms:
+        if term.name in names:
+            raise ValueError(
+                f"sensors turns on {term.name!r}, which {name}['observation_terms'] already has"
+            )
+    return {**task, "observation_terms": [*terms, *given]}
+
+
 def check_world_args(
     scene: Any, flatten_obs: Any, action_frequency: Any, backend_kwargs: Any
 ) -> tuple[scenes.Scene, float]:
@@ -164,9 +203,47 @@ def check_action_frequency(action_frequency: Any) -> float:
     return frequency
 
 
-def action_space(robot: RobotSpec) -> spaces.Box:
-    """The robot's action space: a float32 ``Box`` in ``[-1, 1]`` of shape ``(action_dim,)``."""
+def action_space(robot: RobotSpec, discrete: Any = None) -> spaces.Space[Any]:
+    """The robot's action space: a float32 ``Box`` in ``[-1, 1]`` of shape ``(action_dim,)``,
+    or ``Discrete(discrete.n)`` for a :class:`~pointnav_core.actions.DiscreteActions` set."""
+    if discrete is not None:
+        return spaces.Discrete(discrete.n)
     return spaces.Box(-1.0, 1.0, (robot.action_dim,), dtype=np.float32)
+
+
+def add_stop(task: Any, discrete: Any, name: str = "task") -> Any:
+    """``task`` (as for :func:`add_sensors`) with the STOP success rule
+    (:class:`~pointnav_core.actions.StopAtGoal` as its ``pointgoal`` condition) when the
+    discrete action set ``discrete`` has STOP; unchanged otherwise.
+
+    Raises
+    ------
+    ValueError
+        For a ready ``PointNavigationTask`` whose ``pointgoal`` condition is not a
+        ``StopAtGoal``.
+    """
+    from pointnav_core.actions import StopAtGoal
+
+    if discrete is None or not discrete.stop:
+        return task
+    if isinstance(task, (list, tuple)):
+        return [add_stop(entry, discrete, f"{name}[{i}]") for i, entry in enumerate(task)]
+    if task is None:
+        task = {}
+    if isinstance(task, PointNavigationTask):
+        if not isinstance(task.termination_conditions.get("pointgoal"), StopAtGoal):
+            raise ValueError(
+                f"{name} is a ready PointNavigationTask without the STOP rule: with discrete "
+                f"actions and STOP, pass the task as a dict, or give it "
+                f"termination_conditions=[StopAtGoal()]"
+            )
+        return task
+    if not isinstance(task, Mapping):
+        return task  # make_task names the problem
+    given = list(task.get("termination_conditions") or ())
+    if any(getattr(c, "name", None) == "pointgoal" for c in given):
+        return task  # the caller chose its own success rule
+    return {**task, "termination_conditions": [*given, StopAtGoal()]}
 
 
 def observation_space(task: PointNavigationTask, flatten: bool) -> spaces.Space[Any]:

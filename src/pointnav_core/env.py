@@ -10,6 +10,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from pointnav_core import _envcommon, scenes
+from pointnav_core.actions import check_discrete_action, make_discrete_actions
 from pointnav_core.backend import Backend, RobotSpec, make_backend
 from pointnav_core.maps import BoundedCache
 from pointnav_core.task import PointNavigationTask
@@ -148,6 +149,9 @@ class PointNavEnv(gym.Env[Any, np.ndarray]):
         render_mode: str | None = None,
         flatten_obs: bool = False,
         action_frequency: float = 10.0,
+        sensors: Mapping[str, Any] | None = None,
+        action_space: str = "continuous",
+        discrete_actions: Mapping[str, Any] | None = None,
     ) -> None:
         if render_mode is not None and render_mode not in self.metadata["render_modes"]:
             raise ValueError(
@@ -158,6 +162,8 @@ class PointNavEnv(gym.Env[Any, np.ndarray]):
             scene, flatten_obs, action_frequency, backend_kwargs
         )
         self.robot = _envcommon.make_robot(robot)
+        self.discrete_actions = make_discrete_actions(action_space, discrete_actions)
+        task = _envcommon.add_stop(_envcommon.add_sensors(task, sensors), self.discrete_actions)
         self.task = _envcommon.make_task(task)
         self.scene = scene
         self.robots = (self.robot,)
@@ -172,7 +178,11 @@ class PointNavEnv(gym.Env[Any, np.ndarray]):
         self._idn = self.task.robot_idn
 
         self._action_shape = (self.robot.action_dim,)
-        self.action_space = _envcommon.action_space(self.robot)
+        self.action_space = _envcommon.action_space(self.robot, self.discrete_actions)
+        self._plan = (
+            None if self.discrete_actions is None
+            else self.discrete_actions.commands(self.robot, frequency)
+        )
         self.observation_space = _envcommon.observation_space(self.task, self.flatten_obs)
 
     # ------------------------------------------------------------------ Gymnasium API
@@ -193,6 +203,8 @@ class PointNavEnv(gym.Env[Any, np.ndarray]):
     def step(self, action: Any) -> tuple[Any, float, bool, bool, dict[str, Any]]:
         """Apply ``action`` for one control step; see the class docstring for the rest."""
         self.task.check_step()  # before anything moves: an illegal step changes nothing
+        if self._plan is not None:
+            return self._step_discrete(action)
         action = self._check_action(action)
         self.backend.step({self._idn: action})
         reward, terminated, truncated, info = self.task.step(self, action)
@@ -219,6 +231,21 @@ class PointNavEnv(gym.Env[Any, np.ndarray]):
             close()
 
     # ------------------------------------------------------------------ helpers
+    def _step_discrete(self, action: Any) -> tuple[Any, float, bool, bool, dict[str, Any]]:
+        """One discrete action: its command for its control steps, ending at a contact
+        (:mod:`pointnav_core.actions`)."""
+        index = check_discrete_action(action, len(self._plan))  # type: ignore[arg-type]
+        command, steps = self._plan[index]  # type: ignore[index]
+        idn, backend = self._idn, self.backend
+        contact = False
+        for _ in range(steps):
+            backend.step({idn: command})
+            if backend.in_contact(idn):
+                contact = True
+                break
+        reward, terminated, truncated, info = self.task.step(self, index, contact=contact)
+        return self._get_obs(), reward, terminated, truncated, info
+
     def _check_action(self, action: Any) -> Any:
         return _envcommon.check_action(action, self._action_shape, self.robot.drive)
 

@@ -170,6 +170,7 @@ from pettingzoo import AECEnv, ParallelEnv
 from pettingzoo.utils.conversions import parallel_to_aec, parallel_to_aec_wrapper
 
 from pointnav_core import _envcommon, scenes
+from pointnav_core.actions import check_discrete_action, make_discrete_actions
 from pointnav_core.backend import Backend, RobotSpec, make_backend
 from pointnav_core.maps import BoundedCache
 from pointnav_core.task import PointNavigationTask, TaskStateError
@@ -327,6 +328,9 @@ class MultiPointNavEnv(ParallelEnv[str, Any, np.ndarray]):
         flatten_obs: bool = False,
         finished: str = "park",
         action_frequency: float = 10.0,
+        sensors: Mapping[str, Any] | None = None,
+        action_space: str = "continuous",
+        discrete_actions: Mapping[str, Any] | None = None,
     ) -> None:
         if render_mode is not None and render_mode not in (*self.metadata["render_modes"], "human"):
             raise ValueError(
@@ -341,6 +345,8 @@ class MultiPointNavEnv(ParallelEnv[str, Any, np.ndarray]):
             scene, flatten_obs, action_frequency, backend_kwargs
         )
         self.robots = _make_robots(robot, n)
+        self.discrete_actions = make_discrete_actions(action_space, discrete_actions)
+        task = _envcommon.add_stop(_envcommon.add_sensors(task, sensors), self.discrete_actions)
         tasks = _make_tasks(task, n)
 
         self.scene = scene
@@ -367,9 +373,14 @@ class MultiPointNavEnv(ParallelEnv[str, Any, np.ndarray]):
         self.agents: list[str] = []
         self._index = {agent: i for i, agent in enumerate(self.possible_agents)}
         self.action_spaces = {
-            agent: _envcommon.action_space(rb)
+            agent: _envcommon.action_space(rb, self.discrete_actions)
             for agent, rb in zip(self.possible_agents, self.robots)
         }
+        # Per robot, each discrete action's command and control steps (None: continuous).
+        self._plans = (
+            None if self.discrete_actions is None
+            else [self.discrete_actions.commands(rb, frequency) for rb in self.robots]
+        )
         self.observation_spaces = {
             agent: _envcommon.observation_space(t, self.flatten_obs)
             for agent, t in zip(self.possible_agents, tasks)
@@ -551,7 +562,7 @@ class MultiPointNavEnv(ParallelEnv[str, Any, np.ndarray]):
         if len(actions) != len(agents):
             self._bad_keys(actions)
         # Check every action before anything moves: a rejected step changes nothing.
-        slots, check = self._slots, _envcommon.check_action
+        slots, check, plans = self._slots, _envcommon.check_action, self._plans
         commands: dict[int, np.ndarray] = {}
         todo = []
         for agent in agents:
@@ -566,7 +577,10 @@ class MultiPointNavEnv(ParallelEnv[str, Any, np.ndarray]):
                     f"in env.agents must act"
                 )
             try:
-                action = check(action, shape, drive)
+                if plans is None:
+                    action = check(action, shape, drive)
+                else:
+                    action = check_discrete_action(action, len(plans[i]))
             except ValueError as err:
                 raise ValueError(f"{agent}: {err}") from None
             commands[i] = action
@@ -578,13 +592,20 @@ class MultiPointNavEnv(ParallelEnv[str, Any, np.ndarray]):
         truncations: dict[str, bool] = {}
         infos: dict[str, dict[str, Any]] = {}
         try:
-            self.backend.step(commands)
+            if plans is None:
+                self.backend.step(commands)
+                contacts = None
+            else:
+                contacts = self._step_discrete(commands)
             self._cycles += 1
             cut = self._cycles >= self.max_cycles
             alive = []
             ended = []
             for agent, i, action, task_step, observe in todo:
-                reward, terminated, truncated, info = task_step(self, action)
+                if contacts is None:
+                    reward, terminated, truncated, info = task_step(self, action)
+                else:
+                    reward, terminated, truncated, info = task_step(self, action, contact=contacts[i])
                 if cut:
                     truncated = True
                 observations[agent] = observe(self)
@@ -604,6 +625,20 @@ class MultiPointNavEnv(ParallelEnv[str, Any, np.ndarray]):
             self._void = True
             raise
         return observations, rewards, terminations, truncations, infos
+
+    def _step_discrete(self, actions: dict[int, int]) -> dict[int, bool]:
+        """Run each robot's discrete action for its control steps, all robots together; a
+        robot's action ends at its first contact. Returns whether each robot touched
+        something (:mod:`pointnav_core.actions`)."""
+        plans, backend = self._plans, self.backend
+        todo = {i: plans[i][a] for i, a in actions.items()}  # type: ignore[index]
+        contacts = dict.fromkeys(todo, False)
+        for k in range(max(steps for _, steps in todo.values())):
+            backend.step({i: cmd for i, (cmd, steps) in todo.items() if k < steps and not contacts[i]})
+            for i in todo:
+                if not contacts[i] and backend.in_contact(i):
+                    contacts[i] = True
+        return contacts
 
     def _finish(self, i: int) -> None:
         self._active[i] = False

@@ -152,6 +152,8 @@ class RangeScan(ObservationTerm):
         self.angles = angles
         self._geometry: ScanGeometry | None = None
         self._rng: np.random.Generator | None = None
+        #: ``(x, y, yaw, readings)`` of the last observation (renderers draw it), or None.
+        self.last_scan: tuple[float, float, float, NDArray[np.float64]] | None = None
 
     @property
     def doc_rows(self) -> tuple[tuple[str, str, str], ...]:  # type: ignore[override]
@@ -169,6 +171,7 @@ class RangeScan(ObservationTerm):
             self._geometry = ScanGeometry(tmap)
         if self.noise_std > 0.0 or self.dropout > 0.0:
             self._rng = _spawn(env.np_random)
+        self.last_scan = None
 
     def ranges(self, frame: Frame) -> NDArray[np.float64]:
         """The exact ranges (m) at the frame's pose, before the min-range rule and noise."""
@@ -183,6 +186,11 @@ class RangeScan(ObservationTerm):
         )[0]
 
     def values(self, frame: Frame) -> NDArray[np.float64]:
+        d = self._readings(frame)
+        self.last_scan = (frame.x, frame.y, math.atan2(frame.sin_yaw, frame.cos_yaw), d)
+        return d
+
+    def _readings(self, frame: Frame) -> NDArray[np.float64]:
         d = self.ranges(frame)
         if self.min_range > 0.0:
             d[d < self.min_range] = self.max_range
