@@ -44,6 +44,21 @@ class PointNavEnv(gym.Env[Any, np.ndarray]):
     A holonomic robot (`RobotSpec(drive="holonomic")`) takes `(vx, vy, w)`, shape `(3,)`.
     Values outside `[-1, 1]` are clipped; NaN, infinity or a wrong shape raise `ValueError`.
 
+    With `action_space="discrete"` the action is an integer, `Discrete(4)` (Habitat's
+    actions; `pointnav_core.actions`):
+
+    | Num | Action         | What the robot does                                          |
+    |-----|----------------|--------------------------------------------------------------|
+    | 0   | `MOVE_FORWARD` | drives `forward_step` m straight ahead (default 0.25)        |
+    | 1   | `TURN_LEFT`    | turns in place by `turn_angle` rad (default 10 deg)          |
+    | 2   | `TURN_RIGHT`   | turns in place by `-turn_angle`                              |
+    | 3   | `STOP`         | stands still one control step and ends the episode           |
+
+    Each runs as velocity commands over the fewest control steps the robot's top speeds
+    allow (MOVE_FORWARD: 5 steps at 0.5 m/s; a turn: 2 steps), and ends early at a contact,
+    which counts as one collision. `discrete_actions={"forward_step": ..., "turn_angle":
+    ..., "stop": False}` changes them; without STOP the action space is `Discrete(3)`.
+
     ## Observation Space
 
     A `Dict` of one `float32` array per observation term (`pointnav_core.observations`;
@@ -67,6 +82,22 @@ class PointNavEnv(gym.Env[Any, np.ndarray]):
     left). Values are clipped to these bounds (only a fall's vertical speed reaches them).
     With `flatten_obs=True` the observation is OmniGibson's flat `low_dim` vector: a `Box`
     of shape `(8,)` holding the numbers in the order of the table.
+
+    Sensors (`pointnav_core.sensors`), turned on with `sensors={"scan": {...},
+    "local_map": {...}}`, add their own keys after these, in this order whatever the order
+    of the dict, and their values follow the eight above in the flat vector:
+
+    | Key         | Shape, dtype                   | Values                                  |
+    |-------------|--------------------------------|-----------------------------------------|
+    | `scan`      | `(n_rays,)` float32            | range (m) along each ray, in `[0, max_range]`, in the order of `RangeScan.angles` (rad, robot frame, 0 ahead, positive left) |
+    | `local_map` | `(cells, cells)` uint8 or float32 | the floor around the robot, heading up: 0 free, 1 obstacle, 2 void or off the map, 3 another robot; row by row in the flat vector |
+
+    `scan` arguments: `n_rays` (64), `fov` (2 pi rad), `min_range` (0.05 m: a nearer
+    return reads `max_range`), `max_range` (5.6 m), `noise_std` (0 m) and `dropout` (0).
+    Rays see the floor's obstacle cells and polygons, the map's edge and the other robots;
+    VOID (a hole) is not seen. Noise is seeded by `reset(seed=...)`. `local_map` arguments:
+    `size` (5.0 m), `cells` (32), `dtype` (`"uint8"`). A bad sensor name, key or value
+    raises `ValueError` naming it.
 
     ## Rewards
 
@@ -92,7 +123,8 @@ class PointNavEnv(gym.Env[Any, np.ndarray]):
     The episode ends if any one of the following occurs:
 
     1. Termination (success): the robot's centre is closer than `goal_tolerance` (0.5 m)
-       to the goal (xy).
+       to the goal (xy). With discrete actions and STOP: the robot calls STOP; a success
+       within `goal_tolerance`, a failure otherwise (Habitat's rule).
     2. Termination: the robot has touched something on more than `max_collisions` (500)
        steps.
     3. Termination: the robot fell: its height dropped more than `fall_height` (0.03 m)
@@ -131,10 +163,25 @@ class PointNavEnv(gym.Env[Any, np.ndarray]):
     | `render_mode`      | **str** or `None`            | `None`            | `"rgb_array"` or None|
     | `flatten_obs`      | **bool**                     | `False`           | flat `(8,)` `low_dim`|
     | `action_frequency` | **float**                    | `10.0`            | control rate (Hz)    |
+    | `sensors`          | **dict** or `None`           | `None`            | `scan`, `local_map`  |
+    | `action_space`     | **str**                      | `"continuous"`    | or `"discrete"`      |
+    | `discrete_actions` | **dict** or `None`           | `None`            | step, angle, STOP    |
+
+    ```python
+    >>> env = PointNavEnv(sensors={"scan": {"n_rays": 32}}, action_space="discrete")
+    >>> obs, info = env.reset(seed=0)
+    >>> obs["scan"].shape, env.action_space
+    ((32,), Discrete(4))
+    >>> obs, reward, terminated, truncated, info = env.step(0)  # MOVE_FORWARD
+    >>> round(info["path_length"], 6)
+    0.25
+
+    ```
 
     ## Version History
 
-    * v0: Initial version.
+    * v0: Initial version; range scan and local map sensors, and discrete actions with
+      STOP, added as options (the defaults are unchanged).
     """
 
     metadata = {"render_modes": ["rgb_array"], "render_fps": 10}

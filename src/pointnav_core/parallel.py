@@ -2,15 +2,16 @@
 
 | Import             | `from pointnav_core import parallel`, then `parallel.parallel_env()` |
 |--------------------|----------------------------------------------------------------------|
-| Actions            | Continuous                                                           |
+| Actions            | Continuous; discrete with `action_space="discrete"`                  |
 | Parallel API       | Yes                                                                  |
 | Manual Control     | No                                                                   |
 | Agents             | `agents = ["robot_0", ..., "robot_<n_robots - 1>"]`                 |
 | Number of Agents   | `n_robots` (default 2)                                               |
-| Action Shape       | `(2,)` differential drive, `(3,)` holonomic                          |
-| Action Values      | `[-1, 1]`, float32                                                   |
+| Action Shape       | `(2,)` differential drive, `(3,)` holonomic; `Discrete(4)`           |
+| Action Values      | `[-1, 1]`, float32; or MOVE_FORWARD, TURN_LEFT, TURN_RIGHT, STOP     |
 | Observation Shape  | `Dict` of `xy_pos_to_goal (2,)`, `robot_lin_vel (3,)`,               |
-|                    | `robot_ang_vel (3,)`; `(8,)` with `flatten_obs=True`                 |
+|                    | `robot_ang_vel (3,)`, and `scan (n_rays,)`, `local_map (cells,       |
+|                    | cells)` when on; `(8,)` (plus the sensors') with `flatten_obs=True`  |
 | Observation Values | bounded, float32 (as in `PointNavEnv`)                               |
 | State Shape        | `(8 * n_robots,)`                                                    |
 | State Values       | bounded, float32                                                     |
@@ -34,7 +35,7 @@ Arguments
 ---------
 ``parallel_env(scene=None, n_robots=2, robot=None, task=None, backend="kinematic",
 backend_kwargs=None, max_cycles=500, render_mode=None, flatten_obs=False, finished="park",
-action_frequency=10.0)``
+action_frequency=10.0, sensors=None, action_space="continuous", discrete_actions=None)``
 
 | Argument           | Type                        | Default           | Description            |
 |--------------------|-----------------------------|-------------------|------------------------|
@@ -52,6 +53,10 @@ action_frequency=10.0)``
 | `finished`         | `"park"` or `"remove"`      | `"park"`          | a finished robot stays,|
 |                    |                             |                   | or leaves the world    |
 | `action_frequency` | **float**                   | `10.0`            | control rate (Hz)      |
+| `sensors`          | **dict** or `None`          | `None`            | `scan`, `local_map` for|
+|                    |                             |                   | every robot            |
+| `action_space`     | **str**                     | `"continuous"`    | or `"discrete"`        |
+| `discrete_actions` | **dict** or `None`          | `None`            | step, angle, STOP      |
 
 ``task`` entries are :class:`~pointnav_core.task.PointNavigationTask` keyword arguments
 (a list may also hold ready tasks); the env sets ``robot_idn`` (an entry that gives one must
@@ -63,7 +68,13 @@ Per agent, the same as ``PointNavEnv`` for that robot: the action is ``(v, w)`` 
 ``(vx, vy, w)`` for a holonomic robot) in ``[-1, 1]``, scaled by the robot's maxima and held
 for one control step; the observation is the robot's own goal in its own frame and its own
 velocities (a ``Dict``, or OmniGibson's flat 8-vector with ``flatten_obs=True``). Agents do
-not observe each other: :meth:`MultiPointNavEnv.state` is the global view.
+not observe each other's state: :meth:`MultiPointNavEnv.state` is the global view. With
+``sensors`` (as in ``PointNavEnv``: :mod:`pointnav_core.sensors`) every robot gets its own
+sensors: its range scan sees the other robots present on its floor as discs, and its
+local map marks them. With ``action_space="discrete"`` every agent acts with an integer
+(:mod:`pointnav_core.actions`); the robots' commands run together, each for its own
+action's control steps (a robot whose action is shorter, or ended at a contact, stands
+still meanwhile), and the env step counts once.
 ``observation_space(agent)`` and ``action_space(agent)`` return the same object every call.
 
 State

@@ -201,30 +201,39 @@ def _grid_hits(
     best = np.full(c.shape, np.inf)
 
     for d_along, d_across, g_along, g_across, n_along, n_across, along_is_x in (
-        (c, s, gx, gy, wp, hp, True),
-        (s, c, gy, gx, hp, wp, False),
+        (c, s, gx[:, :, 0], gy[:, :, 0], wp, hp, True),
+        (s, c, gy[:, :, 0], gx[:, :, 0], hp, wp, False),
     ):
-        pos = (d_along >= 0.0)[:, :, None]
-        da = np.where(d_along == 0.0, _TINY, d_along)[:, :, None]
-        # Grid lines ahead: floor(g)+1, +2, ... going up; ceil(g)-1, -2, ... going down.
-        line = np.where(pos, np.floor(g_along) + 1.0 + k, np.ceil(g_along) - 1.0 - k)
-        with np.errstate(over="ignore"):  # a near-zero component: crossings at infinity
-            t = (line - g_along) / da
-            across = g_across + t * d_across[:, :, None]
-        np.clip(across, -1.0, n_across, out=across)
+        # Per ray: the first grid line ahead (floor(g)+1 going up, ceil(g)-1 going down),
+        # the step between lines (+-1), the ray length per line (dt) and the first
+        # crossing's t and across-coordinate. The k-th crossing is at t0 + k dt.
+        pos = d_along >= 0.0
+        sgn = np.where(pos, 1.0, -1.0)
+        base = np.where(pos, np.floor(g_along) + 1.0, np.ceil(g_along) - 1.0)
+        dt = 1.0 / np.maximum(np.abs(d_along), _TINY)  # a zero component: lines at "infinity"
+        t0 = (base - g_along) * sgn * dt
+        a0 = g_across + t0 * d_across
+        step = dt * d_across
+        # Every crossing of every ray at once: (robots, rays, crossings).
+        across = a0[:, :, None] + step[:, :, None] * k
         hi = np.floor(across + e)
         # lo < hi: the crossing grazes the line between rows (columns) hi - 1 and hi.
         grazing = np.floor(across - e) < hi
-        np.clip(hi, 0.0, n_across - 1.0, out=hi)
-        entered = np.where(pos, line, line - 1.0)
-        np.clip(entered, 0.0, n_along - 1.0, out=entered)
+        np.maximum(hi, 0.0, out=hi)
+        np.minimum(hi, n_across - 1.0, out=hi)
+        entered = (base + np.where(pos, 0.0, -1.0))[:, :, None] + sgn[:, :, None] * k
+        np.maximum(entered, 0.0, out=entered)
+        np.minimum(entered, n_along - 1.0, out=entered)
         if along_is_x:  # entering column `entered` at row hi (and hi - 1 if grazing)
             idx = grazing * plane + hi * wp + entered
         else:  # entering row `entered` at column hi (and hi - 1 if grazing)
             idx = grazing * (2 * plane) + entered * wp + hi
         hit = lookup[idx.astype(np.intp)]
-        hit &= t <= reach
-        np.minimum(best, np.where(hit, t, np.inf).min(axis=2), out=best)
+        # Crossings come in order along the ray: the first blocked one is the nearest.
+        first = hit.argmax(axis=2)
+        found = np.take_along_axis(hit, first[:, :, None], axis=2)[:, :, 0]
+        t = t0 + first * dt
+        np.minimum(best, np.where(found & (t <= reach), t, np.inf), out=best)
 
     # An origin touching a blocked cell (or off the map) reads 0.
     x0 = gx[:, 0, 0]
