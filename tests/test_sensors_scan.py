@@ -125,3 +125,18 @@ def test_angles_are_read_only_and_in_the_robot_frame():
     assert scan.angles.tolist() == pytest.approx([-math.pi / 2, -math.pi / 4, 0.0, math.pi / 4, math.pi / 2])
     with pytest.raises(ValueError):
         scan.angles[0] = 1.0
+
+
+def test_scan_geometry_and_sensors_pickle():
+    import pickle
+
+    from pointnav_core.sensors import LocalMap
+
+    scene = scenes.rooms(seed=2)
+    geo = ScanGeometry(scene.floors[0])
+    again = pickle.loads(pickle.dumps(geo))
+    p = [[0.0, 0.0]]
+    np.testing.assert_array_equal(cast_rays(geo, p, [0.3], FULL, 5.6), cast_rays(again, p, [0.3], FULL, 5.6))
+    scan = pickle.loads(pickle.dumps(RangeScan(n_rays=8, noise_std=0.1)))
+    assert scan.angles.tolist() == RangeScan(n_rays=8).angles.tolist()
+    assert pickle.loads(pickle.dumps(LocalMap(cells=4))).shape == (4, 4)
