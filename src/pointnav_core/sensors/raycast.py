@@ -81,6 +81,14 @@ class ScanGeometry:
         left[:, 1:] |= pad[:, :-1]
         self._lookup = np.concatenate([pad.ravel(), below.ravel(), left.ravel()])
         self._plane = pad.size
+        hp, wp = pad.shape
+        # Per crossing family (x, y), shaped to broadcast over (family, robots, rays, k).
+        fam = (2, 1, 1, 1)
+        self._across_max = np.array([hp - 1.0, wp - 1.0]).reshape(fam)
+        self._along_max = np.array([wp - 1.0, hp - 1.0]).reshape(fam)
+        self._plane_of = np.array([pad.size, 2.0 * pad.size]).reshape(fam)
+        self._hi_stride = np.array([float(wp), 1.0]).reshape(fam)
+        self._entered_stride = np.array([1.0, float(wp)]).reshape(fam)
         polygons = tuple(tmap.collision.polygons)
         self.polygons = polygons
         starts: list[NDArray[np.float64]] = []
@@ -96,25 +104,36 @@ class ScanGeometry:
         if starts:
             self.edge_a = np.concatenate(starts)
             self.edge_b = np.concatenate(ends)
-            self._edge_tree: Any = shapely.STRtree(
-                shapely.linestrings(np.stack([self.edge_a, self.edge_b], axis=1))
-            )
-            self._poly_tree: Any = shapely.STRtree(list(polygons))
         else:
             self.edge_a = self.edge_b = np.zeros((0, 2))
-            self._edge_tree = self._poly_tree = None
+        self._edge_vec = self.edge_b - self.edge_a
+        length = np.hypot(self._edge_vec[:, 0], self._edge_vec[:, 1])
+        # |u - 1/2| <= this: the edge's parameter u in [0, 1], widened by TOUCH_EPS metres.
+        self._edge_half_slack = 0.5 + TOUCH_EPS / np.maximum(length, TOUCH_EPS)
+        self._edge_lo = np.minimum(self.edge_a, self.edge_b)
+        self._edge_hi = np.maximum(self.edge_a, self.edge_b)
+        # Cells a polygon touches (padded grid): only an origin in one can be inside one.
+        near = np.zeros(self.shape, dtype=bool)
+        self._poly_tree: Any = None
+        if polygons:
+            self._poly_tree = shapely.STRtree(list(polygons))
+            res, (ox, oy) = self.resolution, self.origin
+            rows, cols = np.indices(self.shape)
+            boxes = shapely.box(
+                ox + (cols - 1) * res, oy + (rows - 1) * res, ox + cols * res, oy + rows * res
+            ).ravel()
+            hit = self._poly_tree.query(boxes, predicate="intersects")[0]
+            near.ravel()[hit] = True
+        self._near_polygon = near.ravel()
 
     def __getstate__(self) -> dict[str, Any]:
         state = self.__dict__.copy()
-        state["_edge_tree"] = state["_poly_tree"] = None  # rebuilt, not shipped
+        state["_poly_tree"] = None  # rebuilt, not shipped
         return state
 
     def __setstate__(self, state: dict[str, Any]) -> None:
         self.__dict__.update(state)
-        if len(self.edge_a):
-            self._edge_tree = shapely.STRtree(
-                shapely.linestrings(np.stack([self.edge_a, self.edge_b], axis=1))
-            )
+        if self.polygons:
             self._poly_tree = shapely.STRtree(list(self.polygons))
 
     def __repr__(self) -> str:
@@ -173,7 +192,7 @@ def cast_rays(
     best = np.minimum(
         _grid_hits(geometry, p, c, s, float(max_range)), float(max_range)
     )
-    if geometry._edge_tree is not None:
+    if len(geometry.edge_a):
         np.minimum(best, _polygon_hits(geometry, p, c, s, float(max_range)), out=best)
     if discs is not None:
         d = np.asarray(discs, dtype=np.float64).reshape(-1, 3)
@@ -198,42 +217,43 @@ def _grid_hits(
     n_cross = int(min(math.ceil(reach) + 1, max(hp, wp) + 1))
     k = np.arange(n_cross, dtype=np.float64)[None, None, :]
     lookup, plane = geo._lookup, geo._plane
-    best = np.full(c.shape, np.inf)
 
-    for d_along, d_across, g_along, g_across, n_along, n_across, along_is_x in (
-        (c, s, gx[:, :, 0], gy[:, :, 0], wp, hp, True),
-        (s, c, gy[:, :, 0], gx[:, :, 0], hp, wp, False),
-    ):
-        # Per ray: the first grid line ahead (floor(g)+1 going up, ceil(g)-1 going down),
-        # the step between lines (+-1), the ray length per line (dt) and the first
-        # crossing's t and across-coordinate. The k-th crossing is at t0 + k dt.
-        pos = d_along >= 0.0
-        sgn = np.where(pos, 1.0, -1.0)
-        base = np.where(pos, np.floor(g_along) + 1.0, np.ceil(g_along) - 1.0)
-        dt = 1.0 / np.maximum(np.abs(d_along), _TINY)  # a zero component: lines at "infinity"
-        t0 = (base - g_along) * sgn * dt
-        a0 = g_across + t0 * d_across
-        step = dt * d_across
-        # Every crossing of every ray at once: (robots, rays, crossings).
-        across = a0[:, :, None] + step[:, :, None] * k
-        hi = np.floor(across + e)
-        # lo < hi: the crossing grazes the line between rows (columns) hi - 1 and hi.
-        grazing = np.floor(across - e) < hi
-        np.maximum(hi, 0.0, out=hi)
-        np.minimum(hi, n_across - 1.0, out=hi)
-        entered = (base + np.where(pos, 0.0, -1.0))[:, :, None] + sgn[:, :, None] * k
-        np.maximum(entered, 0.0, out=entered)
-        np.minimum(entered, n_along - 1.0, out=entered)
-        if along_is_x:  # entering column `entered` at row hi (and hi - 1 if grazing)
-            idx = grazing * plane + hi * wp + entered
-        else:  # entering row `entered` at column hi (and hi - 1 if grazing)
-            idx = grazing * (2 * plane) + entered * wp + hi
-        hit = lookup[idx.astype(np.intp)]
-        # Crossings come in order along the ray: the first blocked one is the nearest.
-        first = hit.argmax(axis=2)
-        found = np.take_along_axis(hit, first[:, :, None], axis=2)[:, :, 0]
-        t = t0 + first * dt
-        np.minimum(best, np.where(found & (t <= reach), t, np.inf), out=best)
+    # Both families at once, stacked on a leading axis: [0] x-crossings (vertical lines),
+    # [1] y-crossings (horizontal lines); "along" is the coordinate the lines cut.
+    d_along = np.stack([c, s])
+    d_across = np.stack([s, c])
+    g2 = np.stack([gx[:, :, 0], gy[:, :, 0]])  # (2, N, 1)
+    g_along, g_across = g2, g2[::-1]
+    # Per ray: the first grid line ahead (floor(g)+1 going up, ceil(g)-1 going down), the
+    # step between lines (+-1), the ray length per line (dt) and the first crossing's t and
+    # across-coordinate. The k-th crossing is at t0 + k dt.
+    pos = d_along >= 0.0
+    sgn = np.where(pos, 1.0, -1.0)
+    base = np.where(pos, np.floor(g_along) + 1.0, np.ceil(g_along) - 1.0)
+    dt = 1.0 / np.maximum(np.abs(d_along), _TINY)  # a zero component: lines at "infinity"
+    t0 = (base - g_along) * sgn * dt
+    a0 = g_across + t0 * d_across
+    step = dt * d_across
+    k4 = k[None]
+    # Every crossing of every ray of every robot: (family, robots, rays, crossings).
+    across = a0[..., None] + step[..., None] * k4
+    hi = np.floor(across + e)
+    # lo < hi: the crossing grazes the line between rows (columns) hi - 1 and hi.
+    grazing = np.floor(across - e) < hi
+    np.maximum(hi, 0.0, out=hi)
+    np.minimum(hi, geo._across_max, out=hi)
+    entered = (base - ~pos)[..., None] + sgn[..., None] * k4
+    np.maximum(entered, 0.0, out=entered)
+    np.minimum(entered, geo._along_max, out=entered)
+    # x: column `entered`, row hi (and hi - 1 if grazing): plane 1 ORs the row below;
+    # y: row `entered`, column hi (and hi - 1 if grazing): plane 2 ORs the column left.
+    idx = grazing * geo._plane_of + hi * geo._hi_stride + entered * geo._entered_stride
+    hit = lookup[idx.astype(np.intp)]
+    # Crossings come in order along the ray: the first blocked one is the nearest.
+    first = hit.argmax(axis=3)
+    found = np.take_along_axis(hit, first[..., None], axis=3)[..., 0]
+    t = t0 + first * dt
+    best = np.where(found & (t <= reach), t, np.inf).min(axis=0)
 
     # An origin touching a blocked cell (or off the map) reads 0.
     x0 = gx[:, 0, 0]
@@ -255,36 +275,46 @@ def _polygon_hits(
     """Range (m) to the first obstacle-polygon edge along each ray (inf: none in range)."""
     n, r = c.shape
     best = np.full((n, r), np.inf)
-    boxes = shapely.box(p[:, 0] - max_range, p[:, 1] - max_range, p[:, 0] + max_range, p[:, 1] + max_range)
-    robot, edge = geo._edge_tree.query(boxes)
-    a = geo.edge_a[edge]
-    e = geo.edge_b[edge] - a
-    fx = a[:, 0] - p[robot, 0]
-    fy = a[:, 1] - p[robot, 1]
+    # Candidate edges: those whose bounding box is within max_range of the origin.
+    lo, hi = geo._edge_lo, geo._edge_hi
+    near = (
+        (hi[None, :, 0] >= p[:, 0, None] - max_range) & (lo[None, :, 0] <= p[:, 0, None] + max_range)
+        & (hi[None, :, 1] >= p[:, 1, None] - max_range) & (lo[None, :, 1] <= p[:, 1, None] + max_range)
+    )
+    robot, edge = np.nonzero(near)
+    e = geo._edge_vec[edge]
+    f = geo.edge_a[edge] - p[robot]
     # Back faces: an origin on the material's side of an edge's line cannot first meet it
     # (an origin inside a polygon reads 0 below).
-    front = e[:, 1] * fx - e[:, 0] * fy <= 0.0
-    robot, e, fx, fy = robot[front], e[front], fx[front, None], fy[front, None]
-    if len(robot):
-        ex = e[:, 0, None]
-        ey = e[:, 1, None]
+    keep = np.flatnonzero(e[:, 1] * f[:, 0] - e[:, 0] * f[:, 1] <= 0.0)
+    if len(keep):
+        robot, edge, e, f = robot[keep], edge[keep], e[keep], f[keep]
+        ex, ey, fx, fy = e[:, 0:1], e[:, 1:2], f[:, 0:1], f[:, 1:2]
         dx = c[robot]
         dy = s[robot]
-        # p + t d = a + u e:  t = (f x e) / (d x e),  u = (f x d) / (d x e).
-        den = dx * ey - dy * ex
-        ok = den != 0.0
-        safe = np.where(ok, den, 1.0)
-        t = (fx * ey - fy * ex) / safe
-        u = (fx * dy - fy * dx) / safe
-        # Touching an end counts: u within TOUCH_EPS metres of [0, 1].
-        slack = TOUCH_EPS / np.maximum(np.hypot(ex, ey), TOUCH_EPS)
-        hit = ok & (t >= 0.0) & (u >= -slack) & (u <= 1.0 + slack)
+        # p + t d = a + u e:  t = (f x e) / (d x e),  u = (f x d) / (d x e); a ray parallel
+        # to an edge gives inf or NaN, which no comparison below accepts.
+        with np.errstate(divide="ignore", invalid="ignore"):
+            inv = 1.0 / (dx * ey - dy * ex)
+            t = (fx * ey - fy * ex) * inv
+            u = (fx * dy - fy * dx) * inv
+            # Touching an end counts: u within TOUCH_EPS metres of [0, 1].
+            hit = (t >= 0.0) & (np.abs(u - 0.5) <= geo._edge_half_slack[edge, None])
         t = np.where(hit, t, np.inf)
-        # Per robot, the nearest over its candidate edges (pairs come grouped by robot).
-        starts = np.flatnonzero(np.r_[True, robot[1:] != robot[:-1]])
-        best[robot[starts]] = np.minimum.reduceat(t, starts, axis=0)
-    inside = geo._poly_tree.query(shapely.points(p), predicate="intersects")[0]
-    best[inside] = 0.0
+        if n == 1:
+            best[0] = t.min(axis=0)
+        else:  # per robot, the nearest over its candidate edges (pairs grouped by robot)
+            starts = np.flatnonzero(np.r_[True, robot[1:] != robot[:-1]])
+            best[robot[starts]] = np.minimum.reduceat(t, starts, axis=0)
+    # An origin inside (or on) a polygon reads 0; only one in a cell a polygon touches can be.
+    hp, wp = geo.shape
+    inv = 1.0 / geo.resolution
+    col = np.clip(np.floor((p[:, 0] - geo.origin[0]) * inv) + 1, 0, wp - 1).astype(np.intp)
+    row = np.clip(np.floor((p[:, 1] - geo.origin[1]) * inv) + 1, 0, hp - 1).astype(np.intp)
+    check = np.flatnonzero(geo._near_polygon[row * wp + col])
+    if len(check):
+        inside = geo._poly_tree.query(shapely.points(p[check]), predicate="intersects")[0]
+        best[check[inside]] = 0.0
     return best
 
 
