@@ -342,3 +342,14 @@ def test_multi_robot_discrete_steps_run_together_and_stop_ends_each():
     assert moved[1] == 0.0
     assert moved[0] == pytest.approx(0.25, abs=1e-9) or infos["robot_0"]["collisions"] == 1
     assert infos["robot_0"]["episode_length"] == 1
+
+
+def test_a_holonomic_robot_moves_and_turns_the_same():
+    env = open_env(robot={"drive": "holonomic"})
+    env.reset(seed=0)
+    env.step(TURN_LEFT)
+    env.step(MOVE_FORWARD)
+    (x, y, _), quat = env.backend.get_pose(0)
+    yaw = math.radians(10)
+    assert float(quat2yaw(quat)) == pytest.approx(yaw, abs=1e-12)
+    assert (x, y) == (pytest.approx(1.0 + 0.25 * math.cos(yaw), abs=1e-9), pytest.approx(2.0 + 0.25 * math.sin(yaw), abs=1e-9))
