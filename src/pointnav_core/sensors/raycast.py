@@ -19,11 +19,17 @@ How the grid part is exact without a loop per ray
 Every cell a ray traverses after its first is entered through a vertical grid line (an
 *x-crossing*) or a horizontal one (a *y-crossing*). The ray's k-th x-crossing is at the k-th
 grid line ahead of it, at ``t = (X_k - x) / cos``; the cell it enters there is the next
-column at the row under the crossing point. So the first blocked cell along a ray is
-``min`` over both families of the crossings that enter a blocked cell, computed for all
-crossings of all rays of all robots at once, as ``(robots, rays, crossings)`` arrays: a
-fixed number of numpy operations, no loop over rays or traversal steps. A crossing within
-:data:`TOUCH_EPS` of a grid vertex tests every cell that touches the vertex.
+column at the row under the crossing point. The crossings of a family form an arithmetic
+sequence in ``t``, so the first blocked one is an ``argmax`` along it, and the range is
+the nearer of the two families' first hits. All crossings of all rays of all robots are
+computed at once, as ``(family, robots, rays, crossings)`` arrays: a fixed number of numpy
+operations, no loop over rays or traversal steps (Amanatides and Woo's traversal visits
+the same cells one step at a time). A crossing within :data:`TOUCH_EPS` of a grid line
+tests the cells on both sides of it.
+
+Polygons are tested edge by edge: the edges whose bounding box is within ``max_range``,
+less those the origin sees from their back (the material's side), against every ray at
+once.
 """
 
 from __future__ import annotations
