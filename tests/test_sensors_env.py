@@ -353,3 +353,21 @@ def test_a_holonomic_robot_moves_and_turns_the_same():
     yaw = math.radians(10)
     assert float(quat2yaw(quat)) == pytest.approx(yaw, abs=1e-12)
     assert (x, y) == (pytest.approx(1.0 + 0.25 * math.cos(yaw), abs=1e-9), pytest.approx(2.0 + 0.25 * math.sin(yaw), abs=1e-9))
+
+
+def test_robots_cast_together_exactly_as_each_alone():
+    from pointnav_core.sensors import cast_rays, other_robot_discs
+
+    penv = parallel.parallel_env(scene=small_scene(), n_robots=4, sensors={"scan": {"n_rays": 24, "min_range": 0.0}})
+    observations, _ = penv.reset(seed=5)
+    scans = [penv.tasks[i].observation_terms["scan"] for i in range(4)]
+    assert scans[0]._share is not None and all(s._share is scans[0]._share for s in scans)
+    for _ in range(4):
+        observations, *_ = penv.step({a: np.array([0.8, -0.4], np.float32) for a in penv.agents})
+    for i, agent in enumerate(penv.agents):
+        (x, y, _), quat = penv.backend.get_pose(i)
+        alone = cast_rays(
+            scans[i]._geometry, [(x, y)], [float(quat2yaw(quat))], scans[i].angles, 5.6,
+            discs=other_robot_discs(penv, i, 0),
+        )[0]
+        np.testing.assert_allclose(observations[agent]["scan"], alone.astype(np.float32), rtol=0, atol=1e-6)

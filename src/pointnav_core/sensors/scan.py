@@ -51,7 +51,7 @@ from pointnav_core.observations import Frame, ObservationTerm
 from pointnav_core.sensors._checks import check_int, check_number
 from pointnav_core.sensors.raycast import ScanGeometry, cast_rays
 
-__all__ = ["RangeScan", "scan_angles", "other_robot_discs"]
+__all__ = ["RangeScan", "ScanShare", "scan_angles", "other_robot_discs"]
 
 _TWO_PI = 2.0 * math.pi
 
@@ -151,6 +151,7 @@ class RangeScan(ObservationTerm):
         angles.flags.writeable = False
         self.angles = angles
         self._geometry: ScanGeometry | None = None
+        self._share: ScanShare | None = None
         self._rng: np.random.Generator | None = None
         #: ``(x, y, yaw, readings)`` of the last observation (renderers draw it), or None.
         self.last_scan: tuple[float, float, float, NDArray[np.float64]] | None = None
@@ -167,6 +168,22 @@ class RangeScan(ObservationTerm):
 
     def reset(self, task: Any, env: Any) -> None:
         tmap = env.scene.floors[task.floor]
+        self._share = None
+        tasks = getattr(env, "tasks", None)
+        if isinstance(tasks, (list, tuple)) and len(tasks) > 1:
+            # Robots of a multi-robot env with alike scans cast together (ScanShare).
+            for other in tasks:
+                peer = other.observation_terms.get(self.name)
+                share = getattr(peer, "_share", None)
+                if peer is not self and share is not None and share.fits(self, tmap):
+                    self._share = share
+                    break
+            else:
+                if self._geometry is None or self._geometry.tmap is not tmap:
+                    self._geometry = ScanGeometry(tmap)
+                self._share = ScanShare(self._geometry, self.angles, self.max_range)
+            self._share.members[task.robot_idn] = self
+            self._geometry = self._share.geometry
         if self._geometry is None or self._geometry.tmap is not tmap:
             self._geometry = ScanGeometry(tmap)
         if self.noise_std > 0.0 or self.dropout > 0.0:
@@ -176,6 +193,10 @@ class RangeScan(ObservationTerm):
     def ranges(self, frame: Frame) -> NDArray[np.float64]:
         """The exact ranges (m) at the frame's pose, before the min-range rule and noise."""
         task, env = frame.task, frame.env
+        if self._share is not None and self._share.geometry.tmap is env.scene.floors[task.floor]:
+            shared = self._share.ranges(env, task.robot_idn, task.floor)
+            if shared is not None:
+                return shared
         if self._geometry is None or self._geometry.tmap is not env.scene.floors[task.floor]:
             self._geometry = ScanGeometry(env.scene.floors[task.floor])
         discs = other_robot_discs(env, task.robot_idn, task.floor)
@@ -209,6 +230,85 @@ class RangeScan(ObservationTerm):
             f"RangeScan(n_rays={self.n_rays}, fov={self.fov:g}, min_range={self.min_range:g}, "
             f"max_range={self.max_range:g}, noise_std={self.noise_std:g}, dropout={self.dropout:g})"
         )
+
+
+def _heading(qx: float, qy: float, qz: float, qw: float) -> float:
+    """Yaw (rad) of a quaternion, as :class:`~pointnav_core.observations.Frame` derives it."""
+    q2 = 2.0 / (qx * qx + qy * qy + qz * qz + qw * qw)
+    r00 = 1.0 - q2 * (qy * qy + qz * qz)
+    r10 = q2 * (qx * qy + qz * qw)
+    h = math.hypot(r00, r10)
+    if h > 1e-12:
+        return math.atan2(r10 / h, r00 / h)
+    r01 = q2 * (qx * qy - qz * qw)
+    r11 = 1.0 - q2 * (qx * qx + qz * qz)
+    return math.atan2(-r01, r11)
+
+
+class ScanShare:
+    """The scans of several robots of one env, cast together (one batch per step).
+
+    The range scans of a multi-robot env's robots that are alike (same floor, bearings and
+    ``max_range``) share one of these: the first robot observed after the world moved
+    casts the rays of every robot still in an episode in one :func:`cast_rays` call, and
+    the others read their row. The rows are the exact ranges; each scan then applies its
+    own ``min_range`` rule, noise and dropout. The batch is keyed by every present robot's
+    pose, so it is recast whenever any robot moved.
+    """
+
+    def __init__(self, geometry: ScanGeometry, angles: NDArray[np.float64], max_range: float) -> None:
+        self.geometry = geometry
+        self.angles = angles
+        self.max_range = max_range
+        self.members: dict[int, RangeScan] = {}
+        self._key: tuple[Any, ...] | None = None
+        self._rows: dict[int, NDArray[np.float64]] = {}
+
+    def fits(self, scan: RangeScan, tmap: Any) -> bool:
+        """Whether ``scan`` on floor ``tmap`` casts the same rays as this batch."""
+        return (
+            self.geometry.tmap is tmap
+            and self.max_range == scan.max_range
+            and np.array_equal(self.angles, scan.angles)
+        )
+
+    def ranges(self, env: Any, idn: int, floor: int) -> NDArray[np.float64] | None:
+        """Robot ``idn``'s exact ranges (a fresh array), or None if it is not in the batch."""
+        from pointnav_core.lifecycle import TaskState
+
+        backend = env.backend
+        pose = float_twin(backend, "get_pose_floats")
+        robots = []
+        for j, spec in enumerate(env.robots):
+            if not backend.is_present(j) or backend.get_robot_floor(j) != floor:
+                continue
+            if pose is not None:
+                x, y, _, qx, qy, qz, qw = pose(j)
+            else:
+                position, quat = backend.get_pose(j)
+                x, y = position[:2].tolist()
+                qx, qy, qz, qw = quat.tolist()
+            robots.append((j, x, y, qx, qy, qz, qw, spec.radius))
+        key = tuple(robots)
+        if key != self._key:
+            tasks = env.tasks
+            cast = [
+                k for k, r in enumerate(robots)
+                if r[0] == idn or (r[0] in self.members and tasks[r[0]].state is TaskState.RUNNING)
+            ]
+            rows = cast_rays(
+                self.geometry,
+                [robots[k][1:3] for k in cast],
+                [_heading(*robots[k][3:7]) for k in cast],
+                self.angles,
+                self.max_range,
+                discs=[(r[1], r[2], r[7]) for r in robots],
+                own_disc=cast,
+            )
+            self._rows = {robots[k][0]: row for k, row in zip(cast, rows)}
+            self._key = key
+        row = self._rows.get(idn)
+        return None if row is None else row.copy()
 
 
 def _spawn(rng: np.random.Generator) -> np.random.Generator:
