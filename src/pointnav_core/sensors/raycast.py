@@ -226,9 +226,9 @@ def _grid_hits(
 
     # Both families at once, stacked on a leading axis: [0] x-crossings (vertical lines),
     # [1] y-crossings (horizontal lines); "along" is the coordinate the lines cut.
-    d_along = np.stack([c, s])
-    d_across = np.stack([s, c])
-    g2 = np.stack([gx[:, :, 0], gy[:, :, 0]])  # (2, N, 1)
+    cs = np.concatenate([c[None], s[None]])
+    d_along, d_across = cs, cs[::-1]
+    g2 = np.concatenate([gx[None, :, :, 0], gy[None, :, :, 0]])  # (2, N, 1)
     g_along, g_across = g2, g2[::-1]
     # Per ray: the first grid line ahead (floor(g)+1 going up, ceil(g)-1 going down), the
     # step between lines (+-1), the ray length per line (dt) and the first crossing's t and
@@ -257,20 +257,20 @@ def _grid_hits(
     hit = lookup[idx.astype(np.intp)]
     # Crossings come in order along the ray: the first blocked one is the nearest.
     first = hit.argmax(axis=3)
-    found = np.take_along_axis(hit, first[..., None], axis=3)[..., 0]
+    found = hit.any(axis=3)
     t = t0 + first * dt
     best = np.where(found & (t <= reach), t, np.inf).min(axis=0)
 
-    # An origin touching a blocked cell (or off the map) reads 0.
+    # An origin touching a blocked cell (or off the map) reads 0: test the cells within
+    # TOUCH_EPS of it (one, or two or four on a grid line or vertex).
     x0 = gx[:, 0, 0]
     y0 = gy[:, 0, 0]
-    cols = np.clip(np.floor(np.stack([x0 - e, x0 + e])), 0, wp - 1).astype(np.intp)
-    rows = np.clip(np.floor(np.stack([y0 - e, y0 + e])), 0, hp - 1).astype(np.intp)
+    c0 = np.minimum(np.maximum(np.floor(x0 - e), 0), wp - 1).astype(np.intp)
+    c1 = np.minimum(np.maximum(np.floor(x0 + e), 0), wp - 1).astype(np.intp)
+    r0 = np.minimum(np.maximum(np.floor(y0 - e), 0), hp - 1).astype(np.intp) * wp
+    r1 = np.minimum(np.maximum(np.floor(y0 + e), 0), hp - 1).astype(np.intp) * wp
     flat = lookup[:plane]
-    touching = (
-        flat[rows[0] * wp + cols[0]] | flat[rows[0] * wp + cols[1]]
-        | flat[rows[1] * wp + cols[0]] | flat[rows[1] * wp + cols[1]]
-    )
+    touching = flat[r0 + c0] | flat[r0 + c1] | flat[r1 + c0] | flat[r1 + c1]
     best[touching] = 0.0
     return best * res
 
@@ -296,8 +296,9 @@ def _polygon_hits(
     if len(keep):
         robot, edge, e, f = robot[keep], edge[keep], e[keep], f[keep]
         ex, ey, fx, fy = e[:, 0:1], e[:, 1:2], f[:, 0:1], f[:, 1:2]
-        dx = c[robot]
-        dy = s[robot]
+        # One robot: its rays broadcast against every edge; several: one row per pair.
+        dx = c if n == 1 else c[robot]
+        dy = s if n == 1 else s[robot]
         # p + t d = a + u e:  t = (f x e) / (d x e),  u = (f x d) / (d x e); a ray parallel
         # to an edge gives inf or NaN, which no comparison below accepts.
         with np.errstate(divide="ignore", invalid="ignore"):
@@ -315,8 +316,8 @@ def _polygon_hits(
     # An origin inside (or on) a polygon reads 0; only one in a cell a polygon touches can be.
     hp, wp = geo.shape
     inv = 1.0 / geo.resolution
-    col = np.clip(np.floor((p[:, 0] - geo.origin[0]) * inv) + 1, 0, wp - 1).astype(np.intp)
-    row = np.clip(np.floor((p[:, 1] - geo.origin[1]) * inv) + 1, 0, hp - 1).astype(np.intp)
+    col = np.minimum(np.maximum(np.floor((p[:, 0] - geo.origin[0]) * inv) + 1, 0), wp - 1).astype(np.intp)
+    row = np.minimum(np.maximum(np.floor((p[:, 1] - geo.origin[1]) * inv) + 1, 0), hp - 1).astype(np.intp)
     check = np.flatnonzero(geo._near_polygon[row * wp + col])
     if len(check):
         inside = geo._poly_tree.query(shapely.points(p[check]), predicate="intersects")[0]
