@@ -301,7 +301,7 @@ def _polygon_hits(
         dy = s if n == 1 else s[robot]
         # p + t d = a + u e:  t = (f x e) / (d x e),  u = (f x d) / (d x e); a ray parallel
         # to an edge gives inf or NaN, which no comparison below accepts.
-        with np.errstate(divide="ignore", invalid="ignore"):
+        with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
             inv = 1.0 / (dx * ey - dy * ex)
             t = (fx * ey - fy * ex) * inv
             u = (fx * dy - fy * dx) * inv
