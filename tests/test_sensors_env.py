@@ -371,3 +371,30 @@ def test_robots_cast_together_exactly_as_each_alone():
             discs=other_robot_discs(penv, i, 0),
         )[0]
         np.testing.assert_allclose(observations[agent]["scan"], alone.astype(np.float32), rtol=0, atol=1e-6)
+
+
+def test_render_draws_the_scan_rays_and_hits():
+    from pointnav_core.render import SCAN_HIT_COLOR, SCAN_RAY_COLOR, ScanGlyph
+
+    def colours(frame, colour):
+        return int((frame == np.array(colour, np.uint8)).all(axis=2).sum())
+
+    env = PointNavEnv(scene=small_scene(), sensors={"scan": {"n_rays": 16}}, render_mode="rgb_array")
+    env.reset(seed=0)
+    frame = env.render()
+    assert colours(frame, SCAN_RAY_COLOR) > 0 and colours(frame, SCAN_HIT_COLOR) > 0
+    plain = PointNavEnv(scene=small_scene(), render_mode="rgb_array")
+    plain.reset(seed=0)
+    frame = plain.render()
+    assert colours(frame, SCAN_RAY_COLOR) == 0 and colours(frame, SCAN_HIT_COLOR) == 0
+    with pytest.raises(ValueError, match="ends_xy"):
+        ScanGlyph(origin_xy=(0.0, 0.0), ends_xy=[[1.0, 0.0]], hit=[True, False])
+
+
+def test_multi_robot_render_draws_every_robots_scan():
+    from pointnav_core.render import SCAN_HIT_COLOR
+
+    penv = parallel.parallel_env(scene=small_scene(), n_robots=2, sensors={"scan": {"n_rays": 8}}, render_mode="rgb_array")
+    penv.reset(seed=0)
+    frame = penv.render()
+    assert (frame == np.array(SCAN_HIT_COLOR, np.uint8)).all(axis=2).sum() > 0
