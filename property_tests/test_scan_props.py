@@ -20,7 +20,7 @@ from pointnav_core.maps import TraversableMap
 from pointnav_core.sensors import ScanGeometry, cast_rays, scan_angles
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
-from scan_reference import assert_within, blocked_shapes, reference_ranges  # noqa: E402
+from scan_reference import assert_within, blocked_shapes, reference_ranges
 
 
 @st.composite
@@ -78,7 +78,7 @@ def test_ranges_agree_with_the_shapely_reference(case):
 
 @given(scan_scenes())
 def test_a_ray_never_passes_a_blocked_cell(case):
-    tmap, polygons, origin, yaw, angles, max_range, discs = case
+    tmap, polygons, origin, yaw, angles, max_range, _ = case
     got = cast_rays(ScanGeometry(tmap), [origin], [yaw], angles, max_range)[0]
     blocked = shapely.union_all(blocked_shapes(tmap.codes, tmap.resolution, tmap.origin, polygons))
     px, py = origin

@@ -9,6 +9,7 @@ import gymnasium as gym
 import numpy as np
 import pytest
 from gymnasium.utils.env_checker import check_env
+from scan_reference import assert_within, blocked_shapes, reference_ranges
 from stable_baselines3.common.env_checker import check_env as sb3_check_env
 
 import pointnav_core  # noqa: F401  (registers the envs)
@@ -18,7 +19,6 @@ from pointnav_core.env import PointNavEnv
 from pointnav_core.maps import FREE, OBSTACLE, VOID
 from pointnav_core.scenes import Scene
 from pointnav_core.transforms import quat2yaw
-from scan_reference import assert_within, blocked_shapes, reference_ranges
 
 with warnings.catch_warnings():
     warnings.filterwarnings("ignore", message="The old environment creation API", category=DeprecationWarning)
@@ -125,7 +125,7 @@ def test_sensors_with_a_ready_task_or_twice_raise():
 @pytest.mark.parametrize("sensors", SENSOR_CONFIGS)
 @pytest.mark.parametrize("action_space", ["continuous", "discrete"])
 def test_checkers_pass_with_each_sensor(sensors, action_space):
-    kwargs = dict(scene=small_scene(), sensors=sensors, action_space=action_space)
+    kwargs = {"scene": small_scene(), "sensors": sensors, "action_space": action_space}
     check_env(PointNavEnv(**kwargs), skip_render_check=True)
     sb3_check_env(PointNavEnv(**kwargs), warn=False)
     sb3_check_env(PointNavEnv(flatten_obs=True, **kwargs), warn=False)
@@ -250,7 +250,7 @@ def test_discrete_actions_move_exactly_a_quarter_metre_and_ten_degrees():
     assert env.action_space == gym.spaces.Discrete(4)
     env.reset(seed=0)
     _, _, _, _, info = env.step(MOVE_FORWARD)
-    (x, y, _), quat = env.backend.get_pose(0)
+    (x, y, _), _ = env.backend.get_pose(0)
     assert (x, y) == (pytest.approx(1.25, abs=1e-12), pytest.approx(2.0, abs=1e-12))
     assert info["path_length"] == pytest.approx(0.25, abs=1e-12) and info["episode_length"] == 1
     env.step(TURN_LEFT)
@@ -264,13 +264,13 @@ def test_with_stop_success_needs_stop_within_tolerance():
     env = open_env()
     env.reset(seed=0)
     for _ in range(3):  # 1.75 m: within 0.3 m of the goal, but no STOP yet
-        *_, terminated, truncated, info = env.step(MOVE_FORWARD)
+        *_, terminated, _, info = env.step(MOVE_FORWARD)
     assert not terminated and not info["success"]
-    _, reward, terminated, truncated, info = env.step(STOP)
+    *_, terminated, _, info = env.step(STOP)
     assert terminated and info["success"] and info["reward_breakdown"]["pointgoal"] == 10.0
     assert info["spl"] > 0.0
     env.reset(seed=0)
-    _, reward, terminated, truncated, info = env.step(STOP)  # 1 m away: ends, failed
+    *_, terminated, _, info = env.step(STOP)  # 1 m away: ends, failed
     assert terminated and not info["success"] and info["reward_breakdown"]["pointgoal"] == 0.0
 
 
@@ -335,7 +335,7 @@ def test_multi_robot_discrete_steps_run_together_and_stop_ends_each():
     penv = parallel.parallel_env(scene=small_scene(), n_robots=2, action_space="discrete")
     penv.reset(seed=0)
     before = [penv.backend.get_pose(i)[0] for i in range(2)]
-    observations, rewards, terminations, truncations, infos = penv.step({"robot_0": MOVE_FORWARD, "robot_1": STOP})
+    _, _, terminations, _, infos = penv.step({"robot_0": MOVE_FORWARD, "robot_1": STOP})
     assert terminations["robot_1"] and not infos["robot_1"]["success"]  # STOP far from the goal
     assert "robot_1" not in penv.agents
     moved = [float(np.hypot(*(penv.backend.get_pose(i)[0] - before[i])[:2])) for i in range(2)]

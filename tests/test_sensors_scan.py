@@ -7,11 +7,11 @@ import math
 import numpy as np
 import pytest
 import shapely
+from scan_reference import assert_within, blocked_shapes, reference_ranges
 
 from pointnav_core import scenes
 from pointnav_core.maps import TraversableMap
 from pointnav_core.sensors import RangeScan, ScanGeometry, cast_rays, scan_angles
-from scan_reference import assert_within, blocked_shapes, reference_ranges
 
 FULL = scan_angles(64, 2 * math.pi)
 

@@ -63,9 +63,9 @@ from pointnav_core.terminations import TerminationCondition
 __all__ = [
     "ACTION_SPACES",
     "MOVE_FORWARD",
+    "STOP",
     "TURN_LEFT",
     "TURN_RIGHT",
-    "STOP",
     "DiscreteActions",
     "StopAtGoal",
     "check_discrete_action",

@@ -50,7 +50,7 @@ from pointnav_core.observations import Frame, ObservationTerm
 from pointnav_core.sensors._checks import check_int, check_number
 from pointnav_core.sensors.scan import other_robot_discs
 
-__all__ = ["LOCAL_FREE", "LOCAL_BLOCKED", "LOCAL_VOID", "LOCAL_ROBOT", "LOCAL_MAP_DTYPES", "LocalMap"]
+__all__ = ["LOCAL_BLOCKED", "LOCAL_FREE", "LOCAL_MAP_DTYPES", "LOCAL_ROBOT", "LOCAL_VOID", "LocalMap"]
 
 LOCAL_FREE = 0
 LOCAL_BLOCKED = 1

@@ -51,7 +51,7 @@ from pointnav_core.observations import Frame, ObservationTerm
 from pointnav_core.sensors._checks import check_int, check_number
 from pointnav_core.sensors.raycast import ScanGeometry, cast_rays
 
-__all__ = ["RangeScan", "ScanShare", "scan_angles", "other_robot_discs"]
+__all__ = ["RangeScan", "ScanShare", "other_robot_discs", "scan_angles"]
 
 _TWO_PI = 2.0 * math.pi
 
