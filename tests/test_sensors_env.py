@@ -77,7 +77,7 @@ def test_gymnasium_make_and_the_parallel_env_take_sensors():
     env = gym.make("pointnav_core/PointNav-v0", scene=small_scene(), sensors={"scan": {"n_rays": 7}})
     obs, _ = env.reset(seed=0)
     assert obs["scan"].shape == (7,)
-    penv = parallel.parallel_env(scene=small_scene(), n_robots=2, sensors={"local_map": {"cells": 3}})
+    penv = parallel.parallel_env(flatten_obs=False, scene=small_scene(), n_robots=2, sensors={"local_map": {"cells": 3}})
     observations, _ = penv.reset(seed=0)
     assert observations["robot_1"]["local_map"].shape == (3, 3)
     # Every robot's task has its own sensor objects.
@@ -129,12 +129,12 @@ def test_checkers_pass_with_each_sensor(sensors, action_space):
     check_env(PointNavEnv(**kwargs), skip_render_check=True)
     sb3_check_env(PointNavEnv(**kwargs), warn=False)
     sb3_check_env(PointNavEnv(flatten_obs=True, **kwargs), warn=False)
-    parallel_api_test(parallel.parallel_env(n_robots=2, **kwargs), num_cycles=100)
+    parallel_api_test(parallel.parallel_env(flatten_obs=False, n_robots=2, **kwargs), num_cycles=100)
     api_test(parallel_to_aec(parallel.parallel_env(n_robots=2, flatten_obs=True, **kwargs)), num_cycles=100)
     with warnings.catch_warnings():
         for message in DICT_OBS_ADVICE:
             warnings.filterwarnings("ignore", message=message, category=UserWarning)
-        api_test(parallel_to_aec(parallel.parallel_env(n_robots=2, **kwargs)), num_cycles=100)
+        api_test(parallel_to_aec(parallel.parallel_env(flatten_obs=False, n_robots=2, **kwargs)), num_cycles=100)
 
 
 # ------------------------------------------------------------------------------ readings
@@ -143,7 +143,7 @@ def test_checkers_pass_with_each_sensor(sensors, action_space):
 def test_the_scan_of_each_robot_agrees_with_the_reference_and_sees_the_others():
     scene = small_scene()
     tmap = scene.floors[0]
-    penv = parallel.parallel_env(scene=scene, n_robots=3, sensors={"scan": {"n_rays": 32, "min_range": 0.0}})
+    penv = parallel.parallel_env(flatten_obs=False, scene=scene, n_robots=3, sensors={"scan": {"n_rays": 32, "min_range": 0.0}})
     observations, _ = penv.reset(seed=4)
     for _ in range(3):
         observations, *_ = penv.step({a: np.array([1.0, 0.5], np.float32) for a in penv.agents})
@@ -207,7 +207,7 @@ def test_local_map_is_egocentric_heading_up_from_first_principles():
     scene = small_scene()
     tmap = scene.floors[0]
     cells, size = 9, 1.8
-    penv = parallel.parallel_env(scene=scene, n_robots=2, sensors={"local_map": {"size": size, "cells": cells}})
+    penv = parallel.parallel_env(flatten_obs=False, scene=scene, n_robots=2, sensors={"local_map": {"size": size, "cells": cells}})
     observations, _ = penv.reset(seed=3)
     (x, y, _), quat = penv.backend.get_pose(0)
     (ox, oy, _), _ = penv.backend.get_pose(1)
@@ -358,7 +358,7 @@ def test_a_holonomic_robot_moves_and_turns_the_same():
 def test_robots_cast_together_exactly_as_each_alone():
     from pointnav_core.sensors import cast_rays, other_robot_discs
 
-    penv = parallel.parallel_env(scene=small_scene(), n_robots=4, sensors={"scan": {"n_rays": 24, "min_range": 0.0}})
+    penv = parallel.parallel_env(flatten_obs=False, scene=small_scene(), n_robots=4, sensors={"scan": {"n_rays": 24, "min_range": 0.0}})
     observations, _ = penv.reset(seed=5)
     scans = [penv.tasks[i].observation_terms["scan"] for i in range(4)]
     assert scans[0]._share is not None and all(s._share is scans[0]._share for s in scans)
