@@ -1,5 +1,12 @@
 """Env speed: PointNav-v0 steps per second beside CartPole-v1, and the cost of a reset.
 
+With sensors: the same env with a 64-ray 360 deg range scan (5.6 m), and with a 32 x 32
+local map, in the same run; the extra time per step each sensor adds is printed in
+microseconds, against a plain env measured beside them ("l2, warm"). The envs share one
+scene and meet the same episodes, so the first PointNav row builds each episode's goal
+field while the later rows find it in the scene's cache: compare the sensor rows with the
+"warm" row, not with the first.
+
 Both envs are built with ``gymnasium.make`` and stepped with random actions in the same
 run, interleaved over several rounds (the best round of each is kept, since the machines
 are shared); resets happen whenever an episode ends and are counted in the step rate.
@@ -49,15 +56,29 @@ def main() -> None:
         "PointNav-v0 (geodesic)": gym.make(
             "pointnav_core/PointNav-v0", scene=scene, task={"reward_type": "geodesic"}
         ),
+        "PointNav-v0 (l2, warm)": gym.make("pointnav_core/PointNav-v0", scene=scene),
+        "PointNav-v0 (l2) + scan 64": gym.make(
+            "pointnav_core/PointNav-v0", scene=scene, sensors={"scan": {"n_rays": 64}}
+        ),
+        "PointNav-v0 (l2) + map 32x32": gym.make(
+            "pointnav_core/PointNav-v0", scene=scene, sensors={"local_map": {"cells": 32}}
+        ),
     }
     best = {name: 0.0 for name in envs}
     for r in range(args.rounds):
         for name, env in envs.items():
             best[name] = max(best[name], steps_per_second(env, args.steps, seed=r))
     cart = best["CartPole-v1"]
-    print(f"{'env':28} {'steps/s':>10} {'x CartPole':>11}")
+    print(f"{'env':32} {'steps/s':>10} {'x CartPole':>11}")
     for name, rate in best.items():
-        print(f"{name:28} {rate:10.0f} {rate / cart:11.3f}")
+        print(f"{name:32} {rate:10.0f} {rate / cart:11.3f}")
+    plain = best["PointNav-v0 (l2, warm)"]
+    for name in ("PointNav-v0 (l2) + scan 64", "PointNav-v0 (l2) + map 32x32"):
+        added = (1.0 / best[name] - 1.0 / plain) * 1e6
+        print(
+            f"{name[len('PointNav-v0 (l2) + '):]} adds {added:.1f} us per step; "
+            f"x CartPole {plain / cart:.3f} without it, {best[name] / cart:.3f} with it"
+        )
 
     env = gym.make(
         "pointnav_core/PointNav-v0",

@@ -14,6 +14,9 @@ each task's own 500-step timeout), so MultiPointNav is also measured with
 in MPE2. The ratio line compares each default configuration. The last two lines split
 MultiPointNav's time: stepping alone (episodes that never end) and the median reset.
 
+With sensors: 8 robots, each with a 64-ray 360 deg range scan (5.6 m; every robot sees the
+others' discs), beside 8 robots without one and MPE2 with ``N=8``.
+
 If ``mpe2`` is not installed (``pip install mpe2``, or ``pip install pointnav-core[bench]``),
 the old ``pettingzoo.mpe`` module is tried; PettingZoo >= 1.25 no longer ships it.
 
@@ -85,6 +88,11 @@ def main() -> None:
         "MultiPointNav-v0 (3 robots, max_cycles=25)": parallel.parallel_env(
             n_robots=3, max_cycles=25
         ),
+        f"{mpe_name} (N=8, max_cycles=25)": mpe_parallel_env(N=8, continuous_actions=True),
+        "MultiPointNav-v0 (8 robots, max_cycles=500)": parallel.parallel_env(n_robots=8),
+        "MultiPointNav-v0 (8 robots, 64-ray scans)": parallel.parallel_env(
+            n_robots=8, sensors={"scan": {"n_rays": 64}}
+        ),
     }
     best = dict.fromkeys(envs, 0.0)
     for r in range(args.rounds):
@@ -97,6 +105,11 @@ def main() -> None:
         print(f"{name:48} {best[name]:14.0f} {best[name] / base:8.2f}")
     ratio = best[names[1]] / base
     print(f"ratio (defaults, MultiPointNav / {mpe_name}): {ratio:.2f} (target >= 3)")
+    mpe8 = best[names[3]]
+    for name in names[4:]:
+        print(f"ratio ({name} / {mpe_name} N=8): {best[name] / mpe8:.2f}")
+    added = (1.0 / best[names[5]] - 1.0 / best[names[4]]) * 1e6 * 8
+    print(f"64-ray scans add {added:.0f} us per env step for 8 robots ({added / 8:.0f} us per robot)")
 
     # Where MultiPointNav's time goes: steps alone (no episode ends), and one reset.
     steady = parallel.parallel_env(

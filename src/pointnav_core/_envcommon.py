@@ -30,10 +30,12 @@ __all__ = [
     "ROBOT_KEYS",
     "TASK_KEYS",
     "action_space",
+    "add_sensors",
     "check_action",
     "check_action_frequency",
     "derives_path_range",
     "fit_path_range",
+    "step_length",
     "make_robot",
     "make_task",
     "observation_space",
@@ -136,6 +138,44 @@ def make_task(
     )
 
 
+def add_sensors(task: Any, sensors: Mapping[str, Any] | None, name: str = "task") -> Any:
+    """``task`` (None, a dict of task arguments, a task, or a list of them) with the terms
+    of ``sensors`` (:func:`pointnav_core.sensors.make_sensors`) added to its
+    ``observation_terms``, before any given there.
+
+    Raises
+    ------
+    ValueError
+        For a bad ``sensors`` config (naming the sensor or key), for a ready
+        ``PointNavigationTask`` (its terms are fixed: pass a dict), or for a sensor the task
+        dict already has among its ``observation_terms``.
+    """
+    from pointnav_core.sensors import make_sensors
+
+    terms = make_sensors(sensors)
+    if not terms:
+        return task
+    if isinstance(task, (list, tuple)):
+        return [add_sensors(entry, sensors, f"{name}[{i}]") for i, entry in enumerate(task)]
+    if task is None:
+        task = {}
+    if isinstance(task, PointNavigationTask):
+        raise ValueError(
+            f"sensors cannot be added to a ready PointNavigationTask ({name}): pass the task "
+            f"as a dict of its arguments, or put the sensor terms in its observation_terms"
+        )
+    if not isinstance(task, Mapping):
+        return task  # make_task names the problem
+    given = list(task.get("observation_terms") or ())
+    names = {getattr(term, "name", None) for term in given}
+    for term in terms:
+        if term.name in names:
+            raise ValueError(
+                f"sensors turns on {term.name!r}, which {name}['observation_terms'] already has"
+            )
+    return {**task, "observation_terms": [*terms, *given]}
+
+
 def check_world_args(
     scene: Any, flatten_obs: Any, action_frequency: Any, backend_kwargs: Any
 ) -> tuple[scenes.Scene, float]:
@@ -188,30 +228,37 @@ def derives_path_range(task: Any) -> bool:
     return task is None or (isinstance(task, Mapping) and "path_range" not in task)
 
 
+def step_length(robot: RobotSpec, frequency: float, discrete: Any = None) -> float:
+    """The farthest (m) one env step takes the robot: a control step at full speed, or a
+    discrete action's ``forward_step``."""
+    if discrete is not None:
+        return float(discrete.forward_step)
+    return robot.max_linear_velocity / frequency
+
+
 def fit_path_range(
     task: PointNavigationTask,
-    robot: RobotSpec,
-    frequency: float,
+    length: float,
     steps: int,
     derive: bool,
     name: str = "task",
 ) -> None:
-    """Make the task's episodes drivable within ``steps`` control steps.
+    """Make the task's episodes drivable within ``steps`` env steps of at most ``length`` m.
 
-    The robot's reach is ``steps * robot.max_linear_velocity / frequency`` metres. With
+    The robot's reach is ``steps * length`` metres (:func:`step_length`). With
     ``derive``, the task's ``path_range`` becomes ``(MIN_GEODESIC, max(SOLVABLE_SHARE *
     reach, MIN_GEODESIC + 1))``; otherwise a ``path_range`` whose maximum exceeds the reach
     gets a ``UserWarning``, as some of its episodes cannot be finished in time.
     """
-    reach = steps * robot.max_linear_velocity / frequency
+    reach = steps * length
     if derive:
         task.path_range = (MIN_GEODESIC, max(SOLVABLE_SHARE * reach, MIN_GEODESIC + 1.0))
         return
     if task.path_range is not None and task.path_range[1] > reach:
         warnings.warn(
             f"{name}: path_range={task.path_range} allows start-goal geodesics up to "
-            f"{task.path_range[1]:g} m, but in max_steps={steps} steps at "
-            f"{frequency:g} Hz the robot drives at most {reach:.4g} m, so some episodes "
+            f"{task.path_range[1]:g} m, but in max_steps={steps} steps of at most "
+            f"{length:g} m the robot drives at most {reach:.4g} m, so some episodes "
             f"cannot be solved; lower path_range or raise max_steps",
             UserWarning,
             stacklevel=_stacklevel_outside_package(),
@@ -230,9 +277,47 @@ def _stacklevel_outside_package() -> int:
 _SKIPPED = frozenset({"pointnav_core", "gymnasium", "pettingzoo"})
 
 
-def action_space(robot: RobotSpec) -> spaces.Box:
-    """The robot's action space: a float32 ``Box`` in ``[-1, 1]`` of shape ``(action_dim,)``."""
+def action_space(robot: RobotSpec, discrete: Any = None) -> spaces.Space[Any]:
+    """The robot's action space: a float32 ``Box`` in ``[-1, 1]`` of shape ``(action_dim,)``,
+    or ``Discrete(discrete.n)`` for a :class:`~pointnav_core.actions.DiscreteActions` set."""
+    if discrete is not None:
+        return spaces.Discrete(discrete.n)
     return spaces.Box(-1.0, 1.0, (robot.action_dim,), dtype=np.float32)
+
+
+def add_stop(task: Any, discrete: Any, name: str = "task") -> Any:
+    """``task`` (as for :func:`add_sensors`) with the STOP success rule
+    (:class:`~pointnav_core.actions.StopAtGoal` as its ``pointgoal`` condition) when the
+    discrete action set ``discrete`` has STOP; unchanged otherwise.
+
+    Raises
+    ------
+    ValueError
+        For a ready ``PointNavigationTask`` whose ``pointgoal`` condition is not a
+        ``StopAtGoal``.
+    """
+    from pointnav_core.actions import StopAtGoal
+
+    if discrete is None or not discrete.stop:
+        return task
+    if isinstance(task, (list, tuple)):
+        return [add_stop(entry, discrete, f"{name}[{i}]") for i, entry in enumerate(task)]
+    if task is None:
+        task = {}
+    if isinstance(task, PointNavigationTask):
+        if not isinstance(task.termination_conditions.get("pointgoal"), StopAtGoal):
+            raise ValueError(
+                f"{name} is a ready PointNavigationTask without the STOP rule: with discrete "
+                f"actions and STOP, pass the task as a dict, or give it "
+                f"termination_conditions=[StopAtGoal()]"
+            )
+        return task
+    if not isinstance(task, Mapping):
+        return task  # make_task names the problem
+    given = list(task.get("termination_conditions") or ())
+    if any(getattr(c, "name", None) == "pointgoal" for c in given):
+        return task  # the caller chose its own success rule
+    return {**task, "termination_conditions": [*given, StopAtGoal()]}
 
 
 def observation_space(task: PointNavigationTask, flatten: bool) -> spaces.Space[Any]:
@@ -247,9 +332,11 @@ def observation_space(task: PointNavigationTask, flatten: bool) -> spaces.Space[
         return spaces.Box(low, high, dtype=np.float32)
     # An OrderedDict keeps the terms' order (a plain dict would be sorted by key), so that
     # FlattenObservation gives the flat order too.
-    return spaces.Dict(
-        OrderedDict((name, spaces.Box(low[s], high[s], dtype=np.float32)) for name, s in layout.slices.items())
-    )
+    boxes = OrderedDict()
+    for name in layout.slices:
+        lo, hi, shape, dtype = layout.space_bounds(name, low, high)
+        boxes[name] = spaces.Box(lo, hi, shape, dtype=dtype)
+    return spaces.Dict(boxes)
 
 
 def check_action(

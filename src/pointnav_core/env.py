@@ -10,6 +10,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from pointnav_core import _envcommon, scenes
+from pointnav_core.actions import check_discrete_action, make_discrete_actions
 from pointnav_core.backend import Backend, RobotSpec, make_backend
 from pointnav_core.maps import BoundedCache
 from pointnav_core.task import PointNavigationTask
@@ -43,6 +44,21 @@ class PointNavEnv(gym.Env[Any, np.ndarray]):
     A holonomic robot (`RobotSpec(drive="holonomic")`) takes `(vx, vy, w)`, shape `(3,)`.
     Values outside `[-1, 1]` are clipped; NaN, infinity or a wrong shape raise `ValueError`.
 
+    With `action_space="discrete"` the action is an integer, `Discrete(4)` (Habitat's
+    actions; `pointnav_core.actions`):
+
+    | Num | Action         | What the robot does                                          |
+    |-----|----------------|--------------------------------------------------------------|
+    | 0   | `MOVE_FORWARD` | drives `forward_step` m straight ahead (default 0.25)        |
+    | 1   | `TURN_LEFT`    | turns in place by `turn_angle` rad (default 10 deg)          |
+    | 2   | `TURN_RIGHT`   | turns in place by `-turn_angle`                              |
+    | 3   | `STOP`         | stands still one control step and ends the episode           |
+
+    Each runs as velocity commands over the fewest control steps the robot's top speeds
+    allow (MOVE_FORWARD: 5 steps at 0.5 m/s; a turn: 2 steps), and ends early at a contact,
+    which counts as one collision. `discrete_actions={"forward_step": ..., "turn_angle":
+    ..., "stop": False}` changes them; without STOP the action space is `Discrete(3)`.
+
     ## Observation Space
 
     A `Dict` of one `float32` array per observation term (`pointnav_core.observations`;
@@ -66,6 +82,22 @@ class PointNavEnv(gym.Env[Any, np.ndarray]):
     left). Values are clipped to these bounds (only a fall's vertical speed reaches them).
     With `flatten_obs=True` the observation is OmniGibson's flat `low_dim` vector: a `Box`
     of shape `(8,)` holding the numbers in the order of the table.
+
+    Sensors (`pointnav_core.sensors`), turned on with `sensors={"scan": {...},
+    "local_map": {...}}`, add their own keys after these, in this order whatever the order
+    of the dict, and their values follow the eight above in the flat vector:
+
+    | Key         | Shape, dtype                   | Values                                  |
+    |-------------|--------------------------------|-----------------------------------------|
+    | `scan`      | `(n_rays,)` float32            | range (m) along each ray, in `[0, max_range]`, in the order of `RangeScan.angles` (rad, robot frame, 0 ahead, positive left) |
+    | `local_map` | `(cells, cells)` uint8 or float32 | the floor around the robot, heading up: 0 free, 1 obstacle, 2 void or off the map, 3 another robot; row by row in the flat vector |
+
+    `scan` arguments: `n_rays` (64), `fov` (2 pi rad), `min_range` (0.05 m: a nearer
+    return reads `max_range`), `max_range` (5.6 m), `noise_std` (0 m) and `dropout` (0).
+    Rays see the floor's obstacle cells and polygons, the map's edge and the other robots;
+    VOID (a hole) is not seen. Noise is seeded by `reset(seed=...)`. `local_map` arguments:
+    `size` (5.0 m), `cells` (32), `dtype` (`"uint8"`). A bad sensor name, key or value
+    raises `ValueError` naming it.
 
     ## Rewards
 
@@ -98,7 +130,8 @@ class PointNavEnv(gym.Env[Any, np.ndarray]):
     The episode ends if any one of the following occurs:
 
     1. Termination (success): the robot's centre is closer than `goal_tolerance` (0.5 m)
-       to the goal (xy).
+       to the goal (xy). With discrete actions and STOP: the robot calls STOP; a success
+       within `goal_tolerance`, a failure otherwise (Habitat's rule).
     2. Termination: the robot has touched something on more than `max_collisions` (500)
        steps.
     3. Termination: the robot fell: its height dropped more than `fall_height` (0.03 m)
@@ -138,10 +171,25 @@ class PointNavEnv(gym.Env[Any, np.ndarray]):
     | `render_mode`      | **str** or `None`            | `None`            | `"rgb_array"` or None|
     | `flatten_obs`      | **bool**                     | `False`           | flat `(8,)` `low_dim`|
     | `action_frequency` | **float**                    | `10.0`            | 0.1 to 10,000 Hz     |
+    | `sensors`          | **dict** or `None`           | `None`            | `scan`, `local_map`  |
+    | `action_space`     | **str**                      | `"continuous"`    | or `"discrete"`      |
+    | `discrete_actions` | **dict** or `None`           | `None`            | step, angle, STOP    |
+
+    ```python
+    >>> env = PointNavEnv(sensors={"scan": {"n_rays": 32}}, action_space="discrete")
+    >>> obs, info = env.reset(seed=0)
+    >>> obs["scan"].shape, env.action_space
+    ((32,), Discrete(4))
+    >>> obs, reward, terminated, truncated, info = env.step(0)  # MOVE_FORWARD
+    >>> round(info["path_length"], 6)
+    0.25
+
+    ```
 
     ## Version History
 
-    * v0: Initial version.
+    * v0: Initial version; range scan and local map sensors, and discrete actions with
+      STOP, added as options (the defaults are unchanged).
     """
 
     metadata = {"render_modes": ["rgb_array"], "render_fps": 10}
@@ -156,6 +204,9 @@ class PointNavEnv(gym.Env[Any, np.ndarray]):
         render_mode: str | None = None,
         flatten_obs: bool = False,
         action_frequency: float = 10.0,
+        sensors: Mapping[str, Any] | None = None,
+        action_space: str = "continuous",
+        discrete_actions: Mapping[str, Any] | None = None,
     ) -> None:
         if render_mode is not None and render_mode not in self.metadata["render_modes"]:
             raise ValueError(
@@ -167,6 +218,8 @@ class PointNavEnv(gym.Env[Any, np.ndarray]):
         )
         self.robot = _envcommon.make_robot(robot)
         self._derive_path_range = _envcommon.derives_path_range(task)
+        self.discrete_actions = make_discrete_actions(action_space, discrete_actions)
+        task = _envcommon.add_stop(_envcommon.add_sensors(task, sensors), self.discrete_actions)
         self.task = _envcommon.make_task(task)
         self.scene = scene
         self.robots = (self.robot,)
@@ -182,7 +235,11 @@ class PointNavEnv(gym.Env[Any, np.ndarray]):
         self._idn = self.task.robot_idn
 
         self._action_shape = (self.robot.action_dim,)
-        self.action_space = _envcommon.action_space(self.robot)
+        self.action_space = _envcommon.action_space(self.robot, self.discrete_actions)
+        self._plan = (
+            None if self.discrete_actions is None
+            else self.discrete_actions.commands(self.robot, frequency)
+        )
         self.observation_space = _envcommon.observation_space(self.task, self.flatten_obs)
 
     # ------------------------------------------------------------------ Gymnasium API
@@ -204,6 +261,8 @@ class PointNavEnv(gym.Env[Any, np.ndarray]):
     def step(self, action: Any) -> tuple[Any, float, bool, bool, dict[str, Any]]:
         """Apply ``action`` for one control step; see the class docstring for the rest."""
         self.task.check_step()  # before anything moves: an illegal step changes nothing
+        if self._plan is not None:
+            return self._step_discrete(action)
         action = self._check_action(action)
         self.backend.step({self._idn: action})
         reward, terminated, truncated, info = self.task.step(self, action)
@@ -243,8 +302,26 @@ class PointNavEnv(gym.Env[Any, np.ndarray]):
     # ------------------------------------------------------------------ helpers
     def _fit_path_range(self) -> None:
         _envcommon.fit_path_range(
-            self.task, self.robot, self.action_frequency, self.task.max_steps, self._derive_path_range
+            self.task,
+            _envcommon.step_length(self.robot, self.action_frequency, self.discrete_actions),
+            self.task.max_steps,
+            self._derive_path_range,
         )
+
+    def _step_discrete(self, action: Any) -> tuple[Any, float, bool, bool, dict[str, Any]]:
+        """One discrete action: its command for its control steps, ending at a contact
+        (:mod:`pointnav_core.actions`)."""
+        index = check_discrete_action(action, len(self._plan))  # type: ignore[arg-type]
+        command, steps = self._plan[index]  # type: ignore[index]
+        idn, backend = self._idn, self.backend
+        contact = False
+        for _ in range(steps):
+            backend.step({idn: command})
+            if backend.in_contact(idn):
+                contact = True
+                break
+        reward, terminated, truncated, info = self.task.step(self, index, contact=contact)
+        return self._get_obs(), reward, terminated, truncated, info
 
     def _check_action(self, action: Any) -> Any:
         return _envcommon.check_action(action, self._action_shape, self.robot.drive)

@@ -142,11 +142,23 @@ class ObservationTerm:
     doc_rows : tuple of (str, str, str)
         Per value: what it is (with its unit), its lower and its upper bound, as the env
         docs' observation table shows them (:func:`markdown_table`).
+    shape : tuple of int or None
+        Shape of the term's array in the ``Dict`` observation; None means ``(size,)``. The
+        flat observation holds its values row by row.
+    dtype : numpy.dtype
+        Dtype of the term's array in the ``Dict`` observation (float32 unless declared);
+        the flat observation is float32 throughout.
+    array_values : bool
+        Whether :meth:`values` returns a numpy array (sensors with many values) rather than
+        a sequence of floats; the layout then copies and clips it with numpy.
     """
 
     name: ClassVar[str] = "observation"
     size: ClassVar[int] = 0
     doc_rows: ClassVar[tuple[tuple[str, str, str], ...]] = ()
+    shape: tuple[int, ...] | None = None
+    dtype: np.dtype[Any] = np.dtype(np.float32)
+    array_values: ClassVar[bool] = False
 
     def bounds(self, task: Any, env: Any) -> tuple[Sequence[float], Sequence[float]]:
         """``(low, high)``, ``size`` finite floats each; called when the task meets ``env``."""
@@ -274,6 +286,16 @@ class ObservationLayout:
             start += term.size
         self.slices = slices
         self.size = start
+        # Terms whose values are arrays, or whose Dict entry is not a flat float32 vector,
+        # take the numpy paths of values() and split(); the built-in terms never do.
+        self._arrays = any(term.array_values for term in self.terms)
+        self._low_arr = np.array(self.low, dtype=np.float64)
+        self._high_arr = np.array(self.high, dtype=np.float64)
+        self._shaped = {
+            term.name: (self.slices[term.name], term.shape, np.dtype(term.dtype))
+            for term in self.terms
+            if term.shape is not None or np.dtype(term.dtype) != np.float32
+        }
 
     @classmethod
     def from_terms(cls, terms: Sequence[ObservationTerm], task: Any, env: Any) -> ObservationLayout:
@@ -296,16 +318,42 @@ class ObservationLayout:
             high += hi
         return cls(terms, low, high)
 
-    def values(self, frame: Frame) -> list[float]:
-        """Every term's values at this step, end to end, clipped to the bounds."""
+    def values(self, frame: Frame) -> list[float] | NDArray[np.float64]:
+        """Every term's values at this step, end to end, clipped to the bounds.
+
+        A list of floats; a float64 array when a term gives its values as an array.
+        """
+        if self._arrays:
+            flat = np.empty(self.size, dtype=np.float64)
+            for term in self.terms:
+                flat[self.slices[term.name]] = term.values(frame)
+            return np.clip(flat, self._low_arr, self._high_arr, out=flat)
         out: list[float] = []
         for term in self.terms:
             out += term.values(frame)
         return [lo if v < lo else hi if v > hi else v for v, lo, hi in zip(out, self.low, self.high)]
 
-    def split(self, flat: NDArray[np.float32]) -> dict[str, NDArray[np.float32]]:
-        """The ``Dict`` observation: one view of ``flat`` per term, in term order."""
-        return {name: flat[s] for name, s in self.slices.items()}
+    def split(self, flat: NDArray[np.float32]) -> dict[str, NDArray[Any]]:
+        """The ``Dict`` observation: one array per term, in term order.
+
+        Views of ``flat``, except for a term with a declared ``shape`` or ``dtype``, which
+        gets ``flat``'s values reshaped and cast (a fresh array).
+        """
+        out = {name: flat[s] for name, s in self.slices.items()}
+        for name, (s, shape, dtype) in self._shaped.items():
+            value = flat[s].astype(dtype)
+            out[name] = value.reshape(shape) if shape is not None else value
+        return out
+
+    def space_bounds(self, name: str, low: NDArray[np.float32], high: NDArray[np.float32]) -> tuple[Any, Any, tuple[int, ...], np.dtype[Any]]:
+        """``(low, high, shape, dtype)`` of term ``name``'s ``Box`` in the ``Dict`` space,
+        from the flat bounds ``low`` and ``high``."""
+        s = self.slices[name]
+        if name not in self._shaped:
+            return low[s], high[s], (s.stop - s.start,), np.dtype(np.float32)
+        _, shape, dtype = self._shaped[name]
+        shape = shape if shape is not None else (s.stop - s.start,)
+        return low[s].reshape(shape).astype(dtype), high[s].reshape(shape).astype(dtype), shape, dtype
 
 
 def markdown_table(terms: Sequence[ObservationTerm]) -> str:

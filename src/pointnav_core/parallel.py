@@ -2,15 +2,17 @@
 
 | Import             | `from pointnav_core import parallel`, then `parallel.parallel_env()` |
 |--------------------|----------------------------------------------------------------------|
-| Actions            | Continuous                                                           |
+| Actions            | Continuous; discrete with `action_space="discrete"`                  |
 | Parallel API       | Yes                                                                  |
 | Manual Control     | No                                                                   |
 | Agents             | `agents = ["robot_0", ..., "robot_<n_robots - 1>"]`                 |
 | Number of Agents   | `n_robots` (default 2)                                               |
-| Action Shape       | `(2,)` differential drive, `(3,)` holonomic                          |
-| Action Values      | `[-1, 1]`, float32                                                   |
-| Observation Shape  | `(8,)`; with `flatten_obs=False` a `Dict` of `xy_pos_to_goal (2,)`,  |
-|                    | `robot_lin_vel (3,)`, `robot_ang_vel (3,)`                           |
+| Action Shape       | `(2,)` differential drive, `(3,)` holonomic; `Discrete(4)`           |
+| Action Values      | `[-1, 1]`, float32; or MOVE_FORWARD, TURN_LEFT, TURN_RIGHT, STOP     |
+| Observation Shape  | `(8,)` (plus the sensors' values when on); with `flatten_obs=False`  |
+|                    | a `Dict` of `xy_pos_to_goal (2,)`, `robot_lin_vel (3,)`,             |
+|                    | `robot_ang_vel (3,)`, and `scan (n_rays,)`, `local_map (cells,       |
+|                    | cells)` when on                                                      |
 | Observation Values | bounded, float32 (as in `PointNavEnv`)                               |
 | State Shape        | `(8 * n_robots,)`                                                    |
 | State Values       | bounded, float32                                                     |
@@ -34,7 +36,7 @@ Arguments
 ---------
 ``parallel_env(scene=None, n_robots=2, robot=None, task=None, backend="kinematic",
 backend_kwargs=None, max_cycles=500, render_mode=None, flatten_obs=True, finished="park",
-action_frequency=10.0)``
+action_frequency=10.0, sensors=None, action_space="continuous", discrete_actions=None)``
 
 | Argument           | Type                        | Default           | Description            |
 |--------------------|-----------------------------|-------------------|------------------------|
@@ -53,6 +55,10 @@ action_frequency=10.0)``
 | `finished`         | `"park"` or `"remove"`      | `"park"`          | a finished robot stays,|
 |                    |                             |                   | or leaves the world    |
 | `action_frequency` | **float**                   | `10.0`            | 0.1 to 10,000 Hz       |
+| `sensors`          | **dict** or `None`          | `None`            | `scan`, `local_map` for|
+|                    |                             |                   | every robot            |
+| `action_space`     | **str**                     | `"continuous"`    | or `"discrete"`        |
+| `discrete_actions` | **dict** or `None`          | `None`            | step, angle, STOP      |
 
 ``task`` entries are :class:`~pointnav_core.task.PointNavigationTask` keyword arguments
 (a list may also hold ready tasks); the env sets ``robot_idn`` (an entry that gives one must
@@ -64,7 +70,13 @@ Per agent, the same as ``PointNavEnv`` for that robot: the action is ``(v, w)`` 
 ``(vx, vy, w)`` for a holonomic robot) in ``[-1, 1]``, scaled by the robot's maxima and held
 for one control step; the observation is the robot's own goal in its own frame and its own
 velocities (OmniGibson's flat 8-vector, or a ``Dict`` with ``flatten_obs=False``). Agents do
-not observe each other: :meth:`MultiPointNavEnv.state` is the global view.
+not observe each other's state: :meth:`MultiPointNavEnv.state` is the global view. With
+``sensors`` (as in ``PointNavEnv``: :mod:`pointnav_core.sensors`) every robot gets its own
+sensors: its range scan sees the other robots present on its floor as discs, and its
+local map marks them. With ``action_space="discrete"`` every agent acts with an integer
+(:mod:`pointnav_core.actions`); the robots' commands run together, each for its own
+action's control steps (a robot whose action is shorter, or ended at a contact, stands
+still meanwhile), and the env step counts once.
 ``observation_space(agent)`` and ``action_space(agent)`` return the same object every call.
 
 State
@@ -171,6 +183,7 @@ from pettingzoo import AECEnv, ParallelEnv
 from pettingzoo.utils.conversions import parallel_to_aec, parallel_to_aec_wrapper
 
 from pointnav_core import _envcommon, scenes
+from pointnav_core.actions import check_discrete_action, make_discrete_actions
 from pointnav_core.backend import Backend, RobotSpec, make_backend
 from pointnav_core.maps import BoundedCache
 from pointnav_core.task import PointNavigationTask, TaskStateError
@@ -337,6 +350,9 @@ class MultiPointNavEnv(ParallelEnv[str, Any, np.ndarray]):
         flatten_obs: bool = True,
         finished: str = "park",
         action_frequency: float = 10.0,
+        sensors: Mapping[str, Any] | None = None,
+        action_space: str = "continuous",
+        discrete_actions: Mapping[str, Any] | None = None,
     ) -> None:
         if render_mode is not None and render_mode not in (*self.metadata["render_modes"], "human"):
             raise ValueError(
@@ -352,6 +368,8 @@ class MultiPointNavEnv(ParallelEnv[str, Any, np.ndarray]):
         )
         self.robots = _make_robots(robot, n)
         derive = _derived_path_ranges(task, n)
+        self.discrete_actions = make_discrete_actions(action_space, discrete_actions)
+        task = _envcommon.add_stop(_envcommon.add_sensors(task, sensors), self.discrete_actions)
         tasks = _make_tasks(task, n)
 
         self.scene = scene
@@ -363,7 +381,8 @@ class MultiPointNavEnv(ParallelEnv[str, Any, np.ndarray]):
         # A robot has min(its task's max_steps, max_cycles) steps to reach its goal.
         for i, (t, rb) in enumerate(zip(tasks, self.robots)):
             steps = min(t.max_steps, self.max_cycles)
-            _envcommon.fit_path_range(t, rb, frequency, steps, derive[i], name=f"task[{i}]")
+            length = _envcommon.step_length(rb, frequency, self.discrete_actions)
+            _envcommon.fit_path_range(t, length, steps, derive[i], name=f"task[{i}]")
         self.backend = make_backend(backend, **dict(backend_kwargs or {}))
         self.backend.load(scene, self.robots, frequency)
         for i, t in enumerate(tasks):
@@ -382,9 +401,14 @@ class MultiPointNavEnv(ParallelEnv[str, Any, np.ndarray]):
         self.agents: list[str] = []
         self._index = {agent: i for i, agent in enumerate(self.possible_agents)}
         self.action_spaces = {
-            agent: _envcommon.action_space(rb)
+            agent: _envcommon.action_space(rb, self.discrete_actions)
             for agent, rb in zip(self.possible_agents, self.robots)
         }
+        # Per robot, each discrete action's command and control steps (None: continuous).
+        self._plans = (
+            None if self.discrete_actions is None
+            else [self.discrete_actions.commands(rb, frequency) for rb in self.robots]
+        )
         self.observation_spaces = {
             agent: _envcommon.observation_space(t, self.flatten_obs)
             for agent, t in zip(self.possible_agents, tasks)
@@ -584,7 +608,7 @@ class MultiPointNavEnv(ParallelEnv[str, Any, np.ndarray]):
         if len(actions) != len(agents):
             self._bad_keys(actions)
         # Check every action before anything moves: a rejected step changes nothing.
-        slots, check = self._slots, _envcommon.check_action
+        slots, check, plans = self._slots, _envcommon.check_action, self._plans
         commands: dict[int, np.ndarray] = {}
         todo = []
         for agent in agents:
@@ -599,7 +623,10 @@ class MultiPointNavEnv(ParallelEnv[str, Any, np.ndarray]):
                     f"in env.agents must act"
                 )
             try:
-                action = check(action, shape, drive)
+                if plans is None:
+                    action = check(action, shape, drive)
+                else:
+                    action = check_discrete_action(action, len(plans[i]))
             except ValueError as err:
                 raise ValueError(f"{agent}: {err}") from None
             commands[i] = action
@@ -611,13 +638,20 @@ class MultiPointNavEnv(ParallelEnv[str, Any, np.ndarray]):
         truncations: dict[str, bool] = {}
         infos: dict[str, dict[str, Any]] = {}
         try:
-            self.backend.step(commands)
+            if plans is None:
+                self.backend.step(commands)
+                contacts = None
+            else:
+                contacts = self._step_discrete(commands)
             self._cycles += 1
             cut = self._cycles >= self.max_cycles
             alive = []
             ended = []
             for agent, i, action, task_step, observe in todo:
-                reward, terminated, truncated, info = task_step(self, action)
+                if contacts is None:
+                    reward, terminated, truncated, info = task_step(self, action)
+                else:
+                    reward, terminated, truncated, info = task_step(self, action, contact=contacts[i])
                 if cut:
                     truncated = True
                 observations[agent] = observe(self)
@@ -637,6 +671,20 @@ class MultiPointNavEnv(ParallelEnv[str, Any, np.ndarray]):
             self._void = True
             raise
         return observations, rewards, terminations, truncations, infos
+
+    def _step_discrete(self, actions: dict[int, int]) -> dict[int, bool]:
+        """Run each robot's discrete action for its control steps, all robots together; a
+        robot's action ends at its first contact. Returns whether each robot touched
+        something (:mod:`pointnav_core.actions`)."""
+        plans, backend = self._plans, self.backend
+        todo = {i: plans[i][a] for i, a in actions.items()}  # type: ignore[index]
+        contacts = dict.fromkeys(todo, False)
+        for k in range(max(steps for _, steps in todo.values())):
+            backend.step({i: cmd for i, (cmd, steps) in todo.items() if k < steps and not contacts[i]})
+            for i in todo:
+                if not contacts[i] and backend.in_contact(i):
+                    contacts[i] = True
+        return contacts
 
     def _finish(self, i: int) -> None:
         self._active[i] = False

@@ -75,6 +75,9 @@ __all__ = [
     "ROBOT_PALETTE",
     "RobotGlyph",
     "Marker",
+    "ScanGlyph",
+    "SCAN_RAY_COLOR",
+    "SCAN_HIT_COLOR",
     "TopDownRenderer",
     "MARKER_COLORS",
     "DEFAULT_PIXELS_PER_METER",
@@ -97,6 +100,11 @@ WAYPOINT_COLOR: RGB = (30, 170, 60)
 
 MARKER_COLORS: Mapping[str, RGB] = {"start": START_COLOR, "goal": GOAL_COLOR, "waypoint": WAYPOINT_COLOR}
 """Marker colour by :attr:`~pointnav_core.markers.VisualMarker.kind`."""
+
+SCAN_RAY_COLOR: RGB = (250, 200, 140)
+"""Range scan rays (light orange), one-pixel lines from the robot's centre to each reading."""
+SCAN_HIT_COLOR: RGB = (200, 0, 200)
+"""Range scan hits (magenta), a 3 x 3 pixel dot where a reading below ``max_range`` ends."""
 
 DEFAULT_PIXELS_PER_METER = 20.0
 """Scale of :func:`render_env` when neither it nor the environment names one: a 20 m house
@@ -278,6 +286,44 @@ class Marker:
         object.__setattr__(self, "alpha", _check_number(self.alpha, "alpha", "", low=0.0, high=1.0))
 
 
+@dataclass(frozen=True, kw_only=True)
+class ScanGlyph:
+    """A range scan to draw: a line per ray, and a dot where a ray hit something.
+
+    Parameters
+    ----------
+    origin_xy : (float, float)
+        World position (m) the rays start from (the robot's centre).
+    ends_xy : array_like, shape (R, 2)
+        World position (m) where each ray's reading ends.
+    hit : array_like of bool, shape (R,)
+        Whether each reading is a return (below ``max_range``); those get a dot.
+
+    Examples
+    --------
+    >>> g = ScanGlyph(origin_xy=(0.0, 0.0), ends_xy=[[1.0, 0.0]], hit=[True])
+    >>> g.ends_xy.shape, g.hit.tolist()
+    ((1, 2), [True])
+    """
+
+    origin_xy: tuple[float, float]
+    ends_xy: NDArray[np.float64]
+    hit: NDArray[np.bool_]
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "origin_xy", _check_xy(self.origin_xy, "origin_xy"))
+        ends = np.array(self.ends_xy, dtype=np.float64).reshape(-1, 2)
+        hit = np.array(self.hit, dtype=bool).reshape(-1)
+        if len(hit) != len(ends) or not np.isfinite(ends).all():
+            raise ValueError(
+                f"ends_xy must be finite (R, 2) points and hit R flags, got shapes {ends.shape} and {hit.shape}"
+            )
+        ends.flags.writeable = False
+        hit.flags.writeable = False
+        object.__setattr__(self, "ends_xy", ends)
+        object.__setattr__(self, "hit", hit)
+
+
 class TopDownRenderer:
     """Draw frames of one floor seen from above, with robots and markers.
 
@@ -410,11 +456,15 @@ class TopDownRenderer:
         out[..., 1] = (self._ymax - xy[..., 1]) * self.scale[1]
         return out
 
-    def draw(self, robots: Sequence[RobotGlyph], markers: Sequence[Marker] = ()) -> NDArray[np.uint8]:
-        """Draw one frame: the floor, then ``markers`` blended in order, then ``robots``.
+    def draw(
+        self, robots: Sequence[RobotGlyph], markers: Sequence[Marker] = (), scans: Sequence[ScanGlyph] = ()
+    ) -> NDArray[np.uint8]:
+        """Draw one frame: the floor, then ``markers`` blended in order, then ``scans``, then ``robots``.
 
         Parameters
         ----------
+        scans : sequence of ScanGlyph, default ()
+            Range scans: rays in :data:`SCAN_RAY_COLOR`, hits in :data:`SCAN_HIT_COLOR`.
         robots : sequence of RobotGlyph
             Robots in index order (the index picks the palette colour of a robot without
             one). Later robots are drawn over earlier ones.
@@ -442,6 +492,10 @@ class TopDownRenderer:
             below = patch[mask].astype(np.float32)
             color = np.asarray(marker.color, dtype=np.float32)
             patch[mask] = (below + marker.alpha * (color - below) + 0.5).astype(np.uint8)
+        for k, scan in enumerate(scans):
+            if not isinstance(scan, ScanGlyph):
+                raise TypeError(f"scans[{k}] must be a ScanGlyph, got {type(scan).__name__}")
+            self._draw_scan(image, scan)
         for k, robot in enumerate(robots):
             if not isinstance(robot, RobotGlyph):
                 raise TypeError(f"robots[{k}] must be a RobotGlyph, got {type(robot).__name__}")
@@ -462,6 +516,25 @@ class TopDownRenderer:
             half_width = max(_MIN_RADIUS_PX, 0.12 * radius_px)
             patch[mask & (along > _MIN_RADIUS_PX) & (across <= half_width)] = contrast_color(color)
         return image
+
+    def _draw_scan(self, image: NDArray[np.uint8], scan: ScanGlyph) -> None:
+        """Rays as one-pixel lines (sampled every half pixel), hits as 3 x 3 dots."""
+        if not len(scan.hit):
+            return
+        height, width = image.shape[:2]
+        start = self.world_to_pixel(scan.origin_xy)
+        ends = self.world_to_pixel(scan.ends_xy)
+        longest = float(np.abs(ends - start).max(initial=0.0))
+        t = np.linspace(0.0, 1.0, max(2, math.ceil(2.0 * longest) + 1))[None, :, None]
+        points = np.floor(start + t * (ends[:, None, :] - start)).reshape(-1, 2).astype(np.intp)
+        ok = (points[:, 0] >= 0) & (points[:, 0] < width) & (points[:, 1] >= 0) & (points[:, 1] < height)
+        image[points[ok, 1], points[ok, 0]] = SCAN_RAY_COLOR
+        dots = np.floor(ends[scan.hit]).astype(np.intp)
+        for dc in (-1, 0, 1):
+            for dr in (-1, 0, 1):
+                cols, rows = dots[:, 0] + dc, dots[:, 1] + dr
+                ok = (cols >= 0) & (cols < width) & (rows >= 0) & (rows < height)
+                image[rows[ok], cols[ok]] = SCAN_HIT_COLOR
 
     def __repr__(self) -> str:
         h, w = self.shape
@@ -612,7 +685,8 @@ def render_env(
         coloured ``ROBOT_PALETTE[idn % 8]``, with a heading tick (robots whose task has not
         had an episode yet are not placed, and not drawn); and over the floor, below the
         robots, the visible markers of every task on that floor, translucent, coloured by
-        kind (:data:`MARKER_COLORS`).
+        kind (:data:`MARKER_COLORS`). A task with a range scan (``"scan"`` observation
+        term) has its last readings drawn as rays from its robot, with a dot at each return.
 
     Notes
     -----
@@ -665,7 +739,19 @@ def render_env(
                 color=ROBOT_PALETTE[idn % len(ROBOT_PALETTE)],
             )
         )
-    return renderer.draw(robots, markers)
+    scans = []
+    for task in tasks:
+        term = task.observation_terms.get("scan")
+        last = getattr(term, "last_scan", None)
+        if task.floor != floor or last is None or task.state is TaskState.IDLE:
+            continue
+        if not backend.is_present(task.robot_idn):
+            continue
+        x, y, yaw, readings = last
+        bearings = yaw + term.angles
+        ends = np.stack([x + readings * np.cos(bearings), y + readings * np.sin(bearings)], axis=1)
+        scans.append(ScanGlyph(origin_xy=(x, y), ends_xy=ends, hit=readings < term.max_range))
+    return renderer.draw(robots, markers, scans)
 
 
 def record_episode(

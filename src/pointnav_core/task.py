@@ -846,7 +846,9 @@ class PointNavigationTask:
         # No geodesic here (e.g. over void): keep the last potential (see Notes).
         return geodesic if geodesic < math.inf else held
 
-    def step(self, env: TaskEnv, action: Any) -> tuple[float, bool, bool, dict[str, Any]]:
+    def step(
+        self, env: TaskEnv, action: Any, *, contact: bool | None = None
+    ) -> tuple[float, bool, bool, dict[str, Any]]:
         """Account for one control step the environment has just taken.
 
         In order: the path length grows by the planar distance moved; every termination
@@ -859,6 +861,10 @@ class PointNavigationTask:
             The environment, whose backend has already advanced one control step.
         action : array_like
             The action that was applied (passed on to conditions and rewards).
+        contact : bool, optional
+            Whether the robot touched something during the step; default: ask the backend
+            (``in_contact``). An env that runs one action as several control steps (discrete
+            actions) passes whether any of them touched.
 
         Returns
         -------
@@ -898,7 +904,7 @@ class PointNavigationTask:
             self._robot_xyz = (x, y, z)
             self._robot_quat = quat
             self._steps += 1
-            contact = bool(backend.in_contact(idn))
+            contact = bool(backend.in_contact(idn)) if contact is None else bool(contact)
             self._in_contact = contact
             if contact:
                 self._collisions += 1

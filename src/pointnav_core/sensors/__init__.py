@@ -1,0 +1,44 @@
+"""Sensors: observation terms that look at the world around a robot.
+
+=====================  ===============  ===================================================
+class                  name             what it observes
+=====================  ===============  ===================================================
+:class:`RangeScan`     ``"scan"``       ranges (m) along ``n_rays`` rays to the blocked set
+                                        and other robots: a planar lidar
+:class:`LocalMap`      ``"local_map"``  an egocentric grid of the floor, heading up
+=====================  ===============  ===================================================
+
+Both are :class:`~pointnav_core.observations.ObservationTerm` objects: name them in the
+envs' ``sensors`` argument (:func:`make_sensors`), or pass them in a task's
+``observation_terms``. The exact ray casting is :mod:`pointnav_core.sensors.raycast`.
+"""
+
+from pointnav_core.sensors.config import SENSOR_ORDER, SENSORS, make_sensors
+from pointnav_core.sensors.local_map import (
+    LOCAL_BLOCKED,
+    LOCAL_FREE,
+    LOCAL_MAP_DTYPES,
+    LOCAL_ROBOT,
+    LOCAL_VOID,
+    LocalMap,
+)
+from pointnav_core.sensors.raycast import TOUCH_EPS, ScanGeometry, cast_rays
+from pointnav_core.sensors.scan import RangeScan, other_robot_discs, scan_angles
+
+__all__ = [
+    "LOCAL_BLOCKED",
+    "LOCAL_FREE",
+    "LOCAL_MAP_DTYPES",
+    "LOCAL_ROBOT",
+    "LOCAL_VOID",
+    "SENSORS",
+    "SENSOR_ORDER",
+    "TOUCH_EPS",
+    "LocalMap",
+    "RangeScan",
+    "ScanGeometry",
+    "cast_rays",
+    "make_sensors",
+    "other_robot_discs",
+    "scan_angles",
+]

@@ -1,0 +1,319 @@
+"""The range scan: a planar lidar at the robot's centre, as an observation term.
+
+:class:`RangeScan` (observation key ``"scan"``) casts ``n_rays`` rays from the robot's
+centre, spread over ``fov`` around its heading, and reports for each the distance in metres
+to the first thing it meets: the floor's OBSTACLE cells, the map's edge, the floor plan's
+obstacle polygons (:class:`~pointnav_core.sensors.raycast.ScanGeometry`: the geometry the
+backends collide with) and the discs of the other robots present on the same floor. VOID
+(holes, stairwells) is not seen. Ranges are capped at ``max_range``.
+
+Readings
+--------
+In order, for each ray:
+
+1. the exact range ``d`` (:func:`~pointnav_core.sensors.raycast.cast_rays`), at most
+   ``max_range``;
+2. a return closer than ``min_range`` is no return: it reads ``max_range``, as a real lidar
+   reports nothing inside its minimum range (a robot standing clear of walls, with a radius
+   above ``min_range``, never sees one);
+3. with ``noise_std > 0``, Gaussian noise of that standard deviation (m) is added to the
+   readings below ``max_range``, and the result is clipped to ``[0, max_range]``;
+4. with ``dropout > 0``, each reading is lost (reads ``max_range``) with that probability.
+
+Noise and dropout draw from a generator the sensor spawns at every reset from the env's
+``np_random`` seed sequence, without drawing from the env's stream: the same seed gives the
+same noisy scans, and turning noise on changes no episode.
+
+Examples
+--------
+>>> scan = RangeScan(n_rays=4, fov=2 * np.pi, max_range=3.0)
+>>> scan.angles.round(4).tolist()  # robot frame: 0 ahead, positive to the left
+[-3.1416, -1.5708, 0.0, 1.5708]
+>>> RangeScan(n_rays=3, fov=np.pi).angles.round(4).tolist()  # both ends included
+[-1.5708, 0.0, 1.5708]
+>>> RangeScan(n_rays=0)
+Traceback (most recent call last):
+...
+ValueError: n_rays must be an integer >= 1, got 0
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from pointnav_core.backend import float_twin
+from pointnav_core.observations import Frame, ObservationTerm
+from pointnav_core.sensors._checks import check_int, check_number
+from pointnav_core.sensors.raycast import ScanGeometry, cast_rays
+
+__all__ = ["RangeScan", "ScanShare", "other_robot_discs", "scan_angles"]
+
+_TWO_PI = 2.0 * math.pi
+
+
+def scan_angles(n_rays: int, fov: float) -> NDArray[np.float64]:
+    """Ray bearings (rad, robot frame, 0 ahead, positive left), symmetric about ahead.
+
+    ``n_rays`` evenly over ``[-fov/2, fov/2]`` with both ends when ``fov < 2 pi``; over a
+    full turn the end that would repeat the start is left out. One ray points ahead.
+    """
+    if n_rays == 1:
+        return np.zeros(1)
+    if fov >= _TWO_PI - 1e-12:
+        return -math.pi + _TWO_PI * np.arange(n_rays) / n_rays
+    return np.linspace(-fov / 2.0, fov / 2.0, n_rays)
+
+
+def other_robot_discs(env: Any, idn: int, floor: int) -> NDArray[np.float64]:
+    """``(M, 3)`` discs ``(x, y, radius)`` of the robots other than ``idn`` present on ``floor``.
+
+    Robots are read through the backend protocol (``is_present``, ``get_robot_floor``,
+    ``get_pose``, or its float twin).
+    """
+    backend = env.backend
+    robots = env.robots
+    if len(robots) == 1:
+        return np.zeros((0, 3))
+    pose = float_twin(backend, "get_pose_floats")
+    out = []
+    for j, spec in enumerate(robots):
+        if j == idn or not backend.is_present(j) or backend.get_robot_floor(j) != floor:
+            continue
+        if pose is not None:
+            x, y = pose(j)[:2]
+        else:
+            x, y = backend.get_pose(j)[0][:2].tolist()
+        out.append((x, y, spec.radius))
+    return np.array(out, dtype=np.float64).reshape(-1, 3)
+
+
+class RangeScan(ObservationTerm):
+    """A planar range scan from the robot's centre (observation key ``"scan"``).
+
+    Parameters
+    ----------
+    n_rays : int
+        Number of rays, >= 1 (default 64).
+    fov : float
+        Field of view (rad) in ``(0, 2 pi]``, centred ahead (default ``2 pi``, a full turn).
+    min_range : float
+        Metres, >= 0 and below ``max_range``; a nearer return reads ``max_range``
+        (default 0.05, OmniGibson's ScanSensor).
+    max_range : float
+        Metres, > 0: the longest reading (default 5.6, iGibson's scan).
+    noise_std : float
+        Standard deviation (m) of Gaussian noise on the readings, >= 0 (default 0).
+    dropout : float
+        Probability in ``[0, 1]`` that a reading is lost and reads ``max_range`` (default 0).
+
+    Attributes
+    ----------
+    angles : ndarray of float64, shape (n_rays,)
+        Ray bearings (rad) in the robot frame: 0 ahead, positive to the left (read-only).
+    size : int
+        ``n_rays``: the scan's values in the flat observation, in the order of ``angles``.
+
+    Raises
+    ------
+    ValueError
+        Naming the parameter, for a value of the wrong type or out of range.
+    """
+
+    name = "scan"
+    array_values = True
+
+    def __init__(
+        self,
+        n_rays: int = 64,
+        fov: float = _TWO_PI,
+        min_range: float = 0.05,
+        max_range: float = 5.6,
+        noise_std: float = 0.0,
+        dropout: float = 0.0,
+    ) -> None:
+        self.n_rays = check_int("n_rays", n_rays, 1)
+        self.fov = check_number("fov", fov, low=0.0, strict_low=True, high=_TWO_PI, unit="rad")
+        self.max_range = check_number("max_range", max_range, low=0.0, strict_low=True, unit="m")
+        self.min_range = check_number("min_range", min_range, low=0.0, unit="m")
+        if self.min_range >= self.max_range:
+            raise ValueError(
+                f"min_range must be below max_range ({self.max_range} m), got {min_range!r}"
+            )
+        self.noise_std = check_number("noise_std", noise_std, low=0.0, unit="m")
+        self.dropout = check_number("dropout", dropout, low=0.0, high=1.0)
+        self.size = self.n_rays
+        angles = scan_angles(self.n_rays, self.fov)
+        angles.flags.writeable = False
+        self.angles = angles
+        self._geometry: ScanGeometry | None = None
+        self._share: ScanShare | None = None
+        self._rng: np.random.Generator | None = None
+        #: ``(x, y, yaw, readings)`` of the last observation (renderers draw it), or None.
+        self.last_scan: tuple[float, float, float, NDArray[np.float64]] | None = None
+
+    @property
+    def doc_rows(self) -> tuple[tuple[str, str, str], ...]:  # type: ignore[override]
+        return tuple(
+            (f"range along the ray at {math.degrees(a):+.1f} deg (m)", "0", f"{self.max_range:g}")
+            for a in self.angles.tolist()
+        )
+
+    def bounds(self, task: Any, env: Any) -> tuple[Sequence[float], Sequence[float]]:
+        return (0.0,) * self.n_rays, (self.max_range,) * self.n_rays
+
+    def reset(self, task: Any, env: Any) -> None:
+        tmap = env.scene.floors[task.floor]
+        self._share = None
+        tasks = getattr(env, "tasks", None)
+        if isinstance(tasks, (list, tuple)) and len(tasks) > 1:
+            # Robots of a multi-robot env with alike scans cast together (ScanShare).
+            for other in tasks:
+                peer = other.observation_terms.get(self.name)
+                share = getattr(peer, "_share", None)
+                if peer is not self and share is not None and share.fits(self, tmap):
+                    self._share = share
+                    break
+            else:
+                if self._geometry is None or self._geometry.tmap is not tmap:
+                    self._geometry = ScanGeometry(tmap)
+                self._share = ScanShare(self._geometry, self.angles, self.max_range)
+            self._share.members[task.robot_idn] = self
+            self._geometry = self._share.geometry
+        if self._geometry is None or self._geometry.tmap is not tmap:
+            self._geometry = ScanGeometry(tmap)
+        if self.noise_std > 0.0 or self.dropout > 0.0:
+            self._rng = _spawn(env.np_random)
+        self.last_scan = None
+
+    def ranges(self, frame: Frame) -> NDArray[np.float64]:
+        """The exact ranges (m) at the frame's pose, before the min-range rule and noise."""
+        task, env = frame.task, frame.env
+        if self._share is not None and self._share.geometry.tmap is env.scene.floors[task.floor]:
+            shared = self._share.ranges(env, task.robot_idn, task.floor)
+            if shared is not None:
+                return shared
+        if self._geometry is None or self._geometry.tmap is not env.scene.floors[task.floor]:
+            self._geometry = ScanGeometry(env.scene.floors[task.floor])
+        discs = other_robot_discs(env, task.robot_idn, task.floor)
+        yaw = math.atan2(frame.sin_yaw, frame.cos_yaw)
+        return cast_rays(
+            self._geometry, ((frame.x, frame.y),), (yaw,), self.angles, self.max_range,
+            discs=discs if len(discs) else None,
+        )[0]
+
+    def values(self, frame: Frame) -> NDArray[np.float64]:
+        d = self._readings(frame)
+        self.last_scan = (frame.x, frame.y, math.atan2(frame.sin_yaw, frame.cos_yaw), d)
+        return d
+
+    def _readings(self, frame: Frame) -> NDArray[np.float64]:
+        d = self.ranges(frame)
+        if self.min_range > 0.0:
+            d[d < self.min_range] = self.max_range
+        if self._rng is not None:
+            rng = self._rng
+            if self.noise_std > 0.0:
+                seen = d < self.max_range
+                d = np.where(seen, d + rng.normal(0.0, self.noise_std, d.shape), d)
+                np.clip(d, 0.0, self.max_range, out=d)
+            if self.dropout > 0.0:
+                d[rng.random(d.shape) < self.dropout] = self.max_range
+        return d
+
+    def __repr__(self) -> str:
+        return (
+            f"RangeScan(n_rays={self.n_rays}, fov={self.fov:g}, min_range={self.min_range:g}, "
+            f"max_range={self.max_range:g}, noise_std={self.noise_std:g}, dropout={self.dropout:g})"
+        )
+
+
+def _heading(qx: float, qy: float, qz: float, qw: float) -> float:
+    """Yaw (rad) of a quaternion, as :class:`~pointnav_core.observations.Frame` derives it."""
+    q2 = 2.0 / (qx * qx + qy * qy + qz * qz + qw * qw)
+    r00 = 1.0 - q2 * (qy * qy + qz * qz)
+    r10 = q2 * (qx * qy + qz * qw)
+    h = math.hypot(r00, r10)
+    if h > 1e-12:
+        return math.atan2(r10 / h, r00 / h)
+    r01 = q2 * (qx * qy - qz * qw)
+    r11 = 1.0 - q2 * (qx * qx + qz * qz)
+    return math.atan2(-r01, r11)
+
+
+class ScanShare:
+    """The scans of several robots of one env, cast together (one batch per step).
+
+    The range scans of a multi-robot env's robots that are alike (same floor, bearings and
+    ``max_range``) share one of these: the first robot observed after the world moved
+    casts the rays of every robot still in an episode in one :func:`cast_rays` call, and
+    the others read their row. The rows are the exact ranges; each scan then applies its
+    own ``min_range`` rule, noise and dropout. The batch is keyed by every present robot's
+    pose, so it is recast whenever any robot moved.
+    """
+
+    def __init__(self, geometry: ScanGeometry, angles: NDArray[np.float64], max_range: float) -> None:
+        self.geometry = geometry
+        self.angles = angles
+        self.max_range = max_range
+        self.members: dict[int, RangeScan] = {}
+        self._key: tuple[Any, ...] | None = None
+        self._rows: dict[int, NDArray[np.float64]] = {}
+
+    def fits(self, scan: RangeScan, tmap: Any) -> bool:
+        """Whether ``scan`` on floor ``tmap`` casts the same rays as this batch."""
+        return (
+            self.geometry.tmap is tmap
+            and self.max_range == scan.max_range
+            and np.array_equal(self.angles, scan.angles)
+        )
+
+    def ranges(self, env: Any, idn: int, floor: int) -> NDArray[np.float64] | None:
+        """Robot ``idn``'s exact ranges (a fresh array), or None if it is not in the batch."""
+        from pointnav_core.lifecycle import TaskState
+
+        backend = env.backend
+        pose = float_twin(backend, "get_pose_floats")
+        robots = []
+        for j, spec in enumerate(env.robots):
+            if not backend.is_present(j) or backend.get_robot_floor(j) != floor:
+                continue
+            if pose is not None:
+                x, y, _, qx, qy, qz, qw = pose(j)
+            else:
+                position, quat = backend.get_pose(j)
+                x, y = position[:2].tolist()
+                qx, qy, qz, qw = quat.tolist()
+            robots.append((j, x, y, qx, qy, qz, qw, spec.radius))
+        key = tuple(robots)
+        if key != self._key:
+            tasks = env.tasks
+            cast = [
+                k for k, r in enumerate(robots)
+                if r[0] == idn or (r[0] in self.members and tasks[r[0]].state is TaskState.RUNNING)
+            ]
+            rows = cast_rays(
+                self.geometry,
+                [robots[k][1:3] for k in cast],
+                [_heading(*robots[k][3:7]) for k in cast],
+                self.angles,
+                self.max_range,
+                discs=[(r[1], r[2], r[7]) for r in robots],
+                own_disc=cast,
+            )
+            self._rows = {robots[k][0]: row for k, row in zip(cast, rows)}
+            self._key = key
+        row = self._rows.get(idn)
+        return None if row is None else row.copy()
+
+
+def _spawn(rng: np.random.Generator) -> np.random.Generator:
+    """A child generator of ``rng``'s seed sequence; ``rng``'s own stream is not drawn from."""
+    seed_seq = getattr(rng.bit_generator, "seed_seq", None)
+    if isinstance(seed_seq, np.random.SeedSequence):
+        return np.random.default_rng(seed_seq.spawn(1)[0])
+    return np.random.default_rng(rng.integers(2**63))
