@@ -45,7 +45,7 @@ Examples
 >>> DiscreteActions(forward_step=0.0)
 Traceback (most recent call last):
 ...
-ValueError: forward_step must be a finite number > 0.0 (m), got 0.0
+ValueError: forward_step must be a finite number > 0 (m), got 0.0
 """
 
 from __future__ import annotations

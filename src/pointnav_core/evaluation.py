@@ -35,6 +35,7 @@ from typing import Any
 
 import numpy as np
 
+from pointnav_core import metrics
 from pointnav_core.datasets.format import EpisodeDataset, PointNavEpisode
 from pointnav_core.datasets.playback import episode_seed
 from pointnav_core.datasets.scene_sets import load_scene
@@ -235,6 +236,12 @@ class _Runner:
             obs, _, terminated, truncated, info = env.step(policy(obs))
             done = terminated or truncated
         ended = "+".join(name for name, r in info["termination_conditions"].items() if r["done"])
+        # The step infos read distances from the goal field's lookup table, whose cells settle
+        # as queries arrive, so a value can depend on what this worker played before (within
+        # the table's accuracy). The results use the exact distance at the end, which does not.
+        final = env.task.get_current_pos(env)
+        distance = env.scene.geodesic_distance(ep.floor, final, env.task.get_goal_pos(), robot=ep.robot_radius)
+        d0, length = float(info["geodesic_dist"]), float(info["path_length"])
         return EpisodeResult(
             episode_id=ep.episode_id,
             scene_id=ep.scene_id,
@@ -242,8 +249,8 @@ class _Runner:
             geodesic_distance=ep.geodesic_distance,
             success=bool(info["success"]),
             spl=float(info["spl"]),
-            soft_spl=float(info["soft_spl"]),
-            distance_to_goal=float(info["distance_to_goal"]),
+            soft_spl=metrics.soft_spl(distance, d0, length),
+            distance_to_goal=float(distance),
             path_length=float(info["path_length"]),
             collisions=int(info["collisions"]),
             steps=int(info["episode_length"]),

@@ -182,7 +182,7 @@ from numpy.typing import NDArray
 from pettingzoo import AECEnv, ParallelEnv
 from pettingzoo.utils.conversions import parallel_to_aec, parallel_to_aec_wrapper
 
-from pointnav_core import _envcommon, scenes
+from pointnav_core import _envcommon, scenes, validation
 from pointnav_core.actions import check_discrete_action, make_discrete_actions
 from pointnav_core.backend import Backend, RobotSpec, make_backend
 from pointnav_core.maps import BoundedCache
@@ -215,11 +215,7 @@ def _prefixed(name: str, err: ValueError) -> ValueError:
 
 
 def _check_int(name: str, value: Any, minimum: int) -> int:
-    if isinstance(value, (bool, np.bool_)) or not isinstance(value, (int, np.integer)):
-        raise ValueError(f"{name} must be an integer >= {minimum}, got {value!r}")
-    if value < minimum:
-        raise ValueError(f"{name} must be an integer >= {minimum}, got {value!r}")
-    return int(value)
+    return validation.integer(name, value, minimum=minimum)
 
 
 def _per_robot(value: Any, n: int, name: str) -> list[Any] | None:

@@ -62,6 +62,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from PIL import Image
 
+from pointnav_core import validation
 from pointnav_core.maps import FREE, OBSTACLE, VOID, BoundedCache, TraversableMap
 from pointnav_core.task import TaskState
 from pointnav_core.transforms import quat2yaw
@@ -161,11 +162,9 @@ def _check_xy(value: object, name: str) -> tuple[float, float]:
 def _check_number(
     value: object, name: str, unit: str, *, low: float, high: float = math.inf, strict: bool = False
 ) -> float:
-    """``value`` as a float in [low, high] (in (low, high] when ``strict``), else ValueError."""
-    try:
-        number = float(value)  # type: ignore[arg-type]
-    except (TypeError, ValueError):
-        number = math.nan
+    """``value`` as a float in [low, high] (in (low, high] when ``strict``), else ValueError;
+    a bool or a string is not a number (:func:`pointnav_core.validation.is_real`)."""
+    number = float(value) if validation.is_real(value) else math.nan  # type: ignore[arg-type]
     above = number > low if strict else number >= low
     if not (math.isfinite(number) and above and number <= high):
         if high < math.inf:

@@ -86,9 +86,8 @@ def real(
         ok = number <= maximum
     if not ok:
         kind = "a finite number" if finite else "a number"
-        raise ValueError(
-            f"{name} must be {kind}{_bound(minimum, strict, maximum)} ({unit}), got {value!r}"
-        )
+        suffix = f" ({unit})" if unit else ""
+        raise ValueError(f"{name} must be {kind}{_bound(minimum, strict, maximum)}{suffix}, got {value!r}")
     return number
 
 
