@@ -156,10 +156,8 @@ class MaxCollision(TerminationCondition):
     max_collisions : int
         Contact steps tolerated, >= 0.
 
-    Attributes
-    ----------
-    collisions : int
-        Contact steps so far in this episode.
+    The count is the task's own (``task.collisions``, which ``info["collisions"]``
+    reports), so the two never disagree.
     """
 
     name = "max_collision"
@@ -167,16 +165,9 @@ class MaxCollision(TerminationCondition):
     def __init__(self, max_collisions: int = 500) -> None:
         super().__init__()
         self.max_collisions = _check_count("max_collisions", max_collisions, minimum=0)
-        self.collisions = 0
-
-    def reset(self, task: Any, env: Any) -> None:
-        super().reset(task, env)
-        self.collisions = 0
 
     def step(self, task: Any, env: Any, action: Any) -> tuple[bool, bool]:
-        if task.in_contact:
-            self.collisions += 1
-        self.done = done = self.collisions > self.max_collisions
+        self.done = done = task.collisions > self.max_collisions
         return done, False
 
     def __repr__(self) -> str:
@@ -194,10 +185,8 @@ class Timeout(TerminationCondition):
     max_steps : int
         Steps per episode, >= 1.
 
-    Attributes
-    ----------
-    steps : int
-        Steps taken in this episode.
+    The count is the task's own (``task.episode_length``, which
+    ``info["episode_length"]`` reports), so the two never disagree.
     """
 
     name = "timeout"
@@ -206,15 +195,9 @@ class Timeout(TerminationCondition):
     def __init__(self, max_steps: int = 500) -> None:
         super().__init__()
         self.max_steps = _check_count("max_steps", max_steps, minimum=1)
-        self.steps = 0
-
-    def reset(self, task: Any, env: Any) -> None:
-        super().reset(task, env)
-        self.steps = 0
 
     def step(self, task: Any, env: Any, action: Any) -> tuple[bool, bool]:
-        self.steps += 1
-        self.done = done = self.steps >= self.max_steps
+        self.done = done = task.episode_length >= self.max_steps
         return done, False
 
     def __repr__(self) -> str:
