@@ -8,7 +8,7 @@ kinematic backend, and prints success, SPL, SoftSPL, path length, collisions and
 ``pointnav dataset generate`` and ``pointnav eval`` are in :mod:`pointnav_core.cli_datasets`.
 
 ``--gif FILE`` writes the first episode as an animated GIF and ``--png FILE`` its last frame
-(top-down, :func:`pointnav_core.render.render_env`). When either is given, the demo's tasks
+(top-down, :func:`pointnav_core.recording.render_env`). When either is given, the demo's tasks
 show their markers (``visualize_goal`` and ``visualize_path``): the start in red, the goal in
 blue and the shortest path ahead as green waypoints. ``--every N`` keeps one frame in N in
 the GIF (which then still plays in real time).
@@ -71,7 +71,7 @@ def run_demo(
         the last one.
     pixels_per_meter : float, optional
         With ``frames``: the picture scale (default 20 px/m, see
-        :func:`pointnav_core.render.render_env`).
+        :func:`pointnav_core.recording.render_env`).
     scene : str, optional
         A scene file instead of generated houses: a MovingAI ``.map``, an OmniGibson
         ``floor_trav_<n>.png`` or a folder of them (any ``scene_id``, see
@@ -171,7 +171,7 @@ def _demo(args: argparse.Namespace) -> int:
     for name, value in rows:
         print(f"  {name:<{width}}  {value}")
     if frames:
-        from pointnav_core.render import save_gif, save_png
+        from pointnav_core.recording import save_gif, save_png
 
         if args.gif:
             save_gif(frames, args.gif, fps=PointNavEnv.metadata["render_fps"] / args.every)

@@ -278,7 +278,7 @@ class PointNavEnv(gym.Env[Any, np.ndarray]):
             )
             return None
         # Imported here: drawing is only needed when rendering.
-        from pointnav_core.render import render_env
+        from pointnav_core.recording import render_env
 
         return render_env(self, renderers=self._renderers)
 

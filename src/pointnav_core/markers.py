@@ -3,7 +3,7 @@
 A :class:`~pointnav_core.task.PointNavigationTask` built with ``visualize_goal`` or
 ``visualize_path`` keeps its markers as part of its state, as :class:`VisualMarker` values
 (``task.markers``); renderers draw the visible ones
-(:func:`pointnav_core.render.render_env`). Markers are pure data: the backend never sees
+(:func:`pointnav_core.recording.render_env`). Markers are pure data: the backend never sees
 them, so they never collide with anything, and a task with both flags off does no marker
 work at all.
 

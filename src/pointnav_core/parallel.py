@@ -140,7 +140,7 @@ next ``reset``.
 Rendering
 ---------
 ``render()`` returns a top-down ``(H, W, 3)`` uint8 image when
-``render_mode="rgb_array"`` (:func:`pointnav_core.render.render_env`): the first task's
+``render_mode="rgb_array"`` (:func:`pointnav_core.recording.render_env`): the first task's
 floor, every robot present on it (parked ones too) and, with ``visualize_goal`` /
 ``visualize_path``, each task's markers. PettingZoo's ``render_test`` builds every env with
 ``render_mode="human"`` first, so ``"human"`` is accepted at construction; it is not
@@ -770,10 +770,10 @@ class MultiPointNavEnv(ParallelEnv[str, Any, np.ndarray]):
             raise NotImplementedError(
                 'render_mode="human" is not supported (pointnav-core opens no window): use '
                 'render_mode="rgb_array" and show or save the frames '
-                "(pointnav_core.render.save_gif)"
+                "(pointnav_core.recording.save_gif)"
             )
         # Imported here: drawing is only needed when rendering.
-        from pointnav_core.render import render_env
+        from pointnav_core.recording import render_env
 
         return render_env(self, renderers=self._renderers)
 
