@@ -15,7 +15,7 @@ from typing import Any, TypeVar
 
 import numpy as np
 
-__all__ = ["FrozenMapping", "thaw"]
+__all__ = ["FrozenMapping", "ThawOnUnpickle", "thaw"]
 
 K = TypeVar("K")
 V = TypeVar("V")
@@ -63,3 +63,12 @@ def thaw(value: Any) -> Any:
     if isinstance(value, tuple) and type(value) is tuple:
         return tuple(thaw(v) for v in value)
     return value
+
+
+class ThawOnUnpickle:
+    """Mixin for objects that fill numpy arrays in place as queries arrive (the planner's
+    sight bounds, a goal field's root table): unpickled from read-only buffers, they get
+    writable copies (:func:`thaw`)."""
+
+    def __setstate__(self, state: dict[str, Any]) -> None:
+        self.__dict__.update(thaw(state))

@@ -21,7 +21,7 @@ from numpy.typing import ArrayLike, NDArray
 from scipy import ndimage, sparse
 from scipy.sparse import csgraph
 
-from pointnav_core.frozen import thaw
+from pointnav_core.frozen import ThawOnUnpickle
 from pointnav_core.tangent_graph import (
     _ANG_TOL,
     _TWO_PI,
@@ -42,7 +42,7 @@ _UNCHECKED = 4
 _MARGIN = 8
 
 
-class GoalField:
+class GoalField(ThawOnUnpickle):
     """Geodesic distances (m) to one goal from every point of the floor.
 
     Build it through :meth:`Planner.goal_field` (cached). A Dijkstra run from the goal
@@ -64,11 +64,6 @@ class GoalField:
         links = planner.point_links(gx, gy) if self.goal_usable else []
         self._search = planner.arc_graph().solve(links)
         self._table: dict[str, Any] | None = None
-
-    def __setstate__(self, state: dict[str, Any]) -> None:
-        # The root table is filled in place as queries arrive; a copy unpickled from read-only
-        # buffers (another process, Ray's object store) gets writable arrays.
-        self.__dict__.update(thaw(state))
 
     @property
     def reachable_from_anywhere(self) -> bool:

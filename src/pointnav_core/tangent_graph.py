@@ -47,7 +47,7 @@ from scipy import ndimage
 from scipy.spatial import cKDTree
 
 from pointnav_core.collision import TOUCH_TOL, FloorCollision, convex_corners
-from pointnav_core.frozen import thaw
+from pointnav_core.frozen import ThawOnUnpickle
 from pointnav_core.paths import path_length, resample_path
 from pointnav_core.tangent_edges import build_edges, sight_radii
 
@@ -113,7 +113,7 @@ def _ccw_pos(ang: Any, phi0: Any, span: Any) -> tuple[Any, Any]:
     return np.minimum(ccw, span), ok
 
 
-class Planner:
+class Planner(ThawOnUnpickle):
     """Tangent graph of one floor's collision geometry for one robot radius.
 
     Parameters
@@ -142,11 +142,6 @@ class Planner:
         self._cell_graph: Any = None
         self._fields: dict[tuple[float, float], GoalField] = {}
         self._field_bytes = 0
-
-    def __setstate__(self, state: dict[str, Any]) -> None:
-        # The sight bounds is filled in place as queries arrive; a copy unpickled from read-only
-        # buffers (another process, Ray's object store) gets writable arrays.
-        self.__dict__.update(thaw(state))
 
     # ------------------------------------------------------------------ nodes
     def _build_nodes(self) -> None:
