@@ -508,13 +508,11 @@ class PointNavigationTask:
 
     @max_steps.setter
     def max_steps(self, value: int) -> None:
-        timeout = Timeout(max_steps=value)  # checks the value, naming max_steps
-        config = dict(self._termination_config)
-        config["max_steps"] = timeout.max_steps
-        self._termination_config = FrozenMapping(config)
+        steps = validation.integer("max_steps", value, minimum=1)
+        self._termination_config = FrozenMapping({**self._termination_config, "max_steps": steps})
         current = self._terminations.get("timeout")
         if isinstance(current, Timeout):
-            current.max_steps = timeout.max_steps
+            current.max_steps = steps
 
     @property
     def visualize_goal(self) -> bool:
