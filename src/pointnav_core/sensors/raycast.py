@@ -34,6 +34,7 @@ once.
 
 from __future__ import annotations
 
+import functools
 import math
 from typing import Any
 
@@ -143,6 +144,7 @@ class ScanGeometry:
         ).reshape(-1, 9))
         self._jit_base = (self.resolution, *self.origin)
         self._clearance_cells: NDArray[np.int32] | None = None
+        self._jit_params_of: dict[float, NDArray[np.float64]] = {}
 
     @property
     def _clearance(self) -> NDArray[np.int32]:
@@ -159,7 +161,12 @@ class ScanGeometry:
 
     def _jit_params(self, max_range: float) -> NDArray[np.float64]:
         """The compiled path's scalars: resolution, origin, max_range, padded shape."""
-        return np.array((*self._jit_base, max_range, *self.shape), dtype=np.float64)
+        params = self._jit_params_of.get(max_range)
+        if params is None:  # a scan asks for the same max_range at every step
+            params = np.array((*self._jit_base, max_range, *self.shape), dtype=np.float64)
+            params.flags.writeable = False
+            self._jit_params_of[max_range] = params
+        return params
 
     def __getstate__(self) -> dict[str, Any]:
         state = self.__dict__.copy()
@@ -234,10 +241,10 @@ def cast_rays(
     if method != "numpy" and raycast_jit.available():
         d = _NO_DISCS if discs is None else np.asarray(discs, dtype=np.float64).reshape(-1, 3)
         if own_disc is None:
-            own = np.full(len(p), -1, dtype=np.int64)
+            own = _no_own(len(p))
         else:
             own = np.asarray(own_disc, dtype=np.int64).reshape(-1)
-        best, near = raycast_jit.cast_rays_compiled(geometry, p, c, s, float(max_range), d, own)
+        best, near = raycast_jit.cast_rays_compiled(geometry, p, bearing, c, s, float(max_range), d, own)
         if near:  # an origin in a cell a polygon touches: shapely decides if it is inside
             best[_inside_polygon(geometry, p)] = 0.0
         return best
@@ -254,6 +261,14 @@ def cast_rays(
             own = None if own_disc is None else np.asarray(own_disc, dtype=np.int64).reshape(-1)
             np.minimum(best, _disc_hits(p, c, s, d, own), out=best)
     return best
+
+
+@functools.lru_cache(maxsize=64)
+def _no_own(n: int) -> NDArray[np.int64]:
+    """``n`` times -1 (no origin has a disc of its own), shared read-only."""
+    own = np.full(n, -1, dtype=np.int64)
+    own.flags.writeable = False
+    return own
 
 
 def _grid_hits(

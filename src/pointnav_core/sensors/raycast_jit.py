@@ -56,13 +56,15 @@ def available() -> bool:
 def cast_rays_compiled(
     geometry: Any,
     p: NDArray[np.float64],
+    bearing: NDArray[np.float64],
     c: NDArray[np.float64],
     s: NDArray[np.float64],
     max_range: float,
     discs: NDArray[np.float64],
     own: NDArray[np.int64],
 ) -> tuple[NDArray[np.float64], int]:
-    """Ranges (m), ``(N, R)``, from origins ``p`` along unit directions ``(c, s)``.
+    """Ranges (m), ``(N, R)``, from origins ``p`` along bearings ``bearing`` (rad), whose
+    cosines and sines are ``c`` and ``s``.
 
     The arguments are :func:`~pointnav_core.sensors.raycast.cast_rays`'s, already converted:
     ``discs`` ``(M, 3)`` (possibly empty) and ``own`` ``(N,)`` (-1: no own disc). Origins
@@ -71,7 +73,7 @@ def cast_rays_compiled(
     """
     out = np.empty(c.shape, dtype=np.float64)
     near = kernel()(
-        p, c, s, geometry._jit_params(max_range), geometry._lookup, geometry._clearance,
+        p, bearing, c, s, geometry._jit_params(max_range), geometry._lookup, geometry._clearance,
         geometry._near_polygon, geometry._jit_edges, discs, own, out,
     )
     return out, near
@@ -89,6 +91,7 @@ def _build(numba: Any) -> Any:
     span_min_dist = 1e-4
     span_min_end = 1e-2
     span_margin = 1e-3
+    two_pi = 2.0 * math.pi
     jit = numba.njit(cache=True, nogil=True, error_model="numpy")
 
     @jit
@@ -129,20 +132,26 @@ def _build(numba: Any) -> Any:
         sy, dty, t0y, a0y, sty, eny = crossings(gy, dy, gx, dx)
         hp = int(fhp)
         wp = int(fwp)
-        # Clear squares: if the cell under a point of the ray at t is C cells (chessboard)
-        # from the nearest blocked cell, every cell a crossing before t + C - 1 tests is
-        # within C - 1 of it, so free; the walk jumps past them (margin: rounding, e).
+        # Clear squares: if the cell under the ray's point at t is C cells (chessboard)
+        # from the nearest blocked cell, the cells within C - 1 of it are free, and so is
+        # every cell a crossing tests while the ray is inside their square; the walk jumps
+        # to where the ray leaves it (less a margin for rounding and e).
         margin = 1e-6 + 2.0 * e
         kx = 0
         ky = 0
         t = 0.0
         while True:
-            qx = math.floor(gx + t * dx)
-            qy = math.floor(gy + t * dy)
-            if 0.0 <= qx < fwp and 0.0 <= qy < fhp:
-                clr = clear[int(qy) * wp + int(qx)]
+            qx = gx + t * dx
+            qy = gy + t * dy
+            cx = math.floor(qx)
+            cy = math.floor(qy)
+            if 0.0 <= cx < fwp and 0.0 <= cy < fhp:
+                clr = clear[int(cy) * wp + int(cx)]
                 if clr >= 2:
-                    target = t + (clr - 1) - margin
+                    # Distance along the ray to the square's sides [c - (C - 1), c + C].
+                    ex_ = (cx + clr - qx if dx > 0.0 else qx - (cx - clr + 1.0)) * dtx
+                    ey_ = (cy + clr - qy if dy > 0.0 else qy - (cy - clr + 1.0)) * dty
+                    target = t + min(ex_, ey_) - margin
                     kx = skip_to(t0x, dtx, kx, target, n_cross)
                     ky = skip_to(t0y, dty, ky, target, n_cross)
             tx = t0x + float(kx) * dtx if kx < n_cross else inf
@@ -165,7 +174,7 @@ def _build(numba: Any) -> Any:
                 t = ty
 
     @jit
-    def cast(p, c, s, params, lookup, clear, near_polygon, edges, discs, own, out):  # pragma: no cover
+    def cast(p, bearing, c, s, params, lookup, clear, near_polygon, edges, discs, own, out):  # pragma: no cover
         res = params[0]
         ox = params[1]
         oy = params[2]
@@ -227,9 +236,10 @@ def _build(numba: Any) -> Any:
                     if t < best:
                         best = t
                 out[i, r] = best
-                phi[r] = math.atan2(dy, dx)
             if n_edges == 0:
                 continue
+            for r in range(n_rays):  # bearings in [-pi, pi], as atan2 gives the edges' ends
+                phi[r] = bearing[i, r] - two_pi * math.floor(bearing[i, r] / two_pi + 0.5)
             order = np.argsort(phi)
             sphi = phi[order]
             # The polygon edges, each against the rays in its angular span only.
