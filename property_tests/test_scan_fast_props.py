@@ -94,3 +94,40 @@ def test_open_scenes_give_equal_ranges_and_meet_the_reference(case):
     shapes = blocked_shapes(tmap.codes, tmap.resolution, tmap.origin, polygons)
     loose, strict = reference_ranges(shapes, origins[0], yaws[0] + angles, max_range, discs[1:])
     assert_within(got[0], loose, strict, atol=1e-4)
+
+
+@pytest.fixture(scope="module")
+def big_floor():
+    """A 2000 x 2000 floor at 0.05 m: rooms of free space between random blocky walls."""
+    from scipy import ndimage
+
+    rng = np.random.default_rng(7)
+    seeds = rng.random((2000, 2000)) < 0.002
+    codes = ndimage.binary_dilation(seeds, np.ones((5, 9), bool)).astype(np.uint8)
+    tmap = TraversableMap(codes, 0.05, (-50.0, -50.0))
+    return tmap, ScanGeometry(tmap)
+
+
+@given(st.data())
+def test_a_2000_by_2000_floor_gives_equal_ranges_that_meet_the_reference(big_floor, data):
+    tmap, geo = big_floor
+    res = tmap.resolution
+    n = data.draw(st.integers(1, 4))
+    cells = np.array(data.draw(st.lists(st.tuples(st.integers(0, 1999), st.integers(0, 1999)), min_size=n, max_size=n)))
+    origins = np.array(tmap.origin) + (cells + np.array(data.draw(st.sampled_from([0.5, 0.37])))) * res
+    yaws = np.array(data.draw(st.lists(st.floats(-math.pi, math.pi), min_size=n, max_size=n)))
+    radii = np.array(data.draw(st.lists(st.floats(0.3, 5.0), min_size=n, max_size=n))) * res
+    discs = np.column_stack([origins, radii])
+    angles = scan_angles(64, 2 * math.pi)
+    max_range = data.draw(st.sampled_from([1.0, 5.6]))
+    got = _both(geo, origins, yaws, angles, max_range, discs=discs, own=np.arange(n))
+    # The reference sees a window around the first origin, wider than max_range (its frame,
+    # where the window is cut inside the map, is out of reach).
+    margin = int(math.ceil(max_range / res)) + 3
+    c0, r0 = np.maximum(cells[0] - margin, 0)
+    c1, r1 = np.minimum(cells[0] + margin + 1, 2000)
+    window = tmap.codes[r0:r1, c0:c1]
+    corner = (tmap.origin[0] + c0 * res, tmap.origin[1] + r0 * res)
+    shapes = blocked_shapes(window, res, corner)
+    loose, strict = reference_ranges(shapes, origins[0], yaws[0] + angles, max_range, discs[1:])
+    assert_within(got[0], loose, strict, atol=1e-4)
