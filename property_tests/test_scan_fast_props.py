@@ -123,7 +123,7 @@ def test_a_2000_by_2000_floor_gives_equal_ranges_that_meet_the_reference(big_flo
     got = _both(geo, origins, yaws, angles, max_range, discs=discs, own=np.arange(n))
     # The reference sees a window around the first origin, wider than max_range (its frame,
     # where the window is cut inside the map, is out of reach).
-    margin = int(math.ceil(max_range / res)) + 3
+    margin = math.ceil(max_range / res) + 3
     c0, r0 = np.maximum(cells[0] - margin, 0)
     c1, r1 = np.minimum(cells[0] + margin + 1, 2000)
     window = tmap.codes[r0:r1, c0:c1]

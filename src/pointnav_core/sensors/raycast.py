@@ -243,8 +243,10 @@ def cast_rays(
         if own_disc is None:
             own = _no_own(len(p))
         else:
-            own = np.asarray(own_disc, dtype=np.int64).reshape(-1)
-        best, near = raycast_jit.cast_rays_compiled(geometry, p, bearing, c, s, float(max_range), d, own)
+            own = np.ascontiguousarray(own_disc, dtype=np.int64).reshape(-1)
+        best, near = raycast_jit.cast_rays_compiled(
+            geometry, np.ascontiguousarray(p), bearing, c, s, float(max_range), np.ascontiguousarray(d), own
+        )
         if near:  # an origin in a cell a polygon touches: shapely decides if it is inside
             best[_inside_polygon(geometry, p)] = 0.0
         return best
@@ -265,10 +267,9 @@ def cast_rays(
 
 @functools.lru_cache(maxsize=64)
 def _no_own(n: int) -> NDArray[np.int64]:
-    """``n`` times -1 (no origin has a disc of its own), shared read-only."""
-    own = np.full(n, -1, dtype=np.int64)
-    own.flags.writeable = False
-    return own
+    """``n`` times -1 (no origin has a disc of its own), shared (the kernel only reads it)."""
+    # Writable like a caller's own_disc, so the kernel is compiled for one array type.
+    return np.full(n, -1, dtype=np.int64)
 
 
 def _grid_hits(
