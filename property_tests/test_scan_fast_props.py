@@ -24,6 +24,7 @@ from hypothesis import strategies as st
 from pointnav_core.floorplans import FloorPlan
 from pointnav_core.maps import TraversableMap
 from pointnav_core.sensors import ScanGeometry, cast_rays, scan_angles
+from pointnav_core.sensors.raycast import cast_pose_compiled
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
 sys.path.insert(0, str(Path(__file__).resolve().parent))
@@ -44,6 +45,15 @@ def _both(geo, origins, yaws, angles, max_range, discs=None, own=None):
 def test_small_scenes_give_equal_ranges(case):
     tmap, _, origin, yaw, angles, max_range, discs = case
     _both(ScanGeometry(tmap), [origin], [yaw], angles, max_range, discs=discs)
+
+
+@given(scan_scenes())
+def test_the_scans_one_pose_path_gives_equal_ranges(case):
+    tmap, _, origin, yaw, angles, max_range, _ = case
+    geo = ScanGeometry(tmap)
+    rays = tuple(np.full((1, len(angles)), np.nan) for _ in range(3))  # overwritten
+    got = cast_pose_compiled(geo, np.array([origin], dtype=np.float64), yaw, angles, max_range, rays)
+    np.testing.assert_array_equal(got, cast_rays(geo, [origin], [yaw], angles, max_range, method="numpy")[0])
 
 
 @st.composite

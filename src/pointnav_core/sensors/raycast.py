@@ -47,7 +47,7 @@ from scipy import ndimage
 from pointnav_core.maps import OBSTACLE, TraversableMap
 from pointnav_core.sensors import raycast_jit
 
-__all__ = ["TOUCH_EPS", "ScanGeometry", "cast_rays"]
+__all__ = ["TOUCH_EPS", "ScanGeometry", "cast_pose_compiled", "cast_rays"]
 
 #: Metres within which a ray counts as touching a blocked square's face or corner.
 TOUCH_EPS = 1e-9
@@ -263,6 +263,32 @@ def cast_rays(
             own = None if own_disc is None else np.asarray(own_disc, dtype=np.int64).reshape(-1)
             np.minimum(best, _disc_hits(p, c, s, d, own), out=best)
     return best
+
+
+def cast_pose_compiled(
+    geometry: ScanGeometry,
+    origin: NDArray[np.float64],
+    yaw: float,
+    angles: NDArray[np.float64],
+    max_range: float,
+    rays: tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]],
+) -> NDArray[np.float64] | None:
+    """One origin's ranges (m), ``(R,)``, by the compiled path, or None without numba.
+
+    :func:`cast_rays` for one robot and no discs, with its conversions left out: ``origin``
+    is a ``(1, 2)`` float64 array, ``rays`` three ``(1, R)`` float64 buffers this call
+    overwrites (bearings, cosines, sines). A scan calls it at every step.
+    """
+    if not raycast_jit.available():
+        return None
+    bearing, c, s = rays
+    np.add(yaw, angles, out=bearing[0])
+    np.cos(bearing, out=c)
+    np.sin(bearing, out=s)
+    best, near = raycast_jit.cast_rays_compiled(geometry, origin, bearing, c, s, max_range, _NO_DISCS, _no_own(1))
+    if near:
+        best[_inside_polygon(geometry, origin)] = 0.0
+    return best[0]
 
 
 @functools.lru_cache(maxsize=64)

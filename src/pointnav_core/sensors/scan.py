@@ -49,7 +49,7 @@ from numpy.typing import NDArray
 from pointnav_core.backend import float_twin
 from pointnav_core.observations import Frame, ObservationTerm
 from pointnav_core.sensors._checks import check_int, check_number
-from pointnav_core.sensors.raycast import ScanGeometry, cast_rays
+from pointnav_core.sensors.raycast import ScanGeometry, cast_pose_compiled, cast_rays
 
 __all__ = ["RangeScan", "ScanShare", "other_robot_discs", "scan_angles"]
 
@@ -154,6 +154,7 @@ class RangeScan(ObservationTerm):
         self._share: ScanShare | None = None
         self._rng: np.random.Generator | None = None
         self._pose = (np.zeros((1, 2)), np.zeros(1))
+        self._rays = (np.zeros((1, self.n_rays)), np.zeros((1, self.n_rays)), np.zeros((1, self.n_rays)))
         #: ``(x, y, yaw, readings)`` of the last observation (renderers draw it), or None.
         self.last_scan: tuple[float, float, float, NDArray[np.float64]] | None = None
 
@@ -206,6 +207,10 @@ class RangeScan(ObservationTerm):
         origin[0, 0] = frame.x
         origin[0, 1] = frame.y
         yaw[0] = math.atan2(frame.sin_yaw, frame.cos_yaw)
+        if discs is None or not len(discs):
+            fast = cast_pose_compiled(self._geometry, origin, yaw[0], self.angles, self.max_range, self._rays)
+            if fast is not None:
+                return fast
         return cast_rays(
             self._geometry, origin, yaw, self.angles, self.max_range,
             discs=discs if discs is not None and len(discs) else None,
