@@ -294,7 +294,7 @@ class VectorPointNavEnv(VectorEnv):
             vel_x[slow] = (sx - x0[slow]) / dt
             vel_y[slow] = (sy - y0[slow]) / dt
             vel_w = xp.where(fast, vel_w, (yaw - yaw0) / dt)
-            vz[slow] = xp.where(fall, -drop / dt, 0.0)
+            vz[slow] = xp.where(fall, -drop / dt, xp.zeros_like(sx))
             z = z.clone() if a.is_torch else z.copy()
             z[slow] = xp.where(fall, z[slow] - drop, z[slow])
             contact[slow] = c
@@ -311,8 +311,9 @@ class VectorPointNavEnv(VectorEnv):
         terminated = (collisions > self.max_collisions) | fell | success
         truncated = steps >= self.max_steps
         r_pot = self.r_potential * (st["pot"] - pot)
-        r_col = xp.where(contact, -self.r_collision, 0.0)
-        r_goal = xp.where(success, self.r_pointgoal, 0.0)
+        zero = xp.zeros_like(x)  # torch.where of two numbers would give float32
+        r_col = xp.where(contact, -self.r_collision, zero)
+        r_goal = xp.where(success, self.r_pointgoal, zero)
         reward = ((0.0 + r_pot) + r_col) + r_goal
         # Commit, then reset the worlds that ended on the previous step (next-step autoreset).
         st.update(x=x, y=y, yaw=yaw, z=z, vx=vel_x, vy=vel_y, vz=vz, w=vel_w, path=path, dist=dist, pot=pot)
@@ -351,7 +352,7 @@ class VectorPointNavEnv(VectorEnv):
         finite = d0 < math.inf
         eff = xp.where(length <= d0, 1.0, d0 / xp.where(length > 0.0, length, 1.0))
         spl = xp.where(success & finite, eff, 0.0)
-        progress = xp.where(d0 > 0.0, 1.0 - d_t / xp.where(d0 > 0.0, d0, 1.0), xp.where(d_t == 0.0, 1.0, 0.0))
+        progress = xp.where(d0 > 0.0, 1.0 - d_t / xp.where(d0 > 0.0, d0, 1.0), xp.where(d_t == 0.0, 1.0, xp.zeros_like(d_t)))
         soft = xp.where(finite & (progress > 0.0), progress * eff, 0.0)
         return {
             "success": success, "spl": spl, "soft_spl": soft, "path_length": length, "geodesic_dist": d0,

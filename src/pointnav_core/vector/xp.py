@@ -53,6 +53,7 @@ class Arrays:
     def full(self, shape: Any, value: Any, dtype: Any = None) -> Any:
         dtype = self.f64 if dtype is None else dtype
         if self.is_torch:
+            shape = (shape,) if isinstance(shape, int) else tuple(shape)
             return self.xp.full(shape, value, dtype=dtype, device=self.device)
         return np.full(shape, value, dtype=dtype)
 
