@@ -70,6 +70,9 @@ class VectorPointNavEnv(VectorEnv):
         Episodes prepared per scene, >= 1 (each with its settled goal field).
     action_frequency : float
         Control steps per second (Hz).
+    max_episode_steps : int, optional
+        The task's ``max_steps``, as ``gymnasium.make(..., max_episode_steps=N)`` sets it for
+        the single env (the derived ``path_range`` follows).
 
     Notes
     -----
@@ -97,6 +100,7 @@ class VectorPointNavEnv(VectorEnv):
         seed: int | None = None,
         pool_size: int = 8,
         action_frequency: float = 10.0,
+        max_episode_steps: int | None = None,
     ) -> None:
         from pointnav_core.env import PointNavEnv
 
@@ -124,6 +128,9 @@ class VectorPointNavEnv(VectorEnv):
             PointNavEnv(scene=s, robot=self.robot, task=dict(task or {}), flatten_obs=True, action_frequency=action_frequency)
             for s in scene_list
         ]
+        if max_episode_steps is not None:
+            for env in self._samplers:  # sets the task's max_steps and refits a derived path_range
+                env.max_episode_steps = max_episode_steps
         first = self._samplers[0]
         self.action_frequency = first.action_frequency
         self.dt = 1.0 / self.action_frequency
