@@ -80,9 +80,16 @@ def advance(
     inf = math.inf
     span = xp.sqrt(mx * mx + my * my)
     max_span = float(span.max()) if span.shape[0] else 0.0
-    wx0, wy0, wx1, wy1, valid = window(floors, scene, x, y, radius + max_span + 4.0 * _ACTIVE)
-    n_contacts = min(CONTACTS, valid.shape[1])
+    reach = radius + max_span + 4.0 * _ACTIVE
+    wx0, wy0, wx1, wy1, valid = window(floors, scene, x, y, reach)
     d0 = square_distance(xp, x[:, None], y[:, None], wx0, wy0, wx1, wy1)[0]
+    # Only walls within reach of the start can be met (sliding only shortens the motion):
+    # keep the most any robot has, nearest first, so that every later test is on few walls.
+    in_reach = valid & (d0 <= reach)
+    k = max(int(in_reach.sum(-1).max()) if in_reach.shape[0] else 0, 1)
+    order = _nearest(xp, xp.where(in_reach, d0, inf), k)
+    wx0, wy0, wx1, wy1, valid, d0 = (_take(xp, v, order) for v in (wx0, wy0, wx1, wy1, in_reach, d0))
+    n_contacts = min(CONTACTS, valid.shape[1])
     hit_r = max(radius - _HIT, _HIT)
     start_x, start_y = x, y
     contact = xp.zeros_like(x) > 1.0

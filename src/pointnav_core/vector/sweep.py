@@ -77,14 +77,13 @@ def square_distance(xp: Any, px: Any, py: Any, x0: Any, y0: Any, x1: Any, y1: An
     dist = xp.sqrt(vx * vx + vy * vy)
     out = dist > 0.0
     safe = xp.where(out, dist, 1.0)
+    nx, ny = vx / safe, vy / safe
+    if bool(out.all()):  # the common case: no point on or in a square
+        return dist, nx, ny
     # Inside or on the boundary: leave through the nearest face (the first of a tie).
     faces = xp.stack([px - x0, x1 - px, py - y0, y1 - py], -1)
     face = xp.argmin(faces, -1)
     depth = xp.amin(faces, -1)
-    fnx = xp.where(face == 0, -1.0, xp.where(face == 1, 1.0, 0.0))
-    fny = xp.where(face == 2, -1.0, xp.where(face == 3, 1.0, 0.0))
-    return (
-        xp.where(out, dist, -depth),
-        xp.where(out, vx / safe, fnx),
-        xp.where(out, vy / safe, fny),
-    )
+    fnx = xp.where(face == 0, -1.0, xp.where(face == 1, 1.0, 0.0 * depth))
+    fny = xp.where(face == 2, -1.0, xp.where(face == 3, 1.0, 0.0 * depth))
+    return xp.where(out, dist, -depth), xp.where(out, nx, fnx), xp.where(out, ny, fny)
