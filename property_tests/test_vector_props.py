@@ -17,7 +17,7 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 from vector_reference import compare, random_episodes
 
-from pointnav_core.maps import OBSTACLE, VOID
+from pointnav_core.maps import FREE, OBSTACLE, VOID
 from pointnav_core.scenes import Scene
 
 DEVICES = ["numpy"] + (["cpu"] if importlib.util.find_spec("torch") else [])
@@ -25,7 +25,7 @@ DEVICES = ["numpy"] + (["cpu"] if importlib.util.find_spec("torch") else [])
 
 @st.composite
 def cluttered_scenes(draw: st.DrawFn) -> Scene:
-    """A walled room, 12 to 30 cells a side, with random obstacle cells and maybe a hole."""
+    """A walled room, 12 to 30 cells a side, with random obstacle cells, maybe a hole, and a free patch."""
     rows, cols = draw(st.integers(12, 30)), draw(st.integers(12, 30))
     rng = np.random.default_rng(draw(st.integers(0, 2**31 - 1)))
     grid = np.zeros((rows, cols), np.uint8)
@@ -34,6 +34,9 @@ def cluttered_scenes(draw: st.DrawFn) -> Scene:
     if draw(st.booleans()):
         r, c = draw(st.integers(1, rows - 4)), draw(st.integers(1, cols - 4))
         grid[r : r + 3, c : c + 3] = VOID
+    # A free 6 x 6 patch somewhere inside, so that the robot always fits.
+    r, c = draw(st.integers(1, rows - 7)), draw(st.integers(1, cols - 7))
+    grid[r : r + 6, c : c + 6] = FREE
     return Scene.from_array(grid, 0.1)
 
 
@@ -55,3 +58,28 @@ def test_vector_matches_single_envs(device: str, scene: Scene, seed: int, n: int
     actions[rng.random((steps, n)) < 0.4, 0] = 1.0
     task = {"reward_type": reward_type, "termination_config": {"max_steps": max_steps, "max_collisions": 20}}
     compare(scene, episodes, actions, task=task, device=device)
+
+
+@settings(max_examples=30, deadline=None)
+@given(scene=cluttered_scenes(), seed=st.integers(0, 2**31 - 1))
+def test_fast_path_equals_contact_path(scene: Scene, seed: int) -> None:
+    """Where the clearance table vouches for a step, sweeping it for contacts changes nothing."""
+    from pointnav_core.vector.contacts import advance
+    from pointnav_core.vector.floors import FloorTables
+    from pointnav_core.vector.xp import make_arrays
+
+    rng = np.random.default_rng(seed)
+    radius = 0.18
+    floors = FloorTables([scene], 0, radius, make_arrays("numpy"))
+    points = np.array([scene.get_random_point(0, robot=radius, rng=rng)[1][:2] for _ in range(64)])
+    x, y = points[:, 0], points[:, 1]
+    heading = rng.uniform(-np.pi, np.pi, 64)
+    length = rng.uniform(0.0, 0.05, 64)
+    mx, my = length * np.cos(heading), length * np.sin(heading)
+    zeros = np.zeros(64, dtype=np.int64)
+    row, col, inside = floors.cells(zeros, x, y)
+    fast = inside & (floors.fast[floors.flat_index(zeros, row, col, inside)] > length)
+    nx, ny, contact = advance(floors, zeros, x, y, mx, my, radius)
+    np.testing.assert_allclose(nx[fast], (x + mx)[fast], rtol=0, atol=1e-12)
+    np.testing.assert_allclose(ny[fast], (y + my)[fast], rtol=0, atol=1e-12)
+    assert not contact[fast].any()
