@@ -24,7 +24,8 @@ INFO_KEYS = ("success", "spl", "soft_spl", "collisions", "episode_length", "path
 def compare(
     scene: Any, episodes: list[tuple[Any, float, Any]], actions: np.ndarray, task: dict | None = None, device: str = "numpy"
 ) -> dict[str, Any]:
-    """Step both for ``len(actions)`` steps; return counts of what happened (ends, contacts).
+    """Step both for ``len(actions)`` steps; return counts of what happened (ends, contacts)
+    and the largest observation and reward differences seen.
 
     ``episodes`` holds one ``(start_xy, yaw, goal_xy)`` per world; ``actions`` has shape
     ``(steps, num_envs, 2)``.
@@ -49,9 +50,10 @@ def compare(
     vobs, _ = venv.reset(options={"episodes": episodes})
     sobs = np.array([env.reset(seed=0)[0] for env in singles])
     ended = [False] * n
-    stats = {"ends": 0, "successes": 0, "contacts": 0, "autoresets": 0}
+    stats = {"ends": 0, "successes": 0, "contacts": 0, "autoresets": 0, "obs_diff": 0.0, "reward_diff": 0.0}
     for t, act in enumerate(actions):
         np.testing.assert_allclose(to_np(vobs), sobs, rtol=0, atol=OBS_TOL, err_msg=f"observations before step {t}")
+        stats["obs_diff"] = max(stats["obs_diff"], float(np.abs(to_np(vobs) - sobs).max()))
         vobs, vrew, vterm, vtrunc, vinfo = venv.step(act)
         vrew, vterm, vtrunc = to_np(vrew), to_np(vterm), to_np(vtrunc)
         vinfo = {k: to_np(v) for k, v in vinfo.items()}
@@ -67,6 +69,7 @@ def compare(
             sobs[i] = obs
             where = f"world {i}, step {t}"
             assert abs(reward - vrew[i]) <= REWARD_TOL, f"reward {where}: {reward} vs {vrew[i]}"
+            stats["reward_diff"] = max(stats["reward_diff"], abs(reward - float(vrew[i])))
             assert (term, trunc) == (bool(vterm[i]), bool(vtrunc[i])), f"flags {where}"
             if info is None:
                 continue
