@@ -84,6 +84,20 @@ class VectorPointNavEnv(VectorEnv):
     ``in_contact``, ``reward_potential``, ``reward_collision``, ``reward_pointgoal`` and
     ``autoreset`` (the worlds this step reset instead of stepping). Arrays are numpy with
     ``device="numpy"`` and torch tensors on the device otherwise.
+
+    Examples
+    --------
+    >>> from pointnav_core.scenes import Scene
+    >>> grid = np.zeros((20, 20), np.uint8)
+    >>> grid[[0, -1], :] = grid[:, [0, -1]] = 1  # a walled 2 x 2 m room
+    >>> env = VectorPointNavEnv(4, scene=Scene.from_array(grid, 0.1), seed=0, pool_size=2,
+    ...                         task={"path_range": (0.5, 1.5)})
+    >>> obs, info = env.reset()
+    >>> obs.shape, obs.dtype
+    ((4, 8), dtype('float32'))
+    >>> obs, reward, terminated, truncated, info = env.step(np.zeros((4, 2)))
+    >>> info["episode_length"].tolist(), reward.tolist()  # standing still: no progress
+    ([1, 1, 1, 1], [0.0, 0.0, 0.0, 0.0])
     """
 
     metadata = {"autoreset_mode": AutoresetMode.NEXT_STEP, "render_modes": []}
