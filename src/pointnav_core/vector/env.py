@@ -375,9 +375,12 @@ class VectorPointNavEnv(VectorEnv):
         spl = xp.where(success & finite, eff, 0.0)
         progress = xp.where(d0 > 0.0, 1.0 - d_t / xp.where(d0 > 0.0, d0, 1.0), xp.where(d_t == 0.0, 1.0, xp.zeros_like(d_t)))
         soft = xp.where(finite & (progress > 0.0), progress * eff, 0.0)
-        return {
+        info = {
             "success": success, "spl": spl, "soft_spl": soft, "path_length": length, "geodesic_dist": d0,
             "distance_to_goal": d_t, "collisions": self._collisions, "episode_length": self._steps,
             "in_contact": contact, "reward_potential": r_pot, "reward_collision": r_col,
             "reward_pointgoal": r_goal, "autoreset": resetting,
         }
+        # Fresh arrays: the engine's state arrays are written in place at the next autoreset.
+        copy = (lambda v: v.clone()) if self.arrays.is_torch else (lambda v: v.copy())
+        return {key: copy(value) for key, value in info.items()}
