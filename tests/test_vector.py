@@ -147,13 +147,13 @@ def test_floors_with_polygons_are_refused() -> None:
 
 
 def test_returned_arrays_are_fresh() -> None:
-    # A world that ends is reset in place by the next step: what the last step returned stays.
+    # reset() writes the engine's state in place: what the last step returned stays.
     env = VectorPointNavEnv(1, scene=room(), task={"termination_config": {"max_steps": 2}})
     env.reset(options={"episodes": [((1.0, 1.5), 0.0, (3.0, 1.5))]})
     env.step(np.array([[1.0, 0.0]]))
     obs, _, _, truncated, info = env.step(np.array([[1.0, 0.0]]))
     kept = {key: np.array(value) for key, value in info.items()}
     assert truncated[0] and info["episode_length"][0] == 2
-    env.step(np.array([[1.0, 0.0]]))  # the autoreset
+    env.reset(options={"episodes": [((1.0, 1.5), 0.0, (3.0, 1.5))]})
     for key, value in info.items():
         np.testing.assert_array_equal(value, kept[key], err_msg=key)
