@@ -98,8 +98,23 @@ def advance(
     forced_all = xp.zeros_like(wx0) > 1.0
 
     def resolve(x: Any, y: Any, mx: Any, my: Any, left: Any, forced_all: Any) -> tuple[Any, Any, Any]:
-        # The walls within _ACTIVE of touching are among the nearest few: slide against those.
+        # Only a moving robot within _ACTIVE of some wall can be blocked: the others keep going.
         dist_all = square_distance(xp, x[:, None], y[:, None], wx0, wy0, wx1, wy1)[0]
+        need = a.nonzero((valid & (dist_all <= radius + _ACTIVE)).any(-1) & ((mx != 0.0) | (my != 0.0)))
+        hit = xp.zeros_like(x) > 1.0
+        if not need.shape[0]:
+            return mx, my, hit
+        sub = (v[need] for v in (x, y, mx, my, left, forced_all, dist_all, wx0, wy0, wx1, wy1, valid))
+        smx, smy, shit = _slide(*sub)
+        mx, my = mx.clone() if a.is_torch else mx.copy(), my.clone() if a.is_torch else my.copy()
+        mx[need], my[need], hit[need] = smx, smy, shit
+        return mx, my, hit
+
+    def _slide(
+        x: Any, y: Any, mx: Any, my: Any, left: Any, forced_all: Any, dist_all: Any,
+        wx0: Any, wy0: Any, wx1: Any, wy1: Any, valid: Any,
+    ) -> tuple[Any, Any, Any]:
+        # The walls within _ACTIVE of touching are among the nearest few: slide against those.
         near = _nearest(xp, xp.where(valid, dist_all, inf), n_contacts)
         cx0, cy0, cx1, cy1, cvalid, forced = (
             _take(xp, v, near) for v in (wx0, wy0, wx1, wy1, valid, forced_all)
