@@ -45,7 +45,8 @@ def window(floors: FloorTables, scene: Any, x: Any, y: Any, reach: float) -> tup
     inside = (col >= 0) & (col < floors.width[sc]) & (row >= 0) & (row < floors.rows[sc])
     valid = inside & floors.edge[floors.flat_index(sc, row, col, inside)]
     res = floors.res[sc]
-    x0 = floors.ox[sc] + col * res
+    # Cells that are no wall move far away, so that no distance test lands inside one.
+    x0 = xp.where(valid, floors.ox[sc] + col * res, 1e9)
     y0 = floors.oy[sc] + row * res
     return x0, y0, x0 + res, y0 + res, valid
 
