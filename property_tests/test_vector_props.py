@@ -79,7 +79,7 @@ def test_fast_path_equals_contact_path(scene: Scene, seed: int) -> None:
     zeros = np.zeros(64, dtype=np.int64)
     row, col, inside = floors.cells(zeros, x, y)
     fast = inside & (floors.fast[floors.flat_index(zeros, row, col, inside)] > length)
-    nx, ny, contact = advance(floors, zeros, x, y, mx, my, radius)
+    nx, ny, contact = advance(floors, zeros, x, y, mx, my, radius, max_travel=0.05)
     np.testing.assert_allclose(nx[fast], (x + mx)[fast], rtol=0, atol=1e-12)
     np.testing.assert_allclose(ny[fast], (y + my)[fast], rtol=0, atol=1e-12)
     assert not contact[fast].any()

@@ -31,24 +31,28 @@ CONTACTS = 6
 
 
 def window(floors: FloorTables, scene: Any, x: Any, y: Any, reach: float) -> tuple[Any, Any, Any, Any, Any]:
-    """The edge obstacle squares within ``reach`` cells of each robot: corners and mask, (M, K)."""
+    """The edge obstacle squares within ``reach`` (m) of each robot's cell: corners and mask, (M, K).
+
+    In row-major order, as the backend lists them; a robot off the map has none.
+    """
     a = floors.arrays
     xp = a.xp
-    k = int(math.ceil(reach / floors.min_res)) + 1
-    offs = a.arange(2 * k + 1) - k
-    dr = offs.reshape(-1, 1) + 0 * offs.reshape(1, -1)
-    dc = 0 * offs.reshape(-1, 1) + offs.reshape(1, -1)
-    row0, col0, _ = floors.cells(scene, x, y)
-    row = row0.reshape(-1, 1) + dr.reshape(1, -1)
-    col = col0.reshape(-1, 1) + dc.reshape(1, -1)
+    table = floors.wall_table(reach)
+    row0, col0, inside = floors.cells(scene, x, y)
+    ids = table[floors.flat_index(scene, row0, col0, inside)]
+    valid = (ids >= 0) & inside[:, None]
     sc = scene.reshape(-1, 1)
-    inside = (col >= 0) & (col < floors.width[sc]) & (row >= 0) & (row < floors.rows[sc])
-    valid = inside & floors.edge[floors.flat_index(sc, row, col, inside)]
+    row, col = _divmod(xp, xp.where(valid, ids - floors.offset[sc], 0), floors.width[sc])
     res = floors.res[sc]
-    # Cells that are no wall move far away, so that no distance test lands inside one.
+    # Slots that hold no wall move far away, so that no distance test lands inside one.
     x0 = xp.where(valid, floors.ox[sc] + col * res, 1e9)
     y0 = floors.oy[sc] + row * res
     return x0, y0, x0 + res, y0 + res, valid
+
+
+def _divmod(xp: Any, a: Any, b: Any) -> tuple[Any, Any]:
+    q = xp.div(a, b, rounding_mode="floor") if hasattr(xp, "Tensor") else a // b
+    return q, a - q * b
 
 
 def _nearest(xp: Any, dist: Any, k: int) -> Any:
@@ -62,7 +66,7 @@ def _take(xp: Any, a: Any, idx: Any) -> Any:
 
 
 def advance(
-    floors: FloorTables, scene: Any, x: Any, y: Any, mx: Any, my: Any, radius: float
+    floors: FloorTables, scene: Any, x: Any, y: Any, mx: Any, my: Any, radius: float, max_travel: float
 ) -> tuple[Any, Any, Any]:
     """Move robots by their chords ``(mx, my)`` (m) with contacts; new ``x``, ``y`` and contact flags.
 
@@ -75,6 +79,8 @@ def advance(
         Start positions and chords, in metres.
     radius : float
         Robot radius (m).
+    max_travel : float
+        The longest chord any step may have (m): the wall table is built for it.
     """
     a = floors.arrays
     xp = a.xp
@@ -82,7 +88,9 @@ def advance(
     span = xp.sqrt(mx * mx + my * my)
     max_span = float(span.max()) if span.shape[0] else 0.0
     reach = radius + max_span + 4.0 * _ACTIVE
-    wx0, wy0, wx1, wy1, valid = window(floors, scene, x, y, reach)
+    if max_span > max_travel:
+        raise ValueError(f"a chord of {max_span} m is longer than max_travel {max_travel} m")
+    wx0, wy0, wx1, wy1, valid = window(floors, scene, x, y, radius + max_travel + 4.0 * _ACTIVE)
     d0 = square_distance(xp, x[:, None], y[:, None], wx0, wy0, wx1, wy1)[0]
     # Only walls within reach of the start can be met (sliding only shortens the motion):
     # keep the most any robot has, nearest first, so that every later test is on few walls.

@@ -165,6 +165,8 @@ class VectorPointNavEnv(VectorEnv):
             )
         a = self.arrays
         self.floors = FloorTables(scene_list, t.floor, spec.radius, a)
+        # A chord is never longer than its arc; the margin covers rounding.
+        self._max_travel = spec.max_linear_velocity * self.dt * (1.0 + 1e-9) + 1e-12
         bounds = [env.task.observation_bounds for env in self._samplers]
         self._low = a.asarray(np.stack([b[0] for b in bounds]).astype(np.float64))
         self._high = a.asarray(np.stack([b[1] for b in bounds]).astype(np.float64))
@@ -307,7 +309,7 @@ class VectorPointNavEnv(VectorEnv):
         z = st["z"]
         slow = a.nonzero(~fast)
         if slow.shape[0]:
-            sx, sy, c = advance(self.floors, scene[slow], x0[slow], y0[slow], dx[slow], dy[slow], spec.radius)
+            sx, sy, c = advance(self.floors, scene[slow], x0[slow], y0[slow], dx[slow], dy[slow], spec.radius, self._max_travel)
             syaw = yaw0[slow] + w[slow] * dt
             fall = self.floors.is_void(scene[slow], sx, sy)
             drop = max(_FALL_SPEED * dt + 0.5 * _GRAVITY * dt * dt, _MIN_FIRST_DROP)

@@ -9,6 +9,7 @@ so the batched engine takes its fast path exactly where the backend does.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Sequence
 from typing import Any
 
@@ -46,6 +47,8 @@ class FloorTables:
         codes, edge, fast, meta = [], [], [], []
         offset = 0
         self.geometries = []
+        self._edges: list[np.ndarray] = []
+        self._walls: dict[float, Any] = {}
         for k, scene in enumerate(scenes):
             tmap = scene.floors[floor]
             if len(tmap.collision.polygons):
@@ -60,6 +63,7 @@ class FloorTables:
             edge.append(np.frombuffer(geom.edge, dtype=np.uint8).astype(bool))
             fast.append(np.asarray(geom.fast_clearance(radius), dtype=np.float64))
             meta.append((offset, geom.rows, geom.width, geom.ox, geom.oy, geom.res, geom.height))
+            self._edges.append(np.frombuffer(geom.edge, dtype=np.uint8).astype(bool).reshape(grid.shape))
             offset += grid.size
         m = np.array(meta, dtype=np.float64)
         a = arrays
@@ -73,6 +77,41 @@ class FloorTables:
         self.inv_res = 1.0 / self.res  # the backend multiplies by it: the same cells at the edges
         self.min_res = float(m[:, 5].min())
         self.arrays = a
+
+    def wall_table(self, reach: float) -> Any:
+        """Per cell, the flat indices of the edge obstacle cells whose squares come within
+        ``reach`` (m) of some point of the cell, in row-major order, padded with -1:
+        an int array ``(all cells, K)``, K the most any cell has. Cached per ``reach``."""
+        table = self._walls.get(reach)
+        if table is not None:
+            return table
+        blocks, offset = [], 0
+        for edge, res in zip(self._edges, self.arrays.numpy(self.res)):
+            rows, cols = edge.shape
+            k = int(math.ceil(reach / res)) + 1
+            r, c = np.divmod(np.arange(rows * cols), cols)
+            found = []
+            for dr in range(-k, k + 1):
+                for dc in range(-k, k + 1):
+                    # The nearest points of two cell squares dr, dc apart are this far apart.
+                    if math.hypot(max(abs(dr) - 1, 0), max(abs(dc) - 1, 0)) * res > reach:
+                        continue
+                    rr, cc = r + dr, c + dc
+                    ok = (rr >= 0) & (rr < rows) & (cc >= 0) & (cc < cols)
+                    ok[ok] = edge[rr[ok], cc[ok]]
+                    found.append(np.where(ok, offset + rr * cols + cc, -1))
+            ids = np.stack(found, 1)
+            # Walls first, each row keeping its row-major order.
+            order = np.argsort(ids < 0, axis=1, kind="stable")
+            blocks.append(np.take_along_axis(ids, order, 1))
+            offset += rows * cols
+        width = max(int((b >= 0).sum(1).max()) if b.size else 0 for b in blocks)
+        width = max(width, 1)
+        table = np.concatenate([b[:, :width] if b.shape[1] >= width else
+                                np.pad(b, ((0, 0), (0, width - b.shape[1])), constant_values=-1) for b in blocks])
+        table = self.arrays.asarray(table, self.arrays.i64)
+        self._walls[reach] = table
+        return table
 
     def cells(self, scene: Any, x: Any, y: Any) -> tuple[Any, Any, Any]:
         """Row, column (int arrays) and on-map mask of the points ``(x, y)`` of worlds on ``scene`` (index array)."""
