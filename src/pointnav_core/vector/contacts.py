@@ -6,9 +6,10 @@ overlap (by more than ``_HIT``), stops ``_PLACE`` short of it, slides along the 
 tangent of a blocking contact that goes into no other contact, and goes on with what is
 left of the motion. The backend resolves up to 8 contacts per robot and sub-step; here
 every robot runs :data:`EVENTS` rounds at once (a robot done early just idles), so the
-rule is the same. The walls are the edge obstacle squares in a fixed window of cells
-around each robot, in row-major order, as the backend lists them; only the
-:data:`CONTACTS` nearest take part in sliding (a disc touches at most four squares).
+rule is the same. The walls are the edge obstacle squares within reach of each robot's
+cell (:meth:`FloorTables.wall_table`, one gather), in row-major order, as the backend
+lists them; only the :data:`CONTACTS` nearest take part in sliding (a disc touches at
+most four squares).
 """
 
 from __future__ import annotations
