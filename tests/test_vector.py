@@ -35,7 +35,7 @@ def test_straight_drive_to_the_goal_by_hand(device: str) -> None:
     np.testing.assert_allclose(to_np(obs)[:, :2], [[1.02, 0.0], [1.02, 0.0]], atol=1e-6)
     total = np.zeros(2)
     for step in range(1, 12):
-        obs, reward, terminated, truncated, info = env.step(np.tile([1.0, 0.0], (2, 1)))
+        obs, reward, terminated, _, info = env.step(np.tile([1.0, 0.0], (2, 1)))
         total += to_np(reward)
         assert to_np(terminated).tolist() == [step == 11] * 2
     np.testing.assert_allclose(to_np(obs)[:, 2], 0.5, atol=1e-6)  # forward speed, m/s
@@ -44,7 +44,7 @@ def test_straight_drive_to_the_goal_by_hand(device: str) -> None:
     np.testing.assert_allclose(to_np(info["soft_spl"]), 1 - 0.47 / 1.02, atol=1e-9)
     np.testing.assert_allclose(to_np(info["path_length"]), 0.55, atol=1e-9)
     # Next-step autoreset: the action is ignored, the episode starts again.
-    obs, reward, terminated, truncated, info = env.step(np.tile([1.0, 1.0], (2, 1)))
+    obs, reward, _, _, info = env.step(np.tile([1.0, 1.0], (2, 1)))
     np.testing.assert_allclose(to_np(obs)[:, :2], [[1.02, 0.0], [1.02, 0.0]], atol=1e-6)
     assert to_np(reward).tolist() == [0.0, 0.0] and to_np(info["autoreset"]).all()
     assert to_np(info["episode_length"]).tolist() == [0, 0]
@@ -57,7 +57,7 @@ def test_wall_contact_slides_and_costs(device: str) -> None:
     env.reset(options={"episodes": [((1.0, 0.3), -math.pi / 4, (3.5, 2.5))]})
     contacts = 0
     for _ in range(20):
-        obs, reward, _, _, info = env.step(np.array([[1.0, 0.0]]))
+        _, _, _, _, info = env.step(np.array([[1.0, 0.0]]))
         contacts += bool(env.arrays.numpy(info["in_contact"])[0])
     y = float(env.arrays.numpy(env._state["y"])[0])
     assert contacts > 0
@@ -100,7 +100,7 @@ def test_make_vec_builds_the_batched_engine() -> None:
     obs, _ = env.reset(seed=0)
     assert obs.shape == (3, 8) and obs.dtype == np.float32
     obs, reward, terminated, truncated, _ = env.step(env.action_space.sample())
-    assert reward.dtype == np.float64 and terminated.dtype == np.bool_ and env.observation_space.contains(obs)
+    assert reward.dtype == np.float64 and terminated.dtype == truncated.dtype == np.bool_ and env.observation_space.contains(obs)
 
 
 @pytest.mark.parametrize("device", ["gpu", "cuda:x", 0, "numpy "])
@@ -151,7 +151,7 @@ def test_returned_arrays_are_fresh() -> None:
     env = VectorPointNavEnv(1, scene=room(), task={"termination_config": {"max_steps": 2}})
     env.reset(options={"episodes": [((1.0, 1.5), 0.0, (3.0, 1.5))]})
     env.step(np.array([[1.0, 0.0]]))
-    obs, _, _, truncated, info = env.step(np.array([[1.0, 0.0]]))
+    _, _, _, truncated, info = env.step(np.array([[1.0, 0.0]]))
     kept = {key: np.array(value) for key, value in info.items()}
     assert truncated[0] and info["episode_length"][0] == 2
     env.reset(options={"episodes": [((1.0, 1.5), 0.0, (3.0, 1.5))]})

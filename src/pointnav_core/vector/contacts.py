@@ -20,7 +20,7 @@ from typing import Any
 from pointnav_core.vector.floors import FloorTables
 from pointnav_core.vector.sweep import enter_rounded_square, square_distance
 
-__all__ = ["EVENTS", "CONTACTS", "advance"]
+__all__ = ["CONTACTS", "EVENTS", "advance"]
 
 _HIT = 0.5e-9
 _PLACE = 1.0e-9

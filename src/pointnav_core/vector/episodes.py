@@ -8,7 +8,6 @@ draws from the pool, so no reset ever samples or plans during a batched step.
 
 from __future__ import annotations
 
-import math
 from collections.abc import Sequence
 from typing import Any
 

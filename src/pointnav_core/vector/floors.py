@@ -88,7 +88,7 @@ class FloorTables:
         blocks, offset = [], 0
         for edge, res in zip(self._edges, self.arrays.numpy(self.res)):
             rows, cols = edge.shape
-            k = int(math.ceil(reach / res)) + 1
+            k = math.ceil(reach / res) + 1
             r, c = np.divmod(np.arange(rows * cols), cols)
             found = []
             for dr in range(-k, k + 1):
