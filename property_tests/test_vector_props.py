@@ -83,3 +83,28 @@ def test_fast_path_equals_contact_path(scene: Scene, seed: int) -> None:
     np.testing.assert_allclose(nx[fast], (x + mx)[fast], rtol=0, atol=1e-12)
     np.testing.assert_allclose(ny[fast], (y + my)[fast], rtol=0, atol=1e-12)
     assert not contact[fast].any()
+
+
+@settings(max_examples=30, deadline=None)
+@given(scene=cluttered_scenes(), seed=st.integers(0, 2**31 - 1), reach=st.floats(0.0, 0.35))
+def test_wall_table_holds_every_wall_within_reach(scene: Scene, seed: int, reach: float) -> None:
+    """Every edge obstacle square within ``reach`` of a point (shapely's distance) is in its window."""
+    from shapely.geometry import Point, box
+
+    from pointnav_core.vector.contacts import window
+    from pointnav_core.vector.floors import FloorTables
+    from pointnav_core.vector.xp import make_arrays
+
+    rng = np.random.default_rng(seed)
+    floors = FloorTables([scene], 0, 0.0, make_arrays("numpy"))
+    codes = np.asarray(scene.floors[0].codes)
+    rows, cols = codes.shape
+    x, y = rng.uniform(0.0, cols * 0.1, 16), rng.uniform(0.0, rows * 0.1, 16)
+    x0, y0, _, _, valid = window(floors, np.zeros(16, dtype=np.int64), x, y, reach)
+    edge = np.frombuffer(floors.geometries[0].edge, dtype=np.uint8).reshape(rows, cols).astype(bool)
+    for i in range(16):
+        got = {(round(a, 9), round(b, 9)) for a, b in zip(x0[i][valid[i]], y0[i][valid[i]])}
+        for r, c in zip(*np.nonzero(edge)):
+            square = box(c * 0.1, r * 0.1, (c + 1) * 0.1, (r + 1) * 0.1)
+            if square.distance(Point(x[i], y[i])) <= reach:
+                assert (round(c * 0.1, 9), round(r * 0.1, 9)) in got
