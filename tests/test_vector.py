@@ -157,3 +157,27 @@ def test_returned_arrays_are_fresh() -> None:
     env.reset(options={"episodes": [((1.0, 1.5), 0.0, (3.0, 1.5))]})
     for key, value in info.items():
         np.testing.assert_array_equal(value, kept[key], err_msg=key)
+
+
+def test_a_disc_exactly_as_wide_as_a_passage_slides_into_it() -> None:
+    # The kinematic backend's case: blocks at x 0.6-0.8, y 0.5-0.7 and x 0.7-0.9, y 1.0-1.2
+    # leave a passage 0.3 m wide; a 0.15 m disc touching the lower block, drifting up by
+    # 1e-9 m a step, meets the upper block's corner. Its slide along the lower block is clear.
+    import shapely
+    from shapely.geometry import Point
+
+    from pointnav_core.vector.contacts import advance
+    from pointnav_core.vector.floors import FloorTables
+    from pointnav_core.vector.xp import make_arrays
+
+    grid = np.zeros((16, 19), dtype=np.uint8)
+    grid[5:7, 6:8] = OBSTACLE
+    grid[10:12, 7:9] = OBSTACLE
+    floors = FloorTables([Scene.from_array(grid, 0.1)], 0, 0.15, make_arrays("numpy"))
+    blocks = shapely.union_all([shapely.box(0.6, 0.5, 0.8, 0.7), shapely.box(0.7, 1.0, 0.9, 1.2)])
+    x, y = np.array([0.69998013]), np.array([0.85 + 3e-10])
+    scene = np.zeros(1, dtype=np.int64)
+    for _ in range(2):
+        x, y, _ = advance(floors, scene, x, y, np.array([0.05]), np.array([1e-9]), 0.15, max_travel=0.051)
+        assert Point(x[0], y[0]).distance(blocks) >= 0.15 - 2e-9
+    assert x[0] > 0.79

@@ -3,7 +3,7 @@
 The array twin of :func:`pointnav_kinematic.contacts.advance` for one robot per world
 (no robot-robot contacts): each robot moves along its chord to the first wall it would
 overlap (by more than ``_HIT``), stops ``_PLACE`` short of it, slides along the longest
-tangent of a blocking contact that goes into no other contact, and goes on with what is
+tangent of a contact that goes into no other contact, and goes on with what is
 left of the motion. The backend resolves up to 8 contacts per robot and sub-step; here
 every robot runs :data:`EVENTS` rounds at once (a robot done early just idles), so the
 rule is the same. The walls are the edge obstacle squares within reach of each robot's
@@ -149,7 +149,9 @@ def advance(
         bad = blocks(tx, ty)
         eye = a.arange(bad.shape[-1])
         bad = bad & (eye.reshape(1, -1, 1) != eye.reshape(1, 1, -1))  # a tangent runs along its own contact
-        ok = blocked & ~bad.any(-1) & (length > 0.0)
+        # Any contact's tangent may save the motion, not only a blocking one's (a passage
+        # exactly as wide as the disc), as in the backend.
+        ok = touching & ~bad.any(-1) & (length > 0.0)
         # The longest clear tangent, the first of a tie (the backend keeps the first).
         score = xp.where(ok, length, -1.0)
         best = xp.argmax(score, -1)
