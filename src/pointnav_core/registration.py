@@ -23,11 +23,19 @@ from collections.abc import Callable, Mapping, Sequence
 from types import MappingProxyType, ModuleType
 from typing import Any
 
-__all__ = ["ENV_IDS", "PARALLEL_ENV_IDS", "AEC_ENV_IDS", "register_envs", "register_when_imported"]
+__all__ = ["ENV_IDS", "VECTOR_ENV_IDS", "PARALLEL_ENV_IDS", "AEC_ENV_IDS", "register_envs", "register_when_imported"]
 
 #: The Gymnasium (single-robot) ids, each with its lazy ``"module:Class"`` entry point.
 ENV_IDS: Mapping[str, str] = MappingProxyType(
     {"pointnav_core/PointNav-v0": "pointnav_core.env:PointNavEnv"}
+)
+
+#: The batched engine's id: ``gymnasium.make_vec(id, num_envs=N)`` builds a
+#: ``VectorPointNavEnv`` (its ``vector_entry_point``); ``gymnasium.make(id)`` one world, a
+#: ``PointNavEnv``. It is an id of its own because Gymnasium 1.2 refuses a vector entry
+#: point on an id with additional wrappers, and ``PointNav-v0`` needs its ``TaskStepLimit``.
+VECTOR_ENV_IDS: Mapping[str, str] = MappingProxyType(
+    {"pointnav_core/VectorPointNav-v0": "pointnav_core.vector:VectorPointNavEnv"}
 )
 
 #: The PettingZoo parallel (multi-robot) ids, each with its lazy ``"module:function"``.
@@ -59,6 +67,15 @@ def register_gymnasium() -> None:
                 entry_point=entry_point,
                 max_episode_steps=None,
                 additional_wrappers=(step_limit,),
+            )
+
+    for env_id, vector_entry in VECTOR_ENV_IDS.items():
+        if env_id not in gymnasium.registry:
+            gymnasium.register(
+                id=env_id,
+                entry_point=ENV_IDS["pointnav_core/PointNav-v0"],
+                max_episode_steps=None,
+                vector_entry_point=vector_entry,
             )
 
 

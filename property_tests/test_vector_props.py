@@ -1,0 +1,110 @@
+"""The batched engine against one single env per world, for random scenes and actions.
+
+For random grid scenes (clutter, walls, a hole to fall into), fixed random episodes and
+random action sequences, ``VectorPointNavEnv`` matches separate ``PointNavEnv``s on the
+kinematic backend step for step (observations within 1e-4, rewards within 1e-5, the same
+flags, success, SPL and SoftSPL) over whole episodes and their autoresets, on numpy and
+on torch on the CPU.
+"""
+
+from __future__ import annotations
+
+import importlib.util
+
+import numpy as np
+import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+from vector_reference import compare, random_episodes
+
+from pointnav_core.maps import FREE, OBSTACLE, VOID
+from pointnav_core.scenes import Scene
+
+DEVICES = ["numpy"] + (["cpu"] if importlib.util.find_spec("torch") else [])
+
+
+@st.composite
+def cluttered_scenes(draw: st.DrawFn) -> Scene:
+    """A walled room, 12 to 30 cells a side, with random obstacle cells, maybe a hole, and a free patch."""
+    rows, cols = draw(st.integers(12, 30)), draw(st.integers(12, 30))
+    rng = np.random.default_rng(draw(st.integers(0, 2**31 - 1)))
+    grid = np.zeros((rows, cols), np.uint8)
+    grid[rng.random((rows, cols)) < draw(st.floats(0.0, 0.12))] = OBSTACLE
+    grid[0, :] = grid[-1, :] = grid[:, 0] = grid[:, -1] = OBSTACLE
+    if draw(st.booleans()):
+        r, c = draw(st.integers(1, rows - 4)), draw(st.integers(1, cols - 4))
+        grid[r : r + 3, c : c + 3] = VOID
+    # A free 6 x 6 patch somewhere inside, so that the robot always fits.
+    r, c = draw(st.integers(1, rows - 7)), draw(st.integers(1, cols - 7))
+    grid[r : r + 6, c : c + 6] = FREE
+    return Scene.from_array(grid, 0.1)
+
+
+@pytest.mark.parametrize("device", DEVICES)
+@settings(max_examples=8, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(
+    scene=cluttered_scenes(),
+    seed=st.integers(0, 2**31 - 1),
+    n=st.integers(1, 5),
+    steps=st.integers(1, 160),
+    reward_type=st.sampled_from(["l2", "geodesic"]),
+    max_steps=st.integers(5, 80),
+)
+def test_vector_matches_single_envs(device: str, scene: Scene, seed: int, n: int, steps: int, reward_type: str, max_steps: int) -> None:
+    rng = np.random.default_rng(seed)
+    episodes = random_episodes(scene, n, rng)
+    # Overshoot [-1, 1] (clipping), and drive straight ahead often, into walls.
+    actions = rng.uniform(-1.2, 1.2, (steps, n, 2)).astype(np.float32)
+    actions[rng.random((steps, n)) < 0.4, 0] = 1.0
+    task = {"reward_type": reward_type, "termination_config": {"max_steps": max_steps, "max_collisions": 20}}
+    compare(scene, episodes, actions, task=task, device=device)
+
+
+@settings(max_examples=30, deadline=None)
+@given(scene=cluttered_scenes(), seed=st.integers(0, 2**31 - 1))
+def test_fast_path_equals_contact_path(scene: Scene, seed: int) -> None:
+    """Where the clearance table vouches for a step, sweeping it for contacts changes nothing."""
+    from pointnav_core.vector.contacts import advance
+    from pointnav_core.vector.floors import FloorTables
+    from pointnav_core.vector.xp import make_arrays
+
+    rng = np.random.default_rng(seed)
+    radius = 0.18
+    floors = FloorTables([scene], 0, radius, make_arrays("numpy"))
+    points = np.array([scene.get_random_point(0, robot=radius, rng=rng)[1][:2] for _ in range(64)])
+    x, y = points[:, 0], points[:, 1]
+    heading = rng.uniform(-np.pi, np.pi, 64)
+    length = rng.uniform(0.0, 0.05, 64)
+    mx, my = length * np.cos(heading), length * np.sin(heading)
+    zeros = np.zeros(64, dtype=np.int64)
+    row, col, inside = floors.cells(zeros, x, y)
+    fast = inside & (floors.fast[floors.flat_index(zeros, row, col, inside)] > length)
+    nx, ny, contact = advance(floors, zeros, x, y, mx, my, radius, max_travel=0.05)
+    np.testing.assert_allclose(nx[fast], (x + mx)[fast], rtol=0, atol=1e-12)
+    np.testing.assert_allclose(ny[fast], (y + my)[fast], rtol=0, atol=1e-12)
+    assert not contact[fast].any()
+
+
+@settings(max_examples=30, deadline=None)
+@given(scene=cluttered_scenes(), seed=st.integers(0, 2**31 - 1), reach=st.floats(0.0, 0.35))
+def test_wall_table_holds_every_wall_within_reach(scene: Scene, seed: int, reach: float) -> None:
+    """Every edge obstacle square within ``reach`` of a point (shapely's distance) is in its window."""
+    from shapely.geometry import Point, box
+
+    from pointnav_core.vector.contacts import window
+    from pointnav_core.vector.floors import FloorTables
+    from pointnav_core.vector.xp import make_arrays
+
+    rng = np.random.default_rng(seed)
+    floors = FloorTables([scene], 0, 0.0, make_arrays("numpy"))
+    codes = np.asarray(scene.floors[0].codes)
+    rows, cols = codes.shape
+    x, y = rng.uniform(0.0, cols * 0.1, 16), rng.uniform(0.0, rows * 0.1, 16)
+    x0, y0, _, _, valid = window(floors, np.zeros(16, dtype=np.int64), x, y, reach)
+    edge = np.frombuffer(floors.geometries[0].edge, dtype=np.uint8).reshape(rows, cols).astype(bool)
+    for i in range(16):
+        got = {(round(a, 9), round(b, 9)) for a, b in zip(x0[i][valid[i]], y0[i][valid[i]])}
+        for r, c in zip(*np.nonzero(edge)):
+            square = box(c * 0.1, r * 0.1, (c + 1) * 0.1, (r + 1) * 0.1)
+            if square.distance(Point(x[i], y[i])) <= reach:
+                assert (round(c * 0.1, 9), round(r * 0.1, 9)) in got

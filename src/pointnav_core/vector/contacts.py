@@ -1,0 +1,198 @@
+"""Batched contact resolution: robots near obstacles advance with swept-disc contacts.
+
+The array twin of :func:`pointnav_kinematic.contacts.advance` for one robot per world
+(no robot-robot contacts): each robot moves along its chord to the first wall it would
+overlap (by more than ``_HIT``), stops ``_PLACE`` short of it, slides along the longest
+tangent of a contact that goes into no other contact, and goes on with what is
+left of the motion. The backend resolves up to 8 contacts per robot and sub-step; here
+every robot runs :data:`EVENTS` rounds at once (a robot done early just idles), so the
+rule is the same. The walls are the edge obstacle squares within reach of each robot's
+cell (:meth:`FloorTables.wall_table`, one gather), in row-major order, as the backend
+lists them; only the :data:`CONTACTS` nearest take part in sliding (a disc touches at
+most four squares).
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+from pointnav_core.vector.floors import FloorTables
+from pointnav_core.vector.sweep import enter_rounded_square, square_distance
+
+__all__ = ["CONTACTS", "EVENTS", "advance"]
+
+_HIT = 0.5e-9
+_PLACE = 1.0e-9
+_ACTIVE = 2.0e-9
+#: Contact events resolved per robot and step (the backend's _EVENTS_PER_ROBOT).
+EVENTS = 8
+#: Nearest walls kept as possible contacts of a robot while it slides.
+CONTACTS = 6
+
+
+def window(floors: FloorTables, scene: Any, x: Any, y: Any, reach: float) -> tuple[Any, Any, Any, Any, Any]:
+    """The edge obstacle squares within ``reach`` (m) of each robot's cell: corners and mask, (M, K).
+
+    In row-major order, as the backend lists them; a robot off the map has none.
+    """
+    a = floors.arrays
+    xp = a.xp
+    table = floors.wall_table(reach)
+    row0, col0, inside = floors.cells(scene, x, y)
+    ids = table[floors.flat_index(scene, row0, col0, inside)]
+    valid = (ids >= 0) & inside[:, None]
+    sc = scene.reshape(-1, 1)
+    row, col = _divmod(xp, xp.where(valid, ids - floors.offset[sc], 0), floors.width[sc])
+    res = floors.res[sc]
+    # Slots that hold no wall move far away, so that no distance test lands inside one.
+    x0 = xp.where(valid, floors.ox[sc] + col * res, 1e9)
+    y0 = floors.oy[sc] + row * res
+    return x0, y0, x0 + res, y0 + res, valid
+
+
+def _divmod(xp: Any, a: Any, b: Any) -> tuple[Any, Any]:
+    q = xp.div(a, b, rounding_mode="floor") if hasattr(xp, "Tensor") else a // b
+    return q, a - q * b
+
+
+def _nearest(xp: Any, dist: Any, k: int) -> Any:
+    """Indices of the ``k`` smallest distances of each row, in their original order."""
+    order = xp.argsort(dist, -1)[..., :k]
+    return xp.sort(order, -1)[0] if hasattr(xp, "Tensor") else xp.sort(order, -1)
+
+
+def _take(xp: Any, a: Any, idx: Any) -> Any:
+    return xp.take_along_axis(a, idx, -1) if not hasattr(xp, "Tensor") else xp.gather(a, -1, idx)
+
+
+def advance(
+    floors: FloorTables, scene: Any, x: Any, y: Any, mx: Any, my: Any, radius: float, max_travel: float
+) -> tuple[Any, Any, Any]:
+    """Move robots by their chords ``(mx, my)`` (m) with contacts; new ``x``, ``y`` and contact flags.
+
+    Parameters
+    ----------
+    floors : FloorTables
+    scene : int array (M,)
+        Each robot's scene index.
+    x, y, mx, my : float arrays (M,)
+        Start positions and chords, in metres.
+    radius : float
+        Robot radius (m).
+    max_travel : float
+        The longest chord any step may have (m): the wall table is built for it.
+    """
+    a = floors.arrays
+    xp = a.xp
+    inf = math.inf
+    span = xp.sqrt(mx * mx + my * my)
+    max_span = float(span.max()) if span.shape[0] else 0.0
+    reach = radius + max_span + 4.0 * _ACTIVE
+    if max_span > max_travel:
+        raise ValueError(f"a chord of {max_span} m is longer than max_travel {max_travel} m")
+    wx0, wy0, wx1, wy1, valid = window(floors, scene, x, y, radius + max_travel + 4.0 * _ACTIVE)
+    d0 = square_distance(xp, x[:, None], y[:, None], wx0, wy0, wx1, wy1)[0]
+    # Only walls within reach of the start can be met (sliding only shortens the motion):
+    # keep the most any robot has, nearest first, so that every later test is on few walls.
+    in_reach = valid & (d0 <= reach)
+    k = max(int(in_reach.sum(-1).max()) if in_reach.shape[0] else 0, 1)
+    order = _nearest(xp, xp.where(in_reach, d0, inf), k)
+    wx0, wy0, wx1, wy1, valid, d0 = (_take(xp, v, order) for v in (wx0, wy0, wx1, wy1, in_reach, d0))
+    n_contacts = min(CONTACTS, valid.shape[1])
+    hit_r = max(radius - _HIT, _HIT)
+    start_x, start_y = x, y
+    contact = xp.zeros_like(x) > 1.0
+    left = xp.ones_like(x)
+    done = span == 0.0
+    forced_all = xp.zeros_like(wx0) > 1.0
+
+    def resolve(x: Any, y: Any, mx: Any, my: Any, left: Any, forced_all: Any) -> tuple[Any, Any, Any]:
+        # Only a moving robot within _ACTIVE of some wall can be blocked: the others keep going.
+        dist_all = square_distance(xp, x[:, None], y[:, None], wx0, wy0, wx1, wy1)[0]
+        need = a.nonzero((valid & (dist_all <= radius + _ACTIVE)).any(-1) & ((mx != 0.0) | (my != 0.0)))
+        hit = xp.zeros_like(x) > 1.0
+        if not need.shape[0]:
+            return mx, my, hit
+        sub = (v[need] for v in (x, y, mx, my, left, forced_all, dist_all, wx0, wy0, wx1, wy1, valid))
+        smx, smy, shit = _slide(*sub)
+        mx, my = mx.clone() if a.is_torch else mx.copy(), my.clone() if a.is_torch else my.copy()
+        mx[need], my[need], hit[need] = smx, smy, shit
+        return mx, my, hit
+
+    def _slide(
+        x: Any, y: Any, mx: Any, my: Any, left: Any, forced_all: Any, dist_all: Any,
+        wx0: Any, wy0: Any, wx1: Any, wy1: Any, valid: Any,
+    ) -> tuple[Any, Any, Any]:
+        # The walls within _ACTIVE of touching are among the nearest few: slide against those.
+        near = _nearest(xp, xp.where(valid, dist_all, inf), n_contacts)
+        cx0, cy0, cx1, cy1, cvalid, forced = (
+            _take(xp, v, near) for v in (wx0, wy0, wx1, wy1, valid, forced_all)
+        )
+        dist, nx, ny = square_distance(xp, x[:, None], y[:, None], cx0, cy0, cx1, cy1)
+        touching = cvalid & (dist <= radius + _ACTIVE)
+
+        def blocks(tx: Any, ty: Any) -> Any:  # (M, K) motions against (M, C) contacts
+            into = tx[..., None] * nx[:, None, :] + ty[..., None] * ny[:, None, :] < 0.0
+            t = enter_rounded_square(
+                xp, x[:, None, None], y[:, None, None], tx[..., None], ty[..., None],
+                cx0[:, None, :], cy0[:, None, :], cx1[:, None, :], cy1[:, None, :], hit_r,
+            )
+            return touching[:, None, :] & into & (forced[:, None, :] | (t <= left[:, None, None]))
+
+        moving = (mx != 0.0) | (my != 0.0)
+        blocked = blocks(mx[:, None], my[:, None])[:, 0, :] & moving[:, None]
+        any_blocked = blocked.any(-1)
+        dot = mx[:, None] * nx + my[:, None] * ny
+        tx, ty = mx[:, None] - dot * nx, my[:, None] - dot * ny
+        length = tx * tx + ty * ty
+        bad = blocks(tx, ty)
+        eye = a.arange(bad.shape[-1])
+        bad = bad & (eye.reshape(1, -1, 1) != eye.reshape(1, 1, -1))  # a tangent runs along its own contact
+        # Any contact's tangent may save the motion, not only a blocking one's (a passage
+        # exactly as wide as the disc), as in the backend.
+        ok = touching & ~bad.any(-1) & (length > 0.0)
+        # The longest clear tangent, the first of a tie (the backend keeps the first).
+        score = xp.where(ok, length, -1.0)
+        best = xp.argmax(score, -1)
+        has = _take(xp, score, best[:, None])[:, 0] > 0.0
+        sx = xp.where(has, _take(xp, tx, best[:, None])[:, 0], 0.0)
+        sy = xp.where(has, _take(xp, ty, best[:, None])[:, 0], 0.0)
+        return xp.where(any_blocked, sx, mx), xp.where(any_blocked, sy, my), any_blocked
+
+    mx, my, hit = resolve(x, y, mx, my, left, forced_all)
+    contact = contact | hit
+    for _ in range(EVENTS):
+        dist, nx, ny = square_distance(xp, x[:, None], y[:, None], wx0, wy0, wx1, wy1)
+        speed = xp.sqrt(mx * mx + my * my)
+        towards = (mx[:, None] * nx + my[:, None] * ny < 0.0) & valid
+        towards = towards & ~(dist - hit_r > (speed * left)[:, None])
+        t = enter_rounded_square(xp, x[:, None], y[:, None], mx[:, None], my[:, None], wx0, wy0, wx1, wy1, hit_r)
+        t = xp.where(towards, t, inf)
+        first = xp.argmin(t, -1)
+        t_first = _take(xp, t, first[:, None])[:, 0]
+        event = (t_first < left) & ~done
+        # No event: the rest of the motion, and this robot is done.
+        free = ~event & ~done
+        x = xp.where(free, x + mx * left, x)
+        y = xp.where(free, y + my * left, y)
+        left = xp.where(free, 0.0, left)
+        done = done | free
+        if not a.any(event):
+            break
+        ex0, ey0, ex1, ey1 = (_take(xp, v, first[:, None])[:, 0] for v in (wx0, wy0, wx1, wy1))
+        place = enter_rounded_square(xp, x, y, mx, my, ex0, ey0, ex1, ey1, radius + _PLACE)
+        step = xp.minimum(xp.maximum(place, xp.zeros_like(place)), t_first)
+        step = xp.where(event, step, 0.0)
+        x, y = x + mx * step, y + my * step
+        left = left - step
+        forced_all = event[:, None] & (a.arange(valid.shape[1]).reshape(1, -1) == first[:, None])
+        nmx, nmy, hit = resolve(x, y, mx, my, left, forced_all)
+        mx, my = xp.where(event, nmx, mx), xp.where(event, nmy, my)
+        contact = contact | (hit & event)
+    # Safety net against rounding: never end deeper in a wall than at the start.
+    depth_end = xp.amax(xp.where(valid, radius - square_distance(xp, x[:, None], y[:, None], wx0, wy0, wx1, wy1)[0], -inf), -1)
+    depth_start = xp.amax(xp.where(valid, radius - d0, -inf), -1)
+    moved = (x != start_x) | (y != start_y)
+    undo = contact & moved & (depth_end > _HIT) & (depth_end > depth_start)
+    return xp.where(undo, start_x, x), xp.where(undo, start_y, y), contact

@@ -1,0 +1,388 @@
+"""``VectorPointNavEnv``: many point-navigation worlds stepped together as arrays.
+
+Every world is a :class:`~pointnav_core.env.PointNavEnv` with one robot on the kinematic
+backend, and the batched step reproduces them (drive, contacts and sliding, the task's
+rewards, terminations, SPL and SoftSPL, the flat ``low_dim`` observation) with array
+operations over all worlds at once: there is no Python loop over worlds on the step path.
+The same code runs on numpy (``device="numpy"``) and on torch (``"cpu"``, ``"cuda"``).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping, Sequence
+from typing import Any
+
+import gymnasium as gym
+import numpy as np
+from gymnasium.vector import AutoresetMode, VectorEnv
+
+from pointnav_core import _envcommon, scenes, validation
+from pointnav_core.vector.contacts import advance
+from pointnav_core.vector.episodes import EpisodePool
+from pointnav_core.vector.floors import FloorTables
+from pointnav_core.vector.xp import make_arrays
+
+__all__ = ["VectorPointNavEnv"]
+
+_GRAVITY = 9.81
+_MIN_FIRST_DROP = 0.05
+_FALL_SPEED = 1.0  # the kinematic backend's default fall_speed (m/s)
+_MAX_TURN = 0.25  # rad per control step the backend resolves without sub-steps
+
+
+def _default_scene() -> scenes.Scene:
+    # The single env's default house, its floor as grid cells only (see docs/decisions.md).
+    house = scenes.rooms(seed=0)
+    floor = house.floors[0]
+    return scenes.Scene.from_array(np.asarray(floor.codes), floor.resolution, origin=tuple(floor.origin))
+
+
+class VectorPointNavEnv(VectorEnv):
+    """``num_envs`` single-robot point-navigation worlds, stepped as arrays.
+
+    A ``gymnasium.vector.VectorEnv`` with next-step autoreset. Each world behaves as a
+    :class:`~pointnav_core.env.PointNavEnv` with ``flatten_obs=True`` on the kinematic
+    backend (same reward terms, terminations, SPL and SoftSPL; the differences are in
+    ``docs/decisions.md``, "The batched engine").
+
+    Parameters
+    ----------
+    num_envs : int
+        Worlds, >= 1.
+    n_robots : int
+        Robots per world; only 1 is supported so far.
+    scene : Scene or sequence of Scene, optional
+        World ``i`` runs on ``scene[i % len(scene)]``. Floors must be grid cells only (no
+        obstacle polygons). Default: the single env's default house as a grid.
+    robot : RobotSpec or dict, optional
+        Differential drive only.
+    task : dict, optional
+        ``PointNavigationTask`` keyword arguments, as for the single env (its default
+        ``path_range`` too). Custom terms are not supported.
+    sensors : None
+        No sensors yet.
+    device : str
+        ``"numpy"`` (default), or torch on ``"cpu"`` or ``"cuda[:n]"``.
+    seed : int, optional
+        Seeds the episode pools and the draws from them.
+    pool_size : int
+        Episodes prepared per scene, >= 1 (each with its settled goal field).
+    action_frequency : float
+        Control steps per second (Hz).
+    max_episode_steps : int, optional
+        The task's ``max_steps``, as ``gymnasium.make(..., max_episode_steps=N)`` sets it for
+        the single env (the derived ``path_range`` follows).
+
+    Notes
+    -----
+    ``step`` takes actions of shape ``(num_envs, 2)`` (or ``(num_envs, 1, 2)``) in
+    ``[-1, 1]`` (clipped) and returns observations ``(num_envs, 8)`` float32, rewards
+    float64, terminated and truncated bool, and ``info``, a dict of arrays of shape
+    ``(num_envs,)``: ``success``, ``spl``, ``soft_spl``, ``path_length``,
+    ``geodesic_dist``, ``distance_to_goal``, ``collisions``, ``episode_length``,
+    ``in_contact``, ``reward_potential``, ``reward_collision``, ``reward_pointgoal`` and
+    ``autoreset`` (the worlds this step reset instead of stepping). Arrays are numpy with
+    ``device="numpy"`` and torch tensors on the device otherwise.
+
+    Examples
+    --------
+    >>> from pointnav_core.scenes import Scene
+    >>> grid = np.zeros((20, 20), np.uint8)
+    >>> grid[[0, -1], :] = grid[:, [0, -1]] = 1  # a walled 2 x 2 m room
+    >>> env = VectorPointNavEnv(4, scene=Scene.from_array(grid, 0.1), seed=0, pool_size=2,
+    ...                         task={"path_range": (0.5, 1.5)})
+    >>> obs, info = env.reset()
+    >>> obs.shape, obs.dtype
+    ((4, 8), dtype('float32'))
+    >>> obs, reward, terminated, truncated, info = env.step(np.zeros((4, 2)))
+    >>> info["episode_length"].tolist(), reward.tolist()  # standing still: no progress
+    ([1, 1, 1, 1], [0.0, 0.0, 0.0, 0.0])
+    """
+
+    metadata = {"autoreset_mode": AutoresetMode.NEXT_STEP, "render_modes": []}
+
+    def __init__(
+        self,
+        num_envs: int = 1,
+        n_robots: int = 1,
+        scene: scenes.Scene | Sequence[scenes.Scene] | None = None,
+        robot: Any = None,
+        task: Mapping[str, Any] | None = None,
+        sensors: Mapping[str, Any] | None = None,
+        device: str = "numpy",
+        seed: int | None = None,
+        pool_size: int = 8,
+        action_frequency: float = 10.0,
+        max_episode_steps: int | None = None,
+    ) -> None:
+        from pointnav_core.env import PointNavEnv
+
+        self.num_envs = validation.integer("num_envs", num_envs, minimum=1)
+        if validation.integer("n_robots", n_robots, minimum=1) != 1:
+            raise ValueError(f"n_robots must be 1: the batched engine has one robot per world so far, got {n_robots}")
+        if sensors is not None:
+            raise ValueError(f"sensors must be None: the batched engine has no sensors yet, got {sensors!r}")
+        if task is not None and not isinstance(task, Mapping):
+            raise ValueError(f"task must be None or a dict of PointNavigationTask arguments, got {task!r}")
+        for key in ("termination_conditions", "reward_functions", "observation_terms"):
+            if task is not None and task.get(key) is not None:
+                raise ValueError(f"task: {key} is not supported by the batched engine")
+        self.pool_size = validation.integer("pool_size", pool_size, minimum=1)
+        self.arrays = make_arrays(device)
+        self.device = device
+        scene_list = [scene] if isinstance(scene, scenes.Scene) else list(scene) if scene is not None else [_default_scene()]
+        if not scene_list or not all(isinstance(s, scenes.Scene) for s in scene_list):
+            raise ValueError(f"scene must be a Scene or a non-empty sequence of Scenes, got {scene!r}")
+        self.robot = _envcommon.make_robot(robot)
+        if self.robot.drive != "differential":
+            raise ValueError(f"robot must have a differential drive in the batched engine, got {self.robot.drive!r}")
+        self.scenes = scene_list
+        self._samplers = [
+            PointNavEnv(scene=s, robot=self.robot, task=dict(task or {}), flatten_obs=True, action_frequency=action_frequency)
+            for s in scene_list
+        ]
+        if max_episode_steps is not None:
+            for env in self._samplers:  # sets the task's max_steps and refits a derived path_range
+                env.max_episode_steps = max_episode_steps
+        first = self._samplers[0]
+        self.action_frequency = first.action_frequency
+        self.dt = 1.0 / self.action_frequency
+        self.task = t = first.task
+        cfg, rcfg = t.termination_config, t.reward_config
+        self.max_steps, self.max_collisions = int(cfg["max_steps"]), int(cfg["max_collisions"])
+        self.fall_height, self.goal_tolerance = float(cfg["fall_height"]), t.goal_tolerance
+        self.r_potential, self.r_collision, self.r_pointgoal = (float(rcfg[k]) for k in ("r_potential", "r_collision", "r_pointgoal"))
+        self.geodesic_reward = t.reward_type == "geodesic"
+        self.goal_in_polar = t.goal_in_polar
+        spec = self.robot
+        if spec.max_angular_velocity * self.dt > _MAX_TURN or spec.max_linear_velocity * self.dt > 0.5 * min(
+            float(s.floors[t.floor].resolution) for s in scene_list
+        ):
+            raise ValueError(
+                f"action_frequency {self.action_frequency} Hz is too low for the batched engine: one control "
+                "step may turn at most 0.25 rad and drive at most half a cell (the kinematic backend's sub-step)"
+            )
+        a = self.arrays
+        self.floors = FloorTables(scene_list, t.floor, spec.radius, a)
+        # A chord is never longer than its arc; the margin covers rounding.
+        self._max_travel = spec.max_linear_velocity * self.dt * (1.0 + 1e-9) + 1e-12
+        bounds = [env.task.observation_bounds for env in self._samplers]
+        self._low = a.asarray(np.stack([b[0] for b in bounds]).astype(np.float64))
+        self._high = a.asarray(np.stack([b[1] for b in bounds]).astype(np.float64))
+        low = np.min([b[0] for b in bounds], axis=0)
+        high = np.max([b[1] for b in bounds], axis=0)
+        self.single_observation_space = gym.spaces.Box(low, high, dtype=np.float32)
+        self.single_action_space = first.action_space
+        self.observation_space = gym.vector.utils.batch_space(self.single_observation_space, self.num_envs)
+        self.action_space = gym.vector.utils.batch_space(self.single_action_space, self.num_envs)
+        self._rng = np.random.default_rng(seed)
+        self._world_scene = a.asarray(np.arange(self.num_envs) % len(scene_list), a.i64)
+        self._fixed: Any = None
+        self.pool: EpisodePool | None = None  # sampled at the first reset that needs it
+        n = self.num_envs
+        self._state = {k: a.zeros(n) for k in ("x", "y", "yaw", "z", "vx", "vy", "vz", "w", "gx", "gy", "d0", "pot", "path", "dist")}
+        self._field = a.zeros(n, a.i64)
+        self._geo_metric = a.zeros(n, a.boolean)
+        self._steps = a.zeros(n, a.i64)
+        self._collisions = a.zeros(n, a.i64)
+        self._needs_reset = a.zeros(n, a.boolean)
+        self._started = False
+
+    # ------------------------------------------------------------------ pools
+    def _build_pool(self, fixed: Sequence[tuple[Any, float, Any, int]]) -> None:
+        size = 0 if fixed else self.pool_size
+        seeds = self._rng.integers(2**31, size=size * len(self.scenes))
+        self.pool = EpisodePool(self._samplers, size, seeds, self.arrays, fixed)
+
+    # ------------------------------------------------------------------ Gymnasium API
+    def reset(self, *, seed: int | None = None, options: dict[str, Any] | None = None) -> tuple[Any, dict[str, Any]]:
+        """Reset every world. ``options={"episodes": [(start_xy, yaw, goal_xy), ...]}`` (one per
+        world, yaw in rad) fixes each world's episode, at this reset and every autoreset, until a
+        reset without it; a new ``seed`` redraws the pools."""
+        a = self.arrays
+        if options is not None and not isinstance(options, Mapping):
+            raise ValueError(f"options must be None or a dict, got {options!r}")
+        episodes = (options or {}).get("episodes")
+        if seed is not None:
+            self._rng = np.random.default_rng(validation.integer("seed", seed, minimum=0))
+        if episodes is not None:
+            if len(episodes) != self.num_envs:
+                raise ValueError(f"options['episodes'] must hold one episode per world ({self.num_envs}), got {len(episodes)}")
+            scene_of = a.numpy(self._world_scene)
+            fixed = []
+            for i, (start, yaw, goal) in enumerate(episodes):
+                s = int(scene_of[i])
+                env = self._samplers[s]
+                for name, xy in (("start", start), ("goal", goal)):
+                    if not env.scene.is_usable(env.task.floor, xy, self.robot):
+                        raise ValueError(f"options['episodes'][{i}]: {name} {list(xy)} is not usable by the robot")
+                fixed.append((start, float(yaw), goal, s))
+            self._build_pool(fixed)
+            self._fixed = a.asarray(self.pool.n_sampled + np.arange(self.num_envs), a.i64)
+        elif self.pool is None or seed is not None or self._fixed is not None:
+            self._fixed = None
+            self._build_pool(())
+        with np.errstate(invalid="ignore", divide="ignore"):
+            self._reset_worlds(a.full(self.num_envs, True, a.boolean))
+        self._started = True
+        obs = self._observe()
+        with np.errstate(invalid="ignore", divide="ignore"):
+            return obs, self._info(a.zeros(self.num_envs, a.boolean), a.zeros(self.num_envs), a.zeros(self.num_envs),
+                                   a.zeros(self.num_envs), a.zeros(self.num_envs, a.boolean), a.zeros(self.num_envs, a.boolean))
+
+    def _reset_worlds(self, mask: Any) -> None:
+        a, xp, st = self.arrays, self.arrays.xp, self._state
+        n = self.num_envs
+        if self._fixed is not None:
+            ep = self._fixed
+        else:
+            k = a.asarray(self._rng.integers(self.pool_size, size=n), a.i64)
+            ep = self._world_scene * self.pool.pool_size + k
+        p = self.pool
+        idx = a.nonzero(mask)
+        e = ep[idx]
+        for key, src in (("x", p.sx), ("y", p.sy), ("yaw", p.syaw), ("gx", p.gx), ("gy", p.gy), ("d0", p.d0)):
+            st[key][idx] = src[e]
+        st["z"][idx] = self.floors.height[self._world_scene[idx]]
+        for key in ("vx", "vy", "vz", "w", "path"):
+            st[key][idx] = 0.0
+        self._field[idx] = e
+        self._steps[idx] = 0
+        self._collisions[idx] = 0
+        d0 = st["d0"][idx]
+        geo = self.geodesic_reward & (d0 < math.inf)
+        self._geo_metric[idx] = geo
+        x, y = st["x"][idx], st["y"][idx]
+        dist = p.fields.distance(e, x, y)
+        st["dist"][idx] = dist
+        l2 = xp.sqrt((st["gx"][idx] - x) ** 2 + (st["gy"][idx] - y) ** 2)
+        st["pot"][idx] = xp.where(geo, xp.where(dist < math.inf, dist, d0), l2)
+        self._needs_reset[idx] = False
+
+    def check_actions(self, actions: Any) -> Any:
+        """``actions`` as a float64 array ``(num_envs, 2)``; ValueError naming ``actions`` if bad."""
+        a = self.arrays
+        shape = tuple(getattr(actions, "shape", np.shape(actions)))
+        n = self.num_envs
+        if shape not in ((n, 2), (n, 1, 2)):
+            raise ValueError(f"actions must have shape ({n}, 2) or ({n}, 1, 2), got {shape}")
+        arr = a.asarray(actions).reshape(n, 2)
+        if not bool(a.xp.isfinite(arr).all()):
+            raise ValueError("actions must be finite (no NaN or infinity)")
+        return arr
+
+    def step(self, actions: Any) -> tuple[Any, Any, Any, Any, dict[str, Any]]:
+        """Advance every world one control step (worlds that ended last step reset instead)."""
+        with np.errstate(invalid="ignore", divide="ignore"):  # inf distances are masked by where
+            return self._step(actions)
+
+    def _step(self, actions: Any) -> tuple[Any, Any, Any, Any, dict[str, Any]]:
+        if not self._started:
+            raise RuntimeError("call reset() before step()")
+        a, xp, st = self.arrays, self.arrays.xp, self._state
+        act = self.check_actions(actions)
+        spec = self.robot
+        one = 1.0
+        v0, v1 = act[:, 0], act[:, 1]
+        vmax, wmax = spec.max_linear_velocity, spec.max_angular_velocity
+        vx = xp.where(v0 >= one, vmax, xp.where(v0 <= -one, -vmax, v0 * vmax))
+        w = xp.where(v1 >= one, wmax, xp.where(v1 <= -one, -wmax, v1 * wmax))
+        dt = self.dt
+        x0, y0, yaw0 = st["x"], st["y"], st["yaw"]
+        # The exact arc over the step (state.drive_arc with vy = 0).
+        half = 0.5 * w * dt
+        safe = xp.where(half != 0.0, half, 1.0)
+        s = dt * xp.where(half != 0.0, xp.sin(safe) / safe, 1.0)
+        mid = yaw0 + half
+        dx = s * (vx * xp.cos(mid) - 0.0 * xp.sin(mid))
+        dy = s * (vx * xp.sin(mid) + 0.0 * xp.cos(mid))
+        travel = xp.abs(vx) * dt
+        scene = self._world_scene
+        row, col, inside = self.floors.cells(scene, x0, y0)
+        budget = self.floors.fast[self.floors.flat_index(scene, row, col, inside)]
+        fast = inside & (budget > travel)
+        x, y, yaw = x0 + dx, y0 + dy, yaw0 + w * dt
+        vel_x, vel_y, vel_w = dx / dt, dy / dt, w
+        vz = xp.zeros_like(x)
+        contact = xp.zeros_like(x) > 1.0
+        z = st["z"]
+        slow = a.nonzero(~fast)
+        if slow.shape[0]:
+            sx, sy, c = advance(self.floors, scene[slow], x0[slow], y0[slow], dx[slow], dy[slow], spec.radius, self._max_travel)
+            syaw = yaw0[slow] + w[slow] * dt
+            fall = self.floors.is_void(scene[slow], sx, sy)
+            drop = max(_FALL_SPEED * dt + 0.5 * _GRAVITY * dt * dt, _MIN_FIRST_DROP)
+            x[slow], y[slow], yaw[slow] = sx, sy, syaw
+            vel_x[slow] = (sx - x0[slow]) / dt
+            vel_y[slow] = (sy - y0[slow]) / dt
+            vel_w = xp.where(fast, vel_w, (yaw - yaw0) / dt)
+            vz[slow] = xp.where(fall, -drop / dt, xp.zeros_like(sx))
+            z = z.clone() if a.is_torch else z.copy()
+            z[slow] = xp.where(fall, z[slow] - drop, z[slow])
+            contact[slow] = c
+        # --- the task's accounting (PointNavigationTask.step)
+        path = st["path"] + xp.sqrt((x - x0) ** 2 + (y - y0) ** 2)
+        steps = self._steps + 1
+        collisions = self._collisions + a.to_int(contact)
+        dist = self.pool.fields.distance(self._field, x, y)
+        gx, gy = st["gx"], st["gy"]
+        l2 = xp.sqrt((gx - x) ** 2 + (gy - y) ** 2)
+        pot = xp.where(self._geo_metric, xp.where(dist < math.inf, dist, st["pot"]), l2)
+        success = l2 < self.goal_tolerance
+        fell = z < self.floors.height[scene] - self.fall_height
+        terminated = (collisions > self.max_collisions) | fell | success
+        truncated = steps >= self.max_steps
+        r_pot = self.r_potential * (st["pot"] - pot)
+        zero = xp.zeros_like(x)  # torch.where of two numbers would give float32
+        r_col = xp.where(contact, -self.r_collision, zero)
+        r_goal = xp.where(success, self.r_pointgoal, zero)
+        reward = ((0.0 + r_pot) + r_col) + r_goal
+        # Commit, then reset the worlds that ended on the previous step (next-step autoreset).
+        st.update(x=x, y=y, yaw=yaw, z=z, vx=vel_x, vy=vel_y, vz=vz, w=vel_w, path=path, dist=dist, pot=pot)
+        self._steps, self._collisions = steps, collisions
+        resetting = self._needs_reset.clone() if a.is_torch else self._needs_reset.copy()
+        if a.any(resetting):
+            self._reset_worlds(resetting)
+            keep = ~resetting
+            reward = xp.where(keep, reward, 0.0)
+            terminated, truncated, success, contact = terminated & keep, truncated & keep, success & keep, contact & keep
+            r_pot, r_col, r_goal = (xp.where(keep, r, 0.0) for r in (r_pot, r_col, r_goal))
+        self._needs_reset = terminated | truncated
+        info = self._info(success, r_pot, r_col, r_goal, contact, resetting)
+        return self._observe(), reward, terminated, truncated, info
+
+    # ------------------------------------------------------------------ observation and info
+    def _observe(self) -> Any:
+        a, xp, st = self.arrays, self.arrays.xp, self._state
+        c, s = xp.cos(st["yaw"]), xp.sin(st["yaw"])
+        dx, dy = st["gx"] - st["x"], st["gy"] - st["y"]
+        lx, ly = c * dx + s * dy, c * dy - s * dx
+        if self.goal_in_polar:
+            rho = xp.sqrt(lx * lx + ly * ly)
+            phi = xp.where(rho > 0.0, xp.arctan2(ly, lx), 0.0)
+            lx, ly = rho, xp.where(phi == -math.pi, math.pi, phi)
+        vx, vy = st["vx"], st["vy"]
+        zero = xp.zeros_like(vx)
+        obs = xp.stack([lx, ly, c * vx + s * vy, c * vy - s * vx, st["vz"], zero, zero, st["w"]], -1)
+        sc = self._world_scene
+        obs = xp.minimum(xp.maximum(obs, self._low[sc]), self._high[sc])
+        return obs.to(xp.float32) if a.is_torch else obs.astype(np.float32)
+
+    def _info(self, success: Any, r_pot: Any, r_col: Any, r_goal: Any, contact: Any, resetting: Any) -> dict[str, Any]:
+        xp, st = self.arrays.xp, self._state
+        d0, length, d_t = st["d0"], st["path"], st["dist"]
+        finite = d0 < math.inf
+        eff = xp.where(length <= d0, 1.0, d0 / xp.where(length > 0.0, length, 1.0))
+        spl = xp.where(success & finite, eff, 0.0)
+        progress = xp.where(d0 > 0.0, 1.0 - d_t / xp.where(d0 > 0.0, d0, 1.0), xp.where(d_t == 0.0, 1.0, xp.zeros_like(d_t)))
+        soft = xp.where(finite & (progress > 0.0), progress * eff, 0.0)
+        info = {
+            "success": success, "spl": spl, "soft_spl": soft, "path_length": length, "geodesic_dist": d0,
+            "distance_to_goal": d_t, "collisions": self._collisions, "episode_length": self._steps,
+            "in_contact": contact, "reward_potential": r_pot, "reward_collision": r_col,
+            "reward_pointgoal": r_goal, "autoreset": resetting,
+        }
+        # Fresh arrays: the engine's state arrays are written in place at the next autoreset.
+        copy = (lambda v: v.clone()) if self.arrays.is_torch else (lambda v: v.copy())
+        return {key: copy(value) for key, value in info.items()}

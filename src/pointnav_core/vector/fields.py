@@ -1,0 +1,133 @@
+"""Goal fields as arrays: every cell's root, so that a geodesic lookup is one gather.
+
+:meth:`pointnav_core.tangent_field.GoalField.distance` answers from a per-cell root
+table that it fills lazily, a block of cells at a time. :func:`settle` fills the whole
+table once (the same blocks, the same rule), and :class:`FieldTables` stores the
+tables of many goals end to end: per grid cell its kind (0 unreachable, 1 straight to
+the goal, 2 by a label of the Dijkstra search) and label, and per label the arc node
+and cost. :meth:`FieldTables.distance` then evaluates ``GoalField.distance``'s formula
+for every robot at once. Because the single env reads the same (now settled) table of
+the same cached field, both give the same numbers.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from typing import Any
+
+import numpy as np
+
+from pointnav_core.tangent_field import _BLOCK, _UNCHECKED, GoalField
+from pointnav_core.tangent_graph import _ANG_TOL, _TWO_PI
+from pointnav_core.vector.xp import Arrays
+
+__all__ = ["FieldTables", "settle"]
+
+
+def settle(field: GoalField) -> dict[str, Any]:
+    """Check every block of ``field``'s root table and settle every cell; the table."""
+    t = field._table if field._table is not None else field._build_table()
+    h, w = field.planner.geo.shape
+    for r0 in range(0, h, _BLOCK):
+        for c0 in range(0, w, _BLOCK):
+            if not t["done"][(r0 // _BLOCK) * t["blocks_w"] + c0 // _BLOCK]:
+                field._check_block(r0 * w + c0)
+    for i in np.flatnonzero(t["kind"] == 3):
+        field._settle_cell(int(i))
+    assert not (t["kind"] == _UNCHECKED).any()
+    return t
+
+
+class FieldTables:
+    """The settled root tables of many goal fields, end to end, on one device.
+
+    Parameters
+    ----------
+    fields : sequence of GoalField
+        All from planners of one robot radius.
+    arrays : Arrays
+    """
+
+    def __init__(self, fields: Sequence[GoalField], arrays: Arrays) -> None:
+        kinds, labels, goal, geo, lab_arrays = [], [], [], [], []
+        cell_off = lab_off = 0
+        for field in fields:
+            t = settle(field)
+            p = field.planner
+            h, w = p.geo.shape
+            near = np.asarray(p.near_usable, dtype=np.int64).ravel()
+            kind = np.where(near >= 0, t["kind"][np.maximum(near, 0)], 0).astype(np.int64)
+            label = np.where(kind == 2, t["label"][np.maximum(near, 0)], 0).astype(np.int64)
+            s = field._search
+            node = np.asarray(s.node, dtype=np.int64)
+            side = np.asarray(s.side, dtype=np.float64)
+            pos = np.asarray(s.pos, dtype=np.float64)
+            n_lab = len(node)
+            ccw = np.where(side > 0, pos, p.span[node] - pos) if n_lab else pos
+            ang = p.phi0[node] + ccw if n_lab else pos
+            lab_arrays.append(np.stack([
+                np.asarray(s.cost, dtype=np.float64), p.cx[node], p.cy[node], side, p.phi0[node],
+                p.span[node], pos, p.cx[node] + p.radius * np.cos(ang), p.cy[node] + p.radius * np.sin(ang),
+            ], 1).reshape(n_lab, 9))
+            kinds.append(kind)
+            labels.append(label + lab_off)
+            goal.append((float(field.goal[0]), float(field.goal[1])))
+            geo.append((cell_off, h, w, p.geo.origin[0], p.geo.origin[1], p.geo.resolution, p.radius))
+            cell_off += h * w
+            lab_off += n_lab
+        a = arrays
+        g = np.array(geo, dtype=np.float64).reshape(-1, 7)
+        self.kind = a.asarray(np.concatenate(kinds), a.i64)
+        self.label = a.asarray(np.concatenate(labels), a.i64)
+        lab = np.concatenate(lab_arrays) if lab_off else np.zeros((1, 9))
+        (self.cost, self.cx, self.cy, self.side, self.phi0, self.span, self.pos,
+         self.qx, self.qy) = (a.asarray(lab[:, i]) for i in range(9))
+        gxy = np.array(goal, dtype=np.float64).reshape(-1, 2)
+        self.gx, self.gy = a.asarray(gxy[:, 0]), a.asarray(gxy[:, 1])
+        self.offset = a.asarray(g[:, 0], a.i64)
+        self.rows, self.width = a.asarray(g[:, 1], a.i64), a.asarray(g[:, 2], a.i64)
+        self.ox, self.oy, self.res, self.radius = (a.asarray(g[:, i]) for i in (3, 4, 5, 6))
+        self.arrays = a
+
+    def __len__(self) -> int:
+        return int(self.gx.shape[0])
+
+    def distance(self, field: Any, x: Any, y: Any) -> Any:
+        """Geodesic distance (m) from each ``(x, y)`` to the goal of its ``field`` (index array); inf if none.
+
+        ``GoalField.distance``'s formula on arrays: straight to the goal, or the cost of
+        the cell's label plus the tangent (and arc) from the point to the label's node.
+        """
+        a = self.arrays
+        xp = a.xp
+        res = self.res[field]
+        col = a.to_int(xp.floor((x - self.ox[field]) / res))
+        row = a.to_int(xp.floor((y - self.oy[field]) / res))
+        inside = (row >= 0) & (row < self.rows[field]) & (col >= 0) & (col < self.width[field])
+        cell = xp.where(inside, self.offset[field] + row * self.width[field] + col, 0)
+        kind = xp.where(inside, self.kind[cell], 0)
+        lab = self.label[cell]
+        direct = xp.sqrt((x - self.gx[field]) ** 2 + (y - self.gy[field]) ** 2)
+        r = self.radius[field]
+        side = self.side[lab]
+        dx, dy = self.cx[lab] - x, self.cy[lab] - y
+        big = xp.sqrt(dx * dx + dy * dy)
+        outside = big > r
+        safe = xp.where(outside, big, 1.0)
+        bend = xp.where(r > 0.0, side * xp.arcsin(xp.minimum(r / safe, xp.ones_like(safe))), 0.0)
+        heading = xp.arctan2(dy, dx) + bend
+        ccw = xp.remainder(heading + side * (math.pi / 2) - self.phi0[lab], _TWO_PI)
+        ccw = xp.where(ccw > _TWO_PI - _ANG_TOL, 0.0, ccw)
+        span = self.span[lab]
+        on_arc = ccw <= span + _ANG_TOL
+        clipped = xp.minimum(ccw, span)
+        dep = xp.where(side > 0, clipped, span - clipped)
+        lp = self.pos[lab]
+        tangent_ok = outside & on_arc & (dep >= lp - _ANG_TOL)
+        tangent = self.cost[lab] + r * xp.maximum(dep - lp, xp.zeros_like(dep)) + xp.sqrt(
+            xp.maximum(big * big - r * r, xp.zeros_like(big))
+        )
+        point = self.cost[lab] + xp.sqrt((x - self.qx[lab]) ** 2 + (y - self.qy[lab]) ** 2)
+        via = xp.where(tangent_ok, tangent, point)
+        return xp.where(kind == 1, direct, xp.where(kind == 2, via, math.inf))

@@ -1,0 +1,92 @@
+"""The reference for the batched engine: one ``PointNavEnv`` (kinematic backend) per world.
+
+:func:`compare` plays the same fixed episodes and actions on a ``VectorPointNavEnv`` and
+on ``num_envs`` separate single envs, resetting each single env the step after its
+episode ended (Gymnasium's next-step autoreset), and fails at the first step where they
+disagree beyond the tolerances of issue 14.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import numpy as np
+
+from pointnav_core.env import PointNavEnv
+from pointnav_core.vector import VectorPointNavEnv
+
+OBS_TOL = 1e-4
+REWARD_TOL = 1e-5
+INFO_KEYS = ("success", "spl", "soft_spl", "collisions", "episode_length", "path_length", "distance_to_goal")
+
+
+def compare(
+    scene: Any, episodes: list[tuple[Any, float, Any]], actions: np.ndarray, task: dict | None = None, device: str = "numpy"
+) -> dict[str, Any]:
+    """Step both for ``len(actions)`` steps; return counts of what happened (ends, contacts)
+    and the largest observation and reward differences seen.
+
+    ``episodes`` holds one ``(start_xy, yaw, goal_xy)`` per world; ``actions`` has shape
+    ``(steps, num_envs, 2)``.
+    """
+    task = dict(task or {})
+    n = len(episodes)
+    venv = VectorPointNavEnv(n, scene=scene, task=task, device=device, seed=0)
+    singles = [
+        PointNavEnv(
+            scene=scene,
+            flatten_obs=True,
+            task=dict(
+                task,
+                initial_pos=[float(s[0]), float(s[1])],
+                initial_quat=[0.0, 0.0, math.sin(yaw / 2), math.cos(yaw / 2)],
+                goal_pos=[float(g[0]), float(g[1])],
+            ),
+        )
+        for s, yaw, g in episodes
+    ]
+    to_np = venv.arrays.numpy
+    vobs, _ = venv.reset(options={"episodes": episodes})
+    sobs = np.array([env.reset(seed=0)[0] for env in singles])
+    ended = [False] * n
+    stats = {"ends": 0, "successes": 0, "contacts": 0, "autoresets": 0, "obs_diff": 0.0, "reward_diff": 0.0}
+    for t, act in enumerate(actions):
+        np.testing.assert_allclose(to_np(vobs), sobs, rtol=0, atol=OBS_TOL, err_msg=f"observations before step {t}")
+        stats["obs_diff"] = max(stats["obs_diff"], float(np.abs(to_np(vobs) - sobs).max()))
+        vobs, vrew, vterm, vtrunc, vinfo = venv.step(act)
+        vrew, vterm, vtrunc = to_np(vrew), to_np(vterm), to_np(vtrunc)
+        vinfo = {k: to_np(v) for k, v in vinfo.items()}
+        for i, env in enumerate(singles):
+            if ended[i]:
+                obs, _ = env.reset()
+                reward, term, trunc, info = 0.0, False, False, None
+                stats["autoresets"] += 1
+                assert vinfo["autoreset"][i], f"world {i} should reset at step {t}"
+            else:
+                obs, reward, term, trunc, info = env.step(act[i])
+            ended[i] = term or trunc
+            sobs[i] = obs
+            where = f"world {i}, step {t}"
+            assert abs(reward - vrew[i]) <= REWARD_TOL, f"reward {where}: {reward} vs {vrew[i]}"
+            stats["reward_diff"] = max(stats["reward_diff"], abs(reward - float(vrew[i])))
+            assert (term, trunc) == (bool(vterm[i]), bool(vtrunc[i])), f"flags {where}"
+            if info is None:
+                continue
+            for key in INFO_KEYS:
+                ref, got = info[key], vinfo[key][i]
+                assert ref == got or abs(ref - got) <= 1e-6, f"{key} {where}: {ref} vs {got}"
+            stats["ends"] += term or trunc
+            stats["successes"] += info["success"]
+            stats["contacts"] += bool(info["collisions"]) and vinfo["in_contact"][i]
+    return stats
+
+
+def random_episodes(scene: Any, n: int, rng: np.random.Generator, radius: float = 0.18) -> list[tuple[Any, float, Any]]:
+    """``n`` episodes with starts and goals drawn uniformly where the robot fits."""
+    out = []
+    for _ in range(n):
+        _, start = scene.get_random_point(0, robot=radius, rng=rng)
+        _, goal = scene.get_random_point(0, robot=radius, rng=rng)
+        out.append((start[:2], float(rng.uniform(-math.pi, math.pi)), goal[:2]))
+    return out
