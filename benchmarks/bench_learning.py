@@ -161,7 +161,8 @@ def train(name: str, sensors: dict | None, args: argparse.Namespace) -> dict[str
                 curve.append((self.num_timesteps, m["success"], m["spl"], time.perf_counter() - start))
                 print(f"  {name:<6} {self.num_timesteps:>8} steps: held-out success {m['success']:.2f}, "
                       f"SPL {m['spl']:.2f} ({time.perf_counter() - start:.0f} s)", flush=True)
-            return True
+            # Past the wall-time limit, training stops; the table reports the steps reached.
+            return not (args.time_limit and time.perf_counter() - start > args.time_limit)
 
     model = PPO(
         "MlpPolicy", vec, n_steps=args.n_steps, batch_size=args.batch_size, n_epochs=args.n_epochs,
@@ -233,6 +234,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     parser.add_argument("--ent-coef", type=float, default=0.01)
     parser.add_argument("--width", type=int, default=256, help="hidden units, two layers")
     parser.add_argument("--seed", type=int, default=0)
+    parser.add_argument("--time-limit", type=float, default=None,
+                        help="stop a policy's training after this many seconds of wall time")
     parser.add_argument("--only", choices=("blind", "scan"), default=None)
     parser.add_argument("--no-oracle", action="store_true", help="skip the oracle's evaluation")
     parser.add_argument("--out", type=Path, default=Path("docs/learning_curve"), help="curve .csv/.png stem")
