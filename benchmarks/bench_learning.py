@@ -256,7 +256,10 @@ def main(argv: Sequence[str] | None = None) -> int:
     for name, sensors in configs.items():
         if args.only and name != args.only:
             continue
-        rows[name] = train(name, sensors, args)
+        rows[name] = r = train(name, sensors, args)
+        print(f"  {name}: held-out success {r['success']:.3f}, SPL {r['spl']:.3f}, SoftSPL {r['soft_spl']:.3f} "
+              f"after {r['steps']} steps, {r['steps_per_s']:.0f} steps/s, {r['wall_s']:.0f} s", flush=True)
+        write_curve(rows, args.out)
     oracle = None
     if not args.no_oracle:
         houses = [EVAL_HOUSE0 + h for h in range(args.eval_houses)]
