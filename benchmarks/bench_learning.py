@@ -179,8 +179,6 @@ def train(name: str, sensors: dict | None, args: argparse.Namespace) -> dict[str
 
 def write_curve(rows: dict[str, dict[str, Any]], out: Path) -> None:
     """The learning curves as ``out``.csv and a Pillow drawing ``out``.png."""
-    from PIL import Image, ImageDraw
-
     curves = {name: r["curve"] for name, r in rows.items() if r["curve"]}
     if not curves:
         return
@@ -191,6 +189,23 @@ def write_curve(rows: dict[str, dict[str, Any]], out: Path) -> None:
         for name, curve in curves.items():
             for steps, success, spl, wall in curve:
                 writer.writerow([name, steps, f"{success:.4f}", f"{spl:.4f}", f"{wall:.1f}"])
+    draw_curve(curves, out.with_suffix(".png"))
+
+
+def read_curve(path: Path) -> dict[str, list[tuple[int, float, float, float]]]:
+    """The curves of a CSV written by :func:`write_curve`."""
+    curves: dict[str, list[tuple[int, float, float, float]]] = {}
+    with open(path, newline="") as fh:
+        for row in csv.DictReader(fh):
+            curves.setdefault(row["policy"], []).append(
+                (int(row["steps"]), float(row["success"]), float(row["spl"]), float(row["wall_s"])))
+    return curves
+
+
+def draw_curve(curves: dict[str, list[tuple[int, float, float, float]]], png: Path) -> None:
+    """Held-out success vs training steps, one line per policy, as a PNG (Pillow)."""
+    from PIL import Image, ImageDraw
+
     w, h, m = 640, 400, 50
     img = Image.new("RGB", (w, h), "white")
     draw = ImageDraw.Draw(img)
@@ -207,11 +222,13 @@ def write_curve(rows: dict[str, dict[str, Any]], out: Path) -> None:
     draw.text((m, 15), "held-out success vs training steps", fill="black")
     colours = {"blind": (200, 60, 40), "scan": (40, 90, 200)}
     for i, (name, curve) in enumerate(curves.items()):
-        pts = [(x_of(0), y_of(0))] + [(x_of(s), y_of(v)) for s, v, *_ in curve]
+        pts = [(x_of(s), y_of(v)) for s, v, *_ in curve]  # measured points only
         colour = colours.get(name, (0, 0, 0))
         draw.line(pts, fill=colour, width=2)
+        for x, y in pts:
+            draw.ellipse([x - 3, y - 3, x + 3, y + 3], fill=colour)
         draw.text((w - m - 60, m + 8 + 14 * i), name, fill=colour)
-    img.save(out.with_suffix(".png"))
+    img.save(png)
 
 
 def main(argv: Sequence[str] | None = None) -> int:
@@ -239,7 +256,11 @@ def main(argv: Sequence[str] | None = None) -> int:
     parser.add_argument("--only", choices=("blind", "scan"), default=None)
     parser.add_argument("--no-oracle", action="store_true", help="skip the oracle's evaluation")
     parser.add_argument("--out", type=Path, default=Path("docs/learning_curve"), help="curve .csv/.png stem")
+    parser.add_argument("--replot", type=Path, default=None, help="only redraw this curve CSV as a PNG beside it")
     args = parser.parse_args(argv)
+    if args.replot is not None:
+        draw_curve(read_curve(args.replot), args.replot.with_suffix(".png"))
+        return 0
     if args.max_steps is None:
         args.max_steps = 150 if args.action_space == "discrete" else 500
     from benchkit import machine
