@@ -56,7 +56,6 @@ from __future__ import annotations
 
 import argparse
 import csv
-import math
 import os
 import time
 from collections.abc import Sequence
@@ -75,7 +74,9 @@ def make_env(house_seed: int, sensors: dict | None, max_steps: int, action_space
     """One env on generated house ``house_seed``; discrete actions have no STOP."""
     from pointnav_core import scenes
     from pointnav_core.env import PointNavEnv
-    from pointnav_kinematic import KinematicBackend  # the class: works from a source tree too
+    from pointnav_kinematic import (
+        KinematicBackend,  # the class: works from a source tree too
+    )
 
     discrete = {"discrete_actions": {"stop": False}} if action_space == "discrete" else {}
     return PointNavEnv(
@@ -231,8 +232,8 @@ def draw_curve(curves: dict[str, list[tuple[int, float, float, float]]], png: Pa
     img = Image.new("RGB", (w, h), "white")
     draw = ImageDraw.Draw(img)
     x_max = max(s for curve in curves.values() for s, *_ in curve)
-    x_of = lambda s: m + (w - 2 * m) * s / x_max  # noqa: E731
-    y_of = lambda v: h - m - (h - 2 * m) * v  # noqa: E731
+    x_of = lambda s: m + (w - 2 * m) * s / x_max
+    y_of = lambda v: h - m - (h - 2 * m) * v
     draw.rectangle([m, m, w - m, h - m], outline="black")
     for v in (0.0, 0.2, 0.4, 0.6, 0.8, 1.0):
         draw.line([m, y_of(v), w - m, y_of(v)], fill=(220, 220, 220) if v not in (0.0, 1.0) else "black")
