@@ -214,6 +214,15 @@ def _prefixed(name: str, err: ValueError) -> ValueError:
     return ValueError(message if message.startswith(name) else f"{name}: {message}")
 
 
+def _named_action_error(err: ValueError, todo: list[Any]) -> ValueError:
+    """The backend's refusal of a step, prefixed with the first agent whose action is not
+    finite (the backend refuses the first bad action it meets, in the agents' order)."""
+    for agent, _, action, *_ in todo:
+        if not np.isfinite(action).all():
+            return ValueError(f"{agent}: {err}")
+    return err
+
+
 def _check_int(name: str, value: Any, minimum: int) -> int:
     return validation.integer(name, value, minimum=minimum)
 
@@ -603,7 +612,8 @@ class MultiPointNavEnv(ParallelEnv[str, Any, np.ndarray]):
             )
         if len(actions) != len(agents):
             self._bad_keys(actions)
-        # Check every action before anything moves: a rejected step changes nothing.
+        # Check every action before anything moves (finiteness: the backend, which moves
+        # nothing when it refuses a step): a rejected step changes nothing.
         slots, check, plans = self._slots, _envcommon.check_action, self._plans
         commands: dict[int, np.ndarray] = {}
         todo = []
@@ -619,8 +629,8 @@ class MultiPointNavEnv(ParallelEnv[str, Any, np.ndarray]):
                     f"in env.agents must act"
                 )
             try:
-                if plans is None:
-                    action = check(action, shape, drive)
+                if plans is None:  # finiteness: the backend's step checks it, below
+                    action = check(action, shape, drive, finite=False)
                 else:
                     action = check_discrete_action(action, len(plans[i]))
             except ValueError as err:
@@ -633,11 +643,18 @@ class MultiPointNavEnv(ParallelEnv[str, Any, np.ndarray]):
         terminations: dict[str, bool] = {}
         truncations: dict[str, bool] = {}
         infos: dict[str, dict[str, Any]] = {}
-        try:
-            if plans is None:
+        if plans is None:
+            try:
                 self.backend.step(commands)
-                contacts = None
-            else:
+            except ValueError as err:  # a rejected step moved nothing: name the agent
+                raise _named_action_error(err, todo) from None
+            except BaseException:
+                self.agents = []
+                self._void = True
+                raise
+            contacts = None
+        try:
+            if plans is not None:
                 contacts = self._step_discrete(commands)
             self._cycles += 1
             cut = self._cycles >= self.max_cycles
