@@ -72,11 +72,7 @@ def make_robot(robot: RobotSpec | Mapping[str, Any] | None, name: str = "robot")
     if isinstance(robot, RobotSpec):
         return robot
     if isinstance(robot, Mapping):
-        unknown = [key for key in robot if key not in ROBOT_KEYS]
-        if unknown:
-            raise ValueError(
-                f"{name} has an unknown key {unknown[0]!r}; valid keys are {list(ROBOT_KEYS)}"
-            )
+        validation.known_keys(name, robot, ROBOT_KEYS)
         return RobotSpec(**robot)
     raise ValueError(f"{name} must be a RobotSpec, a dict of its fields, or None, got {robot!r}")
 
@@ -118,11 +114,7 @@ def make_task(
                 )
         return task
     if isinstance(task, Mapping):
-        unknown = [key for key in task if key not in TASK_KEYS]
-        if unknown:
-            raise ValueError(
-                f"{name} has an unknown key {unknown[0]!r}; valid keys are {list(TASK_KEYS)}"
-            )
+        validation.known_keys(name, task, TASK_KEYS)
         for key, value in fixed.items():
             if key in task and task[key] != value:
                 raise ValueError(

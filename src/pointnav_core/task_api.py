@@ -315,9 +315,7 @@ class OmniGibsonTaskAPI:
         TaskStateError
             Before the task has met an environment (:meth:`load`).
         """
-        if self._obs_layout is None:
-            raise TaskStateError("observation_layout needs an environment: call load(env) first")
-        return self._obs_layout
+        return self._loaded_layout("observation_layout")
 
     @property
     def observation_bounds(self) -> tuple[NDArray[np.float32], NDArray[np.float32]]:
@@ -334,12 +332,13 @@ class OmniGibsonTaskAPI:
         TaskStateError
             Before the task has met an environment (:meth:`load`).
         """
+        layout = self._loaded_layout("observation_bounds")
+        return np.array(layout.low, dtype=np.float32), np.array(layout.high, dtype=np.float32)
+
+    def _loaded_layout(self, what: str) -> ObservationLayout:
         if self._obs_layout is None:
-            raise TaskStateError("observation_bounds needs an environment: call load(env) first")
-        return (
-            np.array(self._obs_layout.low, dtype=np.float32),
-            np.array(self._obs_layout.high, dtype=np.float32),
-        )
+            raise TaskStateError(f"{what} needs an environment: call load(env) first")
+        return self._obs_layout
 
     def get_obs(self, env: TaskEnv) -> dict[str, NDArray[np.float32]]:
         """Return the task's observation: one fresh float32 array per term, by name.

@@ -120,11 +120,7 @@ def merge_config(
         return FrozenMapping(merged)
     if not isinstance(overrides, Mapping):
         raise ValueError(f"{name} must be None or a dict, got {overrides!r}")
-    for key in overrides:
-        if key not in defaults:
-            raise ValueError(
-                f"{name} has an unknown key {key!r}; valid keys are {list(defaults)}"
-            )
+    validation.known_keys(name, overrides, defaults)
     merged.update(overrides)
     return FrozenMapping(merged)
 
