@@ -42,7 +42,7 @@ from collections.abc import Mapping, Sequence
 from typing import TYPE_CHECKING, Any, ClassVar, Protocol
 
 import numpy as np
-from numpy.typing import ArrayLike, NDArray
+from numpy.typing import ArrayLike
 
 from pointnav_core.backend import float_twin
 from pointnav_core.episode_state import EpisodeState
@@ -64,7 +64,12 @@ from pointnav_core.rewards import (
 )
 from pointnav_core.sampling import GoalConstraint, sample_task_episode
 from pointnav_core.task_api import OmniGibsonTaskAPI
-from pointnav_core.task_config import REWARD_TYPES, TaskConfig, compose_terms, merge_config
+from pointnav_core.task_config import (
+    REWARD_TYPES,
+    TaskConfig,
+    compose_terms,
+    merge_config,
+)
 from pointnav_core.terminations import (
     Falling,
     MaxCollision,
