@@ -237,6 +237,25 @@ def test_driving_parallel_along_a_touched_polygon_edge_is_never_a_collision():
     assert (xy(backend) - [3.0, 3.0]) @ along == pytest.approx(1.0, abs=1e-9)
 
 
+def test_a_robot_exactly_as_wide_as_a_passage_slides_into_it_past_the_far_corner():
+    # Blocks at x 0.6-0.8, y 0.5-0.7 and x 0.7-0.9, y 1.0-1.2 leave a passage (x 0.7-0.8)
+    # exactly 0.3 m wide. A 0.15 m robot touching the lower block, drifting up by 1e-9 m a
+    # step as float32 actions do, meets the upper block's corner: its own slide would take
+    # it into the lower block, and it used to stop there for good. The slide along the
+    # lower block it touches is clear.
+    grid = np.zeros((16, 19), dtype=np.uint8)
+    grid[5:7, 6:8] = OBSTACLE
+    grid[10:12, 7:9] = OBSTACLE
+    scene = Scene.from_array(grid, 0.1)
+    backend = loaded(scene, [RobotSpec(radius=0.15, drive="holonomic")])
+    backend.land(0, 0, (0.69998013, 0.85 + 3e-10), quat(0.0))
+    blocks = shapely.union_all([shapely.box(0.6, 0.5, 0.8, 0.7), shapely.box(0.7, 1.0, 0.9, 1.2)])
+    for _ in range(2):
+        backend.step({0: [1.0, 2e-8, 0.0]})
+        assert Point(*xy(backend)).distance(blocks) >= 0.15 - 2 * TOUCH
+    assert xy(backend)[0] > 0.79
+
+
 @pytest.mark.parametrize("scene_kind", ["grid", "polygon"])
 def test_pushing_diagonally_into_a_wall_is_a_collision_on_every_blocked_step(scene_kind):
     if scene_kind == "grid":

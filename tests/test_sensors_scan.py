@@ -140,3 +140,21 @@ def test_scan_geometry_and_sensors_pickle():
     scan = pickle.loads(pickle.dumps(RangeScan(n_rays=8, noise_std=0.1)))
     assert scan.angles.tolist() == RangeScan(n_rays=8).angles.tolist()
     assert pickle.loads(pickle.dumps(LocalMap(cells=4))).shape == (4, 4)
+
+
+def test_method_names_the_choices():
+    geo = ScanGeometry(TraversableMap(np.zeros((2, 2), np.uint8), 1.0))
+    with pytest.raises(ValueError, match=r"method must be one of 'auto', 'numpy', 'numba', got 'fast'"):
+        cast_rays(geo, [[0.5, 0.5]], [0.0], [0.0], 1.0, method="fast")
+
+
+def test_without_numba_auto_takes_numpy_and_numba_is_refused(monkeypatch):
+    from pointnav_core.sensors import raycast_jit
+
+    monkeypatch.setattr(raycast_jit, "_TRIED", True)
+    monkeypatch.setattr(raycast_jit, "_KERNEL", None)
+    geo = ScanGeometry(TraversableMap(np.zeros((1, 4), np.uint8), 1.0))
+    # The map's edge at x = 4 and x = 0, by hand.
+    assert cast_rays(geo, [[0.5, 0.5]], [0.0], [0.0, math.pi], 10.0).tolist() == [[3.5, 0.5]]
+    with pytest.raises(ValueError, match=r"method=\"numba\" needs numba"):
+        cast_rays(geo, [[0.5, 0.5]], [0.0], [0.0], 10.0, method="numba")

@@ -327,7 +327,9 @@ class ObservationLayout:
             flat = np.empty(self.size, dtype=np.float64)
             for term in self.terms:
                 flat[self.slices[term.name]] = term.values(frame)
-            return np.clip(flat, self._low_arr, self._high_arr, out=flat)
+            # maximum/minimum: np.clip's argument checks cost more than the clipping.
+            np.maximum(flat, self._low_arr, out=flat)
+            return np.minimum(flat, self._high_arr, out=flat)
         out: list[float] = []
         for term in self.terms:
             out += term.values(frame)

@@ -30,6 +30,15 @@ _HAIR = 1e-4
 _SAME = 1e-6
 #: Widest heading error (rad) a differential robot drives out on an arc instead of turning.
 _ARC_BEARING = 0.6
+#: Share of a holonomic step the follower may give up, and in how many roundings it
+#: looks for the float32 action that strays least sideways (see _float32_move).
+_SHORTEN = 1e-3
+_ROUNDINGS = 512
+#: Directions tried when stepping out of a contact to where a wider robot fits.
+_OUT_DIRECTIONS = 16
+#: Metres a wider robot's way may add to the true robot's before the follower takes the
+#: true robot's way, which can run through a passage exactly as wide as the robot.
+_DETOUR = 0.5
 #: Chords of a driven arc checked for clearance.
 _ARC_CHORDS = 4
 
@@ -52,6 +61,26 @@ def _nearest_usable(tmap: Any, xy: NDArray[np.float64], radius: float, reach: in
     return centres[int(np.argmin(np.hypot(*(centres - xy).T)))]
 
 
+def _float32_move(dx: float, dy: float, yaw: float, scale: float) -> NDArray[np.float32]:
+    """The float32 body-frame action ``(a0, a1)`` of a holonomic robot heading ``yaw`` (rad)
+    whose world motion ``scale * R(yaw) a`` (m) strays least sideways from ``(dx, dy)`` (m).
+
+    Rounding the ideal action to float32 moves the robot up to ~2e-9 m sideways on a 0.05 m
+    step, more than the 1e-9 m that a passage exactly as wide as the robot leaves. Along
+    the motion a thousandth of the step does not matter, so among the roundings of the
+    ideal action shortened by up to that much, one strays a thousand times less.
+    """
+    c, s = math.cos(yaw), math.sin(yaw)
+    ideal = np.array([c * dx + s * dy, -s * dx + c * dy]) / scale
+    shorter = 1.0 - np.linspace(0.0, _SHORTEN, _ROUNDINGS)[:, None]
+    a = np.clip(ideal * shorter, -1.0, 1.0).astype(np.float32).astype(np.float64)
+    ex = scale * (a[:, 0] * c - a[:, 1] * s) - dx
+    ey = scale * (a[:, 0] * s + a[:, 1] * c) - dy
+    norm = math.hypot(dx, dy)
+    side = np.abs(ex * dy - ey * dx) / norm if norm > 0.0 else np.hypot(ex, ey)
+    return a[int(np.argmin(side))].astype(np.float32)
+
+
 class ShortestPathFollower:
     """Drive one robot along the geodesic to its task's goal, without touching anything.
 
@@ -72,13 +101,19 @@ class ShortestPathFollower:
     Notes
     -----
     Every step heads straight for the farthest of four points up to ``lookahead`` along the
-    exact shortest path that the disc can reach in a straight line (checked against the
-    floor's blocked set), or else for the path's next vertex, so the robot never cuts a
-    corner the path wraps. A holonomic robot translates there without turning. A
-    differential robot drives the circular arc tangent to its heading that ends there,
-    when that arc is clear (checked), and turns in place first otherwise. A robot
-    whose disc overlaps something (a rigid-body solver's slop, a pose set by hand) heads for
-    the nearest cell centre it fits at.
+    shortest path that the disc can reach in a straight line (checked against the floor's
+    blocked set), else a full step along the path's first leg (which leaves a wrapped arc
+    on its tangent), else the path's next vertex, so the robot never cuts a corner the path
+    wraps. The path is that of the wider robot where it has one: a start that touches a
+    wall is first left by a short clear step, and a goal against a wall is replaced, for
+    the wider robot, by the nearest point within half the goal tolerance where it fits.
+    Only where the wider robot has no way (or one over 0.5 m longer) does the follower
+    take the true robot's, which may run through a passage exactly as wide as the robot.
+    A holonomic robot translates there without turning, with the float32 action that
+    strays least sideways. A differential robot drives the circular arc tangent to its
+    heading that ends there, when that arc is clear (checked), and turns in place first
+    otherwise. A robot whose disc overlaps something (a rigid-body solver's slop, a pose set
+    by hand) heads for the nearest cell centre it fits at.
 
     Examples
     --------
@@ -106,6 +141,7 @@ class ShortestPathFollower:
             raise ValueError(f"lookahead must be a finite number > 0 (m), got {lookahead!r}")
         self.margin = float(margin)
         self.lookahead = float(lookahead)
+        self._aims: dict[tuple[float, float, float], NDArray[np.float64] | None] = {}
 
     def _carrot(self, xy: NDArray[np.float64]) -> NDArray[np.float64] | None:
         """The point to head for from ``xy`` (see the class notes), or None if there is none."""
@@ -113,14 +149,22 @@ class ShortestPathFollower:
         spec = env.robots[task.robot_idn]
         goal = np.asarray(task.get_goal_pos(), dtype=np.float64)[:2]
         tmap = env.scene.floors[task.floor]
-        path = None
         # Wider first; then a hair wider than the robot, so that the path never quite
-        # touches a wall (a rigid-body solver counts touching as contact); then exact.
+        # touches a wall (a rigid-body solver counts touching as contact); then exact. A
+        # robot that touches something (a start in a corner) first steps out to where the
+        # wider robot fits: the exact robot's way may run through a passage exactly its
+        # width, which float32 actions cannot thread without grazing a side.
         radii = sorted({spec.radius + self.margin, spec.radius + _HAIR, spec.radius}, reverse=True)
         for radius in radii:
-            path, _ = env.scene.goal_field(task.floor, goal, robot=radius).path(xy, max_length=self.lookahead)
+            aim = self._aim(goal, radius)
+            if aim is None:
+                continue
+            field = env.scene.goal_field(task.floor, aim, robot=radius)
+            path, _ = field.path(xy, max_length=self.lookahead)
             if path is not None:
                 break
+            if radius > spec.radius and (out := self._step_out(xy, goal, field, radius)) is not None:
+                return out
         if path is None:
             centre = _nearest_usable(tmap, xy, spec.radius)
             if centre is None:
@@ -132,15 +176,66 @@ class ShortestPathFollower:
         # Candidates, farthest first: points up to ``lookahead`` along the path, then the
         # path's next vertex. The drawn path circumscribes its arcs, so the straight move to
         # the next vertex is always clear, while a chord to a point further round an arc
-        # would cut it.
+        # would cut it. Chords are checked at the planned radius, so the robot stays where
+        # the path it follows is defined.
         # A robot standing on a wrapped arc is its own first tangent point: skip repeats.
         path = path[np.r_[True, np.hypot(*np.diff(path, axis=0).T) > _SAME]]
         if len(path) < 2:
             return None
-        ahead = np.vstack([resample_path(path, self.lookahead / 4, 5)[1:][::-1], path[1]])
-        reach = min(radius, spec.radius + _HAIR)
-        clear = tmap.collision.segments_clear(np.broadcast_to(xy, ahead.shape), ahead, reach)
+        # On a wrapped arc no further point of the arc is in a straight line (every chord
+        # cuts the corner), only the next vertex a hair ahead. The tangent there stays
+        # outside the arc, so the robot goes on along its first leg instead, up to a full
+        # step: it leaves the arc a little, and the next step's path wraps back to it.
+        first = path[1] - path[0]
+        span = float(np.hypot(*first))
+        along = path[0] + first * (max(self._step_length(), span) / span)
+        ahead = np.vstack([resample_path(path, self.lookahead / 4, 5)[1:][::-1], along, path[1]])
+        clear = tmap.collision.segments_clear(np.broadcast_to(xy, ahead.shape), ahead, radius)
         return ahead[int(np.argmax(clear))] if clear.any() else ahead[-1]
+
+    def _aim(self, goal: NDArray[np.float64], radius: float) -> NDArray[np.float64] | None:
+        """Where a robot of ``radius`` plans to: the goal, or for a wider robot that does not
+        fit there (a goal against a wall), the nearest point within half the goal tolerance
+        where it fits; None if there is none.
+
+        Success needs only the goal tolerance, so the wider robot's way ends in time.
+        """
+        spec = self.env.robots[self.task.robot_idn]
+        if radius == spec.radius:
+            return goal
+        key = (float(goal[0]), float(goal[1]), radius)
+        if key not in self._aims:
+            tmap = self.env.scene.floors[self.task.floor]
+            away = 2.0 * (radius - spec.radius)
+            angles = np.linspace(0.0, 2.0 * math.pi, _OUT_DIRECTIONS, endpoint=False)
+            points = np.vstack([goal, goal + away * np.stack([np.cos(angles), np.sin(angles)], axis=1)])
+            fits = tmap.collision.points_clear(points, radius)
+            tolerance = float(getattr(self.task, "goal_tolerance", 0.0))
+            self._aims[key] = points[int(np.argmax(fits))] if fits.any() and (fits[0] or away < tolerance / 2) else None
+        return self._aims[key]
+
+    def _step_length(self) -> float:
+        """Metres the robot covers in one step at full speed."""
+        spec = self.env.robots[self.task.robot_idn]
+        return spec.max_linear_velocity / getattr(self.env, "action_frequency", 10.0)
+
+    def _step_out(self, xy: NDArray[np.float64], goal: NDArray[np.float64], field: Any, radius: float) -> NDArray[np.float64] | None:
+        """A point a little away from ``xy``, in a clear straight line, where a robot of
+        ``radius`` fits and whose way to the goal costs at most ``_DETOUR`` m more than the
+        true robot's from ``xy``; None if there is none."""
+        spec = self.env.robots[self.task.robot_idn]
+        tmap = self.env.scene.floors[self.task.floor]
+        exact = self.env.scene.goal_field(self.task.floor, goal, robot=spec.radius).exact_distance(xy)
+        away = min(2.0 * (radius - spec.radius), self._step_length())
+        angles = np.linspace(0.0, 2.0 * math.pi, _OUT_DIRECTIONS, endpoint=False)
+        points = xy + away * np.stack([np.cos(angles), np.sin(angles)], axis=1)
+        clear = tmap.collision.segments_clear(np.broadcast_to(xy, points.shape), points, spec.radius)
+        best, best_cost = None, exact + _DETOUR
+        for point in points[clear]:
+            cost = away + field.exact_distance(point)
+            if cost <= best_cost:
+                best, best_cost = point, cost
+        return best
 
     def act(self) -> NDArray[np.float32]:
         """Action in [-1, 1] for the task's robot, from its current true pose."""
@@ -162,8 +257,8 @@ class ShortestPathFollower:
         # Reach the point in one step if it is that close, else go at full speed.
         speed = min(1.0, dist / (spec.max_linear_velocity * dt))
         if spec.drive == "holonomic":
-            action[0] = speed * math.cos(bearing)
-            action[1] = speed * math.sin(bearing)
+            scale = spec.max_linear_velocity * dt
+            action[:2] = _float32_move(speed * dx / dist * scale, speed * dy / dist * scale, yaw, scale)
         elif abs(bearing) <= _FACING:
             action[0] = speed
         elif (arc := self._arc_step(xy, yaw, dist, bearing, dt)) is not None:

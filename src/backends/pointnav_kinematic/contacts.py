@@ -218,14 +218,16 @@ def _blocks(rb: Any, contact: tuple, mx: float, my: float, left: float) -> bool:
 def _slide(
     rb: Any, mx: float, my: float, blocked: list[tuple], contacts: list[tuple], left: float
 ) -> tuple[float, float]:
-    """The longest tangent of a blocking contact that goes into no contact, else zero.
+    """The longest tangent of a contact that goes into no contact, else zero.
 
     In 2D the best motion that keeps clear of all contacts lies on one contact's tangent,
-    or is zero (a concave corner).
+    or is zero (a concave corner). That contact need not be one the motion goes into: in a
+    passage exactly as wide as the disc, a motion that grazes one side into the corner of
+    the other is saved by the tangent of the side it grazes.
     """
     best = (0.0, 0.0)
     best_len = 0.0
-    for along in blocked:
+    for along in contacts:
         nx, ny = along[0], along[1]
         dot = mx * nx + my * ny
         tx, ty = mx - dot * nx, my - dot * ny

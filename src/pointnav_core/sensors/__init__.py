@@ -10,7 +10,9 @@ class                  name             what it observes
 
 Both are :class:`~pointnav_core.observations.ObservationTerm` objects: name them in the
 envs' ``sensors`` argument (:func:`make_sensors`), or pass them in a task's
-``observation_terms``. The exact ray casting is :mod:`pointnav_core.sensors.raycast`.
+``observation_terms``. The exact ray casting is :mod:`pointnav_core.sensors.raycast`; with
+numba installed (the ``fast`` extra) it runs the compiled kernel of
+:mod:`pointnav_core.sensors.raycast_jit`, which gives the same ranges.
 """
 
 from pointnav_core.sensors.config import SENSOR_ORDER, SENSORS, make_sensors

@@ -34,6 +34,7 @@ once.
 
 from __future__ import annotations
 
+import functools
 import math
 from typing import Any
 
@@ -41,16 +42,21 @@ import numpy as np
 import shapely
 import shapely.geometry
 from numpy.typing import ArrayLike, NDArray
+from scipy import ndimage
 
 from pointnav_core.maps import OBSTACLE, TraversableMap
+from pointnav_core.sensors import raycast_jit
 
-__all__ = ["TOUCH_EPS", "ScanGeometry", "cast_rays"]
+__all__ = ["TOUCH_EPS", "ScanGeometry", "cast_pose_compiled", "cast_rays"]
 
 #: Metres within which a ray counts as touching a blocked square's face or corner.
 TOUCH_EPS = 1e-9
 
 # Stand-in for a zero direction component (its crossings are then far beyond any range).
 _TINY = 1e-300
+
+_METHODS = ("auto", "numpy", "numba")
+_NO_DISCS = np.zeros((0, 3))
 
 
 class ScanGeometry:
@@ -131,6 +137,36 @@ class ScanGeometry:
             hit = self._poly_tree.query(boxes, predicate="intersects")[0]
             near.ravel()[hit] = True
         self._near_polygon = near.ravel()
+        # The compiled path's edge table, one row per edge: a, b - a, low corner, high
+        # corner, the |u - 1/2| slack (raycast_jit).
+        self._jit_edges = np.ascontiguousarray(np.column_stack(
+            [self.edge_a, self._edge_vec, self._edge_lo, self._edge_hi, self._edge_half_slack]
+        ).reshape(-1, 9))
+        self._jit_base = (self.resolution, *self.origin)
+        self._clearance_cells: NDArray[np.int32] | None = None
+        self._jit_params_of: dict[float, NDArray[np.float64]] = {}
+
+    @property
+    def _clearance(self) -> NDArray[np.int32]:
+        """Per padded cell, the chessboard distance (cells) to the nearest blocked one.
+
+        Flat, like the lookup planes. The compiled path skips the crossings of a ray that
+        lie in a cell's clear square (raycast_jit); built on first use.
+        """
+        if self._clearance_cells is None:
+            free = ~self._lookup[: self._plane].reshape(self.shape)
+            cdt = ndimage.distance_transform_cdt(free, metric="chessboard")
+            self._clearance_cells = np.ascontiguousarray(cdt, dtype=np.int32).ravel()
+        return self._clearance_cells
+
+    def _jit_params(self, max_range: float) -> NDArray[np.float64]:
+        """The compiled path's scalars: resolution, origin, max_range, padded shape."""
+        params = self._jit_params_of.get(max_range)
+        if params is None:  # a scan asks for the same max_range at every step
+            params = np.array((*self._jit_base, max_range, *self.shape), dtype=np.float64)
+            params.flags.writeable = False
+            self._jit_params_of[max_range] = params
+        return params
 
     def __getstate__(self) -> dict[str, Any]:
         state = self.__dict__.copy()
@@ -154,6 +190,7 @@ def cast_rays(
     max_range: float,
     discs: ArrayLike | None = None,
     own_disc: ArrayLike | None = None,
+    method: str = "auto",
 ) -> NDArray[np.float64]:
     """Distances (m) from each origin along each ray to the first thing the scan sees.
 
@@ -173,6 +210,10 @@ def cast_rays(
         Other robots as discs ``(x, y, radius)`` in metres, seen by every ray.
     own_disc : array_like of int, shape (N,), optional
         Index into ``discs`` of each origin's own disc, which it does not see (-1: none).
+    method : {"auto", "numpy", "numba"}
+        ``"numpy"``: the array path of this module; ``"numba"``: the compiled kernel of
+        :mod:`~pointnav_core.sensors.raycast_jit` (the ``fast`` extra), the same ranges at a
+        fraction of the cost; ``"auto"`` (default): numba when installed, else numpy.
 
     Returns
     -------
@@ -189,12 +230,28 @@ def cast_rays(
     >>> cast_rays(geo, [[0.5, 0.5]], [0.0], [0.0], 1.0).tolist()  # capped
     [[1.0]]
     """
+    if method not in _METHODS:
+        raise ValueError(f"method must be one of {', '.join(map(repr, _METHODS))}, got {method!r}")
     p = np.asarray(origins, dtype=np.float64).reshape(-1, 2)
     yaw = np.asarray(yaws, dtype=np.float64).reshape(-1)
     ang = np.asarray(angles, dtype=np.float64).reshape(-1)
     bearing = yaw[:, None] + ang[None, :]
     c = np.cos(bearing)
     s = np.sin(bearing)
+    if method != "numpy" and raycast_jit.available():
+        d = _NO_DISCS if discs is None else np.asarray(discs, dtype=np.float64).reshape(-1, 3)
+        if own_disc is None:
+            own = _no_own(len(p))
+        else:
+            own = np.ascontiguousarray(own_disc, dtype=np.int64).reshape(-1)
+        best, near = raycast_jit.cast_rays_compiled(
+            geometry, np.ascontiguousarray(p), bearing, c, s, float(max_range), np.ascontiguousarray(d), own
+        )
+        if near:  # an origin in a cell a polygon touches: shapely decides if it is inside
+            best[_inside_polygon(geometry, p)] = 0.0
+        return best
+    if method == "numba":
+        raise ValueError('method="numba" needs numba: pip install "pointnav-core[fast]"')
     best = np.minimum(
         _grid_hits(geometry, p, c, s, float(max_range)), float(max_range)
     )
@@ -206,6 +263,39 @@ def cast_rays(
             own = None if own_disc is None else np.asarray(own_disc, dtype=np.int64).reshape(-1)
             np.minimum(best, _disc_hits(p, c, s, d, own), out=best)
     return best
+
+
+def cast_pose_compiled(
+    geometry: ScanGeometry,
+    origin: NDArray[np.float64],
+    yaw: float,
+    angles: NDArray[np.float64],
+    max_range: float,
+    rays: tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]],
+) -> NDArray[np.float64] | None:
+    """One origin's ranges (m), ``(R,)``, by the compiled path, or None without numba.
+
+    :func:`cast_rays` for one robot and no discs, with its conversions left out: ``origin``
+    is a ``(1, 2)`` float64 array, ``rays`` three ``(1, R)`` float64 buffers this call
+    overwrites (bearings, cosines, sines). A scan calls it at every step.
+    """
+    if not raycast_jit.available():
+        return None
+    bearing, c, s = rays
+    np.add(yaw, angles, out=bearing[0])
+    np.cos(bearing, out=c)
+    np.sin(bearing, out=s)
+    best, near = raycast_jit.cast_rays_compiled(geometry, origin, bearing, c, s, max_range, _NO_DISCS, _no_own(1))
+    if near:
+        best[_inside_polygon(geometry, origin)] = 0.0
+    return best[0]
+
+
+@functools.lru_cache(maxsize=64)
+def _no_own(n: int) -> NDArray[np.int64]:
+    """``n`` times -1 (no origin has a disc of its own), shared (the kernel only reads it)."""
+    # Writable like a caller's own_disc, so the kernel is compiled for one array type.
+    return np.full(n, -1, dtype=np.int64)
 
 
 def _grid_hits(
@@ -313,16 +403,21 @@ def _polygon_hits(
         else:  # per robot, the nearest over its candidate edges (pairs grouped by robot)
             starts = np.flatnonzero(np.r_[True, robot[1:] != robot[:-1]])
             best[robot[starts]] = np.minimum.reduceat(t, starts, axis=0)
-    # An origin inside (or on) a polygon reads 0; only one in a cell a polygon touches can be.
+    best[_inside_polygon(geo, p)] = 0.0
+    return best
+
+
+def _inside_polygon(geo: ScanGeometry, p: NDArray[np.float64]) -> NDArray[np.intp]:
+    """Indices of the origins inside (or on) an obstacle polygon: they read 0."""
+    # Only an origin in a cell a polygon touches can be inside one.
     hp, wp = geo.shape
     inv = 1.0 / geo.resolution
     col = np.minimum(np.maximum(np.floor((p[:, 0] - geo.origin[0]) * inv) + 1, 0), wp - 1).astype(np.intp)
     row = np.minimum(np.maximum(np.floor((p[:, 1] - geo.origin[1]) * inv) + 1, 0), hp - 1).astype(np.intp)
     check = np.flatnonzero(geo._near_polygon[row * wp + col])
     if len(check):
-        inside = geo._poly_tree.query(shapely.points(p[check]), predicate="intersects")[0]
-        best[check[inside]] = 0.0
-    return best
+        return check[geo._poly_tree.query(shapely.points(p[check]), predicate="intersects")[0]]
+    return check
 
 
 def _disc_hits(

@@ -49,7 +49,7 @@ from numpy.typing import NDArray
 from pointnav_core.backend import float_twin
 from pointnav_core.observations import Frame, ObservationTerm
 from pointnav_core.sensors._checks import check_int, check_number
-from pointnav_core.sensors.raycast import ScanGeometry, cast_rays
+from pointnav_core.sensors.raycast import ScanGeometry, cast_pose_compiled, cast_rays
 
 __all__ = ["RangeScan", "ScanShare", "other_robot_discs", "scan_angles"]
 
@@ -153,6 +153,8 @@ class RangeScan(ObservationTerm):
         self._geometry: ScanGeometry | None = None
         self._share: ScanShare | None = None
         self._rng: np.random.Generator | None = None
+        self._pose = (np.zeros((1, 2)), np.zeros(1))
+        self._rays = (np.zeros((1, self.n_rays)), np.zeros((1, self.n_rays)), np.zeros((1, self.n_rays)))
         #: ``(x, y, yaw, readings)`` of the last observation (renderers draw it), or None.
         self.last_scan: tuple[float, float, float, NDArray[np.float64]] | None = None
 
@@ -199,11 +201,19 @@ class RangeScan(ObservationTerm):
                 return shared
         if self._geometry is None or self._geometry.tmap is not env.scene.floors[task.floor]:
             self._geometry = ScanGeometry(env.scene.floors[task.floor])
-        discs = other_robot_discs(env, task.robot_idn, task.floor)
-        yaw = math.atan2(frame.sin_yaw, frame.cos_yaw)
+        discs = other_robot_discs(env, task.robot_idn, task.floor) if len(env.robots) > 1 else None
+        # The pose goes in through small buffers: cheaper than converting tuples each step.
+        origin, yaw = self._pose
+        origin[0, 0] = frame.x
+        origin[0, 1] = frame.y
+        yaw[0] = math.atan2(frame.sin_yaw, frame.cos_yaw)
+        if discs is None or not len(discs):
+            fast = cast_pose_compiled(self._geometry, origin, yaw[0], self.angles, self.max_range, self._rays)
+            if fast is not None:
+                return fast
         return cast_rays(
-            self._geometry, ((frame.x, frame.y),), (yaw,), self.angles, self.max_range,
-            discs=discs if len(discs) else None,
+            self._geometry, origin, yaw, self.angles, self.max_range,
+            discs=discs if discs is not None and len(discs) else None,
         )[0]
 
     def values(self, frame: Frame) -> NDArray[np.float64]:

@@ -1,0 +1,240 @@
+"""The numba kernel behind :mod:`pointnav_core.sensors.raycast_jit` (imports numba).
+
+Imported only by :func:`pointnav_core.sensors.raycast_jit.kernel`, so that the package
+imports without numba. Module-level functions, so that ``cache=True`` stores the compiled
+code on disk and later processes load it instead of compiling again. See
+:mod:`~pointnav_core.sensors.raycast_jit` for what the kernel does and why it is exact.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numba
+import numpy as np
+
+from pointnav_core.sensors.raycast import TOUCH_EPS
+
+__all__ = ["cast"]
+
+_jit = numba.njit(cache=True, nogil=True, error_model="numpy")
+_EPS = TOUCH_EPS
+_TINY = 1e-300  # raycast._TINY
+_INF = math.inf
+# An edge's angular span (see cast): used when the origin is at least _SPAN_MIN_DIST
+# (m) from its line and _SPAN_MIN_END from its ends; widened by _SPAN_MARGIN (rad).
+_SPAN_MIN_DIST = 1e-4
+_SPAN_MIN_END = 1e-2
+_SPAN_MARGIN = 1e-3
+_TWO_PI = 2.0 * math.pi
+
+
+@_jit
+def crossings(g_along, d_along, g_across, d_across):  # pragma: no cover
+    # One crossing family of one ray: sign, dt, t0, a0, step, first cell entered.
+    pos = d_along >= 0.0
+    sgn = 1.0 if pos else -1.0
+    base = math.floor(g_along) + 1.0 if pos else math.ceil(g_along) - 1.0
+    dt = 1.0 / max(abs(d_along), _TINY)
+    t0 = (base - g_along) * sgn * dt
+    return sgn, dt, t0, g_across + t0 * d_across, dt * d_across, base - (0.0 if pos else 1.0)
+
+@_jit
+def blocked(a0, step, kf, ent0, sgn, across_max, along_max, plane_of, hi_stride,
+            entered_stride, lookup, e):  # pragma: no cover
+    # Whether the crossing kf of a family enters (or grazes) a blocked cell.
+    across = a0 + step * kf
+    hi = math.floor(across + e)
+    grazing = math.floor(across - e) < hi
+    hi = min(max(hi, 0.0), across_max)
+    entered = min(max(ent0 + sgn * kf, 0.0), along_max)
+    idx = (plane_of if grazing else 0.0) + hi * hi_stride + entered * entered_stride
+    return lookup[int(idx)]
+
+@_jit
+def skip_to(t0, dt, k, target, n_cross):  # pragma: no cover
+    # The first crossing index at or after k whose t is not below target (about).
+    if t0 < target:
+        k = max(k, math.ceil((target - t0) / dt))
+    return min(k, n_cross)
+
+@_jit
+def grid_range(gx, gy, dx, dy, fhp, fwp, plane, lookup, clear, e, n_cross, reach):  # pragma: no cover
+    # Nearest blocked crossing (cell units) of one ray, _INF past reach: both crossing
+    # families of raycast._grid_hits (the same expressions), merged in order of t so the
+    # walk ends at the first blocked crossing of either.
+    sx, dtx, t0x, a0x, stx, enx = crossings(gx, dx, gy, dy)
+    sy, dty, t0y, a0y, sty, eny = crossings(gy, dy, gx, dx)
+    wp = int(fwp)
+    # Clear squares: if the cell under the ray's point at t is C cells (chessboard)
+    # from the nearest blocked cell, the cells within C - 1 of it are free, and so is
+    # every cell a crossing tests while the ray is inside their square; the walk jumps
+    # to where the ray leaves it (less a margin for rounding and e).
+    margin = 1e-6 + 2.0 * e
+    kx = 0
+    ky = 0
+    t = 0.0
+    while True:
+        qx = gx + t * dx
+        qy = gy + t * dy
+        cx = math.floor(qx)
+        cy = math.floor(qy)
+        if 0.0 <= cx < fwp and 0.0 <= cy < fhp:
+            clr = clear[int(cy) * wp + int(cx)]
+            if clr >= 2:
+                # Distance along the ray to the square's sides [c - (C - 1), c + C].
+                ex_ = (cx + clr - qx if dx > 0.0 else qx - (cx - clr + 1.0)) * dtx
+                ey_ = (cy + clr - qy if dy > 0.0 else qy - (cy - clr + 1.0)) * dty
+                target = t + min(ex_, ey_) - margin
+                kx = skip_to(t0x, dtx, kx, target, n_cross)
+                ky = skip_to(t0y, dty, ky, target, n_cross)
+        tx = t0x + float(kx) * dtx if kx < n_cross else _INF
+        ty = t0y + float(ky) * dty if ky < n_cross else _INF
+        if tx <= ty:
+            if tx > reach:  # t grows along the walk: nothing nearer is left
+                return _INF
+            if blocked(a0x, stx, float(kx), enx, sx, fhp - 1.0, fwp - 1.0, float(plane), fwp, 1.0,
+                       lookup, e):
+                return tx
+            kx += 1
+            t = tx
+        else:
+            if ty > reach:
+                return _INF
+            if blocked(a0y, sty, float(ky), eny, sy, fwp - 1.0, fhp - 1.0, 2.0 * plane, 1.0, fwp,
+                       lookup, e):
+                return ty
+            ky += 1
+            t = ty
+
+@_jit
+def cast(p, bearing, c, s, params, lookup, clear, near_polygon, edges, discs, own, out):  # pragma: no cover
+    res = params[0]
+    ox = params[1]
+    oy = params[2]
+    max_range = params[3]
+    hp = int(params[4])
+    wp = int(params[5])
+    inv = 1.0 / res
+    e = _EPS * inv
+    reach = max_range * inv
+    n_cross = min(math.ceil(reach) + 1, max(hp, wp) + 1)
+    plane = hp * wp
+    fhp = float(hp)
+    fwp = float(wp)
+    n_edges = edges.shape[0]
+    n_discs = discs.shape[0]
+    n_rays = c.shape[1]
+    phi = np.empty(n_rays)
+    n_near = 0
+    for i in range(p.shape[0]):
+        px = p[i, 0]
+        py = p[i, 1]
+        gx = (px - ox) * inv + 1.0
+        gy = (py - oy) * inv + 1.0
+        # An origin in a cell a polygon touches may be inside one (raycast._inside_polygon).
+        col = int(min(max(math.floor((px - ox) * inv) + 1.0, 0.0), wp - 1))
+        row = int(min(max(math.floor((py - oy) * inv) + 1.0, 0.0), hp - 1))
+        if near_polygon[row * wp + col]:
+            n_near += 1
+        # An origin touching a blocked cell (or off the map) reads 0.
+        c0 = int(min(max(math.floor(gx - e), 0.0), wp - 1))
+        c1 = int(min(max(math.floor(gx + e), 0.0), wp - 1))
+        r0 = int(min(max(math.floor(gy - e), 0.0), hp - 1)) * wp
+        r1 = int(min(max(math.floor(gy + e), 0.0), hp - 1)) * wp
+        if lookup[r0 + c0] or lookup[r0 + c1] or lookup[r1 + c0] or lookup[r1 + c1]:
+            out[i, :] = 0.0  # nothing is nearer; the rest are ranges >= 0
+            continue
+        # The grid and the discs, ray by ray.
+        for r in range(n_rays):
+            dx = c[i, r]
+            dy = s[i, r]
+            best = min(grid_range(gx, gy, dx, dy, fhp, fwp, plane, lookup, clear, e, n_cross, reach) * res,
+                       max_range)
+            for m in range(n_discs):
+                if own[i] == m:
+                    continue
+                fx = px - discs[m, 0]
+                fy = py - discs[m, 1]
+                b = fx * dx + fy * dy
+                cc = fx * fx + fy * fy - discs[m, 2] * discs[m, 2]
+                if cc <= 0.0:
+                    t = 0.0
+                else:
+                    disc = b * b - cc
+                    if disc >= 0.0 and b <= 0.0:
+                        denom = math.sqrt(max(disc, 0.0)) - b
+                        t = cc / denom if denom > 0.0 else _INF
+                    else:
+                        t = _INF
+                best = min(best, t)
+            out[i, r] = best
+        if n_edges == 0:
+            continue
+        for r in range(n_rays):  # bearings in [-pi, pi], as atan2 gives the edges' ends
+            phi[r] = bearing[i, r] - _TWO_PI * math.floor(bearing[i, r] / _TWO_PI + 0.5)
+        order = np.argsort(phi)
+        sphi = phi[order]
+        # The polygon edges, each against the rays in its angular span only.
+        for j in range(n_edges):
+            if not (edges[j, 6] >= px - max_range and edges[j, 4] <= px + max_range
+                    and edges[j, 7] >= py - max_range and edges[j, 5] <= py + max_range):
+                continue
+            fx = edges[j, 0] - px
+            fy = edges[j, 1] - py
+            ex = edges[j, 2]
+            ey = edges[j, 3]
+            num0 = ey * fx - ex * fy
+            if num0 > 0.0:  # seen from its back (the material's side)
+                continue
+            full = True
+            lo = hi = 0.0
+            elen = math.hypot(ex, ey)
+            if (-num0 >= _SPAN_MIN_DIST * elen and math.hypot(fx, fy) >= _SPAN_MIN_END
+                    and math.hypot(fx + ex, fy + ey) >= _SPAN_MIN_END):
+                # Far enough from the edge's line and ends: a ray more than _SPAN_MARGIN
+                # outside the directions of its ends misses it by far more than
+                # rounding and TOUCH_EPS, so only the rays between them are tested.
+                pa = math.atan2(fy, fx)
+                pb = math.atan2(fy + ey, fx + ex)
+                width = pb - pa
+                if width > math.pi:
+                    width -= 2.0 * math.pi
+                elif width < -math.pi:
+                    width += 2.0 * math.pi
+                lo = min(pa, pa + width) - _SPAN_MARGIN
+                hi = max(pa, pa + width) + _SPAN_MARGIN
+                full = False
+            for wrap in range(3):  # the span, and its parts shifted by a full turn
+                if full:
+                    if wrap != 1:
+                        continue
+                    k0 = 0
+                    k1 = n_rays
+                else:
+                    a = lo + (wrap - 1) * 2.0 * math.pi
+                    b = hi + (wrap - 1) * 2.0 * math.pi
+                    if b < -math.pi or a > math.pi:
+                        continue
+                    k0 = np.searchsorted(sphi, a)
+                    k1 = np.searchsorted(sphi, b, side="right")
+                for k in range(k0, k1):
+                    r = order[k]
+                    best = out[i, r]
+                    dx = c[i, r]
+                    dy = s[i, r]
+                    cross = dx * ey - dy * ex
+                    num = fx * ey - fy * ex
+                    # Without dividing: t = num / cross surely negative (opposite signs,
+                    # num far from underflow) or surely beyond best changes nothing.
+                    if abs(num) > 1e-250 and (num < 0.0) != (cross < 0.0) and cross != 0.0:
+                        continue
+                    if abs(num) > best * abs(cross) * (1.0 + 1e-12):
+                        continue
+                    den = 1.0 / cross
+                    t = num * den
+                    if t >= 0.0 and t < best:
+                        u = (fx * dy - fy * dx) * den
+                        if abs(u - 0.5) <= edges[j, 8]:
+                            out[i, r] = t
+    return n_near

@@ -1,0 +1,81 @@
+"""The compiled fast path of :func:`~pointnav_core.sensors.raycast.cast_rays` (numba).
+
+The numpy path of :mod:`~pointnav_core.sensors.raycast` tests every grid crossing up to
+``max_range`` of every ray, and every candidate polygon edge against every ray, as whole
+arrays: about forty numpy calls a scan whatever the scene. This module does the same
+arithmetic one ray at a time in a numba kernel, stopping where the ray stops:
+
+- the two crossing families are walked in order of ``t`` and the walk ends at the first
+  blocked crossing (the y-family's walk also ends past the x-family's hit);
+- polygon edges are culled once per origin (bounding box within ``max_range``, back
+  faces), then tested per ray;
+- other robots' discs are tested per ray.
+
+Every quantity is the same expression as in the numpy path, evaluated in the same order on
+the same cosines and sines (computed by numpy in :func:`cast_rays_compiled`), so both paths
+give the same ranges; ``property_tests/test_scan_props.py`` checks that they are equal.
+
+numba is optional (the ``fast`` extra). :func:`kernel` imports it lazily, on the first
+scan (the kernel itself is :mod:`~pointnav_core.sensors._raycast_kernel`), and returns None
+when it is missing; ``cast_rays`` then takes the numpy path. The kernel is compiled once and
+cached on disk (``cache=True``), so later processes load it.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+__all__ = ["available", "cast_rays_compiled", "kernel"]
+
+_KERNEL: Any = None
+_TRIED = False
+
+
+def kernel() -> Any:
+    """The compiled ray-casting kernel, or None when numba is not installed."""
+    global _KERNEL, _TRIED
+    if not _TRIED:
+        _TRIED = True
+        try:
+            from pointnav_core.sensors._raycast_kernel import cast
+        except ModuleNotFoundError as error:
+            if error.name not in ("numba", "llvmlite"):
+                raise
+            _KERNEL = None
+        else:
+            _KERNEL = cast
+    return _KERNEL
+
+
+def available() -> bool:
+    """Whether the compiled path can run (numba importable)."""
+    return kernel() is not None
+
+
+def cast_rays_compiled(
+    geometry: Any,
+    p: NDArray[np.float64],
+    bearing: NDArray[np.float64],
+    c: NDArray[np.float64],
+    s: NDArray[np.float64],
+    max_range: float,
+    discs: NDArray[np.float64],
+    own: NDArray[np.int64],
+) -> tuple[NDArray[np.float64], int]:
+    """Ranges (m), ``(N, R)``, from origins ``p`` along bearings ``bearing`` (rad), whose
+    cosines and sines are ``c`` and ``s``.
+
+    The arguments are :func:`~pointnav_core.sensors.raycast.cast_rays`'s, already converted:
+    ``discs`` ``(M, 3)`` (possibly empty) and ``own`` ``(N,)`` (-1: no own disc). Origins
+    inside an obstacle polygon are not zeroed here: the second value counts the origins in
+    a cell a polygon touches, and the caller asks shapely about those.
+    """
+    out = np.empty(c.shape, dtype=np.float64)
+    near = kernel()(
+        p, bearing, c, s, geometry._jit_params(max_range), geometry._lookup, geometry._clearance,
+        geometry._near_polygon, geometry._jit_edges, discs, own, out,
+    )
+    return out, near
