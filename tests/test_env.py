@@ -264,6 +264,30 @@ def test_out_of_range_actions_are_clipped(backend):
 
 
 @pytest.mark.parametrize("backend", BACKENDS)
+@pytest.mark.parametrize("bad", [math.nan, math.inf, -math.inf])
+@pytest.mark.parametrize("kind", ["float32 array", "list"])
+def test_a_non_finite_action_raises_and_changes_nothing(backend, bad, kind):
+    # The env checks an action's type and shape, the backend its values: the refusal
+    # must still come before anything moves, on every backend.
+    env = PointNavEnv(scene=small_scene(), backend=backend)
+    env.reset(seed=0)
+    env.step(np.array([0.5, 0.3], dtype=np.float32))
+    pose = [a.tolist() for a in env.backend.get_pose(0)]
+    velocity = [a.tolist() for a in env.backend.get_velocity(0)]
+    task = env.unwrapped.task
+    steps, length, contact = task.episode_length, task.path_length, env.backend.in_contact(0)
+    action = [0.2, bad] if kind == "list" else np.array([0.2, bad], dtype=np.float32)
+    with pytest.raises(ValueError, match=r"^action must be finite, got \[0\.2"):
+        env.step(action)
+    assert [a.tolist() for a in env.backend.get_pose(0)] == pose
+    assert [a.tolist() for a in env.backend.get_velocity(0)] == velocity
+    assert env.backend.in_contact(0) == contact
+    assert (task.episode_length, task.path_length) == (steps, length)
+    env.step(np.array([0.5, 0.0], dtype=np.float32))  # the env still works
+    assert task.episode_length == steps + 1
+
+
+@pytest.mark.parametrize("backend", BACKENDS)
 def test_two_envs_sharing_one_scene_agree_on_the_same_seed(backend):
     grid = np.full((16, 20), FREE, dtype=np.uint8)
     grid[0, :] = grid[-1, :] = grid[:, 0] = grid[:, -1] = OBSTACLE

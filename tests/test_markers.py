@@ -15,7 +15,7 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-import pointnav_core.task as task_module
+import pointnav_core.markers as markers_module
 from pointnav_core.backend import RobotSpec
 from pointnav_core.env import PointNavEnv
 from pointnav_core.maps import FREE, OBSTACLE
@@ -384,8 +384,8 @@ def test_no_marker_work_when_visualisation_is_off(monkeypatch):
     def boom(*args, **kwargs):
         raise AssertionError("marker work with visualisation off")
 
-    monkeypatch.setattr(task_module, "_waypoints_along", boom)
-    monkeypatch.setattr(task_module, "VisualMarker", boom)
+    monkeypatch.setattr(markers_module, "_waypoints_along", boom)
+    monkeypatch.setattr(markers_module, "VisualMarker", boom)
     env = make_env()
     env.reset(seed=0)
     for _ in range(5):
@@ -397,7 +397,7 @@ def test_visualize_goal_alone_does_no_path_work(monkeypatch):
     def boom(*args, **kwargs):
         raise AssertionError("waypoint work without visualize_path")
 
-    monkeypatch.setattr(task_module, "_waypoints_along", boom)
+    monkeypatch.setattr(markers_module, "_waypoints_along", boom)
     env = make_env(visualize_goal=True)
     env.reset(seed=0)
     env.step(FORWARD)

@@ -613,6 +613,19 @@ def test_bad_actions_raise_and_change_nothing(actions, match):
     assert env.tasks[1].episode_length == 2
 
 
+@pytest.mark.parametrize("backend", BACKENDS)
+def test_a_non_finite_action_names_its_agent_and_changes_nothing(backend):
+    env = corridor_env(backend, [lane(0.5, 1.5), lane(2.5, 3.5), lane(4.5, 5.5)])
+    env.reset(seed=0)
+    before = snapshot(env)
+    actions = {"robot_0": GO, "robot_1": [0.5, np.inf], "robot_2": np.array([np.nan, 0.0])}
+    with pytest.raises(ValueError, match=r"^robot_1: action must be finite"):
+        env.step(actions)
+    assert snapshot(env) == before
+    env.step({agent: GO for agent in env.agents})  # the env still works
+    assert [t.episode_length for t in env.tasks] == [1, 1, 1]
+
+
 def test_step_before_reset_and_after_the_end_is_a_state_error():
     env = parallel.parallel_env(scene=small_scene(), n_robots=2, max_cycles=1)
     with pytest.raises(TaskStateError, match="call reset"):

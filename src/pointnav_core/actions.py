@@ -57,6 +57,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from pointnav_core import validation
 from pointnav_core.sensors._checks import check_number
 from pointnav_core.terminations import TerminationCondition
 
@@ -172,9 +173,7 @@ def make_discrete_actions(
     if not isinstance(discrete_actions, Mapping):
         raise ValueError(f"discrete_actions must be None or a dict, got {discrete_actions!r}")
     valid = ["forward_step", "turn_angle", "stop"]
-    for key in discrete_actions:
-        if key not in valid:
-            raise ValueError(f"discrete_actions has an unknown key {key!r}; valid keys are {valid}")
+    validation.known_keys("discrete_actions", discrete_actions, valid)
     return DiscreteActions(**discrete_actions)
 
 

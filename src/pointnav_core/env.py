@@ -324,7 +324,8 @@ class PointNavEnv(gym.Env[Any, np.ndarray]):
         return self._get_obs(), reward, terminated, truncated, info
 
     def _check_action(self, action: Any) -> Any:
-        return _envcommon.check_action(action, self._action_shape, self.robot.drive)
+        # Finiteness is the backend's check: a rejected step moves nothing (conformance).
+        return _envcommon.check_action(action, self._action_shape, self.robot.drive, finite=False)
 
     def _get_obs(self) -> Any:
         if self.flatten_obs:

@@ -41,11 +41,12 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-__all__ = ["MARKER_KINDS", "VisualMarker", "place_waypoints"]
+__all__ = ["MARKER_KINDS", "TaskMarkers", "VisualMarker", "place_waypoints"]
 
 #: Valid values of :attr:`VisualMarker.kind`.
 MARKER_KINDS = ("start", "goal", "waypoint")
@@ -194,3 +195,83 @@ def _waypoints_along(
     # can only reach L through rounding when the path is long).
     visible = s < length - 1e-9 * max(1.0, length)
     return positions, visible
+
+
+class TaskMarkers:
+    """The markers of one task's episode: set at reset, waypoints moved after each step.
+
+    The task builds one from its configuration and calls :meth:`clear`, :meth:`place`
+    and :meth:`move_waypoints` only when ``visualize_goal`` or ``visualize_path`` is on,
+    so a task with both off does no marker work. :attr:`markers` is the tuple the
+    task's ``markers`` returns, rebuilt only after the waypoints moved.
+
+    Parameters
+    ----------
+    config : TaskConfig
+        The task's configuration (the ``visualize_*`` flags, heights, widths, counts).
+    """
+
+    def __init__(self, config: Any) -> None:
+        self.config = config
+        self.floor_height = 0.0
+        self.spacing = 0.2  # scene.waypoint_spacing, set when the task meets its env
+        self.clear()
+
+    def clear(self) -> None:
+        """Forget the episode's markers (a reset that fails leaves none)."""
+        self._goal_markers: tuple[VisualMarker, ...] = ()
+        self._waypoint_xy: NDArray[np.float64] | None = None
+        self._waypoint_visible: NDArray[np.bool_] | None = None
+        self._markers: tuple[VisualMarker, ...] | None = ()
+
+    def place(self, start_xy: tuple[float, float], goal_xy: tuple[float, float],
+              field: Any, x: float, y: float) -> None:
+        """Set this episode's markers, the robot standing at (x, y) (m), at reset."""
+        cfg = self.config
+        gx, gy = goal_xy
+        if cfg.visualize_goal:
+            sx, sy = start_xy
+            z = self.floor_height + cfg.goal_height
+            radius = cfg.goal_tolerance
+            self._goal_markers = (
+                VisualMarker(kind="start", position=(sx, sy, z), radius=radius),
+                VisualMarker(kind="goal", position=(gx, gy, z), radius=radius),
+            )
+        if cfg.visualize_path:
+            n = cfg.n_vis_waypoints
+            self._waypoint_xy = np.tile((gx, gy), (n, 1))
+            self._waypoint_visible = np.zeros(n, dtype=bool)
+            self.move_waypoints(field, x, y)
+        self._markers = None
+
+    def move_waypoints(self, field: Any, x: float, y: float) -> None:
+        """Move the waypoint markers onto ``field``'s path from (x, y); hide them if
+        there is none (they then stay where they were)."""
+        # The goal field's cheap path (the source cell's root when the source sees it).
+        points, _ = field.path((x, y), exact=False)
+        count = self.config.n_vis_waypoints
+        if points is None:
+            self._waypoint_visible = np.zeros(count, dtype=bool)
+        else:
+            # place_waypoints' placement, without its checks: the path is the field's.
+            self._waypoint_xy, self._waypoint_visible = _waypoints_along(
+                points, count, self.spacing
+            )
+        self._markers = None
+
+    @property
+    def markers(self) -> tuple[VisualMarker, ...]:
+        """Start and goal markers, then the waypoints (see the task's ``markers``)."""
+        if self._markers is None:
+            markers = self._goal_markers
+            if self._waypoint_xy is not None and self._waypoint_visible is not None:
+                z = self.floor_height + self.config.waypoint_height
+                radius = self.config.waypoint_width
+                markers += tuple(
+                    VisualMarker(kind="waypoint", position=(x, y, z), radius=radius, visible=shown)
+                    for (x, y), shown in zip(
+                        self._waypoint_xy.tolist(), self._waypoint_visible.tolist()
+                    )
+                )
+            self._markers = markers
+        return self._markers

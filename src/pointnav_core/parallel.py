@@ -185,8 +185,17 @@ from pettingzoo.utils.conversions import parallel_to_aec, parallel_to_aec_wrappe
 from pointnav_core import _envcommon, scenes, validation
 from pointnav_core.actions import check_discrete_action, make_discrete_actions
 from pointnav_core.backend import Backend, RobotSpec, make_backend
+from pointnav_core.fleet import (
+    check_fixed_positions,
+    derived_path_ranges,
+    goal_separation,
+    goals_apart,
+    make_robots,
+    make_tasks,
+    prefixed,
+)
 from pointnav_core.maps import BoundedCache
-from pointnav_core.task import PointNavigationTask, TaskStateError
+from pointnav_core.task import TaskStateError
 
 __all__ = [
     "FINISHED_MODES",
@@ -209,85 +218,17 @@ _Z_BELOW = 10.0
 _Z_ABOVE = 1.0
 
 
-def _prefixed(name: str, err: ValueError) -> ValueError:
-    message = str(err)
-    return ValueError(message if message.startswith(name) else f"{name}: {message}")
+def _named_action_error(err: ValueError, todo: list[Any]) -> ValueError:
+    """The backend's refusal of a step, prefixed with the first agent whose action is not
+    finite (the backend refuses the first bad action it meets, in the agents' order)."""
+    for agent, _, action, *_ in todo:
+        if not np.isfinite(action).all():
+            return ValueError(f"{agent}: {err}")
+    return err
 
 
 def _check_int(name: str, value: Any, minimum: int) -> int:
     return validation.integer(name, value, minimum=minimum)
-
-
-def _per_robot(value: Any, n: int, name: str) -> list[Any] | None:
-    """The list of per-robot entries when ``value`` is a list, else None (one shared value)."""
-    if not isinstance(value, (list, tuple)):
-        return None
-    if len(value) != n:
-        raise ValueError(
-            f"{name} must be one value for all robots or a list with one entry per robot "
-            f"(n_robots={n}), got a list of {len(value)}"
-        )
-    return list(value)
-
-
-def _make_robots(robot: Any, n: int) -> tuple[RobotSpec, ...]:
-    entries = _per_robot(robot, n, "robot")
-    if entries is None:
-        return (_envcommon.make_robot(robot),) * n
-    robots = []
-    for i, entry in enumerate(entries):
-        try:
-            robots.append(_envcommon.make_robot(entry, name=f"robot[{i}]"))
-        except ValueError as err:
-            raise _prefixed(f"robot[{i}]", err) from None
-    return tuple(robots)
-
-
-def _make_tasks(task: Any, n: int) -> list[PointNavigationTask]:
-    entries = _per_robot(task, n, "task")
-    if entries is None:
-        if isinstance(task, PointNavigationTask) and n > 1:
-            raise ValueError(
-                f"task is a single PointNavigationTask, which drives one robot; for "
-                f"n_robots={n} pass a dict of its arguments (shared by all robots) or a list "
-                f"of {n} tasks or dicts"
-            )
-        return [_envcommon.make_task(task, name="task", robot_idn=i) for i in range(n)]
-    tasks = []
-    for i, entry in enumerate(entries):
-        try:
-            tasks.append(_envcommon.make_task(entry, name=f"task[{i}]", robot_idn=i))
-        except ValueError as err:
-            raise _prefixed(f"task[{i}]", err) from None
-    if len({id(t) for t in tasks}) != n:
-        raise ValueError("task must not hold the same PointNavigationTask twice")
-    return tasks
-
-
-def _derived_path_ranges(task: Any, n: int) -> list[bool]:
-    """For each robot, whether the env chooses its task's ``path_range``."""
-    entries = _per_robot(task, n, "task")
-    if entries is None:
-        return [_envcommon.derives_path_range(task)] * n
-    return [_envcommon.derives_path_range(entry) for entry in entries]
-
-
-def _goal_separation(
-    scene: scenes.Scene, tasks: Sequence[PointNavigationTask], robots: Sequence[RobotSpec]
-) -> list[list[float]]:
-    """Minimum distance (m) between the goals of robots i and j (on the same floor).
-
-    ``max(tol_i + tol_j, r_i + r_j, cell)``: the success discs do not overlap, both robots
-    fit on their goals, and even point robots with no tolerance get goals a cell apart.
-    """
-    cells = [float(scene.floors[t.floor].resolution) for t in tasks]
-    return [
-        [
-            max(ti.goal_tolerance + tj.goal_tolerance, ri.radius + rj.radius, cell)
-            for tj, rj in zip(tasks, robots)
-        ]
-        for ti, ri, cell in zip(tasks, robots, cells)
-    ]
 
 
 class MultiPointNavEnv(ParallelEnv[str, Any, np.ndarray]):
@@ -362,11 +303,11 @@ class MultiPointNavEnv(ParallelEnv[str, Any, np.ndarray]):
         scene, frequency = _envcommon.check_world_args(
             scene, flatten_obs, action_frequency, backend_kwargs
         )
-        self.robots = _make_robots(robot, n)
-        derive = _derived_path_ranges(task, n)
+        self.robots = make_robots(robot, n)
+        derive = derived_path_ranges(task, n)
         self.discrete_actions = make_discrete_actions(action_space, discrete_actions)
         task = _envcommon.add_stop(_envcommon.add_sensors(task, sensors), self.discrete_actions)
-        tasks = _make_tasks(task, n)
+        tasks = make_tasks(task, n)
 
         self.scene = scene
         self.render_mode = render_mode
@@ -385,11 +326,11 @@ class MultiPointNavEnv(ParallelEnv[str, Any, np.ndarray]):
             try:
                 t.load(self)  # fails here, naming the parameter, if it does not fit
             except ValueError as err:
-                raise _prefixed(f"task[{i}]", err) from None
+                raise prefixed(f"task[{i}]", err) from None
         #: One task per robot, indexed by ``robot_idn`` (read it, don't replace entries).
         self.tasks = tasks
-        self._separation = _goal_separation(scene, tasks, self.robots)
-        self._check_fixed_positions()
+        self._separation = goal_separation(scene, tasks, self.robots)
+        check_fixed_positions(tasks, self.robots, self._separation)
         # Robots with a fixed start are placed first, so no sampled start can take it.
         self._reset_order = sorted(range(n), key=lambda i: tasks[i].initial_pos is None)
 
@@ -429,36 +370,6 @@ class MultiPointNavEnv(ParallelEnv[str, Any, np.ndarray]):
         self._started = False  # whether reset() was ever called
 
     # ------------------------------------------------------------------ construction
-    def _check_fixed_positions(self) -> None:
-        tasks, robots = self.tasks, self.robots
-        for i, ti in enumerate(tasks):
-            for j in range(i + 1, len(tasks)):
-                tj = tasks[j]
-                if ti.floor != tj.floor:
-                    continue
-                si, sj = ti.initial_pos, tj.initial_pos
-                if si is not None and sj is not None:
-                    gap = math.hypot(*(si[:2] - sj[:2]))
-                    need = robots[i].radius + robots[j].radius
-                    if gap < need:
-                        raise ValueError(
-                            f"task[{i}] and task[{j}] have fixed initial_pos {si[:2].tolist()} "
-                            f"and {sj[:2].tolist()}, {gap:.3g} m apart: the robots would "
-                            f"overlap (fixed starts must be at least the sum of the radii, "
-                            f"{need:.3g} m, apart)"
-                        )
-                gi, gj = ti.goal_pos, tj.goal_pos
-                if gi is not None and gj is not None:
-                    gap = math.hypot(*(gi[:2] - gj[:2]))
-                    need = self._separation[i][j]
-                    if gap < need:
-                        raise ValueError(
-                            f"task[{i}] and task[{j}] have fixed goal_pos {gi[:2].tolist()} and "
-                            f"{gj[:2].tolist()}, {gap:.3g} m apart: goals must be distinct, at "
-                            f"least max(sum of goal tolerances, sum of radii, one cell) = "
-                            f"{need:.3g} m apart"
-                        )
-
     def _build_state_space(self) -> spaces.Box:
         scene = self.scene
         extents = [scene.floors[f].extent for f in range(scene.n_floors)]
@@ -552,31 +463,8 @@ class MultiPointNavEnv(ParallelEnv[str, Any, np.ndarray]):
 
     def _reset_robot(self, i: int, placed: list[int], episode: Any = None) -> dict[str, Any]:
         """Reset task ``i`` with its goal kept apart from the goals decided so far."""
-        task, tasks = self.tasks[i], self.tasks
-        # Goals to keep clear of: those placed, and the fixed goals of robots still to come
-        # (fixed goals were checked against each other at construction).
-        others = [
-            j
-            for j in range(len(tasks))
-            if j != i
-            and tasks[j].floor == task.floor
-            and (j in placed or tasks[j].goal_pos is not None)
-        ]
-        separation = self._separation[i]
-
-        def apart(gx: float, gy: float) -> str | None:
-            for j in others:
-                ox, oy = tasks[j].goal_xy  # type: ignore[misc]
-                if math.hypot(gx - ox, gy - oy) < separation[j]:
-                    return (
-                        f"the goal must be distinct from the other robots' goals, at least max(sum "
-                        f"of goal tolerances, sum of radii, one cell) apart ({separation[j]:.3g} m "
-                        f"from robot {j}'s); use fewer robots, a smaller goal_tolerance or a "
-                        f"larger scene"
-                    )
-            return None
-
-        return task.reset(self, goal_constraint=apart if others else None, episode=episode)
+        constraint = goals_apart(self.tasks, i, placed, self._separation)
+        return self.tasks[i].reset(self, goal_constraint=constraint, episode=episode)
 
     def step(
         self, actions: Mapping[str, Any]
@@ -603,7 +491,8 @@ class MultiPointNavEnv(ParallelEnv[str, Any, np.ndarray]):
             )
         if len(actions) != len(agents):
             self._bad_keys(actions)
-        # Check every action before anything moves: a rejected step changes nothing.
+        # Check every action before anything moves (finiteness: the backend, which moves
+        # nothing when it refuses a step): a rejected step changes nothing.
         slots, check, plans = self._slots, _envcommon.check_action, self._plans
         commands: dict[int, np.ndarray] = {}
         todo = []
@@ -619,8 +508,8 @@ class MultiPointNavEnv(ParallelEnv[str, Any, np.ndarray]):
                     f"in env.agents must act"
                 )
             try:
-                if plans is None:
-                    action = check(action, shape, drive)
+                if plans is None:  # finiteness: the backend's step checks it, below
+                    action = check(action, shape, drive, finite=False)
                 else:
                     action = check_discrete_action(action, len(plans[i]))
             except ValueError as err:
@@ -633,11 +522,18 @@ class MultiPointNavEnv(ParallelEnv[str, Any, np.ndarray]):
         terminations: dict[str, bool] = {}
         truncations: dict[str, bool] = {}
         infos: dict[str, dict[str, Any]] = {}
-        try:
-            if plans is None:
+        if plans is None:
+            try:
                 self.backend.step(commands)
-                contacts = None
-            else:
+            except ValueError as err:  # a rejected step moved nothing: name the agent
+                raise _named_action_error(err, todo) from None
+            except BaseException:
+                self.agents = []
+                self._void = True
+                raise
+            contacts = None
+        try:
+            if plans is not None:
                 contacts = self._step_discrete(commands)
             self._cycles += 1
             cut = self._cycles >= self.max_cycles

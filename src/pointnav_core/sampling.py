@@ -28,7 +28,7 @@ from typing import Any
 
 from pointnav_core.errors import SamplingError
 
-__all__ = ["Episode", "GoalConstraint", "sample_episode"]
+__all__ = ["Episode", "GoalConstraint", "sample_episode", "sample_task_episode"]
 
 _TWO_PI = 2.0 * math.pi
 
@@ -159,3 +159,50 @@ def sample_episode(
         f"could not sample an episode for robot {robot_idn} on floor {floor} in {max_trials} "
         f"trials: {worst} ({detail})"
     )
+
+
+def sample_task_episode(
+    env: Any,
+    config: Any,
+    *,
+    spec: Any,
+    floor_height: float,
+    max_trials: int,
+    goal_constraint: GoalConstraint | None = None,
+    given: Any = None,
+) -> Episode:
+    """:func:`sample_episode` with a task's :class:`~pointnav_core.task_config.TaskConfig`.
+
+    A dataset episode ``given`` (:mod:`pointnav_core.datasets`) replaces the fixed or
+    sampled start, start orientation and goal; it is checked first, and every error then
+    names it.
+
+    Raises
+    ------
+    SamplingError, ValueError
+        As :func:`sample_episode`; a ``ValueError`` of a dataset episode names its id.
+    """
+    start, quat, goal = config.initial_pos, config.initial_quat, config.goal_pos
+    if given is not None:
+        from pointnav_core.datasets.playback import episode_poses
+
+        start, quat, goal = episode_poses(given, env.scene, config.floor, spec, config.robot_idn)
+    try:
+        return sample_episode(
+            env,
+            robot_idn=config.robot_idn,
+            floor=config.floor,
+            spec=spec,
+            floor_height=floor_height,
+            initial_pos=start,
+            initial_quat=quat,
+            goal_pos=goal,
+            goal_tolerance=config.goal_tolerance,
+            path_range=config.path_range,
+            max_trials=max_trials,
+            goal_constraint=goal_constraint,
+        )
+    except ValueError as err:
+        if given is None:
+            raise
+        raise ValueError(f"episode {given.episode_id!r}: field 'start_position': {err}") from None

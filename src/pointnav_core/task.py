@@ -7,6 +7,20 @@ episode is over (:mod:`~pointnav_core.terminations`), pays rewards
 never moves anything itself: the environment steps the backend, then calls
 :meth:`PointNavigationTask.step`.
 
+The task orchestrates parts that each live in their own module:
+
+=====================================  ==================================================
+module                                 part
+=====================================  ==================================================
+:mod:`~pointnav_core.lifecycle`        states, events and the transition table
+:mod:`~pointnav_core.task_config`      the frozen, checked configuration; term composition
+:mod:`~pointnav_core.sampling`         episode sampling, with a goal-constraint hook
+:mod:`~pointnav_core.episode_state`    the per-step snapshot every term reads, and ``info``
+:mod:`~pointnav_core.observations`     observation terms, their frame and layout
+:mod:`~pointnav_core.markers`          the start, goal and waypoint markers
+:mod:`~pointnav_core.task_api`         the OmniGibson-compatible properties and queries
+=====================================  ==================================================
+
 Lifecycle
 ---------
 The task is a small state machine (h11 style, :mod:`~pointnav_core.lifecycle`): its states
@@ -23,28 +37,19 @@ multi-robot env). The task reads only the four members of :class:`TaskEnv`.
 
 from __future__ import annotations
 
-import math
+import dataclasses
 from collections.abc import Mapping, Sequence
 from typing import TYPE_CHECKING, Any, ClassVar, Protocol
 
 import numpy as np
-from numpy.typing import ArrayLike, NDArray
+from numpy.typing import ArrayLike
 
-from pointnav_core import validation
 from pointnav_core.backend import float_twin
+from pointnav_core.episode_state import EpisodeState
 from pointnav_core.frozen import FrozenMapping
-from pointnav_core.lifecycle import (
-    ERROR,
-    IDLE,
-    ILLEGAL_HINT,
-    TaskState,
-    TaskStateError,
-    allows,
-    move,
-)
+from pointnav_core.lifecycle import IDLE, TaskState, TaskStateError, allows, move
 from pointnav_core.lifecycle import Event as _Event
-from pointnav_core.markers import VisualMarker, _waypoints_along
-from pointnav_core.metrics import _soft_spl, _spl
+from pointnav_core.markers import TaskMarkers
 from pointnav_core.observations import (
     Frame,
     ObservationLayout,
@@ -57,34 +62,34 @@ from pointnav_core.rewards import (
     PotentialReward,
     RewardFunction,
 )
-from pointnav_core.sampling import GoalConstraint, sample_episode
+from pointnav_core.sampling import GoalConstraint, sample_task_episode
+from pointnav_core.task_api import OmniGibsonTaskAPI
+from pointnav_core.task_config import (
+    REWARD_TYPES,
+    TaskConfig,
+    compose_terms,
+    merge_config,
+)
 from pointnav_core.terminations import (
     Falling,
     MaxCollision,
     PointGoal,
     TerminationCondition,
     Timeout,
-    _check_count,
-    _check_length,
 )
 
 if TYPE_CHECKING:
     from pointnav_core.backend import Backend, RobotSpec
-    from pointnav_core.scenes import FloorGoalField, Scene
+    from pointnav_core.scenes import Scene
 
 __all__ = [
     "REWARD_TYPES",
     "PointNavigationTask",
+    "TaskConfig",
     "TaskEnv",
     "TaskState",
     "TaskStateError",
 ]
-
-#: Valid values of ``reward_type``: the distance the potential reward is measured in.
-REWARD_TYPES = ("l2", "geodesic")
-
-# How far from 1 the norm of a fixed initial_quat may be (it is then normalised).
-_QUAT_NORM_TOL = 1e-3
 
 
 class TaskEnv(Protocol):
@@ -114,107 +119,7 @@ class TaskEnv(Protocol):
         ...
 
 
-# ------------------------------------------------------------------------------ validation
-
-
-_check_bool = validation.boolean
-
-
-def _check_position(name: str, value: Any) -> tuple[float, float] | None:
-    if value is None:
-        return None
-    try:
-        arr = validation.vector(name, value, sizes=(2, 3))
-    except ValueError:
-        raise ValueError(
-            f"{name} must be None or a finite position (x, y, z) in metres (z is replaced by "
-            f"the floor height), got {value!r}"
-        ) from None
-    return float(arr[0]), float(arr[1])
-
-
-def _check_quat(name: str, value: Any) -> tuple[float, float, float, float] | None:
-    if value is None:
-        return None
-    try:
-        arr = validation.vector(name, value, sizes=(4,))
-    except ValueError:
-        raise ValueError(
-            f"{name} must be None or a finite unit quaternion (x, y, z, w), got {value!r}"
-        ) from None
-    norm = math.sqrt(float(arr @ arr))
-    if abs(norm - 1.0) > _QUAT_NORM_TOL:
-        raise ValueError(
-            f"{name} must be a unit quaternion (x, y, z, w), got {value!r} of norm {norm:.6g}"
-        )
-    x, y, z, w = (float(c) / norm for c in arr)
-    return x, y, z, w
-
-
-def _check_path_range(value: Any) -> tuple[float, float] | None:
-    if value is None:
-        return None
-    try:
-        # Not finite-only: the maximum may be inf. '12' is not (1.0, 2.0), nor True 1.0.
-        lo, hi = validation.vector("path_range", value, sizes=(2,), finite=False)
-    except (TypeError, ValueError):
-        raise ValueError(
-            f"path_range must be None or (min, max) geodesic distances in metres, got {value!r}"
-        ) from None
-    if not (math.isfinite(lo) and lo >= 0.0 and hi > lo):  # hi may be inf; NaN fails
-        raise ValueError(
-            f"path_range must be (min, max) with 0 <= min < max (m), min finite, got {value!r}"
-        )
-    return float(lo), float(hi)
-
-
-def _check_index(name: str, value: Any) -> int:
-    return validation.integer(name, value, minimum=0)
-
-
-def _merge_config(
-    name: str, defaults: Mapping[str, Any], overrides: Mapping[str, Any] | None
-) -> Mapping[str, Any]:
-    merged = dict(defaults)
-    if overrides is None:
-        return FrozenMapping(merged)
-    if not isinstance(overrides, Mapping):
-        raise ValueError(f"{name} must be None or a dict, got {overrides!r}")
-    for key in overrides:
-        if key not in defaults:
-            raise ValueError(
-                f"{name} has an unknown key {key!r}; valid keys are {list(defaults)}"
-            )
-    merged.update(overrides)
-    return FrozenMapping(merged)
-
-
-def _compose(kind: str, base: type, defaults: Sequence[Any], extra: Any) -> dict[str, Any]:
-    """Defaults plus ``extra`` terms by name: a term named like a default replaces it in
-    place, any other is appended. ``kind`` names the argument in errors."""
-    terms = {t.name: t for t in defaults}
-    if extra is None:
-        return terms
-    if isinstance(extra, (str, bytes, Mapping)) or not isinstance(extra, Sequence):
-        raise ValueError(f"{kind} must be None or a sequence of {base.__name__} objects, got {extra!r}")
-    seen: set[str] = set()
-    for term in extra:
-        if not isinstance(term, base):
-            raise ValueError(f"{kind} must hold {base.__name__} objects, got {term!r}")
-        name = term.name
-        if not isinstance(name, str) or not name:
-            raise ValueError(f"{kind}: {term!r} must have a non-empty str name, got {name!r}")
-        if name in seen:
-            raise ValueError(f"{kind} has two terms named {name!r}")
-        seen.add(name)
-        terms[name] = term
-    return terms
-
-
-# ------------------------------------------------------------------------------ the task
-
-
-class PointNavigationTask:
+class PointNavigationTask(OmniGibsonTaskAPI):
     """Drive robot ``robot_idn`` to a goal position on floor ``floor``.
 
     A faithful, bug-fixed port of OmniGibson's ``PointNavigationTask`` (same parameters,
@@ -341,34 +246,22 @@ class PointNavigationTask:
         reward_functions: Sequence[RewardFunction] | None = None,
         observation_terms: Sequence[ObservationTerm] | None = None,
     ) -> None:
-        self._robot_idn = _check_index("robot_idn", robot_idn)
-        self._floor = _check_index("floor", floor)
-        self._initial_pos = _check_position("initial_pos", initial_pos)
-        self._initial_quat = _check_quat("initial_quat", initial_quat)
-        self._goal_pos = _check_position("goal_pos", goal_pos)
-        self._goal_tolerance = _check_length("goal_tolerance", goal_tolerance)
-        self._goal_in_polar = _check_bool("goal_in_polar", goal_in_polar)
-        self._path_range = _check_path_range(path_range)
-        self._visualize_goal = _check_bool("visualize_goal", visualize_goal)
-        self._visualize_path = _check_bool("visualize_path", visualize_path)
-        self._goal_height = _check_length("goal_height", goal_height)
-        self._waypoint_height = _check_length("waypoint_height", waypoint_height)
-        self._waypoint_width = _check_length("waypoint_width", waypoint_width)
-        if self._waypoint_width == 0.0:
-            raise ValueError(
-                f"waypoint_width must be a finite number > 0 (m), got {waypoint_width!r}"
-            )
-        self._n_vis_waypoints = _check_count("n_vis_waypoints", n_vis_waypoints, minimum=1)
-        if not isinstance(reward_type, str) or reward_type not in REWARD_TYPES:
-            raise ValueError(
-                f"reward_type must be one of {list(REWARD_TYPES)}, got {reward_type!r}"
-            )
-        self._reward_type = reward_type
-        self._termination_config = _merge_config(
-            "termination_config", self.default_termination_config, termination_config
+        config = TaskConfig(
+            robot_idn=robot_idn, floor=floor, initial_pos=initial_pos,
+            initial_quat=initial_quat, goal_pos=goal_pos, goal_tolerance=goal_tolerance,
+            goal_in_polar=goal_in_polar, path_range=path_range,
+            visualize_goal=visualize_goal, visualize_path=visualize_path,
+            goal_height=goal_height, waypoint_height=waypoint_height,
+            waypoint_width=waypoint_width, n_vis_waypoints=n_vis_waypoints,
+            reward_type=reward_type,
         )
-        self._reward_config = _merge_config(
-            "reward_config", self.default_reward_config, reward_config
+        # Merged over the class's defaults (a subclass may change them), then checked.
+        self._config = dataclasses.replace(
+            config,
+            termination_config=merge_config(
+                "termination_config", self.default_termination_config, termination_config
+            ),
+            reward_config=merge_config("reward_config", self.default_reward_config, reward_config),
         )
         try:
             terminations = dict(self._create_termination_conditions())
@@ -378,10 +271,11 @@ class PointNavigationTask:
             rewards = dict(self._create_reward_functions())
         except ValueError as err:
             raise ValueError(f"reward_config: {err}") from None
-        terminations = _compose("termination_conditions", TerminationCondition, list(terminations.values()), termination_conditions)
-        rewards = _compose("reward_functions", RewardFunction, list(rewards.values()), reward_functions)
-        observations = _compose(
-            "observation_terms", ObservationTerm, default_observation_terms(self._goal_in_polar), observation_terms
+        terminations = compose_terms("termination_conditions", TerminationCondition, list(terminations.values()), termination_conditions)
+        rewards = compose_terms("reward_functions", RewardFunction, list(rewards.values()), reward_functions)
+        observations = compose_terms(
+            "observation_terms", ObservationTerm,
+            default_observation_terms(self._config.goal_in_polar), observation_terms,
         )
         self._observations: Mapping[str, ObservationTerm] = FrozenMapping(observations)
         self._obs_layout: ObservationLayout | None = None
@@ -394,6 +288,7 @@ class PointNavigationTask:
         self._reward_items = tuple(rewards.items())
 
         self._state = IDLE
+        self._idn = self._config.robot_idn  # read on every step
         # Bound at the first meeting with an env (load): caches for the per-step path.
         self._env: Any = None
         self._spec: Any = None
@@ -403,270 +298,32 @@ class PointNavigationTask:
         self._pose_floats: Any = None
         self._velocity_floats: Any = None
         self._floor_height = 0.0
-        # The episode (valid from the first successful reset).
-        self._start_xy: tuple[float, float] | None = None
-        self._start_quat: tuple[float, float, float, float] | None = None
-        self._goal_xy: tuple[float, float] | None = self._goal_pos
-        self._goal_field: FloorGoalField | None = None
-        self._field_distance: Any = None
-        self._geodesic_dist = math.inf
-        self._metric = "l2"
-        self._robot_xyz = (0.0, 0.0, 0.0)
-        self._robot_quat: list[float] = [0.0, 0.0, 0.0, 1.0]
-        self._potential = 0.0
-        self._distance_to_goal = math.inf
-        self._path_length = 0.0
-        self._collisions = 0
-        self._in_contact = False
-        self._steps = 0
-        self._success = False
-        self._results: dict[str, tuple[bool, bool]] = {}
-        # Visual markers (pointnav_core.markers): touched only when visualize_goal or
-        # visualize_path is on. ``_markers`` is the tuple ``markers`` returns, None when a
-        # step moved the waypoints and it must be rebuilt.
-        self._waypoint_spacing = 0.2
-        self._goal_markers: tuple[VisualMarker, ...] = ()
-        self._waypoint_xy: NDArray[np.float64] | None = None
-        self._waypoint_visible: NDArray[np.bool_] | None = None
-        self._markers: tuple[VisualMarker, ...] | None = ()
+        self._ep = EpisodeState(goal_xy=self._config.goal_pos)
+        # Touched only when visualize_goal or visualize_path is on.
+        self._marks = TaskMarkers(self._config)
+        self._show_markers = self._config.visualize_goal or self._config.visualize_path
 
     # ------------------------------------------------------------------ composition
     def _create_termination_conditions(self) -> dict[str, TerminationCondition]:
         """Build the termination conditions, in evaluation order (override to change them)."""
-        cfg = self._termination_config
+        cfg = self._config.termination_config
         conditions: list[TerminationCondition] = [
             MaxCollision(max_collisions=cfg["max_collisions"]),
             Timeout(max_steps=cfg["max_steps"]),
             Falling(fall_height=cfg["fall_height"]),
-            PointGoal(goal_tolerance=self._goal_tolerance),
+            PointGoal(goal_tolerance=self._config.goal_tolerance),
         ]
         return {c.name: c for c in conditions}
 
     def _create_reward_functions(self) -> dict[str, RewardFunction]:
         """Build the reward functions, in evaluation order (override to change them)."""
-        cfg = self._reward_config
+        cfg = self._config.reward_config
         rewards: list[RewardFunction] = [
             PotentialReward(r_potential=cfg["r_potential"]),
             CollisionReward(r_collision=cfg["r_collision"]),
             PointGoalReward(r_pointgoal=cfg["r_pointgoal"]),
         ]
         return {r.name: r for r in rewards}
-
-    # ------------------------------------------------------------------ parameters
-    @property
-    def robot_idn(self) -> int:
-        """Index of the robot this task drives."""
-        return self._robot_idn
-
-    @property
-    def floor(self) -> int:
-        """Floor the task navigates on."""
-        return self._floor
-
-    @property
-    def initial_pos(self) -> NDArray[np.float64] | None:
-        """The fixed start (x, y, z) in metres with z = 0 until loaded, or None (sampled)."""
-        if self._initial_pos is None:
-            return None
-        return np.array((*self._initial_pos, self._floor_height))
-
-    @property
-    def initial_quat(self) -> NDArray[np.float64] | None:
-        """The fixed start orientation (x, y, z, w), or None (random heading)."""
-        return None if self._initial_quat is None else np.array(self._initial_quat)
-
-    @property
-    def goal_pos(self) -> NDArray[np.float64] | None:
-        """The fixed goal (x, y, z) in metres, or None (sampled); see :meth:`get_goal_pos`."""
-        return None if self._goal_pos is None else np.array((*self._goal_pos, self._floor_height))
-
-    @property
-    def goal_tolerance(self) -> float:
-        """Success radius (m)."""
-        return self._goal_tolerance
-
-    @property
-    def goal_in_polar(self) -> bool:
-        """Whether the goal observation is (rho, phi)."""
-        return self._goal_in_polar
-
-    @property
-    def path_range(self) -> tuple[float, float] | None:
-        """(min, max) geodesic of sampled start/goal pairs (m), or None; settable, used
-        from the next reset (the envs set it to what the robot can drive in time)."""
-        return self._path_range
-
-    @path_range.setter
-    def path_range(self, value: tuple[float, float] | None) -> None:
-        self._path_range = _check_path_range(value)
-
-    @property
-    def max_steps(self) -> int:
-        """Steps after which the episode is truncated (``termination_config["max_steps"]``);
-        settable, used from the next step (``gymnasium.make(max_episode_steps=...)`` sets it)."""
-        return int(self._termination_config["max_steps"])
-
-    @max_steps.setter
-    def max_steps(self, value: int) -> None:
-        steps = validation.integer("max_steps", value, minimum=1)
-        self._termination_config = FrozenMapping({**self._termination_config, "max_steps": steps})
-        current = self._terminations.get("timeout")
-        if isinstance(current, Timeout):
-            current.max_steps = steps
-
-    @property
-    def visualize_goal(self) -> bool:
-        """Whether renderers draw the start and goal markers."""
-        return self._visualize_goal
-
-    @property
-    def visualize_path(self) -> bool:
-        """Whether renderers draw the shortest path's waypoint markers."""
-        return self._visualize_path
-
-    @property
-    def goal_height(self) -> float:
-        """Goal marker height (m)."""
-        return self._goal_height
-
-    @property
-    def waypoint_height(self) -> float:
-        """Waypoint marker height (m)."""
-        return self._waypoint_height
-
-    @property
-    def waypoint_width(self) -> float:
-        """Waypoint marker radius (m)."""
-        return self._waypoint_width
-
-    @property
-    def n_vis_waypoints(self) -> int:
-        """Number of waypoint markers."""
-        return self._n_vis_waypoints
-
-    @property
-    def markers(self) -> tuple[VisualMarker, ...]:
-        """The markers this task shows now, as :class:`~pointnav_core.markers.VisualMarker`.
-
-        In order: the ``start`` and ``goal`` markers (radius ``goal_tolerance``, at
-        ``goal_height`` above the floor) when ``visualize_goal``, then ``n_vis_waypoints``
-        ``waypoint`` markers (radius ``waypoint_width``, at ``waypoint_height``) when
-        ``visualize_path``, placed along the shortest path from the robot to the goal at
-        reset and after every step (spacing and hiding rules:
-        :func:`~pointnav_core.markers.place_waypoints`; all hidden when the robot has no
-        path to the goal). Empty when both flags are off, and until a reset succeeds.
-        Markers are data for renderers: nothing collides with them.
-        """
-        if self._markers is None:
-            markers = self._goal_markers
-            if self._waypoint_xy is not None and self._waypoint_visible is not None:
-                z = self._floor_height + self._waypoint_height
-                radius = self._waypoint_width
-                markers += tuple(
-                    VisualMarker(kind="waypoint", position=(x, y, z), radius=radius, visible=shown)
-                    for (x, y), shown in zip(
-                        self._waypoint_xy.tolist(), self._waypoint_visible.tolist()
-                    )
-                )
-            self._markers = markers
-        return self._markers
-
-    @property
-    def reward_type(self) -> str:
-        """``"l2"`` or ``"geodesic"``."""
-        return self._reward_type
-
-    @property
-    def termination_config(self) -> Mapping[str, Any]:
-        """The merged termination configuration (read-only)."""
-        return self._termination_config
-
-    @property
-    def reward_config(self) -> Mapping[str, Any]:
-        """The merged reward configuration (read-only)."""
-        return self._reward_config
-
-    @property
-    def termination_conditions(self) -> Mapping[str, TerminationCondition]:
-        """Name -> termination condition, in evaluation order (read-only mapping)."""
-        return self._terminations
-
-    @property
-    def reward_functions(self) -> Mapping[str, RewardFunction]:
-        """Name -> reward function, in evaluation order (read-only mapping)."""
-        return self._rewards
-
-    # ------------------------------------------------------------------ episode state
-    @property
-    def state(self) -> TaskState:
-        """Where the task is in its lifecycle."""
-        return self._state
-
-    @property
-    def robot_xyz(self) -> tuple[float, float, float]:
-        """Robot position (m) at the last reset or step, refreshed before the conditions run."""
-        return self._robot_xyz
-
-    @property
-    def in_contact(self) -> bool:
-        """Whether the robot touched an obstacle or another robot in this step (backend's word)."""
-        return self._in_contact
-
-    @property
-    def floor_height(self) -> float:
-        """Height (m) of the task's floor (0.0 until the task has met an env)."""
-        return self._floor_height
-
-    @property
-    def goal_xy(self) -> tuple[float, float] | None:
-        """This episode's goal (x, y) in metres (None before the first reset of a sampled goal)."""
-        return self._goal_xy
-
-    @property
-    def potential(self) -> float:
-        """Potential (m) at the last reset or step: the distance the potential reward uses."""
-        return self._potential
-
-    @property
-    def distance_to_goal(self) -> float:
-        """Geodesic distance (m) from the robot to the goal at the last reset or step
-        (``inf`` where none is defined, e.g. over void); ``info["distance_to_goal"]``."""
-        return self._distance_to_goal
-
-    @property
-    def potential_metric(self) -> str:
-        """``"l2"`` or ``"geodesic"``: the potential's metric this episode (fixed at reset)."""
-        return self._metric
-
-    @property
-    def termination_results(self) -> Mapping[str, tuple[bool, bool]]:
-        """Name -> ``(done, success)`` of every condition at this step (read it, don't write)."""
-        return self._results
-
-    @property
-    def geodesic_dist(self) -> float:
-        """Geodesic distance (m) from this episode's start to the goal; ``inf`` if unreachable."""
-        return self._geodesic_dist
-
-    @property
-    def path_length(self) -> float:
-        """Planar distance (m) driven in this episode, including the last step."""
-        return self._path_length
-
-    @property
-    def collisions(self) -> int:
-        """Steps with a contact in this episode."""
-        return self._collisions
-
-    @property
-    def episode_length(self) -> int:
-        """Steps taken in this episode."""
-        return self._steps
-
-    @property
-    def success(self) -> bool:
-        """Whether the episode has ended in success."""
-        return self._success
 
     # ------------------------------------------------------------------ lifecycle
     def _move(self, event: _Event) -> None:
@@ -695,29 +352,29 @@ class PointNavigationTask:
         ValueError
             Naming ``robot_idn``, ``floor``, ``initial_pos`` or ``goal_pos``.
         """
-        robots = env.robots
-        if self._robot_idn >= len(robots):
+        cfg, robots, scene = self._config, env.robots, env.scene
+        idn, floor = cfg.robot_idn, cfg.floor
+        if idn >= len(robots):
             raise ValueError(
                 f"robot_idn must be in [0, {len(robots)}) for an environment with "
-                f"{len(robots)} robot(s), got {self._robot_idn}"
+                f"{len(robots)} robot(s), got {idn}"
             )
-        scene = env.scene
-        if self._floor >= scene.n_floors:
+        if floor >= scene.n_floors:
             raise ValueError(
                 f"floor must be in [0, {scene.n_floors}) for a scene with {scene.n_floors} "
-                f"floor(s), got {self._floor}"
+                f"floor(s), got {floor}"
             )
-        spec = robots[self._robot_idn]
-        for name, xy in (("initial_pos", self._initial_pos), ("goal_pos", self._goal_pos)):
-            if xy is not None and not scene.is_usable(self._floor, xy, spec):
+        spec = robots[idn]
+        for name, xy in (("initial_pos", cfg.initial_pos), ("goal_pos", cfg.goal_pos)):
+            if xy is not None and not scene.is_usable(floor, xy, spec):
                 raise ValueError(
-                    f"{name} {list(xy)} is not usable on floor {self._floor} by robot "
-                    f"{self._robot_idn} (radius {spec.radius} m): it is off the map, on an "
+                    f"{name} {list(xy)} is not usable on floor {floor} by robot "
+                    f"{idn} (radius {spec.radius} m): it is off the map, on an "
                     f"obstacle or void, or closer than the radius to one"
                 )
         self._spec = spec
-        self._floor_height = float(scene.get_floor_height(self._floor))
-        self._waypoint_spacing = float(scene.waypoint_spacing)
+        self._floor_height = self._marks.floor_height = float(scene.get_floor_height(floor))
+        self._marks.spacing = float(scene.waypoint_spacing)
         # Observation bounds are finite, so that Gymnasium's checker accepts the spaces.
         self._obs_layout = ObservationLayout.from_terms(tuple(self._observations.values()), self, env)
         self._frame.task, self._frame.env = self, env
@@ -757,92 +414,39 @@ class PointNavigationTask:
             :meth:`load`), or the fixed start is occupied by another robot.
         """
         try:
-            self._clear_markers()
+            marks = self._marks
+            marks.clear()
             if env is not self._env:
                 self.load(env)
             self._bind(env.backend)  # every episode: a backend patched since is seen
-            self._sample_episode(env, goal_constraint, episode)
-            pos, quat = env.backend.get_pose(self._robot_idn)
-            x, y, z = pos.tolist()
-            self._robot_xyz = (x, y, z)
-            self._robot_quat = quat.tolist()
-            self._path_length = 0.0
-            self._collisions = 0
-            self._in_contact = False
-            self._steps = 0
-            self._success = False
-            self._distance_to_goal = self._geodesic_at(x, y)
-            self._potential = self._potential_at(x, y, self._distance_to_goal, self._geodesic_dist)
-            self._results = {name: (False, False) for name in self._terminations}
+            sampled = sample_task_episode(
+                env, self._config, spec=self._spec, floor_height=self._floor_height,
+                max_trials=self.max_trials, goal_constraint=goal_constraint, given=episode,
+            )
+            # The robot stands at the start: it was landed there in the accepted trial.
+            pos, quat = env.backend.get_pose(self._idn)
+            ep = self._ep
+            ep.begin(sampled, self._config.reward_type, tuple(pos.tolist()), quat.tolist(),
+                     self._terminations)
             for condition in self._terminations.values():
                 condition.reset(self, env)
             for reward in self._rewards.values():
                 reward.reset(self, env)
             for term in self._observations.values():
                 term.reset(self, env)
-            if self._visualize_goal or self._visualize_path:
-                self._place_markers(x, y)
+            if self._show_markers:
+                x, y, _ = ep.robot_xyz
+                marks.place(ep.start_xy, ep.goal_xy, ep.field, x, y)  # type: ignore[arg-type]
         except BaseException:
             self._move(_Event.FAIL)
             raise
         self._move(_Event.RESET)
-        return self._info(
+        return ep.info(
             False,
             False,
             {name: 0.0 for name in self._rewards},
             {name: {"done": False, "success": False} for name in self._terminations},
         )
-
-    def _sample_episode(self, env: TaskEnv, goal_constraint: GoalConstraint | None, given: Any = None) -> None:
-        start, quat, goal = self._initial_pos, self._initial_quat, self._goal_pos
-        if given is not None:  # a dataset episode: checked here, named in every error
-            from pointnav_core.datasets.playback import episode_poses
-
-            start, quat, goal = episode_poses(given, env.scene, self._floor, self._spec, self._robot_idn)
-        try:
-            episode = sample_episode(
-                env,
-                robot_idn=self._robot_idn,
-                floor=self._floor,
-                spec=self._spec,
-                floor_height=self._floor_height,
-                initial_pos=start,
-                initial_quat=quat,
-                goal_pos=goal,
-                goal_tolerance=self._goal_tolerance,
-                path_range=self._path_range,
-                max_trials=self.max_trials,
-                goal_constraint=goal_constraint,
-            )
-        except ValueError as err:
-            if given is None:
-                raise
-            raise ValueError(f"episode {given.episode_id!r}: field 'start_position': {err}") from None
-        # The robot stands at the start: it was landed there in the accepted trial.
-        self._start_xy = episode.start_xy
-        self._start_quat = episode.start_quat
-        self._goal_xy = episode.goal_xy
-        self._goal_field = episode.field
-        self._field_distance = episode.field.distance
-        self._geodesic_dist = geodesic = episode.geodesic
-        # Decided once per episode, so the potential never jumps between metrics.
-        geodesic_metric = self._reward_type == "geodesic" and geodesic < math.inf
-        self._metric = "geodesic" if geodesic_metric else "l2"
-
-    # ------------------------------------------------------------------ per step
-    def _geodesic_at(self, x: float, y: float) -> float:
-        """Geodesic distance (m) from (x, y) to the goal: the goal field's O(1) lookup.
-
-        ``inf`` where the robot's centre cannot reach the goal (over void, off the map).
-        """
-        return self._field_distance(x, y)
-
-    def _potential_at(self, x: float, y: float, geodesic: float, held: float) -> float:
-        if self._metric == "l2":
-            gx, gy = self._goal_xy  # type: ignore[misc]
-            return math.hypot(gx - x, gy - y)
-        # No geodesic here (e.g. over void): keep the last potential (see Notes).
-        return geodesic if geodesic < math.inf else held
 
     def step(
         self, env: TaskEnv, action: Any, *, contact: bool | None = None
@@ -890,25 +494,16 @@ class PointNavigationTask:
             backend = env.backend
             if backend is not self._backend:
                 self._bind(backend)
-            idn = self._robot_idn
+            idn = self._idn
             if self._pose_floats is not None:
                 x, y, z, *quat = self._pose_floats(idn)
             else:
                 pos, orientation = backend.get_pose(idn)
                 x, y, z = pos.tolist()
                 quat = orientation.tolist()
-            px, py, _ = self._robot_xyz
-            self._path_length += math.hypot(x - px, y - py)
-            self._robot_xyz = (x, y, z)
-            self._robot_quat = quat
-            self._steps += 1
             contact = bool(backend.in_contact(idn)) if contact is None else bool(contact)
-            self._in_contact = contact
-            if contact:
-                self._collisions += 1
-            geodesic = self._geodesic_at(x, y)
-            self._distance_to_goal = geodesic
-            self._potential = self._potential_at(x, y, geodesic, self._potential)
+            ep = self._ep
+            ep.advance(x, y, z, quat, contact)
 
             # Each condition's result, and the same as info["termination_conditions"].
             results: dict[str, tuple[bool, bool]] = {}
@@ -927,16 +522,16 @@ class PointNavigationTask:
                         truncated = True
                     else:
                         terminated = True
-            self._results = results
-            self._success = success
+            ep.results = results
+            ep.success = success
 
             breakdown: dict[str, float] = {}
             for name, fn in self._reward_items:
                 breakdown[name] = fn.step(self, env, action)
             reward = sum(breakdown.values(), 0.0)  # the sum a user gets from the breakdown
-            info = self._info(success, done, breakdown, conditions)
-            if self._visualize_path:
-                self._place_waypoints(x, y)
+            info = ep.info(success, done, breakdown, conditions)
+            if self._config.visualize_path:
+                self._marks.move_waypoints(ep.field, x, y)
         except BaseException:
             self._move(_Event.FAIL)
             raise
@@ -952,230 +547,8 @@ class PointNavigationTask:
         self._velocity_floats = float_twin(backend, "get_velocity_floats")
         self._backend = backend
 
-    # ------------------------------------------------------------------ markers
-    def _clear_markers(self) -> None:
-        self._goal_markers = ()
-        self._waypoint_xy = self._waypoint_visible = None
-        self._markers = ()
-
-    def _place_markers(self, x: float, y: float) -> None:
-        """Set this episode's markers, the robot standing at (x, y) (reset)."""
-        gx, gy = self._goal_xy  # type: ignore[misc]
-        if self._visualize_goal:
-            sx, sy = self._start_xy  # type: ignore[misc]
-            z = self._floor_height + self._goal_height
-            radius = self._goal_tolerance
-            self._goal_markers = (
-                VisualMarker(kind="start", position=(sx, sy, z), radius=radius),
-                VisualMarker(kind="goal", position=(gx, gy, z), radius=radius),
-            )
-        if self._visualize_path:
-            n = self._n_vis_waypoints
-            self._waypoint_xy = np.tile((gx, gy), (n, 1))
-            self._waypoint_visible = np.zeros(n, dtype=bool)
-            self._place_waypoints(x, y)
-        self._markers = None
-
-    def _place_waypoints(self, x: float, y: float) -> None:
-        """Move the waypoint markers onto the path from (x, y); hide them if there is none."""
-        # The goal field's cheap path (the source cell's root when the source sees it).
-        points, _ = self._goal_field.path((x, y), exact=False)  # type: ignore[union-attr]
-        if points is None:
-            self._waypoint_visible = np.zeros(self._n_vis_waypoints, dtype=bool)
-        else:
-            # The placement of markers.place_waypoints, without its checks.
-            self._waypoint_xy, self._waypoint_visible = _waypoints_along(
-                points, self._n_vis_waypoints, self._waypoint_spacing
-            )
-        self._markers = None
-
-    def _info(
-        self,
-        success: bool,
-        done: bool,
-        breakdown: dict[str, float],
-        conditions: dict[str, dict[str, bool]],
-    ) -> dict[str, Any]:
-        d0, length, d_t = self._geodesic_dist, self._path_length, self._distance_to_goal
-        return {
-            "success": success,
-            "done": done,
-            "path_length": length,
-            "spl": _spl(success, d0, length),
-            "soft_spl": _soft_spl(d_t, d0, length),
-            "geodesic_dist": d0,
-            "distance_to_goal": d_t,
-            "collisions": self._collisions,
-            "reward_breakdown": breakdown,
-            "termination_conditions": conditions,
-            "episode_length": self._steps,
-            "potential_metric": self._metric,
-        }
-
-    # ------------------------------------------------------------------ observations
-    def _require_episode(self, what: str) -> None:
-        if self._state is IDLE or self._state is ERROR:
-            raise TaskStateError(
-                f"{what} needs an episode, but the task is {self._state.name}: "
-                f"{ILLEGAL_HINT[self._state]}"
-            )
-
-    def _obs_values(self, env: TaskEnv) -> list[float]:
-        """Every observation term's values at this step, in order, clipped to the bounds."""
-        backend = env.backend
-        if backend is not self._backend:
-            self._bind(backend)
-        frame = self._frame
-        if self._velocity_floats is not None:
-            vx, vy, vz, wx, wy, wz = self._velocity_floats(self._robot_idn)
-            frame.lin_vel, frame.ang_vel = (vx, vy, vz), (wx, wy, wz)
-        else:
-            lin, ang = backend.get_velocity(self._robot_idn)
-            frame.lin_vel, frame.ang_vel = tuple(lin.tolist()), tuple(ang.tolist())
-        # The pose recorded at the last reset or step: the one the metrics saw.
-        x, y, z = self._robot_xyz
-        frame.set_pose(x, y, z, self._robot_quat)
-        frame.goal_x, frame.goal_y = self._goal_xy  # type: ignore[misc]
-        frame.env = env
-        return self._obs_layout.values(frame)  # type: ignore[union-attr]
-
-    @property
-    def observation_terms(self) -> Mapping[str, ObservationTerm]:
-        """Name -> observation term, in observation order (read-only mapping)."""
-        return self._observations
-
-    @property
-    def observation_layout(self) -> ObservationLayout:
-        """Slices and bounds of the terms in the flat observation (after :meth:`load`).
-
-        Raises
-        ------
-        TaskStateError
-            Before the task has met an environment (:meth:`load`).
-        """
-        if self._obs_layout is None:
-            raise TaskStateError("observation_layout needs an environment: call load(env) first")
-        return self._obs_layout
-
-    @property
-    def observation_bounds(self) -> tuple[NDArray[np.float32], NDArray[np.float32]]:
-        """``(low, high)`` of every observation value in flat order, float32 arrays.
-
-        With the built-in terms (see :mod:`~pointnav_core.observations`): the goal lies
-        within the floor's diagonal plus 1 m (``rho`` in ``[0, that]`` and ``phi`` in
-        ``[-pi, pi]`` when polar); linear velocities within ``sqrt(2) * max_linear_velocity``
-        and angular ones within ``max_angular_velocity``. Observations are clipped to these
-        bounds (a falling robot's vertical speed can exceed them).
-
-        Raises
-        ------
-        TaskStateError
-            Before the task has met an environment (:meth:`load`).
-        """
-        if self._obs_layout is None:
-            raise TaskStateError("observation_bounds needs an environment: call load(env) first")
-        return (
-            np.array(self._obs_layout.low, dtype=np.float32),
-            np.array(self._obs_layout.high, dtype=np.float32),
-        )
-
-    def get_obs(self, env: TaskEnv) -> dict[str, NDArray[np.float32]]:
-        """Return the task's observation: one fresh float32 array per term, by name.
-
-        Returns
-        -------
-        dict
-            With the built-in terms: ``xy_pos_to_goal`` (2,): the goal minus the robot's
-            position in the robot's heading frame (+x ahead, +y left), in metres; or
-            ``(rho, phi)`` (m, rad in (-pi, pi]) when ``goal_in_polar``. ``robot_lin_vel``
-            (3,) m/s and ``robot_ang_vel`` (3,) rad/s: world velocities rotated into the
-            robot frame. Then any added terms. Values are clipped to
-            :attr:`observation_bounds`.
-
-        Notes
-        -----
-        The pose is the one the task recorded at the last reset or step (what its
-        rewards and metrics saw; the environment has not moved the robot since), the
-        velocities are read from the backend.
-
-        Raises
-        ------
-        TaskStateError
-            Before the first reset (there is no goal yet).
-        """
-        self._require_episode("get_obs()")
-        # One fresh buffer per call, split by term (cheaper than one array per term).
-        flat = np.array(self._obs_values(env), dtype=np.float32)
-        return self._obs_layout.split(flat)  # type: ignore[union-attr]
-
-    def get_low_dim_obs(self, env: TaskEnv) -> NDArray[np.float32]:
-        """Return OmniGibson's flat ``low_dim`` observation: :meth:`get_obs`'s arrays
-        concatenated in term order (with the built-in terms ``xy_pos_to_goal``,
-        ``robot_lin_vel``, ``robot_ang_vel``: 8 float32 values), a fresh array."""
-        self._require_episode("get_low_dim_obs()")
-        return np.array(self._obs_values(env), dtype=np.float32)
-
-    # ------------------------------------------------------------------ OmniGibson API
-    def get_goal_pos(self) -> NDArray[np.float64] | None:
-        """Return this episode's goal (x, y, z) in metres, z the floor height (fresh array).
-
-        Before the first reset: the fixed goal, or None when the goal is sampled.
-        """
-        if self._goal_xy is None:
-            return None
-        return np.array((*self._goal_xy, self._floor_height))
-
-    def get_start_pos(self) -> NDArray[np.float64] | None:
-        """Return this episode's start (x, y, z) in metres (None before the first reset)."""
-        if self._start_xy is None:
-            return None
-        return np.array((*self._start_xy, self._floor_height))
-
-    def get_current_pos(self, env: TaskEnv) -> NDArray[np.float64]:
-        """Return the robot's current position (x, y, z) in metres (fresh array)."""
-        pos, _ = env.backend.get_pose(self._robot_idn)
-        return np.array(pos, dtype=np.float64)
-
-    def get_potential(self, env: TaskEnv) -> float:
-        """Return the potential (m) at the robot's current position.
-
-        The xy L2 distance to the goal, or the geodesic distance when ``reward_type`` is
-        ``"geodesic"`` and the goal is reachable (``potential_metric``).
-        """
-        self._require_episode("get_potential()")
-        x, y, _ = env.backend.get_pose(self._robot_idn)[0].tolist()
-        return self._potential_at(x, y, self._geodesic_at(x, y), self._potential)
-
-    def get_shortest_path_to_goal(
-        self, env: TaskEnv, start_xy_pos: ArrayLike | None = None, entire_path: bool = False
-    ) -> tuple[NDArray[np.float64], float] | tuple[None, None]:
-        """Return the shortest path to the goal and its geodesic length.
-
-        Parameters
-        ----------
-        env : TaskEnv
-        start_xy_pos : array_like, shape (2,), optional
-            Where the path starts (m); default: the robot's current position.
-        entire_path : bool
-            True: the whole any-angle polyline. False: ``scene.num_waypoints`` waypoints
-            ``scene.waypoint_spacing`` apart (OmniGibson's convention).
-
-        Returns
-        -------
-        waypoints : ndarray (N, 2) or None
-            World (x, y) in metres.
-        geodesic_distance : float or None
-            Metres; ``(None, None)`` when the goal is not reachable from the start.
-        """
-        self._require_episode("get_shortest_path_to_goal()")
-        if start_xy_pos is None:
-            start_xy_pos = env.backend.get_pose(self._robot_idn)[0][:2]
-        return env.scene.get_shortest_path(
-            self._floor, start_xy_pos, self._goal_xy, entire_path=entire_path, robot=self._spec
-        )
-
     def __repr__(self) -> str:
         return (
-            f"PointNavigationTask(robot_idn={self._robot_idn}, floor={self._floor}, "
-            f"reward_type={self._reward_type!r}, state={self._state.name})"
+            f"PointNavigationTask(robot_idn={self._idn}, floor={self._config.floor}, "
+            f"reward_type={self._config.reward_type!r}, state={self._state.name})"
         )

@@ -32,7 +32,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-__all__ = ["boolean", "integer", "is_real", "real", "vector"]
+__all__ = ["boolean", "integer", "is_real", "known_keys", "real", "vector"]
 
 _REAL_KINDS = "biuf"  # numpy dtype kinds that hold real numbers (b: refused below)
 
@@ -103,6 +103,19 @@ def integer(name: str, value: Any, *, minimum: int | None = None) -> int:
         bound = "" if minimum is None else f" >= {minimum}"
         raise ValueError(f"{name} must be an integer{bound}, got {value!r}")
     return int(number)
+
+
+def known_keys(name: str, keys: Any, valid: Any) -> None:
+    """Raise ValueError naming ``name`` and its first key not in ``valid`` (listed), if any.
+
+    >>> known_keys("robot", {"size": 1}, ("radius", "drive"))
+    Traceback (most recent call last):
+    ...
+    ValueError: robot has an unknown key 'size'; valid keys are ['radius', 'drive']
+    """
+    for key in keys:
+        if key not in valid:
+            raise ValueError(f"{name} has an unknown key {key!r}; valid keys are {list(valid)}")
 
 
 def boolean(name: str, value: Any) -> bool:
