@@ -10,8 +10,9 @@ import pytest
 from pointnav_kinematic.contacts import advance
 from pointnav_kinematic.geometry import FloorGeometry
 
-from pointnav_core.maps import TraversableMap
-from pointnav_core.vector.robots import advance_robots
+from pointnav_core.maps import OBSTACLE, TraversableMap
+from pointnav_core.scenes import Scene
+from pointnav_core.vector.robots import advance_robots, robot_walls
 from pointnav_core.vector.xp import make_arrays
 
 DEVICES = ["numpy"] + (["cpu"] if importlib.util.find_spec("torch") else [])
@@ -97,3 +98,46 @@ def test_random_crowds_match_the_backend(device: str, n_robots: int) -> None:
     gap = np.hypot(got[0][:, :, None] - got[0][:, None, :], got[1][:, :, None] - got[1][:, None, :])
     gap[:, np.arange(n_robots), np.arange(n_robots)] = np.inf
     assert gap.min() >= 2 * radius - 1e-8
+
+
+@pytest.mark.parametrize("device", DEVICES)
+@pytest.mark.parametrize("n_robots", [2, 4])
+def test_random_crowds_among_walls_match_the_backend(device: str, n_robots: int) -> None:
+    # A cluttered 3 x 3 m room (0.1 m cells) with robots packed near each other and the clutter.
+    from pointnav_core.vector.floors import FloorTables
+
+    rng = np.random.default_rng(10 + n_robots)
+    grid = (rng.random((30, 30)) < 0.12).astype(np.uint8)
+    grid[[0, -1], :] = grid[:, [0, -1]] = OBSTACLE
+    scene = Scene.from_array(grid, 0.1)
+    geom = FloorGeometry(scene.floors[0], 0.0)
+    a = make_arrays(device)
+    n_worlds, radius, travel = 120, 0.12, 0.05
+    x = np.empty((n_worlds, n_robots))
+    y = np.empty((n_worlds, n_robots))
+    for w in range(n_worlds):
+        centre = rng.uniform(0.6, 2.4, 2)
+        pts: list[tuple[float, float]] = []
+        while len(pts) < n_robots:
+            p = tuple(centre + rng.uniform(-0.5, 0.5, 2))
+            if scene.is_usable(0, p, radius) and all(math.dist(p, q) >= 2 * radius for q in pts):
+                pts.append(p)
+        x[w], y[w] = np.array(pts).T
+    speed = rng.uniform(0.0, travel, (n_worlds, n_robots)) * (rng.random((n_worlds, n_robots)) > 0.2)
+    heading = rng.uniform(-math.pi, math.pi, (n_worlds, n_robots))
+    mx, my = speed * np.cos(heading), speed * np.sin(heading)
+    want_x, want_y, want_c = np.empty_like(x), np.empty_like(y), np.zeros(x.shape, bool)
+    for w in range(n_worlds):
+        discs = [_Disc(*map(float, v), radius) for v in zip(x[w], y[w], mx[w], my[w])]
+        for d in discs:
+            d.geom = geom
+        advance(discs, stop=False)
+        want_x[w], want_y[w], want_c[w] = [d.x for d in discs], [d.y for d in discs], [d.contact for d in discs]
+    floors = FloorTables([scene], 0, radius, a)
+    args = [a.asarray(v) for v in (x, y, mx, my)]
+    walls = robot_walls(floors, a.zeros(x.shape, a.i64), *args, radius, travel * (1 + 1e-9))
+    got = [a.numpy(v) for v in advance_robots(a, *args, radius, walls=walls)]
+    np.testing.assert_allclose(got[0], want_x, atol=1e-9)
+    np.testing.assert_allclose(got[1], want_y, atol=1e-9)
+    np.testing.assert_array_equal(got[2], want_c)
+    assert want_c.any() and not want_c.all()

@@ -1,12 +1,12 @@
-"""Batched robot-robot contacts: the robots of each world advance together, as the backend's.
+"""Batched contacts of several robots per world: they advance together, as in the backend.
 
-The array twin of the robot-robot part of :func:`pointnav_kinematic.contacts.advance`, for
-robots away from walls: within a world, every robot follows its chord at once; the world
-moves to the earliest moment at which two robots closing on each other would overlap (by
-more than ``_HIT``), places them ``_PLACE`` short of touching, resolves every robot's
-contacts there (a blocked motion slides along the longest tangent of a robot contact that
-goes into no other one, else stops; both parties' flags are set) and goes on with what is
-left. Robots without motion still block the others. As in the backend, a world resolves
+The array twin of :func:`pointnav_kinematic.contacts.advance` with robot-robot contacts:
+within a world, every robot follows its chord at once; the world moves to the earliest
+moment at which a robot would overlap a wall, or two robots closing on each other would
+overlap (by more than ``_HIT``), places the parties ``_PLACE`` short of touching, resolves
+every robot's contacts there (a blocked motion slides along the longest tangent of a
+contact, wall or robot, that goes into no other one, else stops; both robots' flags are
+set when robots meet) and goes on with what is left. Robots without motion still block the others. As in the backend, a world resolves
 at most ``8`` events per moving robot; each world keeps its own clock, so the Python loop
 is over event rounds only, never over worlds or robots.
 
@@ -19,10 +19,14 @@ from __future__ import annotations
 import math
 from typing import Any
 
-from pointnav_core.vector.sweep import enter_disc
+from pointnav_core.vector.contacts import _nearest as nearest
+from pointnav_core.vector.contacts import _take as take_along
+from pointnav_core.vector.contacts import window
+from pointnav_core.vector.floors import FloorTables
+from pointnav_core.vector.sweep import enter_disc, enter_rounded_square, square_distance
 from pointnav_core.vector.xp import Arrays
 
-__all__ = ["advance_robots"]
+__all__ = ["advance_robots", "robot_walls"]
 
 _HIT = 0.5e-9
 _PLACE = 1.0e-9
@@ -35,9 +39,9 @@ def _hit_radius(radius: float) -> float:
 
 
 def advance_robots(
-    arrays: Arrays, x: Any, y: Any, mx: Any, my: Any, radius: float, present: Any = None
+    arrays: Arrays, x: Any, y: Any, mx: Any, my: Any, radius: float, present: Any = None, walls: Any = None
 ) -> tuple[Any, Any, Any]:
-    """Move every world's robots by their chords ``(mx, my)`` (m), resolving robot contacts.
+    """Move every world's robots by their chords ``(mx, my)`` (m), resolving their contacts.
 
     Parameters
     ----------
@@ -49,13 +53,16 @@ def advance_robots(
         Every robot's radius (m), >= 0.
     present : bool array (W, R), optional
         Robots that take part; absent ones neither move nor block. Default: all.
+    walls : tuple of arrays (W, R, K), optional
+        Each robot's walls within reach of its whole chord, in the backend's order: the
+        squares' ``x0, y0, x1, y1`` (m) and a validity mask. Default: none (open space).
 
     Returns
     -------
     x, y : float arrays (W, R)
         End positions (m).
     contact : bool array (W, R)
-        Whether each robot was blocked by, or blocked, another robot.
+        Whether each robot was blocked by a wall or another robot, or blocked one.
     """
     a = arrays
     xp = a.xp
@@ -63,6 +70,13 @@ def advance_robots(
     n_worlds, n_robots = x.shape
     if present is None:
         present = xp.ones_like(x) > 0.0
+    if walls is None:
+        far = xp.zeros_like(x)[..., None] + 1e9
+        walls = (far, far, far + 1.0, far + 1.0, far < 0.0)
+    wx0, wy0, wx1, wy1, wvalid = walls
+    wvalid = wvalid & present[..., None]
+    n_walls = wx0.shape[-1]
+    start_x, start_y = x, y
     mx = xp.where(present, mx, 0.0 * mx)
     my = xp.where(present, my, 0.0 * my)
     span = xp.sqrt(mx * mx + my * my)
@@ -77,70 +91,87 @@ def advance_robots(
         & (moving[:, :, None] | moving[:, None, :]) & (gap2 < reach * reach)
     )
     pair = pair | (pair.transpose(1, 2) if a.is_torch else xp.swapaxes(pair, 1, 2))
+    hit_w = _hit_radius(radius)
     hit_r = _hit_radius(2.0 * radius)
     left = xp.ones_like(x[:, 0])
     contact = xp.zeros_like(x) > 1.0
-    no_event = xp.zeros_like(gap2) > 1.0
+    no_pair = xp.zeros_like(gap2) > 1.0
+    no_wall = xp.zeros_like(wx0) > 1.0
+    wk = a.arange(n_walls)
+    rows = a.arange(n_worlds)
 
-    def resolve(x: Any, y: Any, mx: Any, my: Any, forced: Any, left: Any, active: Any) -> tuple[Any, Any, Any]:
-        # Every moving robot of an active world: slide along (or stop at) the robots it
-        # touches if its motion goes into one; returns new chords and contact flags.
+    def take(v: Any, idx: Any) -> Any:
+        return (xp.gather(v, -1, idx) if a.is_torch else xp.take_along_axis(v, idx, -1))[..., 0]
+
+    def resolve(x: Any, y: Any, mx: Any, my: Any, forced_p: Any, forced_w: Any, left: Any, active: Any) -> tuple[Any, Any, Any]:
+        # Every moving robot of an active world: slide along (or stop at) what it touches
+        # if its motion goes into it; contacts are its walls, then the other robots.
+        wd, wnx, wny = square_distance(xp, x[..., None], y[..., None], wx0, wy0, wx1, wy1)
+        wtouch = wvalid & (wd <= radius + _ACTIVE)
         ex, ey = x[:, :, None] - x[:, None, :], y[:, :, None] - y[:, None, :]
         dist = xp.sqrt(ex * ex + ey * ey)
-        touching = pair & (dist <= 2.0 * radius + _ACTIVE)
+        ptouch = pair & (dist <= 2.0 * radius + _ACTIVE)
         safe = xp.where(dist > 0.0, dist, 1.0)
-        nx = xp.where(dist > 0.0, ex / safe, 1.0)
-        ny = xp.where(dist > 0.0, ey / safe, 0.0)
-        ox, oy = x[:, None, :], y[:, None, :]  # the other robot of each pair
+        nx = xp.cat([wnx, xp.where(dist > 0.0, ex / safe, 1.0)], -1) if a.is_torch else xp.concatenate([wnx, xp.where(dist > 0.0, ex / safe, 1.0)], -1)
+        ny = xp.cat([wny, xp.where(dist > 0.0, ey / safe, 0.0)], -1) if a.is_torch else xp.concatenate([wny, xp.where(dist > 0.0, ey / safe, 0.0)], -1)
+        cat = xp.cat if a.is_torch else xp.concatenate
+        touching = cat([wtouch, ptouch], -1)
+        forced = cat([forced_w, forced_p], -1)
+        px, py = x[:, :, None, None], y[:, :, None, None]
 
         def blocks(tx: Any, ty: Any) -> Any:
-            # (W, R, K) motions of robot i against its contacts j: (W, R, K, R).
+            # (W, R, T) motions of robot i against its contacts: (W, R, T, K + R).
             into = tx[..., None] * nx[:, :, None, :] + ty[..., None] * ny[:, :, None, :] < 0.0
-            t = enter_disc(
-                xp, x[:, :, None, None], y[:, :, None, None], tx[..., None], ty[..., None],
-                ox[:, :, None, :], oy[:, :, None, :], hit_r,
+            tw = enter_rounded_square(
+                xp, px, py, tx[..., None], ty[..., None], wx0[:, :, None, :], wy0[:, :, None, :],
+                wx1[:, :, None, :], wy1[:, :, None, :], hit_w,
             )
-            lim = left[:, None, None, None]
-            return touching[:, :, None, :] & into & (forced[:, :, None, :] | (t <= lim))
+            tr = enter_disc(xp, px, py, tx[..., None], ty[..., None], x[:, None, None, :], y[:, None, None, :], hit_r)
+            t = cat([tw, tr], -1)
+            return touching[:, :, None, :] & into & (forced[:, :, None, :] | (t <= left[:, None, None, None]))
 
         go = ((mx != 0.0) | (my != 0.0)) & active[:, None]
         blocked = blocks(mx[..., None], my[..., None])[:, :, 0, :] & go[..., None]
         any_blocked = blocked.any(-1)
-        hit = any_blocked | blocked.any(1)  # the robot it ran into is in contact too
+        hit = any_blocked | blocked[..., n_walls:].any(1)  # the robot it ran into too
         dot = mx[..., None] * nx + my[..., None] * ny
         tx, ty = mx[..., None] - dot * nx, my[..., None] - dot * ny
         length = tx * tx + ty * ty
         bad = blocks(tx, ty)
-        bad = bad & (eye.reshape(1, 1, -1, 1) != eye.reshape(1, 1, 1, -1))  # along its own contact
+        ck = a.arange(n_walls + n_robots)
+        bad = bad & (ck.reshape(1, 1, -1, 1) != ck.reshape(1, 1, 1, -1))  # along its own contact
         ok = touching & ~bad.any(-1) & (length > 0.0)
         score = xp.where(ok, length, -1.0)
         best = xp.argmax(score, -1)[..., None]
-        take = (lambda v: xp.take_along_axis(v, best, -1)[..., 0]) if not a.is_torch else (
-            lambda v: xp.gather(v, -1, best)[..., 0]
-        )
-        has = take(score) > 0.0
-        sx, sy = xp.where(has, take(tx), 0.0), xp.where(has, take(ty), 0.0)
+        has = take(score, best) > 0.0
+        sx, sy = xp.where(has, take(tx, best), 0.0), xp.where(has, take(ty, best), 0.0)
         return xp.where(any_blocked, sx, mx), xp.where(any_blocked, sy, my), hit
 
-    active = pair.any(-1).any(-1)
-    mx, my, hit = resolve(x, y, mx, my, no_event, left, active)
+    active = moving.any(-1)
+    mx, my, hit = resolve(x, y, mx, my, no_pair, no_wall, left, active)
     contact = contact | hit
-    # Worlds without pairs just move.
-    x, y = xp.where(active[:, None], x, x + mx), xp.where(active[:, None], y, y + my)
     done = ~active
     budget = _EVENTS_PER_ROBOT * moving.sum(-1)
     for k in range(_EVENTS_PER_ROBOT * n_robots):
         live = ~done & (budget > k)
         if not a.any(live):
             break
+        # Wall events, robot by robot and wall by wall, then pair events: the first wins a tie.
+        wd, wnx, wny = square_distance(xp, x[..., None], y[..., None], wx0, wy0, wx1, wy1)
+        speed = xp.sqrt(mx * mx + my * my)
+        towards = wvalid & (mx[..., None] * wnx + my[..., None] * wny < 0.0)
+        towards = towards & ~(wd - hit_w > (speed * left[:, None])[..., None])
+        tw = enter_rounded_square(xp, x[..., None], y[..., None], mx[..., None], my[..., None], wx0, wy0, wx1, wy1, hit_w)
+        tw = xp.where(towards, tw, inf)
         vx = mx[:, :, None] - mx[:, None, :]
         vy = my[:, :, None] - my[:, None, :]
-        t = enter_disc(xp, x[:, :, None], y[:, :, None], vx, vy, x[:, None, :], y[:, None, :], hit_r)
+        tp = enter_disc(xp, x[:, :, None], y[:, :, None], vx, vy, x[:, None, :], y[:, None, :], hit_r)
         apart = (x[:, :, None] - x[:, None, :]) * vx + (y[:, :, None] - y[:, None, :]) * vy >= 0.0
-        t = xp.where(pair & upper & ((vx != 0.0) | (vy != 0.0)) & ~((t == 0.0) & apart), t, inf)
-        flat = t.reshape(n_worlds, -1)
+        tp = xp.where(pair & upper & ((vx != 0.0) | (vy != 0.0)) & ~((tp == 0.0) & apart), tp, inf)
+        cat = xp.cat if a.is_torch else xp.concatenate
+        flat = cat([tw.reshape(n_worlds, -1), tp.reshape(n_worlds, -1)], -1)
         first = xp.argmin(flat, -1)
-        t_first = (xp.take_along_axis(flat, first[:, None], -1) if not a.is_torch else xp.gather(flat, -1, first[:, None]))[:, 0]
+        t_first = take(flat, first[:, None])
         event = live & (t_first < left)
         free = live & ~event
         x = xp.where(free[:, None], x + mx * left[:, None], x)
@@ -149,19 +180,70 @@ def advance_robots(
         done = done | free
         if not a.any(event):
             break
-        i, j = first // n_robots, first % n_robots
-        rows = a.arange(n_worlds)
-        ax, ay, bx, by = x[rows, i], y[rows, i], x[rows, j], y[rows, j]
-        place = enter_disc(xp, ax, ay, mx[rows, i] - mx[rows, j], my[rows, i] - my[rows, j], bx, by, 2.0 * radius + _PLACE)
-        step = xp.minimum(xp.maximum(place, 0.0 * place), t_first)
-        step = xp.where(event, step, 0.0 * step)
+        is_wall = first < n_robots * n_walls
+        fw = xp.where(is_wall, first, 0)
+        wi, wkk = fw // max(n_walls, 1), fw % max(n_walls, 1)
+        fp = xp.where(is_wall, 0, first - n_robots * n_walls)
+        i, j = xp.where(is_wall, wi, fp // n_robots), fp % n_robots
+        ex0, ey0, ex1, ey1 = (v[rows, wi, wkk] for v in (wx0, wy0, wx1, wy1))
+        place_w = enter_rounded_square(xp, x[rows, wi], y[rows, wi], mx[rows, wi], my[rows, wi], ex0, ey0, ex1, ey1, radius + _PLACE)
+        place_p = enter_disc(
+            xp, x[rows, i], y[rows, i], mx[rows, i] - mx[rows, j], my[rows, i] - my[rows, j], x[rows, j], y[rows, j],
+            2.0 * radius + _PLACE,
+        )
+        place = xp.where(is_wall, place_w, place_p)
+        step = xp.minimum(xp.maximum(place, xp.zeros_like(place)), t_first)
+        step = xp.where(event, step, xp.zeros_like(step))
         x, y = x + mx * step[:, None], y + my * step[:, None]
         left = left - step
         ii, jj = eye.reshape(1, -1, 1), eye.reshape(1, 1, -1)
-        forced = event[:, None, None] & (
+        pe = (event & ~is_wall)[:, None, None]
+        forced_p = pe & (
             ((ii == i[:, None, None]) & (jj == j[:, None, None])) | ((ii == j[:, None, None]) & (jj == i[:, None, None]))
         )
-        nmx, nmy, hit = resolve(x, y, mx, my, forced, left, event)
+        we = (event & is_wall)[:, None, None]
+        forced_w = we & (ii == wi[:, None, None]) & (wk.reshape(1, 1, -1) == wkk[:, None, None])
+        nmx, nmy, hit = resolve(x, y, mx, my, forced_p, forced_w, left, event)
         mx, my = xp.where(event[:, None], nmx, mx), xp.where(event[:, None], nmy, my)
         contact = contact | (hit & event[:, None])
-    return x, y, contact
+    # Safety net against rounding: never end deeper in a wall than at the start.
+    d_end = square_distance(xp, x[..., None], y[..., None], wx0, wy0, wx1, wy1)[0]
+    d_start = square_distance(xp, start_x[..., None], start_y[..., None], wx0, wy0, wx1, wy1)[0]
+    depth_end = xp.amax(xp.where(wvalid, radius - d_end, -inf), -1)
+    depth_start = xp.amax(xp.where(wvalid, radius - d_start, -inf), -1)
+    moved = (x != start_x) | (y != start_y)
+    undo = contact & moved & (depth_end > _HIT) & (depth_end > depth_start)
+    return xp.where(undo, start_x, x), xp.where(undo, start_y, y), contact
+
+
+def robot_walls(floors: FloorTables, scene: Any, x: Any, y: Any, mx: Any, my: Any, radius: float, max_travel: float) -> tuple[Any, ...]:
+    """Each robot's walls within reach of its chord, the few that can matter: ``(W, R, K)`` arrays.
+
+    Parameters
+    ----------
+    floors : FloorTables
+    scene : int array (W, R)
+        Each robot's scene index.
+    x, y, mx, my : float arrays (W, R)
+        Start positions and chords (m).
+    radius, max_travel : float
+        Robot radius and the longest chord of any step (m).
+
+    Returns
+    -------
+    tuple
+        ``x0, y0, x1, y1`` of the squares (m) and their validity mask, in the backend's
+        (row-major) order, for :func:`advance_robots`.
+    """
+    xp = floors.arrays.xp
+    n_worlds, n_robots = x.shape
+    flat = [v.reshape(-1) for v in (scene, x, y, mx, my)]
+    sc, fx, fy, fmx, fmy = flat
+    wx0, wy0, wx1, wy1, valid = window(floors, sc, fx, fy, radius + max_travel + 4.0 * _ACTIVE)
+    d0 = square_distance(xp, fx[:, None], fy[:, None], wx0, wy0, wx1, wy1)[0]
+    reach = radius + xp.sqrt(fmx * fmx + fmy * fmy) + 4.0 * _ACTIVE
+    in_reach = valid & (d0 <= reach[:, None])
+    k = max(int(in_reach.sum(-1).max()) if in_reach.shape[0] else 0, 1)
+    order = nearest(xp, xp.where(in_reach, d0, math.inf), k)
+    out = [take_along(xp, v, order).reshape(n_worlds, n_robots, k) for v in (wx0, wy0, wx1, wy1, in_reach)]
+    return tuple(out)
