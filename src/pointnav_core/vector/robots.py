@@ -32,6 +32,7 @@ _HIT = 0.5e-9
 _PLACE = 1.0e-9
 _ACTIVE = 2.0e-9
 _EVENTS_PER_ROBOT = 8
+_CONTACTS = 6  # nearest walls that may be contacts while sliding, as in vector.contacts
 
 
 def _hit_radius(radius: float) -> float:
@@ -76,6 +77,7 @@ def advance_robots(
     wx0, wy0, wx1, wy1, wvalid = walls
     wvalid = wvalid & present[..., None]
     n_walls = wx0.shape[-1]
+    n_near = min(_CONTACTS, n_walls)
     start_x, start_y = x, y
     mx = xp.where(present, mx, 0.0 * mx)
     my = xp.where(present, my, 0.0 * my)
@@ -106,8 +108,13 @@ def advance_robots(
     def resolve(x: Any, y: Any, mx: Any, my: Any, forced_p: Any, forced_w: Any, left: Any, active: Any) -> tuple[Any, Any, Any]:
         # Every moving robot of an active world: slide along (or stop at) what it touches
         # if its motion goes into it; contacts are its walls, then the other robots.
-        wd, wnx, wny = square_distance(xp, x[..., None], y[..., None], wx0, wy0, wx1, wy1)
-        wtouch = wvalid & (wd <= radius + _ACTIVE)
+        # The walls within _ACTIVE of touching are among the nearest few (a disc touches at
+        # most four squares): only those take part, in their original order.
+        wd = square_distance(xp, x[..., None], y[..., None], wx0, wy0, wx1, wy1)[0]
+        near = nearest(xp, xp.where(wvalid, wd, inf), n_near)
+        cx0, cy0, cx1, cy1, cvalid, forced_w = (take_along(xp, v, near) for v in (wx0, wy0, wx1, wy1, wvalid, forced_w))
+        wd, wnx, wny = square_distance(xp, x[..., None], y[..., None], cx0, cy0, cx1, cy1)
+        wtouch = cvalid & (wd <= radius + _ACTIVE)
         ex, ey = x[:, :, None] - x[:, None, :], y[:, :, None] - y[:, None, :]
         dist = xp.sqrt(ex * ex + ey * ey)
         ptouch = pair & (dist <= 2.0 * radius + _ACTIVE)
@@ -123,8 +130,8 @@ def advance_robots(
             # (W, R, T) motions of robot i against its contacts: (W, R, T, K + R).
             into = tx[..., None] * nx[:, :, None, :] + ty[..., None] * ny[:, :, None, :] < 0.0
             tw = enter_rounded_square(
-                xp, px, py, tx[..., None], ty[..., None], wx0[:, :, None, :], wy0[:, :, None, :],
-                wx1[:, :, None, :], wy1[:, :, None, :], hit_w,
+                xp, px, py, tx[..., None], ty[..., None], cx0[:, :, None, :], cy0[:, :, None, :],
+                cx1[:, :, None, :], cy1[:, :, None, :], hit_w,
             )
             tr = enter_disc(xp, px, py, tx[..., None], ty[..., None], x[:, None, None, :], y[:, None, None, :], hit_r)
             t = cat([tw, tr], -1)
@@ -133,12 +140,12 @@ def advance_robots(
         go = ((mx != 0.0) | (my != 0.0)) & active[:, None]
         blocked = blocks(mx[..., None], my[..., None])[:, :, 0, :] & go[..., None]
         any_blocked = blocked.any(-1)
-        hit = any_blocked | blocked[..., n_walls:].any(1)  # the robot it ran into too
+        hit = any_blocked | blocked[..., n_near:].any(1)  # the robot it ran into too
         dot = mx[..., None] * nx + my[..., None] * ny
         tx, ty = mx[..., None] - dot * nx, my[..., None] - dot * ny
         length = tx * tx + ty * ty
         bad = blocks(tx, ty)
-        ck = a.arange(n_walls + n_robots)
+        ck = a.arange(n_near + n_robots)
         bad = bad & (ck.reshape(1, 1, -1, 1) != ck.reshape(1, 1, 1, -1))  # along its own contact
         ok = touching & ~bad.any(-1) & (length > 0.0)
         score = xp.where(ok, length, -1.0)
