@@ -68,7 +68,7 @@ def advance_robots(
     a = arrays
     xp = a.xp
     inf = math.inf
-    n_worlds, n_robots = x.shape
+    n_robots = x.shape[1]
     if present is None:
         present = xp.ones_like(x) > 0.0
     if walls is None:
@@ -100,16 +100,18 @@ def advance_robots(
     no_pair = xp.zeros_like(gap2) > 1.0
     no_wall = xp.zeros_like(wx0) > 1.0
     wk = a.arange(n_walls)
-    rows = a.arange(n_worlds)
 
     def take(v: Any, idx: Any) -> Any:
         return (xp.gather(v, -1, idx) if a.is_torch else xp.take_along_axis(v, idx, -1))[..., 0]
 
-    def resolve(x: Any, y: Any, mx: Any, my: Any, forced_p: Any, forced_w: Any, left: Any, active: Any) -> tuple[Any, Any, Any]:
+    def resolve(
+        x: Any, y: Any, mx: Any, my: Any, forced_p: Any, forced_w: Any, left: Any, active: Any, geo: tuple[Any, ...]
+    ) -> tuple[Any, Any, Any]:
         # Every moving robot of an active world: slide along (or stop at) what it touches
         # if its motion goes into it; contacts are its walls, then the other robots.
         # The walls within _ACTIVE of touching are among the nearest few (a disc touches at
         # most four squares): only those take part, in their original order.
+        wx0, wy0, wx1, wy1, wvalid, pair = geo
         wd = square_distance(xp, x[..., None], y[..., None], wx0, wy0, wx1, wy1)[0]
         near = nearest(xp, xp.where(wvalid, wd, inf), n_near)
         cx0, cy0, cx1, cy1, cvalid, forced_w = (take_along(xp, v, near) for v in (wx0, wy0, wx1, wy1, wvalid, forced_w))
@@ -155,64 +157,78 @@ def advance_robots(
         return xp.where(any_blocked, sx, mx), xp.where(any_blocked, sy, my), hit
 
     active = moving.any(-1)
-    mx, my, hit = resolve(x, y, mx, my, no_pair, no_wall, left, active)
+    x, y = x + 0.0, y + 0.0
+    mx, my, hit = resolve(x, y, mx, my, no_pair, no_wall, left, active, (wx0, wy0, wx1, wy1, wvalid, pair))
     contact = contact | hit
     done = ~active
+    mx, my = mx + 0.0, my + 0.0
     budget = _EVENTS_PER_ROBOT * moving.sum(-1)
     for k in range(_EVENTS_PER_ROBOT * n_robots):
         live = ~done & (budget > k)
         if not a.any(live):
             break
+        # Only the worlds still under way take part in the round.
+        sel = a.nonzero(live)
+        n = sel.shape[0]
+        rows = a.arange(n)
+        geo = tuple(v[sel] for v in (wx0, wy0, wx1, wy1, wvalid, pair))
+        gx0, gy0, gx1, gy1, gvalid, gpair = geo
+        sx, sy, smx, smy, sleft = x[sel], y[sel], mx[sel], my[sel], left[sel]
         # Wall events, robot by robot and wall by wall, then pair events: the first wins a tie.
-        wd, wnx, wny = square_distance(xp, x[..., None], y[..., None], wx0, wy0, wx1, wy1)
-        speed = xp.sqrt(mx * mx + my * my)
-        towards = wvalid & (mx[..., None] * wnx + my[..., None] * wny < 0.0)
-        towards = towards & ~(wd - hit_w > (speed * left[:, None])[..., None])
-        tw = enter_rounded_square(xp, x[..., None], y[..., None], mx[..., None], my[..., None], wx0, wy0, wx1, wy1, hit_w)
+        wd, wnx, wny = square_distance(xp, sx[..., None], sy[..., None], gx0, gy0, gx1, gy1)
+        speed = xp.sqrt(smx * smx + smy * smy)
+        towards = gvalid & (smx[..., None] * wnx + smy[..., None] * wny < 0.0)
+        towards = towards & ~(wd - hit_w > (speed * sleft[:, None])[..., None])
+        tw = enter_rounded_square(xp, sx[..., None], sy[..., None], smx[..., None], smy[..., None], gx0, gy0, gx1, gy1, hit_w)
         tw = xp.where(towards, tw, inf)
-        vx = mx[:, :, None] - mx[:, None, :]
-        vy = my[:, :, None] - my[:, None, :]
-        tp = enter_disc(xp, x[:, :, None], y[:, :, None], vx, vy, x[:, None, :], y[:, None, :], hit_r)
-        apart = (x[:, :, None] - x[:, None, :]) * vx + (y[:, :, None] - y[:, None, :]) * vy >= 0.0
-        tp = xp.where(pair & upper & ((vx != 0.0) | (vy != 0.0)) & ~((tp == 0.0) & apart), tp, inf)
+        vx = smx[:, :, None] - smx[:, None, :]
+        vy = smy[:, :, None] - smy[:, None, :]
+        tp = enter_disc(xp, sx[:, :, None], sy[:, :, None], vx, vy, sx[:, None, :], sy[:, None, :], hit_r)
+        apart = (sx[:, :, None] - sx[:, None, :]) * vx + (sy[:, :, None] - sy[:, None, :]) * vy >= 0.0
+        tp = xp.where(gpair & upper & ((vx != 0.0) | (vy != 0.0)) & ~((tp == 0.0) & apart), tp, inf)
         cat = xp.cat if a.is_torch else xp.concatenate
-        flat = cat([tw.reshape(n_worlds, -1), tp.reshape(n_worlds, -1)], -1)
+        flat = cat([tw.reshape(n, -1), tp.reshape(n, -1)], -1)
         first = xp.argmin(flat, -1)
         t_first = take(flat, first[:, None])
-        event = live & (t_first < left)
-        free = live & ~event
-        x = xp.where(free[:, None], x + mx * left[:, None], x)
-        y = xp.where(free[:, None], y + my * left[:, None], y)
-        left = xp.where(free, 0.0 * left, left)
-        done = done | free
+        event = t_first < sleft
+        free = ~event
+        sx = xp.where(free[:, None], sx + smx * sleft[:, None], sx)
+        sy = xp.where(free[:, None], sy + smy * sleft[:, None], sy)
+        sleft = xp.where(free, xp.zeros_like(sleft), sleft)
+        done[sel] = free
+        if a.any(event):
+            is_wall = first < n_robots * n_walls
+            fw = xp.where(is_wall, first, 0)
+            wi, wkk = fw // max(n_walls, 1), fw % max(n_walls, 1)
+            fp = xp.where(is_wall, 0, first - n_robots * n_walls)
+            i, j = xp.where(is_wall, wi, fp // n_robots), fp % n_robots
+            ex0, ey0, ex1, ey1 = (v[rows, wi, wkk] for v in (gx0, gy0, gx1, gy1))
+            place_w = enter_rounded_square(
+                xp, sx[rows, wi], sy[rows, wi], smx[rows, wi], smy[rows, wi], ex0, ey0, ex1, ey1, radius + _PLACE
+            )
+            place_p = enter_disc(
+                xp, sx[rows, i], sy[rows, i], smx[rows, i] - smx[rows, j], smy[rows, i] - smy[rows, j],
+                sx[rows, j], sy[rows, j], 2.0 * radius + _PLACE,
+            )
+            place = xp.where(is_wall, place_w, place_p)
+            step = xp.minimum(xp.maximum(place, xp.zeros_like(place)), t_first)
+            step = xp.where(event, step, xp.zeros_like(step))
+            sx, sy = sx + smx * step[:, None], sy + smy * step[:, None]
+            sleft = sleft - step
+            ii, jj = eye.reshape(1, -1, 1), eye.reshape(1, 1, -1)
+            pe = (event & ~is_wall)[:, None, None]
+            forced_p = pe & (
+                ((ii == i[:, None, None]) & (jj == j[:, None, None]))
+                | ((ii == j[:, None, None]) & (jj == i[:, None, None]))
+            )
+            we = (event & is_wall)[:, None, None]
+            forced_w = we & (ii == wi[:, None, None]) & (wk.reshape(1, 1, -1) == wkk[:, None, None])
+            nmx, nmy, hit = resolve(sx, sy, smx, smy, forced_p, forced_w, sleft, event, geo)
+            mx[sel], my[sel] = xp.where(event[:, None], nmx, smx), xp.where(event[:, None], nmy, smy)
+            contact[sel] = contact[sel] | (hit & event[:, None])
+        x[sel], y[sel], left[sel] = sx, sy, sleft
         if not a.any(event):
             break
-        is_wall = first < n_robots * n_walls
-        fw = xp.where(is_wall, first, 0)
-        wi, wkk = fw // max(n_walls, 1), fw % max(n_walls, 1)
-        fp = xp.where(is_wall, 0, first - n_robots * n_walls)
-        i, j = xp.where(is_wall, wi, fp // n_robots), fp % n_robots
-        ex0, ey0, ex1, ey1 = (v[rows, wi, wkk] for v in (wx0, wy0, wx1, wy1))
-        place_w = enter_rounded_square(xp, x[rows, wi], y[rows, wi], mx[rows, wi], my[rows, wi], ex0, ey0, ex1, ey1, radius + _PLACE)
-        place_p = enter_disc(
-            xp, x[rows, i], y[rows, i], mx[rows, i] - mx[rows, j], my[rows, i] - my[rows, j], x[rows, j], y[rows, j],
-            2.0 * radius + _PLACE,
-        )
-        place = xp.where(is_wall, place_w, place_p)
-        step = xp.minimum(xp.maximum(place, xp.zeros_like(place)), t_first)
-        step = xp.where(event, step, xp.zeros_like(step))
-        x, y = x + mx * step[:, None], y + my * step[:, None]
-        left = left - step
-        ii, jj = eye.reshape(1, -1, 1), eye.reshape(1, 1, -1)
-        pe = (event & ~is_wall)[:, None, None]
-        forced_p = pe & (
-            ((ii == i[:, None, None]) & (jj == j[:, None, None])) | ((ii == j[:, None, None]) & (jj == i[:, None, None]))
-        )
-        we = (event & is_wall)[:, None, None]
-        forced_w = we & (ii == wi[:, None, None]) & (wk.reshape(1, 1, -1) == wkk[:, None, None])
-        nmx, nmy, hit = resolve(x, y, mx, my, forced_p, forced_w, left, event)
-        mx, my = xp.where(event[:, None], nmx, mx), xp.where(event[:, None], nmy, my)
-        contact = contact | (hit & event[:, None])
     # Safety net against rounding: never end deeper in a wall than at the start.
     d_end = square_distance(xp, x[..., None], y[..., None], wx0, wy0, wx1, wy1)[0]
     d_start = square_distance(xp, start_x[..., None], start_y[..., None], wx0, wy0, wx1, wy1)[0]
