@@ -141,3 +141,19 @@ def test_random_crowds_among_walls_match_the_backend(device: str, n_robots: int)
     np.testing.assert_allclose(got[1], want_y, atol=1e-9)
     np.testing.assert_array_equal(got[2], want_c)
     assert want_c.any() and not want_c.all()
+
+
+@pytest.mark.parametrize("device", DEVICES)
+def test_absent_robots_neither_move_nor_block(device: str) -> None:
+    # Robot 1 stands in robot 0's way; absent, robot 0 drives through its place untouched.
+    a = make_arrays(device)
+    x, y = np.array([[10.0, 10.3], [10.0, 10.3]]), np.full((2, 2), 10.0)
+    mx, my = np.array([[0.3, 0.0], [0.3, 0.0]]), np.zeros((2, 2))
+    present = np.array([[True, False], [True, True]])
+    args = [a.asarray(v) for v in (x, y, mx, my)]
+    ex, ey, c = (a.numpy(v) for v in advance_robots(a, *args, 0.1, present=a.asarray(present, a.boolean)))
+    assert ex[0].tolist() == [10.3, 10.3] and c[0].tolist() == [False, False]
+    assert (ey == 10.0).all()
+    # Present, robot 1 stops robot 0 head-on where the discs touch, 0.1 m on.
+    np.testing.assert_allclose(ex[1], [10.1, 10.3], atol=1e-8)
+    assert c[1].tolist() == [True, True]
