@@ -1,0 +1,272 @@
+"""Batched contacts of several robots per world: they advance together, as in the backend.
+
+The array twin of :func:`pointnav_kinematic.contacts.advance` with robot-robot contacts:
+within a world, every robot follows its chord at once; the world moves to the earliest
+moment at which a robot would overlap a wall, or two robots closing on each other would
+overlap (by more than ``_HIT``), places the parties ``_PLACE`` short of touching, resolves
+every robot's contacts there (a blocked motion slides along the longest tangent of a
+contact, wall or robot, that goes into no other one, else stops; both robots' flags are
+set when robots meet) and goes on with what is left. Robots without motion still block the others. As in the backend, a world resolves
+at most ``8`` events per moving robot; each world keeps its own clock, so the Python loop
+is over event rounds only, never over worlds or robots.
+
+Arrays have leading axes ``(num_worlds, n_robots)``; pair arrays add a second robot axis
+``(W, R, R)``, entry ``[w, i, j]`` meaning robot ``i`` against robot ``j``.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+from pointnav_core.vector.contacts import _nearest as nearest
+from pointnav_core.vector.contacts import _take as take_along
+from pointnav_core.vector.contacts import window
+from pointnav_core.vector.floors import FloorTables
+from pointnav_core.vector.sweep import enter_disc, enter_rounded_square, square_distance
+from pointnav_core.vector.xp import Arrays
+
+__all__ = ["advance_robots", "robot_walls"]
+
+_HIT = 0.5e-9
+_PLACE = 1.0e-9
+_ACTIVE = 2.0e-9
+_EVENTS_PER_ROBOT = 8
+_CONTACTS = 6  # nearest walls that may be contacts while sliding, as in vector.contacts
+
+
+def _hit_radius(radius: float) -> float:
+    return max(radius - _HIT, _HIT)
+
+
+def advance_robots(
+    arrays: Arrays, x: Any, y: Any, mx: Any, my: Any, radius: float, present: Any = None, walls: Any = None
+) -> tuple[Any, Any, Any]:
+    """Move every world's robots by their chords ``(mx, my)`` (m), resolving their contacts.
+
+    Parameters
+    ----------
+    arrays : Arrays
+        The array namespace (numpy or torch) the inputs live in.
+    x, y, mx, my : float arrays (W, R)
+        Start positions and chords over the step, in metres.
+    radius : float
+        Every robot's radius (m), >= 0.
+    present : bool array (W, R), optional
+        Robots that take part; absent ones neither move nor block. Default: all.
+    walls : tuple of arrays (W, R, K), optional
+        Each robot's walls within reach of its whole chord, in the backend's order: the
+        squares' ``x0, y0, x1, y1`` (m) and a validity mask. Default: none (open space).
+
+    Returns
+    -------
+    x, y : float arrays (W, R)
+        End positions (m).
+    contact : bool array (W, R)
+        Whether each robot was blocked by a wall or another robot, or blocked one.
+    """
+    a = arrays
+    xp = a.xp
+    inf = math.inf
+    n_robots = x.shape[1]
+    if present is None:
+        present = xp.ones_like(x) > 0.0
+    if walls is None:
+        far = xp.zeros_like(x)[..., None] + 1e9
+        walls = (far, far, far + 1.0, far + 1.0, far < 0.0)
+    wx0, wy0, wx1, wy1, wvalid = walls
+    wvalid = wvalid & present[..., None]
+    n_walls = wx0.shape[-1]
+    n_near = min(_CONTACTS, n_walls)
+    start_x, start_y = x, y
+    mx = xp.where(present, mx, 0.0 * mx)
+    my = xp.where(present, my, 0.0 * my)
+    span = xp.sqrt(mx * mx + my * my)
+    moving = span > 0.0
+    eye = a.arange(n_robots)
+    upper = eye.reshape(1, -1, 1) < eye.reshape(1, 1, -1)
+    # The backend's pair list: robots on the floor, not both still, within reach of each other.
+    reach = 2.0 * radius + span[:, :, None] + span[:, None, :] + 4.0 * _ACTIVE
+    gap2 = (x[:, :, None] - x[:, None, :]) ** 2 + (y[:, :, None] - y[:, None, :]) ** 2
+    pair = (
+        upper & present[:, :, None] & present[:, None, :]
+        & (moving[:, :, None] | moving[:, None, :]) & (gap2 < reach * reach)
+    )
+    pair = pair | (pair.transpose(1, 2) if a.is_torch else xp.swapaxes(pair, 1, 2))
+    hit_w = _hit_radius(radius)
+    hit_r = _hit_radius(2.0 * radius)
+    left = xp.ones_like(x[:, 0])
+    contact = xp.zeros_like(x) > 1.0
+    no_pair = xp.zeros_like(gap2) > 1.0
+    no_wall = xp.zeros_like(wx0) > 1.0
+    wk = a.arange(n_walls)
+
+    def take(v: Any, idx: Any) -> Any:
+        return (xp.gather(v, -1, idx) if a.is_torch else xp.take_along_axis(v, idx, -1))[..., 0]
+
+    def resolve(
+        x: Any, y: Any, mx: Any, my: Any, forced_p: Any, forced_w: Any, left: Any, active: Any, geo: tuple[Any, ...]
+    ) -> tuple[Any, Any, Any]:
+        # Every moving robot of an active world: slide along (or stop at) what it touches
+        # if its motion goes into it; contacts are its walls, then the other robots.
+        # The walls within _ACTIVE of touching are among the nearest few (a disc touches at
+        # most four squares): only those take part, in their original order.
+        wx0, wy0, wx1, wy1, wvalid, pair = geo
+        wd = square_distance(xp, x[..., None], y[..., None], wx0, wy0, wx1, wy1)[0]
+        near = nearest(xp, xp.where(wvalid, wd, inf), n_near)
+        cx0, cy0, cx1, cy1, cvalid, forced_w = (take_along(xp, v, near) for v in (wx0, wy0, wx1, wy1, wvalid, forced_w))
+        wd, wnx, wny = square_distance(xp, x[..., None], y[..., None], cx0, cy0, cx1, cy1)
+        wtouch = cvalid & (wd <= radius + _ACTIVE)
+        ex, ey = x[:, :, None] - x[:, None, :], y[:, :, None] - y[:, None, :]
+        dist = xp.sqrt(ex * ex + ey * ey)
+        ptouch = pair & (dist <= 2.0 * radius + _ACTIVE)
+        safe = xp.where(dist > 0.0, dist, 1.0)
+        nx = xp.cat([wnx, xp.where(dist > 0.0, ex / safe, 1.0)], -1) if a.is_torch else xp.concatenate([wnx, xp.where(dist > 0.0, ex / safe, 1.0)], -1)
+        ny = xp.cat([wny, xp.where(dist > 0.0, ey / safe, 0.0)], -1) if a.is_torch else xp.concatenate([wny, xp.where(dist > 0.0, ey / safe, 0.0)], -1)
+        cat = xp.cat if a.is_torch else xp.concatenate
+        touching = cat([wtouch, ptouch], -1)
+        forced = cat([forced_w, forced_p], -1)
+        px, py = x[:, :, None, None], y[:, :, None, None]
+
+        def blocks(tx: Any, ty: Any) -> Any:
+            # (W, R, T) motions of robot i against its contacts: (W, R, T, K + R).
+            into = tx[..., None] * nx[:, :, None, :] + ty[..., None] * ny[:, :, None, :] < 0.0
+            tw = enter_rounded_square(
+                xp, px, py, tx[..., None], ty[..., None], cx0[:, :, None, :], cy0[:, :, None, :],
+                cx1[:, :, None, :], cy1[:, :, None, :], hit_w,
+            )
+            tr = enter_disc(xp, px, py, tx[..., None], ty[..., None], x[:, None, None, :], y[:, None, None, :], hit_r)
+            t = cat([tw, tr], -1)
+            return touching[:, :, None, :] & into & (forced[:, :, None, :] | (t <= left[:, None, None, None]))
+
+        go = ((mx != 0.0) | (my != 0.0)) & active[:, None]
+        blocked = blocks(mx[..., None], my[..., None])[:, :, 0, :] & go[..., None]
+        any_blocked = blocked.any(-1)
+        hit = any_blocked | blocked[..., n_near:].any(1)  # the robot it ran into too
+        dot = mx[..., None] * nx + my[..., None] * ny
+        tx, ty = mx[..., None] - dot * nx, my[..., None] - dot * ny
+        length = tx * tx + ty * ty
+        bad = blocks(tx, ty)
+        ck = a.arange(n_near + n_robots)
+        bad = bad & (ck.reshape(1, 1, -1, 1) != ck.reshape(1, 1, 1, -1))  # along its own contact
+        ok = touching & ~bad.any(-1) & (length > 0.0)
+        score = xp.where(ok, length, -1.0)
+        best = xp.argmax(score, -1)[..., None]
+        has = take(score, best) > 0.0
+        sx, sy = xp.where(has, take(tx, best), 0.0), xp.where(has, take(ty, best), 0.0)
+        return xp.where(any_blocked, sx, mx), xp.where(any_blocked, sy, my), hit
+
+    active = moving.any(-1)
+    x, y = x + 0.0, y + 0.0
+    mx, my, hit = resolve(x, y, mx, my, no_pair, no_wall, left, active, (wx0, wy0, wx1, wy1, wvalid, pair))
+    contact = contact | hit
+    done = ~active
+    mx, my = mx + 0.0, my + 0.0
+    budget = _EVENTS_PER_ROBOT * moving.sum(-1)
+    for k in range(_EVENTS_PER_ROBOT * n_robots):
+        live = ~done & (budget > k)
+        if not a.any(live):
+            break
+        # Only the worlds still under way take part in the round.
+        sel = a.nonzero(live)
+        n = sel.shape[0]
+        rows = a.arange(n)
+        geo = tuple(v[sel] for v in (wx0, wy0, wx1, wy1, wvalid, pair))
+        gx0, gy0, gx1, gy1, gvalid, gpair = geo
+        sx, sy, smx, smy, sleft = x[sel], y[sel], mx[sel], my[sel], left[sel]
+        # Wall events, robot by robot and wall by wall, then pair events: the first wins a tie.
+        wd, wnx, wny = square_distance(xp, sx[..., None], sy[..., None], gx0, gy0, gx1, gy1)
+        speed = xp.sqrt(smx * smx + smy * smy)
+        towards = gvalid & (smx[..., None] * wnx + smy[..., None] * wny < 0.0)
+        towards = towards & ~(wd - hit_w > (speed * sleft[:, None])[..., None])
+        tw = enter_rounded_square(xp, sx[..., None], sy[..., None], smx[..., None], smy[..., None], gx0, gy0, gx1, gy1, hit_w)
+        tw = xp.where(towards, tw, inf)
+        vx = smx[:, :, None] - smx[:, None, :]
+        vy = smy[:, :, None] - smy[:, None, :]
+        tp = enter_disc(xp, sx[:, :, None], sy[:, :, None], vx, vy, sx[:, None, :], sy[:, None, :], hit_r)
+        apart = (sx[:, :, None] - sx[:, None, :]) * vx + (sy[:, :, None] - sy[:, None, :]) * vy >= 0.0
+        tp = xp.where(gpair & upper & ((vx != 0.0) | (vy != 0.0)) & ~((tp == 0.0) & apart), tp, inf)
+        cat = xp.cat if a.is_torch else xp.concatenate
+        flat = cat([tw.reshape(n, -1), tp.reshape(n, -1)], -1)
+        first = xp.argmin(flat, -1)
+        t_first = take(flat, first[:, None])
+        event = t_first < sleft
+        free = ~event
+        sx = xp.where(free[:, None], sx + smx * sleft[:, None], sx)
+        sy = xp.where(free[:, None], sy + smy * sleft[:, None], sy)
+        sleft = xp.where(free, xp.zeros_like(sleft), sleft)
+        done[sel] = free
+        if a.any(event):
+            is_wall = first < n_robots * n_walls
+            fw = xp.where(is_wall, first, 0)
+            wi, wkk = fw // max(n_walls, 1), fw % max(n_walls, 1)
+            fp = xp.where(is_wall, 0, first - n_robots * n_walls)
+            i, j = xp.where(is_wall, wi, fp // n_robots), fp % n_robots
+            ex0, ey0, ex1, ey1 = (v[rows, wi, wkk] for v in (gx0, gy0, gx1, gy1))
+            place_w = enter_rounded_square(
+                xp, sx[rows, wi], sy[rows, wi], smx[rows, wi], smy[rows, wi], ex0, ey0, ex1, ey1, radius + _PLACE
+            )
+            place_p = enter_disc(
+                xp, sx[rows, i], sy[rows, i], smx[rows, i] - smx[rows, j], smy[rows, i] - smy[rows, j],
+                sx[rows, j], sy[rows, j], 2.0 * radius + _PLACE,
+            )
+            place = xp.where(is_wall, place_w, place_p)
+            step = xp.minimum(xp.maximum(place, xp.zeros_like(place)), t_first)
+            step = xp.where(event, step, xp.zeros_like(step))
+            sx, sy = sx + smx * step[:, None], sy + smy * step[:, None]
+            sleft = sleft - step
+            ii, jj = eye.reshape(1, -1, 1), eye.reshape(1, 1, -1)
+            pe = (event & ~is_wall)[:, None, None]
+            forced_p = pe & (
+                ((ii == i[:, None, None]) & (jj == j[:, None, None]))
+                | ((ii == j[:, None, None]) & (jj == i[:, None, None]))
+            )
+            we = (event & is_wall)[:, None, None]
+            forced_w = we & (ii == wi[:, None, None]) & (wk.reshape(1, 1, -1) == wkk[:, None, None])
+            nmx, nmy, hit = resolve(sx, sy, smx, smy, forced_p, forced_w, sleft, event, geo)
+            mx[sel], my[sel] = xp.where(event[:, None], nmx, smx), xp.where(event[:, None], nmy, smy)
+            contact[sel] = contact[sel] | (hit & event[:, None])
+        x[sel], y[sel], left[sel] = sx, sy, sleft
+        if not a.any(event):
+            break
+    # Safety net against rounding: never end deeper in a wall than at the start.
+    d_end = square_distance(xp, x[..., None], y[..., None], wx0, wy0, wx1, wy1)[0]
+    d_start = square_distance(xp, start_x[..., None], start_y[..., None], wx0, wy0, wx1, wy1)[0]
+    depth_end = xp.amax(xp.where(wvalid, radius - d_end, -inf), -1)
+    depth_start = xp.amax(xp.where(wvalid, radius - d_start, -inf), -1)
+    moved = (x != start_x) | (y != start_y)
+    undo = contact & moved & (depth_end > _HIT) & (depth_end > depth_start)
+    return xp.where(undo, start_x, x), xp.where(undo, start_y, y), contact
+
+
+def robot_walls(floors: FloorTables, scene: Any, x: Any, y: Any, mx: Any, my: Any, radius: float, max_travel: float) -> tuple[Any, ...]:
+    """Each robot's walls within reach of its chord, the few that can matter: ``(W, R, K)`` arrays.
+
+    Parameters
+    ----------
+    floors : FloorTables
+    scene : int array (W, R)
+        Each robot's scene index.
+    x, y, mx, my : float arrays (W, R)
+        Start positions and chords (m).
+    radius, max_travel : float
+        Robot radius and the longest chord of any step (m).
+
+    Returns
+    -------
+    tuple
+        ``x0, y0, x1, y1`` of the squares (m) and their validity mask, in the backend's
+        (row-major) order, for :func:`advance_robots`.
+    """
+    xp = floors.arrays.xp
+    n_worlds, n_robots = x.shape
+    flat = [v.reshape(-1) for v in (scene, x, y, mx, my)]
+    sc, fx, fy, fmx, fmy = flat
+    wx0, wy0, wx1, wy1, valid = window(floors, sc, fx, fy, radius + max_travel + 4.0 * _ACTIVE)
+    d0 = square_distance(xp, fx[:, None], fy[:, None], wx0, wy0, wx1, wy1)[0]
+    reach = radius + xp.sqrt(fmx * fmx + fmy * fmy) + 4.0 * _ACTIVE
+    in_reach = valid & (d0 <= reach[:, None])
+    k = max(int(in_reach.sum(-1).max()) if in_reach.shape[0] else 0, 1)
+    order = nearest(xp, xp.where(in_reach, d0, math.inf), k)
+    out = [take_along(xp, v, order).reshape(n_worlds, n_robots, k) for v in (wx0, wy0, wx1, wy1, in_reach)]
+    return tuple(out)
