@@ -48,6 +48,12 @@ def _wrap(angle: float) -> float:
     return math.pi - (math.pi - angle) % (2.0 * math.pi)
 
 
+def _ring(centre: NDArray[np.float64], radius: float) -> NDArray[np.float64]:
+    """``_OUT_DIRECTIONS`` points evenly round a circle of ``radius`` (m) about ``centre``."""
+    angles = np.linspace(0.0, 2.0 * math.pi, _OUT_DIRECTIONS, endpoint=False)
+    return centre + radius * np.stack([np.cos(angles), np.sin(angles)], axis=1)
+
+
 def _nearest_usable(tmap: Any, xy: NDArray[np.float64], radius: float, reach: int = 3) -> NDArray[np.float64] | None:
     """Centre of the nearest cell within ``reach`` cells whose centre the disc fits at."""
     usable = tmap.usable(radius)
@@ -207,8 +213,7 @@ class ShortestPathFollower:
         if key not in self._aims:
             tmap = self.env.scene.floors[self.task.floor]
             away = 2.0 * (radius - spec.radius)
-            angles = np.linspace(0.0, 2.0 * math.pi, _OUT_DIRECTIONS, endpoint=False)
-            points = np.vstack([goal, goal + away * np.stack([np.cos(angles), np.sin(angles)], axis=1)])
+            points = np.vstack([goal, _ring(goal, away)])
             fits = tmap.collision.points_clear(points, radius)
             tolerance = float(getattr(self.task, "goal_tolerance", 0.0))
             self._aims[key] = points[int(np.argmax(fits))] if fits.any() and (fits[0] or away < tolerance / 2) else None
@@ -227,8 +232,7 @@ class ShortestPathFollower:
         tmap = self.env.scene.floors[self.task.floor]
         exact = self.env.scene.goal_field(self.task.floor, goal, robot=spec.radius).exact_distance(xy)
         away = min(2.0 * (radius - spec.radius), self._step_length())
-        angles = np.linspace(0.0, 2.0 * math.pi, _OUT_DIRECTIONS, endpoint=False)
-        points = xy + away * np.stack([np.cos(angles), np.sin(angles)], axis=1)
+        points = _ring(xy, away)
         clear = tmap.collision.segments_clear(np.broadcast_to(xy, points.shape), points, spec.radius)
         best, best_cost = None, exact + _DETOUR
         for point in points[clear]:
