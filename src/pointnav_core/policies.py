@@ -161,6 +161,7 @@ class ShortestPathFollower:
         # wider robot fits: the exact robot's way may run through a passage exactly its
         # width, which float32 actions cannot thread without grazing a side.
         radii = sorted({spec.radius + self.margin, spec.radius + _HAIR, spec.radius}, reverse=True)
+        exact = None  # the true robot's distance to the goal, found once if needed
         for radius in radii:
             aim = self._aim(goal, radius)
             if aim is None:
@@ -169,8 +170,11 @@ class ShortestPathFollower:
             path, _ = field.path(xy, max_length=self.lookahead)
             if path is not None:
                 break
-            if radius > spec.radius and (out := self._step_out(xy, goal, field, radius)) is not None:
-                return out
+            if radius > spec.radius:
+                if exact is None:
+                    exact = env.scene.goal_field(task.floor, goal, robot=spec.radius).exact_distance(xy)
+                if (out := self._step_out(xy, exact, field, radius)) is not None:
+                    return out
         if path is None:
             centre = _nearest_usable(tmap, xy, spec.radius)
             if centre is None:
@@ -224,13 +228,12 @@ class ShortestPathFollower:
         spec = self.env.robots[self.task.robot_idn]
         return spec.max_linear_velocity / getattr(self.env, "action_frequency", 10.0)
 
-    def _step_out(self, xy: NDArray[np.float64], goal: NDArray[np.float64], field: Any, radius: float) -> NDArray[np.float64] | None:
+    def _step_out(self, xy: NDArray[np.float64], exact: float, field: Any, radius: float) -> NDArray[np.float64] | None:
         """A point a little away from ``xy``, in a clear straight line, where a robot of
         ``radius`` fits and whose way to the goal costs at most ``_DETOUR`` m more than the
-        true robot's from ``xy``; None if there is none."""
+        true robot's, ``exact`` m from ``xy``; None if there is none."""
         spec = self.env.robots[self.task.robot_idn]
         tmap = self.env.scene.floors[self.task.floor]
-        exact = self.env.scene.goal_field(self.task.floor, goal, robot=spec.radius).exact_distance(xy)
         away = min(2.0 * (radius - spec.radius), self._step_length())
         points = _ring(xy, away)
         clear = tmap.collision.segments_clear(np.broadcast_to(xy, points.shape), points, spec.radius)

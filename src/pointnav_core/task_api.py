@@ -15,7 +15,7 @@ It changes nothing but the two settable parameters; the lifecycle (``load``, ``r
 from __future__ import annotations
 
 import dataclasses
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
@@ -59,8 +59,7 @@ class OmniGibsonTaskAPI:
     _terminations: Mapping[str, TerminationCondition]
     _rewards: Mapping[str, RewardFunction]
 
-    def _bind(self, backend: Any) -> None:  # the task's; declared for the observations
-        raise NotImplementedError
+    _bind: Callable[[Any], None]  # the task's backend binding, which get_obs may redo
 
     # ------------------------------------------------------------------ parameters
     @property
