@@ -22,21 +22,28 @@ INFO_KEYS = ("success", "spl", "soft_spl", "collisions", "episode_length", "path
 
 
 def compare(
-    scene: Any, episodes: list[tuple[Any, float, Any]], actions: np.ndarray, task: dict | None = None, device: str = "numpy"
+    scene: Any,
+    episodes: list[tuple[Any, float, Any]],
+    actions: np.ndarray,
+    task: dict | None = None,
+    device: str = "numpy",
+    **env_kwargs: Any,
 ) -> dict[str, Any]:
     """Step both for ``len(actions)`` steps; return counts of what happened (ends, contacts)
     and the largest observation and reward differences seen.
 
     ``episodes`` holds one ``(start_xy, yaw, goal_xy)`` per world; ``actions`` has shape
-    ``(steps, num_envs, 2)``.
+    ``(steps, num_envs, 2)``, or ``(steps, num_envs)`` for discrete actions.
+    ``env_kwargs`` (``action_space``, ``discrete_actions``) go to both engines.
     """
     task = dict(task or {})
     n = len(episodes)
-    venv = VectorPointNavEnv(n, scene=scene, task=task, device=device, seed=0)
+    venv = VectorPointNavEnv(n, scene=scene, task=task, device=device, seed=0, **env_kwargs)
     singles = [
         PointNavEnv(
             scene=scene,
             flatten_obs=True,
+            **env_kwargs,
             task=dict(
                 task,
                 initial_pos=[float(s[0]), float(s[1])],

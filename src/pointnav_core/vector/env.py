@@ -19,6 +19,7 @@ from gymnasium.vector import AutoresetMode, VectorEnv
 
 from pointnav_core import _envcommon, scenes, validation
 from pointnav_core.vector.contacts import advance
+from pointnav_core.vector.discrete import MOVED, DiscretePlan
 from pointnav_core.vector.episodes import EpisodePool
 from pointnav_core.vector.floors import FloorTables
 from pointnav_core.vector.xp import make_arrays
@@ -115,6 +116,8 @@ class VectorPointNavEnv(VectorEnv):
         pool_size: int = 8,
         action_frequency: float = 10.0,
         max_episode_steps: int | None = None,
+        action_space: str = "continuous",
+        discrete_actions: Mapping[str, Any] | None = None,
     ) -> None:
         from pointnav_core.env import PointNavEnv
 
@@ -139,7 +142,8 @@ class VectorPointNavEnv(VectorEnv):
             raise ValueError(f"robot must have a differential drive in the batched engine, got {self.robot.drive!r}")
         self.scenes = scene_list
         self._samplers = [
-            PointNavEnv(scene=s, robot=self.robot, task=dict(task or {}), flatten_obs=True, action_frequency=action_frequency)
+            PointNavEnv(scene=s, robot=self.robot, task=dict(task or {}), flatten_obs=True, action_frequency=action_frequency,
+                        action_space=action_space, discrete_actions=discrete_actions)
             for s in scene_list
         ]
         if max_episode_steps is not None:
@@ -164,6 +168,8 @@ class VectorPointNavEnv(VectorEnv):
                 "step may turn at most 0.25 rad and drive at most half a cell (the kinematic backend's sub-step)"
             )
         a = self.arrays
+        acts = first.discrete_actions
+        self._discrete = None if acts is None else DiscretePlan(acts, spec, self.action_frequency, a)
         self.floors = FloorTables(scene_list, t.floor, spec.radius, a)
         # A chord is never longer than its arc; the margin covers rounding.
         self._max_travel = spec.max_linear_velocity * self.dt * (1.0 + 1e-9) + 1e-12
@@ -261,8 +267,11 @@ class VectorPointNavEnv(VectorEnv):
         self._needs_reset[idx] = False
 
     def check_actions(self, actions: Any) -> Any:
-        """``actions`` as a float64 array ``(num_envs, 2)``; ValueError naming ``actions`` if bad."""
+        """``actions`` as a float64 array ``(num_envs, 2)``, or with discrete actions an int64
+        array ``(num_envs,)``; ValueError naming ``actions`` if bad."""
         a = self.arrays
+        if self._discrete is not None:
+            return self._discrete.check(actions, self.num_envs)
         shape = tuple(getattr(actions, "shape", np.shape(actions)))
         n = self.num_envs
         if shape not in ((n, 2), (n, 1, 2)):
@@ -280,8 +289,19 @@ class VectorPointNavEnv(VectorEnv):
     def _step(self, actions: Any) -> tuple[Any, Any, Any, Any, dict[str, Any]]:
         if not self._started:
             raise RuntimeError("call reset() before step()")
-        a, xp, st = self.arrays, self.arrays.xp, self._state
+        st = self._state
         act = self.check_actions(actions)
+        if self._discrete is None:
+            moved, contact = self._drive(act, st)
+            stopped = None
+        else:
+            moved, contact, stopped = self._discrete.run(self, act)
+        return self._account(moved, contact, stopped)
+
+    def _drive(self, act: Any, state: Mapping[str, Any]) -> tuple[dict[str, Any], Any]:
+        """One control step of every world from ``state`` under commands ``act`` ``(num_envs, 2)``,
+        not committed: the new pose, height and velocities (keys ``MOVED``) and the contacts."""
+        a, xp = self.arrays, self.arrays.xp
         spec = self.robot
         one = 1.0
         v0, v1 = act[:, 0], act[:, 1]
@@ -289,7 +309,7 @@ class VectorPointNavEnv(VectorEnv):
         vx = xp.where(v0 >= one, vmax, xp.where(v0 <= -one, -vmax, v0 * vmax))
         w = xp.where(v1 >= one, wmax, xp.where(v1 <= -one, -wmax, v1 * wmax))
         dt = self.dt
-        x0, y0, yaw0 = st["x"], st["y"], st["yaw"]
+        x0, y0, yaw0 = state["x"], state["y"], state["yaw"]
         # The exact arc over the step (state.drive_arc with vy = 0).
         half = 0.5 * w * dt
         safe = xp.where(half != 0.0, half, 1.0)
@@ -306,7 +326,7 @@ class VectorPointNavEnv(VectorEnv):
         vel_x, vel_y, vel_w = dx / dt, dy / dt, w
         vz = xp.zeros_like(x)
         contact = xp.zeros_like(x) > 1.0
-        z = st["z"]
+        z = state["z"]
         slow = a.nonzero(~fast)
         if slow.shape[0]:
             sx, sy, c = advance(self.floors, scene[slow], x0[slow], y0[slow], dx[slow], dy[slow], spec.radius, self._max_travel)
@@ -321,6 +341,15 @@ class VectorPointNavEnv(VectorEnv):
             z = z.clone() if a.is_torch else z.copy()
             z[slow] = xp.where(fall, z[slow] - drop, z[slow])
             contact[slow] = c
+        moved = {"x": x, "y": y, "yaw": yaw, "z": z, "vx": vel_x, "vy": vel_y, "w": vel_w, "vz": vz}
+        return moved, contact
+
+    def _account(self, moved: Mapping[str, Any], contact: Any, stopped: Any) -> tuple[Any, Any, Any, Any, dict[str, Any]]:
+        """The task's step over the worlds' moves from the committed state: rewards, ends, info,
+        then the commit and the next-step autoresets. ``stopped``: the worlds that called STOP."""
+        a, xp, st = self.arrays, self.arrays.xp, self._state
+        x0, y0, scene = st["x"], st["y"], self._world_scene
+        x, y, yaw, z, vel_x, vel_y, vel_w, vz = (moved[k] for k in MOVED)
         # --- the task's accounting (PointNavigationTask.step)
         path = st["path"] + xp.sqrt((x - x0) ** 2 + (y - y0) ** 2)
         steps = self._steps + 1
@@ -330,8 +359,12 @@ class VectorPointNavEnv(VectorEnv):
         l2 = xp.sqrt((gx - x) ** 2 + (gy - y) ** 2)
         pot = xp.where(self._geo_metric, xp.where(dist < math.inf, dist, st["pot"]), l2)
         success = l2 < self.goal_tolerance
+        if stopped is not None:  # with STOP, success needs STOP within the tolerance (StopAtGoal)
+            success = success & stopped
         fell = z < self.floors.height[scene] - self.fall_height
         terminated = (collisions > self.max_collisions) | fell | success
+        if stopped is not None:
+            terminated = terminated | stopped
         truncated = steps >= self.max_steps
         r_pot = self.r_potential * (st["pot"] - pot)
         zero = xp.zeros_like(x)  # torch.where of two numbers would give float32
