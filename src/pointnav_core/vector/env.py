@@ -68,9 +68,18 @@ class VectorPointNavEnv(VectorEnv):
     seed : int, optional
         Seeds the episode pools and the draws from them.
     pool_size : int
-        Episodes prepared per scene, >= 1 (each with its settled goal field).
+        Goals prepared per scene, >= 1 (each with its settled goal field).
     action_frequency : float
         Control steps per second (Hz).
+    action_space : str
+        ``"continuous"`` (default) or ``"discrete"``: Habitat's actions, as the single env
+        (:mod:`pointnav_core.actions`), each run as its control steps
+        (:mod:`pointnav_core.vector.discrete`).
+    discrete_actions : dict, optional
+        ``forward_step``, ``turn_angle``, ``stop``, as the single env.
+    starts_per_goal : int
+        Episodes per pool goal, >= 1: the extra starts share the goal's field, so a larger
+        pool costs next to nothing more to prepare.
     max_episode_steps : int, optional
         The task's ``max_steps``, as ``gymnasium.make(..., max_episode_steps=N)`` sets it for
         the single env (the derived ``path_range`` follows).
@@ -78,7 +87,7 @@ class VectorPointNavEnv(VectorEnv):
     Notes
     -----
     ``step`` takes actions of shape ``(num_envs, 2)`` (or ``(num_envs, 1, 2)``) in
-    ``[-1, 1]`` (clipped) and returns observations ``(num_envs, 8)`` float32, rewards
+    ``[-1, 1]`` (clipped), or with discrete actions integers of shape ``(num_envs,)``, and returns observations ``(num_envs, 8)`` float32, rewards
     float64, terminated and truncated bool, and ``info``, a dict of arrays of shape
     ``(num_envs,)``: ``success``, ``spl``, ``soft_spl``, ``path_length``,
     ``geodesic_dist``, ``distance_to_goal``, ``collisions``, ``episode_length``,
@@ -118,6 +127,7 @@ class VectorPointNavEnv(VectorEnv):
         max_episode_steps: int | None = None,
         action_space: str = "continuous",
         discrete_actions: Mapping[str, Any] | None = None,
+        starts_per_goal: int = 1,
     ) -> None:
         from pointnav_core.env import PointNavEnv
 
@@ -132,6 +142,7 @@ class VectorPointNavEnv(VectorEnv):
             if task is not None and task.get(key) is not None:
                 raise ValueError(f"task: {key} is not supported by the batched engine")
         self.pool_size = validation.integer("pool_size", pool_size, minimum=1)
+        self.starts_per_goal = validation.integer("starts_per_goal", starts_per_goal, minimum=1)
         self.arrays = make_arrays(device)
         self.device = device
         scene_list = [scene] if isinstance(scene, scenes.Scene) else list(scene) if scene is not None else [_default_scene()]
@@ -199,7 +210,7 @@ class VectorPointNavEnv(VectorEnv):
     def _build_pool(self, fixed: Sequence[tuple[Any, float, Any, int]]) -> None:
         size = 0 if fixed else self.pool_size
         seeds = self._rng.integers(2**31, size=size * len(self.scenes))
-        self.pool = EpisodePool(self._samplers, size, seeds, self.arrays, fixed)
+        self.pool = EpisodePool(self._samplers, size, seeds, self.arrays, fixed, self.starts_per_goal)
 
     # ------------------------------------------------------------------ Gymnasium API
     def reset(self, *, seed: int | None = None, options: dict[str, Any] | None = None) -> tuple[Any, dict[str, Any]]:
@@ -243,7 +254,7 @@ class VectorPointNavEnv(VectorEnv):
         if self._fixed is not None:
             ep = self._fixed
         else:
-            k = a.asarray(self._rng.integers(self.pool_size, size=n), a.i64)
+            k = a.asarray(self._rng.integers(self.pool.pool_size, size=n), a.i64)
             ep = self._world_scene * self.pool.pool_size + k
         p = self.pool
         idx = a.nonzero(mask)
@@ -253,14 +264,14 @@ class VectorPointNavEnv(VectorEnv):
         st["z"][idx] = self.floors.height[self._world_scene[idx]]
         for key in ("vx", "vy", "vz", "w", "path"):
             st[key][idx] = 0.0
-        self._field[idx] = e
+        self._field[idx] = p.field[e]
         self._steps[idx] = 0
         self._collisions[idx] = 0
         d0 = st["d0"][idx]
         geo = self.geodesic_reward & (d0 < math.inf)
         self._geo_metric[idx] = geo
         x, y = st["x"][idx], st["y"][idx]
-        dist = p.fields.distance(e, x, y)
+        dist = p.fields.distance(p.field[e], x, y)
         st["dist"][idx] = dist
         l2 = xp.sqrt((st["gx"][idx] - x) ** 2 + (st["gy"][idx] - y) ** 2)
         st["pot"][idx] = xp.where(geo, xp.where(dist < math.inf, dist, d0), l2)
