@@ -119,3 +119,27 @@ def test_starts_per_goal_share_goals_with_exact_geodesics() -> None:
     low, high = env.task.path_range
     assert (pool.d0 > low).all() and (pool.d0 < high).all()
     assert len({(round(x, 9), round(y, 9)) for x, y in zip(pool.sx, pool.sy)}) == 10  # distinct starts
+
+
+@pytest.mark.parametrize("device", DEVICES)
+@pytest.mark.parametrize("stop", [True, False])
+def test_discrete_matches_single_envs_in_clutter(device: str, stop: bool) -> None:
+    from vector_reference import compare, random_episodes
+
+    from pointnav_core.maps import VOID
+
+    rng = np.random.default_rng(11)
+    grid = np.zeros((22, 28), np.uint8)
+    grid[rng.random(grid.shape) < 0.1] = OBSTACLE
+    grid[0, :] = grid[-1, :] = grid[:, 0] = grid[:, -1] = OBSTACLE
+    grid[10:13, 3:6] = VOID
+    scene = Scene.from_array(grid, 0.1)
+    episodes = random_episodes(scene, 6, rng)
+    episodes = [(s, yaw, s if k % 2 else g) for k, (s, yaw, g) in enumerate(episodes)]  # some goals at the start
+    n = 4 if stop else 3
+    p = np.array([0.55, 0.2, 0.2, 0.05][:n])
+    actions = rng.choice(n, size=(300, 6), p=p / p.sum())
+    stats = compare(scene, episodes, actions, device=device, action_space="discrete", discrete_actions={"stop": stop},
+                    task={"reward_type": "geodesic", "termination_config": {"max_steps": 40, "max_collisions": 20}})
+    # The case exercised what it claims: contacts, successes and autoresets.
+    assert stats["contacts"] > 0 and stats["successes"] > 0 and stats["autoresets"] > 0
