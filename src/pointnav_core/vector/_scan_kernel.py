@@ -1,0 +1,89 @@
+"""The compiled path of :func:`pointnav_core.vector.scan.cast_batch` (imports numba).
+
+Imported only when the compiled path runs, so the package imports without numba. One loop
+over worlds, robots and rays, inside the kernel; each ray is the single env's
+``grid_range`` (:mod:`pointnav_core.sensors._raycast_kernel`) on its world's grid, then
+the discs of the world's other present robots, with the same expressions as the array
+path.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numba
+import numpy as np
+
+from pointnav_core.sensors._raycast_kernel import grid_range
+from pointnav_core.sensors.raycast import TOUCH_EPS
+
+__all__ = ["cast_worlds"]
+
+_INF = math.inf
+
+
+@numba.njit(cache=True, nogil=True, error_model="numpy")
+def cast_worlds(scene, x, y, cyaw, syaw, ca, sa, present, radius, max_range, meta, lookup, clear, out):  # pragma: no cover
+    n_worlds, n_robots = x.shape
+    n_rays = ca.shape[0]
+    r2 = radius * radius
+    c = np.empty(n_rays)
+    s = np.empty(n_rays)
+    for w in range(n_worlds):
+        k = scene[w]
+        loff = int(meta[k, 0])
+        coff = int(meta[k, 1])
+        hp = int(meta[k, 2])
+        wp = int(meta[k, 3])
+        res = meta[k, 4]
+        ox = meta[k, 5]
+        oy = meta[k, 6]
+        inv = 1.0 / res
+        e = TOUCH_EPS * inv
+        reach = max_range * inv
+        n_cross = min(math.ceil(reach) + 1, max(hp, wp) + 1)
+        plane = hp * wp
+        look = lookup[loff : loff + 3 * plane]
+        clr = clear[coff : coff + plane]
+        for i in range(n_robots):
+            if not present[w, i]:
+                out[w, i, :] = max_range
+                continue
+            px = x[w, i]
+            py = y[w, i]
+            gx = (px - ox) * inv + 1.0
+            gy = (py - oy) * inv + 1.0
+            # An origin touching a blocked cell (or off the map) reads 0.
+            c0 = int(min(max(math.floor(gx - e), 0.0), wp - 1.0))
+            c1 = int(min(max(math.floor(gx + e), 0.0), wp - 1.0))
+            q0 = int(min(max(math.floor(gy - e), 0.0), hp - 1.0)) * wp
+            q1 = int(min(max(math.floor(gy + e), 0.0), hp - 1.0)) * wp
+            if look[q0 + c0] or look[q0 + c1] or look[q1 + c0] or look[q1 + c1]:
+                out[w, i, :] = 0.0
+                continue
+            for r in range(n_rays):  # the products of scan.directions, in its order
+                c[r] = cyaw[w, i] * ca[r] - syaw[w, i] * sa[r]
+                s[r] = syaw[w, i] * ca[r] + cyaw[w, i] * sa[r]
+            for r in range(n_rays):
+                dx = c[r]
+                dy = s[r]
+                best = min(grid_range(gx, gy, dx, dy, float(hp), float(wp), plane, look, clr, e, n_cross, reach) * res,
+                           max_range)
+                for m in range(n_robots):
+                    if m == i or not present[w, m]:
+                        continue
+                    fx = px - x[w, m]
+                    fy = py - y[w, m]
+                    b = fx * dx + fy * dy
+                    cc = fx * fx + fy * fy - r2
+                    if cc <= 0.0:
+                        t = 0.0
+                    else:
+                        disc = b * b - cc
+                        if disc >= 0.0 and b <= 0.0:
+                            denom = math.sqrt(max(disc, 0.0)) - b
+                            t = cc / denom if denom > 0.0 else _INF
+                        else:
+                            t = _INF
+                    best = min(best, t)
+                out[w, i, r] = best
