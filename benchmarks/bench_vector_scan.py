@@ -2,8 +2,8 @@
 
 The default house (``scenes.rooms(seed=0)`` as grid cells, 0.1 m cells), ``--worlds`` worlds
 of ``--robots`` robots at random usable poses, ``--rays`` rays over a full turn up to 5.6 m.
-In the same run, interleaved over ``--rounds`` rounds (the best round of each kept, since
-the machines are shared), on one thread:
+In the same run, interleaved over ``--rounds`` rounds (the best round of each kept, in
+process time, since the machines are shared), on one thread:
 
 - ``batched numba``: :func:`pointnav_core.vector.scan.cast_batch`, compiled path, every
   robot of every world in one call (each sees the other robots of its world);
@@ -15,9 +15,12 @@ the machines are shared), on one thread:
   call with their discs (what a multi-robot env's ``ScanShare`` runs), once per world.
 
 Every row is in microseconds per robot-scan; the last column is that row over
-``batched numba``.
+``batched numba``. With ``--engine``, also ``VectorPointNavEnv`` steps (numpy, geodesic
+reward, random actions, ``worlds x robots`` one-robot worlds) without and with a 32-ray
+scan, in microseconds of process time per agent-step (process time, not wall time: the
+machines are shared).
 
-Run: ``python benchmarks/bench_vector_scan.py [--worlds 1024] [--robots 4] [--rays 32] [--rounds 5]``
+Run: ``python benchmarks/bench_vector_scan.py [--worlds 1024] [--robots 4] [--rays 32] [--rounds 5] [--engine]``
 """
 
 from __future__ import annotations
@@ -44,6 +47,7 @@ def main() -> None:
     parser.add_argument("--robots", type=int, default=4)
     parser.add_argument("--rays", type=int, default=32)
     parser.add_argument("--rounds", type=int, default=5)
+    parser.add_argument("--engine", action="store_true", help="also time the engine's step without and with the scan")
     args = parser.parse_args()
     if not compiled_available():
         raise SystemExit('numba is not installed: pip install "pointnav-core[fast]"')
@@ -100,15 +104,39 @@ def main() -> None:
     best = dict.fromkeys(rows, np.inf)
     for k in range(args.rounds):
         for name, fn in rows.items():
-            t = time.perf_counter()
+            t = time.process_time()  # process time: the machines are shared
             fn()
-            best[name] = min(best[name], time.perf_counter() - t)
+            best[name] = min(best[name], time.process_time() - t)
     base = best["batched numba"]
     print(f"{w} worlds x {r} robots x {args.rays} rays, max_range {MAX_RANGE} m, default house as grid; "
-          f"best of {args.rounds} rounds, one thread")
+          f"best of {args.rounds} rounds, one thread, process time")
     print(f"{'':22s}{'us / robot-scan':>16s}{'x batched numba':>17s}")
     for name, sec in best.items():
         print(f"{name:22s}{sec / (w * r) * 1e6:16.3f}{sec / base:17.2f}")
+    if args.engine:
+        _engine(w * r, args.rays, args.rounds)
+
+
+def _engine(n: int, rays: int, rounds: int) -> None:
+    from pointnav_core.vector import VectorPointNavEnv
+
+    envs = {
+        label: VectorPointNavEnv(n, seed=0, pool_size=2, task={"reward_type": "geodesic"}, sensors=sensors)
+        for label, sensors in (("engine, no scan", None), (f"engine, {rays}-ray scan", {"scan": {"n_rays": rays}}))
+    }
+    actions = np.random.default_rng(0).uniform(-1.0, 1.0, (20, n, 2))
+    for env in envs.values():
+        env.reset(seed=0)
+    best = dict.fromkeys(envs, np.inf)
+    for _ in range(rounds):
+        for label, env in envs.items():
+            start = time.process_time()
+            for act in actions:
+                env.step(act)
+            best[label] = min(best[label], (time.process_time() - start) / len(actions))
+    print(f"{n} one-robot worlds, numpy, 20 steps a round, best of {rounds}, process time")
+    for label, sec in best.items():
+        print(f"{label:22s}{sec / n * 1e6:10.3f} us / agent-step{n / sec:14,.0f} agent-steps/s")
 
 
 if __name__ == "__main__":
