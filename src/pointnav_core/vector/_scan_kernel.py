@@ -70,9 +70,9 @@ def walk(gx, gy, dx, dy, hp, wp, look, clr, e, n_cross, reach):  # pragma: no co
                 # Jump each family to its first crossing at or after target (about: the
                 # margin keeps a rounding either way inside the free square).
                 if t0x < target:
-                    kx = max(kx, int(math.ceil((target - t0x) * adx)))
+                    kx = max(kx, math.ceil((target - t0x) * adx))
                 if t0y < target:
-                    ky = max(ky, int(math.ceil((target - t0y) * ady)))
+                    ky = max(ky, math.ceil((target - t0y) * ady))
         fkx = float(kx)
         fky = float(ky)
         tx = t0x + fkx * dtx if kx < n_cross else _INF

@@ -2,8 +2,9 @@
 
 Every world is a :class:`~pointnav_core.env.PointNavEnv` with one robot on the kinematic
 backend, and the batched step reproduces them (drive, contacts and sliding, the task's
-rewards, terminations, SPL and SoftSPL, the flat ``low_dim`` observation) with array
-operations over all worlds at once: there is no Python loop over worlds on the step path.
+rewards, terminations, SPL and SoftSPL, the flat ``low_dim`` observation and the range
+scan) with array operations over all worlds at once: there is no Python loop over worlds
+on the step path.
 The same code runs on numpy (``device="numpy"``) and on torch (``"cpu"``, ``"cuda"``).
 """
 
@@ -94,7 +95,8 @@ class VectorPointNavEnv(VectorEnv):
     Notes
     -----
     ``step`` takes actions of shape ``(num_envs, 2)`` (or ``(num_envs, 1, 2)``) in
-    ``[-1, 1]`` (clipped) and returns observations ``(num_envs, 8)`` float32, rewards
+    ``[-1, 1]`` (clipped) and returns observations ``(num_envs, 8)`` float32 (``8 + n_rays``
+    with the scan), rewards
     float64, terminated and truncated bool, and ``info``, a dict of arrays of shape
     ``(num_envs,)``: ``success``, ``spl``, ``soft_spl``, ``path_length``,
     ``geodesic_dist``, ``distance_to_goal``, ``collisions``, ``episode_length``,
