@@ -96,15 +96,16 @@ def _check_scenes(scenes, x, y, yaw, present, scene, radius, angles, max_range):
 def test_paths_agree_with_each_other_and_shapely(seed, n_worlds, n_robots, ratio, res, n_rays, max_range) -> None:
     rng = np.random.default_rng(seed)
     scenes = []
-    for _ in range(2):
+    for cell in (res, float(rng.choice([0.05, 0.1, 0.25]))):  # worlds on floors of different cell sizes
         rows, cols = rng.integers(4, 30, 2)
-        scenes.append(Scene.from_array(_grid(rng, rows, cols, rng.uniform(0.0, 0.3)), res, origin=tuple(rng.uniform(-2, 2, 2))))
+        scenes.append(Scene.from_array(_grid(rng, rows, cols, rng.uniform(0.0, 0.3)), cell, origin=tuple(rng.uniform(-2, 2, 2))))
     scene = rng.integers(0, 2, n_worlds)
     x = np.empty((n_worlds, n_robots))
     y = np.empty((n_worlds, n_robots))
     for w in range(n_worlds):
         tmap = scenes[scene[w]].floors[0]
         h, wd = np.asarray(tmap.codes).shape
+        res = float(tmap.resolution)
         # Anywhere on the map, obstacles and VOID included; some on grid lines.
         x[w] = tmap.origin[0] + rng.uniform(0, wd, n_robots) * res
         y[w] = tmap.origin[1] + rng.uniform(0, h, n_robots) * res
@@ -113,7 +114,7 @@ def test_paths_agree_with_each_other_and_shapely(seed, n_worlds, n_robots, ratio
     yaw = rng.uniform(-2 * np.pi, 2 * np.pi, (n_worlds, n_robots))
     present = rng.random((n_worlds, n_robots)) < 0.8
     angles = scan_angles(n_rays, rng.uniform(0.5, 2 * np.pi))
-    _check_scenes(scenes, x, y, yaw, present, scene, ratio * res, angles, max_range)
+    _check_scenes(scenes, x, y, yaw, present, scene, ratio * float(scenes[0].floors[0].resolution), angles, max_range)
 
 
 @settings(max_examples=3, deadline=None, suppress_health_check=[HealthCheck.too_slow])
