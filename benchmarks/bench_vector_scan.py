@@ -82,14 +82,17 @@ def main() -> None:
         ttables = ScanTables([scene], 0, make_arrays("cpu"))
         tx, ty, tyaw, tp, ts = (torch.as_tensor(v) for v in (x, y, yaw, present, world_scene))
         rows["batched torch"] = lambda: cast_batch(ttables, ts, tx, ty, tyaw, tp, 0.18, angles, MAX_RANGE)
-    origin = np.zeros((1, 2))
-    rays = (np.zeros((1, args.rays)), np.zeros((1, args.rays)), np.zeros((1, args.rays)))
+    origin, one_yaw, heading = np.zeros((1, 2)), np.zeros(1), np.zeros(2)
+    directions = (np.cos(angles), np.sin(angles))
 
-    def single_one() -> None:
+    def single_one() -> None:  # RangeScan's own steps for one robot
         for i in range(w):
             for j in range(r):
                 origin[0, 0], origin[0, 1] = x[i, j], y[i, j]
-                cast_pose_compiled(geo, origin, float(yaw[i, j]), angles, MAX_RANGE, rays)
+                one_yaw[0] = yaw[i, j]
+                np.cos(one_yaw, out=heading[:1])
+                np.sin(one_yaw, out=heading[1:])
+                cast_pose_compiled(geo, origin, heading, directions, MAX_RANGE)
 
     def single_world() -> None:
         for i in range(w):
