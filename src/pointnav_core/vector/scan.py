@@ -37,7 +37,7 @@ from pointnav_core.sensors.raycast import TOUCH_EPS, ScanGeometry
 from pointnav_core.sensors.scan import RangeScan
 from pointnav_core.vector.xp import Arrays
 
-__all__ = ["BLOCK", "ScanTables", "VectorScan", "cast_batch", "compiled_available"]
+__all__ = ["BLOCK", "ScanTables", "VectorScan", "cast_batch", "compiled_available", "directions"]
 
 #: Crossings per family taken together by one iteration of the array path.
 BLOCK = 8
@@ -146,6 +146,22 @@ def cast_batch(
     -------
     float64 array, shape (W, R, n)
         In ``[0, max_range]``; ``max_range`` for absent robots.
+
+    Examples
+    --------
+    Two robots 0.1 m apart (radius 0.02 m) before a wall from x = 0.5 m to 0.6 m, looking
+    ahead and back:
+
+    >>> from pointnav_core.scenes import Scene
+    >>> from pointnav_core.vector.xp import make_arrays
+    >>> grid = np.zeros((5, 8), np.uint8)
+    >>> grid[:, 5] = 1
+    >>> tables = ScanTables([Scene.from_array(grid, 0.1)], 0, make_arrays("numpy"))
+    >>> x, y, yaw = np.array([[0.25, 0.15]]), np.full((1, 2), 0.25), np.zeros((1, 2))
+    >>> d = cast_batch(tables, np.zeros(1, np.int64), x, y, yaw, np.ones((1, 2), bool), 0.02,
+    ...                np.array([0.0, np.pi]), 2.0)
+    >>> d.round(9).tolist()  # the wall and the other robot; the other robot and the map's edge
+    [[[0.25, 0.08], [0.08, 0.15]]]
     """
     if method not in _METHODS:
         raise ValueError(f"method must be one of {', '.join(map(repr, _METHODS))}, got {method!r}")
