@@ -95,9 +95,9 @@ class VectorPointNavEnv(VectorEnv):
     Notes
     -----
     ``step`` takes actions of shape ``(num_envs, 2)`` (or ``(num_envs, 1, 2)``) in
-    ``[-1, 1]`` (clipped) and returns observations ``(num_envs, 8)`` float32 (``8 + n_rays``
-    with the scan), rewards
-    float64, terminated and truncated bool, and ``info``, a dict of arrays of shape
+    ``[-1, 1]`` (clipped) and returns observations ``(num_envs, 8)`` float32
+    (``(num_envs, 8 + n_rays)`` with the scan), rewards float64, terminated and truncated
+    bool, and ``info``, a dict of arrays of shape
     ``(num_envs,)``: ``success``, ``spl``, ``soft_spl``, ``path_length``,
     ``geodesic_dist``, ``distance_to_goal``, ``collisions``, ``episode_length``,
     ``in_contact``, ``reward_potential``, ``reward_collision``, ``reward_pointgoal`` and
