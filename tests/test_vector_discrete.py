@@ -122,8 +122,8 @@ def test_starts_per_goal_share_goals_with_exact_geodesics() -> None:
 
 
 @pytest.mark.parametrize("device", DEVICES)
-@pytest.mark.parametrize("stop", [True, False])
-def test_discrete_matches_single_envs_in_clutter(device: str, stop: bool) -> None:
+@pytest.mark.parametrize(("stop", "sensors"), [(True, None), (False, None), (False, {"scan": {"n_rays": 16}})])
+def test_discrete_matches_single_envs_in_clutter(device: str, stop: bool, sensors: dict | None) -> None:
     from vector_reference import compare, random_episodes
 
     from pointnav_core.maps import VOID
@@ -139,7 +139,8 @@ def test_discrete_matches_single_envs_in_clutter(device: str, stop: bool) -> Non
     n = 4 if stop else 3
     p = np.array([0.55, 0.2, 0.2, 0.05][:n])
     actions = rng.choice(n, size=(300, 6), p=p / p.sum())
-    stats = compare(scene, episodes, actions, device=device, action_space="discrete", discrete_actions={"stop": stop},
+    stats = compare(scene, episodes, actions, device=device, sensors=sensors, action_space="discrete",
+                    discrete_actions={"stop": stop},
                     task={"reward_type": "geodesic", "termination_config": {"max_steps": 40, "max_collisions": 20}})
     # The case exercised what it claims: contacts, successes and autoresets.
     assert stats["contacts"] > 0 and stats["successes"] > 0 and stats["autoresets"] > 0

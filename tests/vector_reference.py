@@ -27,22 +27,24 @@ def compare(
     actions: np.ndarray,
     task: dict | None = None,
     device: str = "numpy",
+    sensors: dict | None = None,
     **env_kwargs: Any,
 ) -> dict[str, Any]:
     """Step both for ``len(actions)`` steps; return counts of what happened (ends, contacts)
     and the largest observation and reward differences seen.
 
     ``episodes`` holds one ``(start_xy, yaw, goal_xy)`` per world; ``actions`` has shape
-    ``(steps, num_envs, 2)``, or ``(steps, num_envs)`` for discrete actions.
-    ``env_kwargs`` (``action_space``, ``discrete_actions``) go to both engines.
+    ``(steps, num_envs, 2)``, or ``(steps, num_envs)`` for discrete actions; ``sensors``
+    and ``env_kwargs`` (``action_space``, ``discrete_actions``) go to both engines.
     """
     task = dict(task or {})
     n = len(episodes)
-    venv = VectorPointNavEnv(n, scene=scene, task=task, device=device, seed=0, **env_kwargs)
+    venv = VectorPointNavEnv(n, scene=scene, task=task, device=device, seed=0, sensors=sensors, **env_kwargs)
     singles = [
         PointNavEnv(
             scene=scene,
             flatten_obs=True,
+            sensors=sensors,
             **env_kwargs,
             task=dict(
                 task,
