@@ -17,6 +17,28 @@ engine's episode pools (their goal fields settled), the rollouts, the updates an
 learning-curve evaluations (as bench_learning.py counts its own); the final held-out
 evaluation is not counted, as there.
 
+Measured on the same kind of machine as bench_learning.py's figures (2 x86_64 CPUs shared
+with other jobs, python 3.11.7, torch 1 thread), seed 0, 400 worlds, numpy engine::
+
+    cd benchmarks && nice -n 5 python bench_learning_vector.py --sensors scan --steps 4000000 --time-limit 2000 --curve-every 250000
+    cd benchmarks && nice -n 5 python bench_learning_vector.py --sensors blind --steps 1500000 --time-limit 2000
+
+======================  =======  =====  =======  =========  =======  ======  =======
+policy                  success  SPL    SoftSPL  steps      steps/s  wall s  pools s
+======================  =======  =====  =======  =========  =======  ======  =======
+scan, batched + PPO     0.965    0.892  0.799    3 993 600  3 064    1 303   400
+blind, batched + PPO    0.415    0.407  0.468    1 497 600  1 306    1 146   867
+scan, SB3 (reference)   0.835    0.730  0.688    491 904    246      2 000
+blind, SB3 (reference)  0.360    0.357  0.443    600 064    858      699
+======================  =======  =====  =======  =========  =======  ======  =======
+
+The scan policy's curve (60 other held-out episodes, wall s from the start, pools
+included): 256k 0.68 (482 s), 512k 0.87 (537 s), 1.0M 0.93 (615 s), 1.5M 0.95 (696 s),
+2.5M 0.97 (957 s), 3.75M 0.93 (1262 s). steps/s is over the whole wall time (pools
+included); the training alone ran 4,500-5,700 steps/s. The pools took 400 s in the scan
+run and 867 s in the blind one: the machine's load differed (other jobs, and this
+project's tests beside the blind run), so wall times here move by about 2 x between runs.
+
 Run::
 
     cd benchmarks && nice -n 5 python bench_learning_vector.py --time-limit 2000
