@@ -102,6 +102,19 @@ class VectorPointNavEnv(VectorEnv):
 
     metadata = {"autoreset_mode": AutoresetMode.NEXT_STEP, "render_modes": []}
 
+    def __new__(cls, *args: Any, **kwargs: Any) -> VectorPointNavEnv:
+        # Several robots per world are their own engine (vector.fleet_env), built from here.
+        if cls is VectorPointNavEnv:
+            n_robots = kwargs.get("n_robots", args[1] if len(args) > 1 else 1)
+            if isinstance(n_robots, (int, np.integer)) and not isinstance(n_robots, bool) and n_robots > 1:
+                from pointnav_core.vector.fleet_env import VectorFleetEnv
+
+                return super().__new__(VectorFleetEnv)
+            for name in ("max_cycles", "finished"):
+                if name in kwargs:
+                    raise ValueError(f"{name} applies to several robots per world (n_robots > 1), got n_robots={n_robots!r}")
+        return super().__new__(cls)
+
     def __init__(
         self,
         num_envs: int = 1,
@@ -119,8 +132,8 @@ class VectorPointNavEnv(VectorEnv):
         from pointnav_core.env import PointNavEnv
 
         self.num_envs = validation.integer("num_envs", num_envs, minimum=1)
-        if validation.integer("n_robots", n_robots, minimum=1) != 1:
-            raise ValueError(f"n_robots must be 1: the batched engine has one robot per world so far, got {n_robots}")
+        if validation.integer("n_robots", n_robots, minimum=1) != 1:  # several: built by __new__
+            raise ValueError(f"n_robots must be 1 here, got {n_robots}: VectorPointNavEnv builds the multi-robot engine")
         if sensors is not None:
             raise ValueError(f"sensors must be None: the batched engine has no sensors yet, got {sensors!r}")
         if task is not None and not isinstance(task, Mapping):
