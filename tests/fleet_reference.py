@@ -118,17 +118,18 @@ def fleet_episodes(
 ) -> list[list[tuple[Any, float, Any]]]:
     """Random fixed episodes: starts where the robot fits, at least two radii apart; goals
     at least ``goal_gap`` m apart (the multi-robot env's separation for the task used)."""
+    def apart(gap: float) -> list[Any]:
+        points: list[Any] = []
+        for _ in range(10_000):  # rejection sampling; a scene with room for the robots ends early
+            _, p = scene.get_random_point(0, robot=radius, rng=rng)
+            if all(math.dist(p[:2], q) >= gap for q in points):
+                points.append(p[:2])
+                if len(points) == n_robots:
+                    return points
+        raise AssertionError(f"no room for {n_robots} robots {gap} m apart")
+
     worlds = []
     for _ in range(n_worlds):
-        starts: list[Any] = []
-        goals: list[Any] = []
-        while len(starts) < n_robots:
-            _, p = scene.get_random_point(0, robot=radius, rng=rng)
-            if all(math.dist(p[:2], q) >= 2 * radius for q in starts):
-                starts.append(p[:2])
-        while len(goals) < n_robots:
-            _, g = scene.get_random_point(0, robot=radius, rng=rng)
-            if all(math.dist(g[:2], q) >= goal_gap for q in goals):
-                goals.append(g[:2])
+        starts, goals = apart(2 * radius), apart(goal_gap)
         worlds.append([(s, float(rng.uniform(-math.pi, math.pi)), g) for s, g in zip(starts, goals)])
     return worlds
