@@ -61,7 +61,8 @@ def compare_fleet(
     for i, env in enumerate(refs):
         obs, _ = env.reset(seed=0)
         sobs[i] = [obs[a] for a in agents]
-    stats = {"ends": 0, "successes": 0, "contacts": 0, "autoresets": 0, "robot_contacts": 0, "parked_steps": 0}
+    stats = {"ends": 0, "successes": 0, "contacts": 0, "autoresets": 0, "robot_contacts": 0, "parked_steps": 0,
+             "falls": 0}
     assert to_np(vinfo["active"]).all()
     for t, act in enumerate(actions):
         np.testing.assert_allclose(to_np(vobs), sobs, rtol=0, atol=OBS_TOL, err_msg=f"observations before step {t}")
@@ -100,6 +101,7 @@ def compare_fleet(
                 stats["successes"] += info[a]["success"]
                 stats["contacts"] += bool(vinfo["in_contact"][i, k])
                 stats["robot_contacts"] += bool(vinfo["in_contact"][i, k]) and _touches_robot(env, k)
+                stats["falls"] += bool(term[a]) and env.backend.get_pose(k)[0][2] < env.tasks[k].floor_height
     return stats
 
 

@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 from fleet_reference import compare_fleet, fleet_episodes
 
-from pointnav_core.maps import OBSTACLE
+from pointnav_core.maps import OBSTACLE, VOID
 from pointnav_core.scenes import Scene
 from pointnav_core.vector import VectorPointNavEnv
 
@@ -107,11 +107,13 @@ def test_a_removed_robot_lets_the_others_pass(device: str) -> None:
 
 @pytest.mark.parametrize("device", DEVICES)
 def test_crowded_worlds_match_parallel_envs(device: str) -> None:
-    # A 1.6 m room, four robots each: they meet each other and the parked ones often.
+    # A 1.6 x 2 m room, four robots each: they meet each other and the parked ones often;
+    # a hole at one end takes robots that drive into it out of the world.
     rng = np.random.default_rng(1)
-    grid = np.zeros((16, 16), np.uint8)
+    grid = np.zeros((20, 16), np.uint8)
     grid[0, :] = grid[-1, :] = grid[:, 0] = grid[:, -1] = OBSTACLE
     grid[5, 5] = OBSTACLE
+    grid[16:19, 1:15] = VOID
     scene = Scene.from_array(grid, 0.1)
     actions = rng.uniform(-1.2, 1.2, (150, 4, 4, 2)).astype(np.float32)
     actions[rng.random((150, 4, 4)) < 0.5, 0] = 1.0
@@ -121,7 +123,7 @@ def test_crowded_worlds_match_parallel_envs(device: str) -> None:
                               finished=finished, max_cycles=45)
         # The run exercised what it claims to: robot contacts, parked robots, ends, autoresets.
         assert stats["robot_contacts"] > 10 and stats["parked_steps"] > 100
-        assert stats["successes"] > 0 and stats["autoresets"] > 0
+        assert stats["successes"] > 0 and stats["autoresets"] > 0 and stats["falls"] > 0
 
 
 @pytest.mark.parametrize("device", DEVICES)

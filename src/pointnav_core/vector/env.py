@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Mapping, Sequence
-from typing import Any
+from typing import Any, Self
 
 import gymnasium as gym
 import numpy as np
@@ -126,7 +126,7 @@ class VectorPointNavEnv(VectorEnv):
 
     metadata = {"autoreset_mode": AutoresetMode.NEXT_STEP, "render_modes": []}
 
-    def __new__(cls, *args: Any, **kwargs: Any) -> VectorPointNavEnv:
+    def __new__(cls, *args: Any, **kwargs: Any) -> Self:
         # Several robots per world are their own engine (vector.fleet_env), built from here.
         if cls is VectorPointNavEnv:
             n_robots = kwargs.get("n_robots", args[1] if len(args) > 1 else 1)

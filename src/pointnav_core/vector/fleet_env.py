@@ -18,7 +18,14 @@ import gymnasium as gym
 import numpy as np
 
 from pointnav_core import _envcommon, scenes, validation
-from pointnav_core.vector.env import _FALL_SPEED, _GRAVITY, _MAX_TURN, _MIN_FIRST_DROP, VectorPointNavEnv, _default_scene
+from pointnav_core.vector.env import (
+    _FALL_SPEED,
+    _GRAVITY,
+    _MAX_TURN,
+    _MIN_FIRST_DROP,
+    VectorPointNavEnv,
+    _default_scene,
+)
 from pointnav_core.vector.fleet_pool import FleetPool, check_fixed_episode
 from pointnav_core.vector.floors import FloorTables
 from pointnav_core.vector.robots import advance_robots, robot_walls
