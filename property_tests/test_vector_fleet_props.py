@@ -67,3 +67,36 @@ def test_fleet_matches_parallel_envs(
     task = {"reward_type": reward_type, "goal_tolerance": 0.2,
             "termination_config": {"max_steps": max_steps, "max_collisions": 15}}
     compare_fleet(scene, episodes, actions, task=task, device=device, finished=finished, max_cycles=max_cycles)
+
+
+@pytest.mark.parametrize("device", DEVICES)
+@settings(max_examples=30, deadline=None)
+@given(scene=crowded_scenes(), seed=st.integers(0, 2**31 - 1), n_robots=st.integers(1, 4))
+def test_one_slow_robot_resolves_as_in_the_multi_robot_resolver(device: str, scene: Scene, seed: int, n_robots: int) -> None:
+    """The env's shortcut for a world with one slow robot (the one-robot resolver) equals
+    the multi-robot resolver with that robot the only one present."""
+    from pointnav_core.vector.contacts import advance
+    from pointnav_core.vector.floors import FloorTables
+    from pointnav_core.vector.robots import advance_robots, robot_walls
+    from pointnav_core.vector.xp import make_arrays
+
+    rng = np.random.default_rng(seed)
+    a, radius, travel, worlds = make_arrays(device), 0.18, 0.05, 32
+    floors = FloorTables([scene], 0, radius, a)
+    xy = np.array([scene.get_random_point(0, robot=radius, rng=rng)[1][:2] for _ in range(worlds * n_robots)])
+    x, y = xy[:, 0].reshape(worlds, n_robots), xy[:, 1].reshape(worlds, n_robots)
+    heading = rng.uniform(-np.pi, np.pi, (worlds, n_robots))
+    length = rng.uniform(0.0, travel, (worlds, n_robots))
+    mx, my = length * np.cos(heading), length * np.sin(heading)
+    mover = rng.integers(n_robots, size=worlds)
+    present = np.arange(n_robots)[None, :] == mover[:, None]
+    args = [a.asarray(v) for v in (x, y, mx, my)]
+    scene_ids = a.zeros((worlds, n_robots), a.i64)
+    walls = robot_walls(floors, scene_ids, *args, radius, travel)
+    got = [a.numpy(v) for v in advance_robots(a, *args, radius, present=a.asarray(present, a.boolean), walls=walls)]
+    rows = np.arange(worlds)
+    one = [a.asarray(v[rows, mover]) for v in (x, y, mx, my)]
+    want = [a.numpy(v) for v in advance(floors, a.zeros(worlds, a.i64), *one, radius, travel)]
+    np.testing.assert_allclose(got[0][rows, mover], want[0], rtol=0, atol=1e-12)
+    np.testing.assert_allclose(got[1][rows, mover], want[1], rtol=0, atol=1e-12)
+    np.testing.assert_array_equal(got[2][rows, mover], want[2])

@@ -3,8 +3,9 @@
 Every world is a :class:`~pointnav_core.parallel.MultiPointNavEnv` with ``R`` robots on
 the kinematic backend (``finished="park"`` by default, or ``"remove"``), stepped as
 ``(num_envs, n_robots)`` arrays: robots that could meet a wall or each other are resolved
-together by :func:`~pointnav_core.vector.robots.advance_robots` on one clock per world,
-the others move by their arc (the backend's fast path). Each robot's task accounting is
+together by :func:`~pointnav_core.vector.robots.advance_robots` on one clock per world
+(by the one-robot :func:`~pointnav_core.vector.contacts.advance` where a world has only
+one such robot), the others move by their arc (the backend's fast path). Each robot's task accounting is
 the one-robot engine's, masked by the robots still active (PettingZoo's ``agents``).
 """
 
@@ -18,6 +19,7 @@ import gymnasium as gym
 import numpy as np
 
 from pointnav_core import _envcommon, scenes, validation
+from pointnav_core.vector.contacts import advance
 from pointnav_core.vector.env import (
     _FALL_SPEED,
     _GRAVITY,
@@ -268,7 +270,15 @@ class VectorFleetEnv(VectorPointNavEnv):
         x, y, yaw = x0 + xp.where(fast, dx, zero), y0 + xp.where(fast, dy, zero), yaw0 + w * dt
         contact = zero > 1.0
         z, vz = st["z"], zero + 0.0
-        busy = a.nonzero(slow.any(-1))
+        n_slow = slow.sum(-1)
+        # A world with one slow robot is the one-robot resolver's case (the backend's
+        # advance with a single robot): cheaper, and most busy worlds are such.
+        alone = a.nonzero((slow & (n_slow == 1)[:, None]).reshape(-1))
+        if alone.shape[0]:
+            flat = [v.reshape(-1)[alone] for v in (scene, x0, y0, dx, dy)]
+            nx, ny, c = advance(self.floors, *flat, radius, self._max_travel)
+            x.reshape(-1)[alone], y.reshape(-1)[alone], contact.reshape(-1)[alone] = nx, ny, c
+        busy = a.nonzero(n_slow > 1)
         if busy.shape[0]:
             bx, by, bdx, bdy = x0[busy], y0[busy], dx[busy], dy[busy]
             walls = robot_walls(self.floors, scene[busy], bx, by, bdx, bdy, radius, self._max_travel)
