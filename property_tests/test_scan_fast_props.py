@@ -51,8 +51,10 @@ def test_small_scenes_give_equal_ranges(case):
 def test_the_scans_one_pose_path_gives_equal_ranges(case):
     tmap, _, origin, yaw, angles, max_range, _ = case
     geo = ScanGeometry(tmap)
-    rays = tuple(np.full((1, len(angles)), np.nan) for _ in range(3))  # overwritten
-    got = cast_pose_compiled(geo, np.array([origin], dtype=np.float64), yaw, angles, max_range, rays)
+    yaws = np.array([yaw], dtype=np.float64)
+    heading = np.concatenate([np.cos(yaws), np.sin(yaws)])
+    directions = (np.cos(np.asarray(angles, dtype=np.float64)), np.sin(np.asarray(angles, dtype=np.float64)))
+    got = cast_pose_compiled(geo, np.array([origin], dtype=np.float64), heading, directions, max_range)
     np.testing.assert_array_equal(got, cast_rays(geo, [origin], [yaw], angles, max_range, method="numpy")[0])
 
 

@@ -22,21 +22,23 @@ INFO_KEYS = ("success", "spl", "soft_spl", "collisions", "episode_length", "path
 
 
 def compare(
-    scene: Any, episodes: list[tuple[Any, float, Any]], actions: np.ndarray, task: dict | None = None, device: str = "numpy"
+    scene: Any, episodes: list[tuple[Any, float, Any]], actions: np.ndarray, task: dict | None = None, device: str = "numpy",
+    sensors: dict | None = None,
 ) -> dict[str, Any]:
     """Step both for ``len(actions)`` steps; return counts of what happened (ends, contacts)
     and the largest observation and reward differences seen.
 
     ``episodes`` holds one ``(start_xy, yaw, goal_xy)`` per world; ``actions`` has shape
-    ``(steps, num_envs, 2)``.
+    ``(steps, num_envs, 2)``; ``sensors`` goes to both.
     """
     task = dict(task or {})
     n = len(episodes)
-    venv = VectorPointNavEnv(n, scene=scene, task=task, device=device, seed=0)
+    venv = VectorPointNavEnv(n, scene=scene, task=task, device=device, seed=0, sensors=sensors)
     singles = [
         PointNavEnv(
             scene=scene,
             flatten_obs=True,
+            sensors=sensors,
             task=dict(
                 task,
                 initial_pos=[float(s[0]), float(s[1])],

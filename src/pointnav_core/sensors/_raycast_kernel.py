@@ -26,7 +26,11 @@ _INF = math.inf
 _SPAN_MIN_DIST = 1e-4
 _SPAN_MIN_END = 1e-2
 _SPAN_MARGIN = 1e-3
-_TWO_PI = 2.0 * math.pi
+_SPAN_MIN_DIST2 = _SPAN_MIN_DIST * _SPAN_MIN_DIST
+_SPAN_MIN_END2 = _SPAN_MIN_END * _SPAN_MIN_END
+# An edge whose nearest point is farther than this (m) beyond every ray's range so far is
+# skipped: it lies beyond all of them (the margin covers rounding and TOUCH_EPS).
+_CULL_MARGIN = 1e-6
 
 
 @_jit
@@ -108,7 +112,15 @@ def grid_range(gx, gy, dx, dy, fhp, fwp, plane, lookup, clear, e, n_cross, reach
             t = ty
 
 @_jit
-def cast(p, bearing, c, s, params, lookup, clear, near_polygon, edges, discs, own, out):  # pragma: no cover
+def pseudo_angle(y, x):  # pragma: no cover
+    # A monotone stand-in for atan2(y, x), in (-2, 2] (the "diamond angle"), without atan2.
+    # Its slope is 1/2 to 1 per rad, so a margin of m rad is covered by a margin of m, and
+    # half a turn is 2 (spans of less than half a turn stay below 2).
+    q = x / (abs(x) + abs(y))
+    return 1.0 - q if y >= 0.0 else q - 1.0
+
+@_jit
+def cast(p, cy, sy, ca, sa, params, lookup, clear, near_polygon, edges, discs, own, out):  # pragma: no cover
     res = params[0]
     ox = params[1]
     oy = params[2]
@@ -124,8 +136,10 @@ def cast(p, bearing, c, s, params, lookup, clear, near_polygon, edges, discs, ow
     fwp = float(wp)
     n_edges = edges.shape[0]
     n_discs = discs.shape[0]
-    n_rays = c.shape[1]
+    n_rays = ca.shape[0]
     phi = np.empty(n_rays)
+    c = np.empty(n_rays)
+    s = np.empty(n_rays)
     n_near = 0
     for i in range(p.shape[0]):
         px = p[i, 0]
@@ -145,10 +159,13 @@ def cast(p, bearing, c, s, params, lookup, clear, near_polygon, edges, discs, ow
         if lookup[r0 + c0] or lookup[r0 + c1] or lookup[r1 + c0] or lookup[r1 + c1]:
             out[i, :] = 0.0  # nothing is nearer; the rest are ranges >= 0
             continue
+        for r in range(n_rays):  # the rays' directions: raycast.cast_rays' products
+            c[r] = cy[i] * ca[r] - sy[i] * sa[r]
+            s[r] = sy[i] * ca[r] + cy[i] * sa[r]
         # The grid and the discs, ray by ray.
         for r in range(n_rays):
-            dx = c[i, r]
-            dy = s[i, r]
+            dx = c[r]
+            dy = s[r]
             best = min(grid_range(gx, gy, dx, dy, fhp, fwp, plane, lookup, clear, e, n_cross, reach) * res,
                        max_range)
             for m in range(n_discs):
@@ -171,8 +188,11 @@ def cast(p, bearing, c, s, params, lookup, clear, near_polygon, edges, discs, ow
             out[i, r] = best
         if n_edges == 0:
             continue
-        for r in range(n_rays):  # bearings in [-pi, pi], as atan2 gives the edges' ends
-            phi[r] = bearing[i, r] - _TWO_PI * math.floor(bearing[i, r] / _TWO_PI + 0.5)
+        far = 0.0
+        for r in range(n_rays):  # the rays' directions, as pseudo_angle gives the edges' ends
+            phi[r] = pseudo_angle(s[r], c[r])
+            far = max(far, out[i, r])
+        far += _CULL_MARGIN
         order = np.argsort(phi)
         sphi = phi[order]
         # The polygon edges, each against the rays in its angular span only.
@@ -187,21 +207,30 @@ def cast(p, bearing, c, s, params, lookup, clear, near_polygon, edges, discs, ow
             num0 = ey * fx - ex * fy
             if num0 > 0.0:  # seen from its back (the material's side)
                 continue
+            # The edge's nearest point beyond every ray's range so far: no ray reaches it.
+            ee = ex * ex + ey * ey
+            tt = min(max(-(fx * ex + fy * ey) / ee, 0.0), 1.0) if ee > 0.0 else 0.0
+            nx = fx + tt * ex
+            ny = fy + tt * ey
+            if nx * nx + ny * ny > far * far:
+                continue
             full = True
             lo = hi = 0.0
-            elen = math.hypot(ex, ey)
-            if (-num0 >= _SPAN_MIN_DIST * elen and math.hypot(fx, fy) >= _SPAN_MIN_END
-                    and math.hypot(fx + ex, fy + ey) >= _SPAN_MIN_END):
+            gx2 = fx + ex
+            gy2 = fy + ey
+            # (Squared distances: no square roots.)
+            if (num0 * num0 >= _SPAN_MIN_DIST2 * ee and fx * fx + fy * fy >= _SPAN_MIN_END2
+                    and gx2 * gx2 + gy2 * gy2 >= _SPAN_MIN_END2):
                 # Far enough from the edge's line and ends: a ray more than _SPAN_MARGIN
                 # outside the directions of its ends misses it by far more than
                 # rounding and TOUCH_EPS, so only the rays between them are tested.
-                pa = math.atan2(fy, fx)
-                pb = math.atan2(fy + ey, fx + ex)
+                pa = pseudo_angle(fy, fx)
+                pb = pseudo_angle(gy2, gx2)
                 width = pb - pa
-                if width > math.pi:
-                    width -= 2.0 * math.pi
-                elif width < -math.pi:
-                    width += 2.0 * math.pi
+                if width > 2.0:
+                    width -= 4.0
+                elif width < -2.0:
+                    width += 4.0
                 lo = min(pa, pa + width) - _SPAN_MARGIN
                 hi = max(pa, pa + width) + _SPAN_MARGIN
                 full = False
@@ -212,17 +241,17 @@ def cast(p, bearing, c, s, params, lookup, clear, near_polygon, edges, discs, ow
                     k0 = 0
                     k1 = n_rays
                 else:
-                    a = lo + (wrap - 1) * 2.0 * math.pi
-                    b = hi + (wrap - 1) * 2.0 * math.pi
-                    if b < -math.pi or a > math.pi:
+                    a = lo + (wrap - 1) * 4.0
+                    b = hi + (wrap - 1) * 4.0
+                    if b < -2.0 or a > 2.0:
                         continue
                     k0 = np.searchsorted(sphi, a)
                     k1 = np.searchsorted(sphi, b, side="right")
                 for k in range(k0, k1):
                     r = order[k]
                     best = out[i, r]
-                    dx = c[i, r]
-                    dy = s[i, r]
+                    dx = c[r]
+                    dy = s[r]
                     cross = dx * ey - dy * ex
                     num = fx * ey - fy * ex
                     # Without dividing: t = num / cross surely negative (opposite signs,

@@ -235,9 +235,10 @@ def cast_rays(
     p = np.asarray(origins, dtype=np.float64).reshape(-1, 2)
     yaw = np.asarray(yaws, dtype=np.float64).reshape(-1)
     ang = np.asarray(angles, dtype=np.float64).reshape(-1)
-    bearing = yaw[:, None] + ang[None, :]
-    c = np.cos(bearing)
-    s = np.sin(bearing)
+    # Directions: the rays' robot-frame directions turned by the heading (the compiled path
+    # evaluates the same products, so both give the same bits).
+    cy, sy = np.cos(yaw), np.sin(yaw)
+    ca, sa = np.cos(ang), np.sin(ang)
     if method != "numpy" and raycast_jit.available():
         d = _NO_DISCS if discs is None else np.asarray(discs, dtype=np.float64).reshape(-1, 3)
         if own_disc is None:
@@ -245,13 +246,15 @@ def cast_rays(
         else:
             own = np.ascontiguousarray(own_disc, dtype=np.int64).reshape(-1)
         best, near = raycast_jit.cast_rays_compiled(
-            geometry, np.ascontiguousarray(p), bearing, c, s, float(max_range), np.ascontiguousarray(d), own
+            geometry, np.ascontiguousarray(p), cy, sy, ca, sa, float(max_range), np.ascontiguousarray(d), own
         )
         if near:  # an origin in a cell a polygon touches: shapely decides if it is inside
             best[_inside_polygon(geometry, p)] = 0.0
         return best
     if method == "numba":
         raise ValueError('method="numba" needs numba: pip install "pointnav-core[fast]"')
+    c = cy[:, None] * ca[None, :] - sy[:, None] * sa[None, :]
+    s = sy[:, None] * ca[None, :] + cy[:, None] * sa[None, :]
     best = np.minimum(
         _grid_hits(geometry, p, c, s, float(max_range)), float(max_range)
     )
@@ -268,24 +271,23 @@ def cast_rays(
 def cast_pose_compiled(
     geometry: ScanGeometry,
     origin: NDArray[np.float64],
-    yaw: float,
-    angles: NDArray[np.float64],
+    heading: NDArray[np.float64],
+    angles: tuple[NDArray[np.float64], NDArray[np.float64]],
     max_range: float,
-    rays: tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]],
 ) -> NDArray[np.float64] | None:
     """One origin's ranges (m), ``(R,)``, by the compiled path, or None without numba.
 
     :func:`cast_rays` for one robot and no discs, with its conversions left out: ``origin``
-    is a ``(1, 2)`` float64 array, ``rays`` three ``(1, R)`` float64 buffers this call
-    overwrites (bearings, cosines, sines). A scan calls it at every step.
+    is a ``(1, 2)`` float64 array, ``heading`` a ``(2,)`` float64 array of the yaw's
+    ``np.cos`` and ``np.sin`` (one ``np.cos`` and one ``np.sin`` of a length-1 yaw array),
+    ``angles`` the bearings' ``np.cos`` and ``np.sin``, computed once. A scan calls it at
+    every step.
     """
     if not raycast_jit.available():
         return None
-    bearing, c, s = rays
-    np.add(yaw, angles, out=bearing[0])
-    np.cos(bearing, out=c)
-    np.sin(bearing, out=s)
-    best, near = raycast_jit.cast_rays_compiled(geometry, origin, bearing, c, s, max_range, _NO_DISCS, _no_own(1))
+    best, near = raycast_jit.cast_rays_compiled(
+        geometry, origin, heading[:1], heading[1:], angles[0], angles[1], max_range, _NO_DISCS, _no_own(1)
+    )
     if near:
         best[_inside_polygon(geometry, origin)] = 0.0
     return best[0]
@@ -437,7 +439,8 @@ def _disc_hits(
     # The nearer root, -b - sqrt(disc), written without cancellation as cc / (-b + sqrt).
     root = np.sqrt(np.maximum(disc, 0.0))
     denom = root - b
-    t = np.where(denom > 0.0, cc / np.where(denom > 0.0, denom, 1.0), np.inf)
+    with np.errstate(over="ignore"):  # a subnormal denom: the root is beyond any range (inf)
+        t = np.where(denom > 0.0, cc / np.where(denom > 0.0, denom, 1.0), np.inf)
     hit = (disc >= 0.0) & (b <= 0.0)
     t = np.where(cc <= 0.0, 0.0, np.where(hit, t, np.inf))
     if own is not None:

@@ -8,12 +8,14 @@ arithmetic one ray at a time in a numba kernel, stopping where the ray stops:
 - the two crossing families are walked in order of ``t`` and the walk ends at the first
   blocked crossing (the y-family's walk also ends past the x-family's hit);
 - polygon edges are culled once per origin (bounding box within ``max_range``, back
-  faces), then tested per ray;
+  faces, nearest point beyond every ray's range so far), then tested against the rays
+  within their angular span only (directions compared by a monotone stand-in for
+  ``atan2``, with a margin far above rounding);
 - other robots' discs are tested per ray.
 
 Every quantity is the same expression as in the numpy path, evaluated in the same order on
-the same cosines and sines (computed by numpy in :func:`cast_rays_compiled`), so both paths
-give the same ranges; ``property_tests/test_scan_props.py`` checks that they are equal.
+the same cosines and sines (computed by numpy in :func:`~pointnav_core.sensors.raycast.cast_rays`,
+and turned into ray directions by the same products), so both paths give the same ranges; ``property_tests/test_scan_props.py`` checks that they are equal.
 
 numba is optional (the ``fast`` extra). :func:`kernel` imports it lazily, on the first
 scan (the kernel itself is :mod:`~pointnav_core.sensors._raycast_kernel`), and returns None
@@ -58,24 +60,25 @@ def available() -> bool:
 def cast_rays_compiled(
     geometry: Any,
     p: NDArray[np.float64],
-    bearing: NDArray[np.float64],
-    c: NDArray[np.float64],
-    s: NDArray[np.float64],
+    cy: NDArray[np.float64],
+    sy: NDArray[np.float64],
+    ca: NDArray[np.float64],
+    sa: NDArray[np.float64],
     max_range: float,
     discs: NDArray[np.float64],
     own: NDArray[np.int64],
 ) -> tuple[NDArray[np.float64], int]:
-    """Ranges (m), ``(N, R)``, from origins ``p`` along bearings ``bearing`` (rad), whose
-    cosines and sines are ``c`` and ``s``.
+    """Ranges (m), ``(N, R)``, from origins ``p`` with headings of cosine ``cy`` and sine
+    ``sy`` ``(N,)``, along rays at bearings of cosine ``ca`` and sine ``sa`` ``(R,)``.
 
     The arguments are :func:`~pointnav_core.sensors.raycast.cast_rays`'s, already converted:
     ``discs`` ``(M, 3)`` (possibly empty) and ``own`` ``(N,)`` (-1: no own disc). Origins
     inside an obstacle polygon are not zeroed here: the second value counts the origins in
     a cell a polygon touches, and the caller asks shapely about those.
     """
-    out = np.empty(c.shape, dtype=np.float64)
+    out = np.empty((len(cy), len(ca)), dtype=np.float64)
     near = kernel()(
-        p, bearing, c, s, geometry._jit_params(max_range), geometry._lookup, geometry._clearance,
+        p, cy, sy, ca, sa, geometry._jit_params(max_range), geometry._lookup, geometry._clearance,
         geometry._near_polygon, geometry._jit_edges, discs, own, out,
     )
     return out, near

@@ -153,8 +153,10 @@ class RangeScan(ObservationTerm):
         self._geometry: ScanGeometry | None = None
         self._share: ScanShare | None = None
         self._rng: np.random.Generator | None = None
-        self._pose = (np.zeros((1, 2)), np.zeros(1))
-        self._rays = (np.zeros((1, self.n_rays)), np.zeros((1, self.n_rays)), np.zeros((1, self.n_rays)))
+        # The pose goes in through small buffers (origin, yaw, the yaw's cosine and sine):
+        # cheaper than converting tuples each step; the bearings' cosines and sines are fixed.
+        self._pose = (np.zeros((1, 2)), np.zeros(1), np.zeros(2))
+        self._directions = (np.cos(angles), np.sin(angles))
         #: ``(x, y, yaw, readings)`` of the last observation (renderers draw it), or None.
         self.last_scan: tuple[float, float, float, NDArray[np.float64]] | None = None
 
@@ -202,13 +204,14 @@ class RangeScan(ObservationTerm):
         if self._geometry is None or self._geometry.tmap is not env.scene.floors[task.floor]:
             self._geometry = ScanGeometry(env.scene.floors[task.floor])
         discs = other_robot_discs(env, task.robot_idn, task.floor) if len(env.robots) > 1 else None
-        # The pose goes in through small buffers: cheaper than converting tuples each step.
-        origin, yaw = self._pose
+        origin, yaw, heading = self._pose
         origin[0, 0] = frame.x
         origin[0, 1] = frame.y
         yaw[0] = math.atan2(frame.sin_yaw, frame.cos_yaw)
         if discs is None or not len(discs):
-            fast = cast_pose_compiled(self._geometry, origin, yaw[0], self.angles, self.max_range, self._rays)
+            np.cos(yaw, out=heading[:1])  # as cast_rays turns its rays
+            np.sin(yaw, out=heading[1:])
+            fast = cast_pose_compiled(self._geometry, origin, heading, self._directions, self.max_range)
             if fast is not None:
                 return fast
         return cast_rays(

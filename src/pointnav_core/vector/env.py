@@ -1,9 +1,10 @@
 """``VectorPointNavEnv``: many point-navigation worlds stepped together as arrays.
 
 Every world is a :class:`~pointnav_core.env.PointNavEnv` with one robot on the kinematic
-backend (several robots per world: :mod:`pointnav_core.vector.fleet_env`), and the batched step reproduces them (drive, contacts and sliding, the task's
-rewards, terminations, SPL and SoftSPL, the flat ``low_dim`` observation) with array
-operations over all worlds at once: there is no Python loop over worlds on the step path.
+backend (several robots per world: :mod:`pointnav_core.vector.fleet_env`), and the batched
+step reproduces them (drive, contacts and sliding, the task's rewards, terminations, SPL
+and SoftSPL, the flat ``low_dim`` observation and the range scan) with array operations
+over all worlds at once: there is no Python loop over worlds on the step path.
 The same code runs on numpy (``device="numpy"``) and on torch (``"cpu"``, ``"cuda"``).
 """
 
@@ -21,6 +22,7 @@ from pointnav_core import _envcommon, scenes, validation
 from pointnav_core.vector.contacts import advance
 from pointnav_core.vector.episodes import EpisodePool
 from pointnav_core.vector.floors import FloorTables
+from pointnav_core.vector.scan import ScanTables, VectorScan
 from pointnav_core.vector.xp import make_arrays
 
 __all__ = ["VectorPointNavEnv"]
@@ -29,6 +31,17 @@ _GRAVITY = 9.81
 _MIN_FIRST_DROP = 0.05
 _FALL_SPEED = 1.0  # the kinematic backend's default fall_speed (m/s)
 _MAX_TURN = 0.25  # rad per control step the backend resolves without sub-steps
+
+
+def _scan_term(sensors: Mapping[str, Any] | None) -> Any:
+    """The range scan ``sensors`` asks for, or None; ValueError naming an unsupported sensor."""
+    from pointnav_core.sensors import make_sensors
+
+    terms = make_sensors(sensors)  # the single envs' checks: unknown sensors and keys
+    for term in terms:
+        if term.name != "scan":
+            raise ValueError(f"sensors: {term.name!r} is not supported by the batched engine (only 'scan')")
+    return terms[0] if terms else None
 
 
 def _default_scene() -> scenes.Scene:
@@ -63,8 +76,13 @@ class VectorPointNavEnv(VectorEnv):
     task : dict, optional
         ``PointNavigationTask`` keyword arguments, as for the single env (its default
         ``path_range`` too). Custom terms are not supported.
-    sensors : None
-        No sensors yet.
+    sensors : dict, optional
+        ``{"scan": {...}}`` (:class:`~pointnav_core.sensors.RangeScan` arguments, as for the
+        single env): the flat observation is the 8 ``low_dim`` values, then the scan's
+        ``n_rays`` ranges (m, in ``[0, max_range]``), in the single env's order and bounds,
+        cast by :mod:`pointnav_core.vector.scan` (compiled with numba on numpy, arrays on
+        torch). Noise and dropout draw from a stream of their own, not the single env's.
+        ``local_map`` is not supported.
     device : str
         ``"numpy"`` (default), or torch on ``"cpu"`` or ``"cuda[:n]"``.
     seed : int, optional
@@ -80,8 +98,9 @@ class VectorPointNavEnv(VectorEnv):
     Notes
     -----
     ``step`` takes actions of shape ``(num_envs, 2)`` (or ``(num_envs, 1, 2)``) in
-    ``[-1, 1]`` (clipped) and returns observations ``(num_envs, 8)`` float32, rewards
-    float64, terminated and truncated bool, and ``info``, a dict of arrays of shape
+    ``[-1, 1]`` (clipped) and returns observations ``(num_envs, 8)`` float32
+    (``(num_envs, 8 + n_rays)`` with the scan), rewards float64, terminated and truncated
+    bool, and ``info``, a dict of arrays of shape
     ``(num_envs,)``: ``success``, ``spl``, ``soft_spl``, ``path_length``,
     ``geodesic_dist``, ``distance_to_goal``, ``collisions``, ``episode_length``,
     ``in_contact``, ``reward_potential``, ``reward_collision``, ``reward_pointgoal`` and
@@ -158,8 +177,7 @@ class VectorPointNavEnv(VectorEnv):
         self.num_envs = validation.integer("num_envs", num_envs, minimum=1)
         if validation.integer("n_robots", n_robots, minimum=1) != 1:  # several: built by __new__
             raise ValueError(f"n_robots must be 1 here, got {n_robots}: VectorPointNavEnv builds the multi-robot engine")
-        if sensors is not None:
-            raise ValueError(f"sensors must be None: the batched engine has no sensors yet, got {sensors!r}")
+        scan_term = _scan_term(sensors)
         if task is not None and not isinstance(task, Mapping):
             raise ValueError(f"task must be None or a dict of PointNavigationTask arguments, got {task!r}")
         for key in ("termination_conditions", "reward_functions", "observation_terms"):
@@ -176,7 +194,8 @@ class VectorPointNavEnv(VectorEnv):
             raise ValueError(f"robot must have a differential drive in the batched engine, got {self.robot.drive!r}")
         self.scenes = scene_list
         self._samplers = [
-            PointNavEnv(scene=s, robot=self.robot, task=dict(task or {}), flatten_obs=True, action_frequency=action_frequency)
+            PointNavEnv(scene=s, robot=self.robot, task=dict(task or {}), sensors=sensors, flatten_obs=True,
+                        action_frequency=action_frequency)
             for s in scene_list
         ]
         if max_episode_steps is not None:
@@ -225,6 +244,9 @@ class VectorPointNavEnv(VectorEnv):
         self._collisions = a.zeros(n, a.i64)
         self._needs_reset = a.zeros(n, a.boolean)
         self._started = False
+        self.scan = None if scan_term is None else VectorScan(scan_term, ScanTables(scene_list, t.floor, a))
+        if self.scan is not None:
+            self.scan.seed(self._rng)
 
     # ------------------------------------------------------------------ pools
     def _build_pool(self, fixed: Sequence[tuple[Any, float, Any, int]]) -> None:
@@ -243,6 +265,8 @@ class VectorPointNavEnv(VectorEnv):
         episodes = (options or {}).get("episodes")
         if seed is not None:
             self._rng = np.random.default_rng(validation.integer("seed", seed, minimum=0))
+            if self.scan is not None:
+                self.scan.seed(self._rng)
         if episodes is not None:
             if len(episodes) != self.num_envs:
                 raise ValueError(f"options['episodes'] must hold one episode per world ({self.num_envs}), got {len(episodes)}")
@@ -402,6 +426,10 @@ class VectorPointNavEnv(VectorEnv):
         vx, vy = st["vx"], st["vy"]
         zero = xp.zeros_like(vx)
         obs = xp.stack([lx, ly, c * vx + s * vy, c * vy - s * vx, st["vz"], zero, zero, st["w"]], -1)
+        if self.scan is not None:  # the heading as the single env's frame gives it
+            yaw, one = xp.arctan2(s, c)[:, None], xp.ones_like(c)[:, None] > 0.0
+            ranges = self.scan.readings(self._world_scene, st["x"][:, None], st["y"][:, None], yaw, one, self.robot.radius)
+            obs = (xp.cat if a.is_torch else xp.concatenate)([obs, ranges[:, 0]], -1)
         sc = self._world_scene
         obs = xp.minimum(xp.maximum(obs, self._low[sc]), self._high[sc])
         return obs.to(xp.float32) if a.is_torch else obs.astype(np.float32)

@@ -79,8 +79,9 @@ class VectorFleetEnv(VectorPointNavEnv):
         if not isinstance(finished, str) or finished not in FINISHED_MODES:
             raise ValueError(f"finished must be one of {list(FINISHED_MODES)}, got {finished!r}")
         self.finished = finished
-        if sensors is not None:
-            raise ValueError(f"sensors must be None with several robots per world, got {sensors!r}")
+        if sensors is not None:  # vector.scan casts (W, R) robots, but it is not wired here yet
+            raise ValueError(f"sensors must be None with several robots per world (not supported yet), got {sensors!r}")
+        self.scan = None
         if task is not None and not isinstance(task, Mapping):
             raise ValueError(f"task must be None or a dict of PointNavigationTask arguments, got {task!r}")
         for key in ("termination_conditions", "reward_functions", "observation_terms"):

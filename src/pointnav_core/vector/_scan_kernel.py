@@ -1,0 +1,180 @@
+"""The compiled path of :func:`pointnav_core.vector.scan.cast_batch` (imports numba).
+
+Imported only when the compiled path runs, so the package imports without numba. One loop
+over worlds, robots and rays, inside the kernel; each ray is the single env's
+crossing walk (:func:`walk`: the crossing test of ``sensors._raycast_kernel.grid_range``
+with cheaper jumps over the clear squares) on its world's grid, then
+the discs of the world's other present robots, with the same expressions as the array
+path.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numba
+import numpy as np
+
+from pointnav_core.sensors.raycast import TOUCH_EPS
+
+__all__ = ["cast_worlds", "walk"]
+
+_INF = math.inf
+_TINY = 1e-300  # raycast._TINY
+_jit = numba.njit(cache=True, nogil=True, error_model="numpy")
+
+
+@_jit
+def walk(gx, gy, dx, dy, hp, wp, look, clr, e, n_cross, reach):  # pragma: no cover
+    # Nearest blocked crossing (cell units) of one ray, _INF past reach: the crossing
+    # families and the crossing test of raycast._grid_hits (the same expressions, so the
+    # same decisions), walked in order of t. Where the cell under the ray is C >= 2 cells
+    # (chessboard) from the nearest blocked one, the cells within C - 1 of it are free: the
+    # walk jumps to where the ray leaves that square, less a margin for rounding and e.
+    plane = hp * wp
+    fhp1 = float(hp - 1)
+    fwp1 = float(wp - 1)
+    posx = dx >= 0.0
+    sx = 1.0 if posx else -1.0
+    bx = math.floor(gx) + 1.0 if posx else math.ceil(gx) - 1.0
+    adx = max(abs(dx), _TINY)
+    dtx = 1.0 / adx
+    t0x = (bx - gx) * sx * dtx
+    a0x = gy + t0x * dy
+    stx = dtx * dy
+    enx = bx - (0.0 if posx else 1.0)
+    posy = dy >= 0.0
+    sy = 1.0 if posy else -1.0
+    by = math.floor(gy) + 1.0 if posy else math.ceil(gy) - 1.0
+    ady = max(abs(dy), _TINY)
+    dty = 1.0 / ady
+    t0y = (by - gy) * sy * dty
+    a0y = gx + t0y * dx
+    sty = dty * dx
+    eny = by - (0.0 if posy else 1.0)
+    margin = 1e-6 + 2.0 * e
+    kx = 0
+    ky = 0
+    t = 0.0
+    while True:
+        qx = gx + t * dx
+        qy = gy + t * dy
+        cx = math.floor(qx)
+        cy = math.floor(qy)
+        if 0.0 <= cx <= fwp1 and 0.0 <= cy <= fhp1:
+            c = clr[int(cy) * wp + int(cx)]
+            if c >= 2:
+                ex = (cx + c - qx if posx else qx - (cx - c + 1.0)) * dtx
+                ey = (cy + c - qy if posy else qy - (cy - c + 1.0)) * dty
+                target = t + min(ex, ey) - margin
+                # Jump each family to its first crossing at or after target (about: the
+                # margin keeps a rounding either way inside the free square).
+                if t0x < target:
+                    kx = max(kx, math.ceil((target - t0x) * adx))
+                if t0y < target:
+                    ky = max(ky, math.ceil((target - t0y) * ady))
+        fkx = float(kx)
+        fky = float(ky)
+        tx = t0x + fkx * dtx if kx < n_cross else _INF
+        ty = t0y + fky * dty if ky < n_cross else _INF
+        if tx <= ty:
+            if tx > reach:  # t grows along the walk: nothing nearer is left
+                return _INF
+            across = a0x + stx * fkx
+            hi = math.floor(across + e)
+            graze = math.floor(across - e) < hi
+            hi = min(max(hi, 0.0), fhp1)
+            ent = min(max(enx + sx * fkx, 0.0), fwp1)
+            if look[(plane if graze else 0) + int(hi) * wp + int(ent)]:
+                return tx
+            kx += 1
+            t = tx
+        else:
+            if ty > reach:
+                return _INF
+            across = a0y + sty * fky
+            hi = math.floor(across + e)
+            graze = math.floor(across - e) < hi
+            hi = min(max(hi, 0.0), fwp1)
+            ent = min(max(eny + sy * fky, 0.0), fhp1)
+            if look[(2 * plane if graze else 0) + int(hi) + int(ent) * wp]:
+                return ty
+            ky += 1
+            t = ty
+
+
+@_jit
+def cast_worlds(scene, x, y, cyaw, syaw, ca, sa, present, radius, max_range, meta, lookup, clear, out):  # pragma: no cover
+    n_worlds, n_robots = x.shape
+    n_rays = ca.shape[0]
+    r2 = radius * radius
+    c = np.empty(n_rays)
+    s = np.empty(n_rays)
+    near = np.empty(n_robots, np.int64)
+    # Farther than this (m^2, with a margin for rounding) a disc is out of every ray's reach.
+    reach2 = ((max_range + radius) * (1.0 + 1e-9) + 1e-12) ** 2
+    for w in range(n_worlds):
+        k = scene[w]
+        loff = int(meta[k, 0])
+        coff = int(meta[k, 1])
+        hp = int(meta[k, 2])
+        wp = int(meta[k, 3])
+        res = meta[k, 4]
+        ox = meta[k, 5]
+        oy = meta[k, 6]
+        inv = 1.0 / res
+        e = TOUCH_EPS * inv
+        reach = max_range * inv
+        n_cross = min(math.ceil(reach) + 1, max(hp, wp) + 1)
+        plane = hp * wp
+        look = lookup[loff : loff + 3 * plane]
+        clr = clear[coff : coff + plane]
+        for i in range(n_robots):
+            if not present[w, i]:
+                out[w, i, :] = max_range
+                continue
+            px = x[w, i]
+            py = y[w, i]
+            gx = (px - ox) * inv + 1.0
+            gy = (py - oy) * inv + 1.0
+            # An origin touching a blocked cell (or off the map) reads 0.
+            c0 = int(min(max(math.floor(gx - e), 0.0), wp - 1.0))
+            c1 = int(min(max(math.floor(gx + e), 0.0), wp - 1.0))
+            q0 = int(min(max(math.floor(gy - e), 0.0), hp - 1.0)) * wp
+            q1 = int(min(max(math.floor(gy + e), 0.0), hp - 1.0)) * wp
+            if look[q0 + c0] or look[q0 + c1] or look[q1 + c0] or look[q1 + c1]:
+                out[w, i, :] = 0.0
+                continue
+            for r in range(n_rays):  # the products of scan.directions, in its order
+                c[r] = cyaw[w, i] * ca[r] - syaw[w, i] * sa[r]
+                s[r] = syaw[w, i] * ca[r] + cyaw[w, i] * sa[r]
+            # The discs a ray can reach: present, not its own, centre within max_range + radius.
+            n_near = 0
+            for m in range(n_robots):
+                if m != i and present[w, m]:
+                    fx = px - x[w, m]
+                    fy = py - y[w, m]
+                    if fx * fx + fy * fy <= reach2:
+                        near[n_near] = m
+                        n_near += 1
+            for r in range(n_rays):
+                dx = c[r]
+                dy = s[r]
+                best = min(walk(gx, gy, dx, dy, hp, wp, look, clr, e, n_cross, reach) * res, max_range)
+                for j in range(n_near):
+                    m = near[j]
+                    fx = px - x[w, m]
+                    fy = py - y[w, m]
+                    b = fx * dx + fy * dy
+                    cc = fx * fx + fy * fy - r2
+                    if cc <= 0.0:
+                        t = 0.0
+                    else:
+                        disc = b * b - cc
+                        if disc >= 0.0 and b <= 0.0:
+                            denom = math.sqrt(max(disc, 0.0)) - b
+                            t = cc / denom if denom > 0.0 else _INF
+                        else:
+                            t = _INF
+                    best = min(best, t)
+                out[w, i, r] = best

@@ -1,0 +1,341 @@
+"""The range scan of a batch of worlds: ``(W, R, n_rays)`` ranges in one call.
+
+Every world has its own grid floor and up to ``R`` robots; each present robot casts the
+rays of a :class:`~pointnav_core.sensors.RangeScan` from its centre and reads, per ray,
+the distance (m) to the first thing the single env's scan sees
+(:mod:`pointnav_core.sensors.raycast`): an OBSTACLE cell, the map's edge (one ring of
+blocked cells around the map) or the disc of another present robot of the same world.
+VOID is not seen; touching counts (within :data:`~pointnav_core.sensors.TOUCH_EPS`); an
+origin touching a blocked cell reads 0. Absent robots neither see nor are seen; their rows
+read ``max_range``.
+
+Two paths give the same ranges (``property_tests/test_vector_scan_props.py``):
+
+- the array path (numpy, or torch on any device, through
+  :class:`~pointnav_core.vector.xp.Arrays`): the single env's crossing formulas
+  (``raycast._grid_hits``) for every ray of every robot at once, the crossings taken in a
+  fixed number of blocks of :data:`BLOCK` (set by ``max_range`` and the finest cell size,
+  not by the scene), so that the temporaries stay small;
+- the compiled path (numpy on the CPU with numba, the ``fast`` extra): the single env's
+  kernel (``sensors._raycast_kernel.grid_range``, which jumps over the clear square of a
+  Chebyshev distance transform) ray by ray, in one compiled loop over worlds, robots and
+  rays (:mod:`pointnav_core.vector._scan_kernel`).
+
+Both take the rays' directions from the same products ``cos(yaw) cos(a) - sin(yaw) sin(a)``
+(and the sine alike), so they decide every crossing on the same numbers.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from typing import Any
+
+import numpy as np
+
+from pointnav_core.sensors.raycast import TOUCH_EPS, ScanGeometry
+from pointnav_core.sensors.scan import RangeScan
+from pointnav_core.vector.xp import Arrays
+
+__all__ = ["BLOCK", "ScanTables", "VectorScan", "cast_batch", "compiled_available", "directions"]
+
+#: Crossings per family taken together by one iteration of the array path.
+BLOCK = 8
+_TINY = 1e-300  # raycast._TINY: a zero direction component puts its lines at "infinity"
+_METHODS = ("auto", "array", "numba")
+
+
+class ScanTables:
+    """What the scan sees on one floor per scene, as flat arrays (numpy and ``arrays``).
+
+    Parameters
+    ----------
+    scenes : sequence of Scene
+        Their floor ``floor`` is used; grid cells only (obstacle polygons are refused).
+    floor : int
+        The task's floor.
+    arrays : Arrays
+        Namespace and device of the array path.
+
+    Raises
+    ------
+    ValueError
+        Naming ``scene`` when a floor holds obstacle polygons.
+    """
+
+    def __init__(self, scenes: Sequence[Any], floor: int, arrays: Arrays) -> None:
+        lookups, clears, meta = [], [], []
+        lo = co = 0
+        for k, scene in enumerate(scenes):
+            tmap = scene.floors[floor]
+            if len(tmap.collision.polygons):
+                raise ValueError(f"scene {k} has obstacle polygons on floor {floor}; the batched scan sees grid cells only")
+            geo = ScanGeometry(tmap)
+            hp, wp = geo.shape
+            lookups.append(geo._lookup)
+            clears.append(geo._clearance)
+            # lookup offset, clearance offset, padded rows, padded columns, cell size, origin
+            meta.append((lo, co, hp, wp, geo.resolution, geo.origin[0], geo.origin[1]))
+            lo += geo._lookup.size
+            co += geo._clearance.size
+        #: Per scene: lookup offset, clearance offset, hp, wp, resolution, ox, oy (float64).
+        self.meta = np.ascontiguousarray(meta, dtype=np.float64)
+        #: The three lookup planes of every padded grid, end to end (bool, numpy).
+        self.lookup = np.ascontiguousarray(np.concatenate(lookups))
+        #: Chessboard distance (cells) of every padded cell to the nearest blocked one (int32).
+        self.clearance = np.ascontiguousarray(np.concatenate(clears), dtype=np.int32)
+        self.min_res = float(self.meta[:, 4].min())
+        self.max_side = int(self.meta[:, 2:4].max())
+        a = self.arrays = arrays
+        self.lookup_x = a.asarray(self.lookup, a.boolean)
+        m = self.meta
+        self.m_off = a.asarray(m[:, 0], a.i64)
+        self.m_hp, self.m_wp, self.m_res, self.m_ox, self.m_oy = (a.asarray(m[:, i]) for i in (2, 3, 4, 5, 6))
+
+
+def compiled_available() -> bool:
+    """Whether the compiled path can run (numba importable)."""
+    from pointnav_core.sensors import raycast_jit
+
+    return raycast_jit.available()
+
+
+def directions(arrays: Arrays, yaw: Any, angles: Any) -> tuple[Any, Any]:
+    """Cosines and sines ``(W, R, n)`` of the bearings ``yaw + angles`` (rad), by the
+    angle-sum products: one cosine and sine per robot, not per ray."""
+    xp = arrays.xp
+    cy, sy = xp.cos(yaw)[..., None], xp.sin(yaw)[..., None]
+    ca, sa = xp.cos(angles), xp.sin(angles)
+    return cy * ca - sy * sa, sy * ca + cy * sa
+
+
+def cast_batch(
+    tables: ScanTables,
+    scene: Any,
+    x: Any,
+    y: Any,
+    yaw: Any,
+    present: Any,
+    radius: float,
+    angles: Any,
+    max_range: float,
+    method: str = "auto",
+) -> Any:
+    """Exact ranges (m) of every present robot's rays, before the min-range rule.
+
+    Parameters
+    ----------
+    tables : ScanTables
+        The scenes' floors.
+    scene : int array, shape (W,)
+        Each world's scene (index into ``tables``' scenes).
+    x, y, yaw : float64 arrays, shape (W, R)
+        Robot centres (m) and headings (rad).
+    present : bool array, shape (W, R)
+        Robots that see and are seen.
+    radius : float
+        Robot radius (m): the discs the other robots see.
+    angles : float64 array, shape (n,)
+        Ray bearings in the robot frame (rad).
+    max_range : float
+        Longest reading (m).
+    method : {"auto", "array", "numba"}
+        ``"auto"``: numba for numpy arrays when installed, else the array path.
+
+    Returns
+    -------
+    float64 array, shape (W, R, n)
+        In ``[0, max_range]``; ``max_range`` for absent robots.
+
+    Examples
+    --------
+    Two robots 0.1 m apart (radius 0.02 m) before a wall from x = 0.5 m to 0.6 m, looking
+    ahead and back:
+
+    >>> from pointnav_core.scenes import Scene
+    >>> from pointnav_core.vector.xp import make_arrays
+    >>> grid = np.zeros((5, 8), np.uint8)
+    >>> grid[:, 5] = 1
+    >>> tables = ScanTables([Scene.from_array(grid, 0.1)], 0, make_arrays("numpy"))
+    >>> x, y, yaw = np.array([[0.25, 0.15]]), np.full((1, 2), 0.25), np.zeros((1, 2))
+    >>> d = cast_batch(tables, np.zeros(1, np.int64), x, y, yaw, np.ones((1, 2), bool), 0.02,
+    ...                np.array([0.0, np.pi]), 2.0)
+    >>> d.round(9).tolist()  # the wall and the other robot; the other robot and the map's edge
+    [[[0.25, 0.08], [0.08, 0.15]]]
+    """
+    if method not in _METHODS:
+        raise ValueError(f"method must be one of {', '.join(map(repr, _METHODS))}, got {method!r}")
+    a = tables.arrays
+    if method == "numba" and (a.is_torch or not compiled_available()):
+        raise ValueError('method="numba" needs numpy arrays and numba: pip install "pointnav-core[fast]"')
+    angles = a.asarray(angles)
+    if method != "array" and not a.is_torch and compiled_available():
+        from pointnav_core.vector._scan_kernel import cast_worlds
+
+        w, r = x.shape
+        out = np.empty((w, r, angles.shape[0]))
+        cast_worlds(
+            np.ascontiguousarray(scene, dtype=np.int64), np.ascontiguousarray(x, dtype=np.float64),
+            np.ascontiguousarray(y, dtype=np.float64), np.cos(yaw), np.sin(yaw), np.cos(angles), np.sin(angles),
+            np.ascontiguousarray(present, dtype=np.bool_), float(radius), float(max_range),
+            tables.meta, tables.lookup, tables.clearance, out,
+        )
+        return out
+    c, s = directions(a, yaw, angles)
+    best = _grid_ranges(tables, scene, x, y, c, s, float(max_range))
+    best = a.xp.minimum(best, _disc_ranges(a, x, y, c, s, present, float(radius)))
+    return a.xp.where(present[..., None], best, a.xp.full_like(best, float(max_range)))
+
+
+def _grid_ranges(tables: ScanTables, scene: Any, x: Any, y: Any, c: Any, s: Any, max_range: float) -> Any:
+    """Range (m) to the first blocked cell along each ray, at most ``max_range``."""
+    a, xp = tables.arrays, tables.arrays.xp
+    sc = scene[:, None]  # (W, 1): broadcasts over robots
+    inv = 1.0 / tables.m_res[sc]
+    hp, wp, off = tables.m_hp[sc], tables.m_wp[sc], tables.m_off[sc]
+    gx = (x - tables.m_ox[sc]) * inv + 1.0
+    gy = (y - tables.m_oy[sc]) * inv + 1.0
+    e = TOUCH_EPS * inv
+    reach = max_range * inv
+    plane = hp * wp
+    lookup = tables.lookup_x
+    # The crossings the finest floor can need (raycast._grid_hits' n_cross), in blocks.
+    n_cross = min(math.ceil(max_range / tables.min_res) + 1, tables.max_side + 1)
+    ks = a.asarray(np.arange(BLOCK, dtype=np.float64))
+    best = None
+    unit = xp.ones_like(hp)
+    # x-crossings (vertical lines): along x, across y, the row hi is looked up (plane 1
+    # ORs the row below); y-crossings: along y, across x (plane 2 ORs the column left).
+    for g_along, g_across, d_along, d_across, across_max, along_max, plane_of, hi_stride, ent_stride in (
+        (gx, gy, c, s, hp - 1.0, wp - 1.0, plane, wp, unit),
+        (gy, gx, s, c, wp - 1.0, hp - 1.0, 2.0 * plane, unit, wp),
+    ):
+        ga, gc = g_along[..., None], g_across[..., None]
+        pos = d_along >= 0.0
+        one = xp.ones_like(d_along)  # torch.where of two numbers would give float32
+        sgn = xp.where(pos, one, -one)
+        base = xp.where(pos, xp.floor(ga) + 1.0, xp.ceil(ga) - 1.0)
+        dt = 1.0 / xp.abs(d_along).clip(_TINY, None)
+        t0 = (base - ga) * sgn * dt
+        a0 = gc + t0 * d_across
+        step = dt * d_across
+        ent0 = base - xp.where(pos, 0.0 * one, one)
+        ee = e[..., None, None]
+        amax, lmax = across_max[..., None, None], along_max[..., None, None]
+        pl, hs, es = plane_of[..., None, None], hi_stride[..., None, None], ent_stride[..., None, None]
+        base_idx = off[..., None, None]
+        first = xp.full_like(t0, math.inf)
+        for k0 in range(0, n_cross, BLOCK):
+            k = ks + float(k0)  # (BLOCK,)
+            k = k[: min(BLOCK, n_cross - k0)]
+            across = a0[..., None] + step[..., None] * k
+            hi = xp.floor(across + ee)
+            grazing = xp.floor(across - ee) < hi
+            hi = xp.minimum(hi.clip(0.0, None), amax)
+            entered = xp.minimum((ent0[..., None] + sgn[..., None] * k).clip(0.0, None), lmax)
+            idx = xp.where(grazing, pl, 0.0) + hi * hs + entered * es
+            hit = lookup[a.to_int(idx) + base_idx]
+            t = t0[..., None] + k * dt[..., None]
+            # Crossings come in order along the ray: the nearest blocked one is the first.
+            tk = _min_last(xp, xp.where(hit, t, math.inf))
+            first = xp.where(xp.isinf(first), tk, first)
+        best = first if best is None else xp.minimum(best, first)
+    best = xp.where(best <= reach[..., None], best, math.inf)
+    best = (best * tables.m_res[sc][..., None]).clip(None, max_range)
+    # An origin touching a blocked cell (or off the map) reads 0.
+    flat = lookup
+    col0 = xp.minimum(xp.floor(gx - e).clip(0.0, None), wp - 1.0)
+    col1 = xp.minimum(xp.floor(gx + e).clip(0.0, None), wp - 1.0)
+    row0 = xp.minimum(xp.floor(gy - e).clip(0.0, None), hp - 1.0) * wp
+    row1 = xp.minimum(xp.floor(gy + e).clip(0.0, None), hp - 1.0) * wp
+    touching = xp.zeros_like(gx) > 1.0
+    for rr in (row0, row1):
+        for cc in (col0, col1):
+            touching = touching | flat[a.to_int(rr + cc) + off]
+    return xp.where(touching[..., None], xp.zeros_like(best), best)
+
+
+def _disc_ranges(a: Arrays, x: Any, y: Any, c: Any, s: Any, present: Any, radius: float) -> Any:
+    """Range (m) to the first other present robot's disc of the same world (inf: none)."""
+    xp = a.xp
+    r = x.shape[1]
+    if r == 1:
+        return xp.full_like(c, math.inf)
+    # (W, R, 1, M): robot i's rays against robot m's disc.
+    fx = (x[:, :, None] - x[:, None, :])[:, :, None, :]
+    fy = (y[:, :, None] - y[:, None, :])[:, :, None, :]
+    b = fx * c[..., None] + fy * s[..., None]
+    cc = fx * fx + fy * fy - radius * radius
+    disc = b * b - cc
+    # The nearer root, written without cancellation (raycast._disc_hits).
+    denom = xp.sqrt(disc.clip(0.0, None)) - b
+    t = xp.where(denom > 0.0, cc / xp.where(denom > 0.0, denom, 1.0), math.inf)
+    hit = (disc >= 0.0) & (b <= 0.0)
+    t = xp.where(cc <= 0.0, 0.0, xp.where(hit, t, math.inf))
+    other = a.asarray(~np.eye(r, dtype=bool), a.boolean)
+    seen = (other[None] & present[:, None, :])[:, :, None, :]
+    return _min_last(xp, xp.where(seen, t, math.inf))
+
+
+def _min_last(xp: Any, v: Any) -> Any:
+    """Minimum over the last axis, for numpy and torch alike."""
+    if xp is np:
+        return v.min(axis=-1)
+    return xp.amin(v, dim=-1)
+
+
+class VectorScan:
+    """A :class:`~pointnav_core.sensors.RangeScan` for a batch of worlds.
+
+    Applies the single scan's reading rules (its module docstring) to :func:`cast_batch`'s
+    ranges: a return nearer than ``min_range`` reads ``max_range``; then, if configured,
+    Gaussian noise on the readings below ``max_range`` (clipped to ``[0, max_range]``)
+    and dropout. Noise and dropout come from :attr:`rng`, which :meth:`seed` spawns from
+    the env's generator: the same seed gives the same scans, but not the stream of the
+    single env's scan (``docs/decisions.md``).
+
+    Parameters
+    ----------
+    term : RangeScan
+        The configuration (rays, ranges, noise).
+    tables : ScanTables
+        The floors.
+    method : {"auto", "array", "numba"}
+        The path of :func:`cast_batch`.
+    """
+
+    def __init__(self, term: RangeScan, tables: ScanTables, method: str = "auto") -> None:
+        if not isinstance(term, RangeScan):
+            raise ValueError(f"term must be a RangeScan, got {term!r}")
+        self.term = term
+        self.tables = tables
+        self.method = method
+        a = tables.arrays
+        self.angles = a.asarray(np.array(term.angles))
+        self.rng = np.random.default_rng()
+
+    def seed(self, rng: np.random.Generator) -> None:
+        """Take a child of ``rng``'s seed sequence for noise and dropout (``rng``'s stream is
+        not drawn from)."""
+        seq = getattr(rng.bit_generator, "seed_seq", None)
+        if isinstance(seq, np.random.SeedSequence):
+            self.rng = np.random.default_rng(seq.spawn(1)[0])
+        else:
+            self.rng = np.random.default_rng(rng.integers(2**63))
+
+    def readings(self, scene: Any, x: Any, y: Any, yaw: Any, present: Any, radius: float) -> Any:
+        """The scan's readings (m), ``(W, R, n_rays)`` float64 on the arrays' device."""
+        t, a = self.term, self.tables.arrays
+        xp = a.xp
+        d = cast_batch(self.tables, scene, x, y, yaw, present, radius, self.angles, t.max_range, self.method)
+        top = t.max_range
+        if t.min_range > 0.0:
+            d = xp.where(d < t.min_range, top, d)
+        if t.noise_std > 0.0:
+            noise = a.asarray(self.rng.normal(0.0, t.noise_std, tuple(d.shape)))
+            d = xp.where(d < top, d + noise, d)
+            d = d.clip(0.0, top)
+        if t.dropout > 0.0:
+            lost = a.asarray(self.rng.random(tuple(d.shape))) < t.dropout
+            d = xp.where(lost, top, d)
+        return d
