@@ -144,3 +144,10 @@ def test_discrete_matches_single_envs_in_clutter(device: str, stop: bool, sensor
                     task={"reward_type": "geodesic", "termination_config": {"max_steps": 40, "max_collisions": 20}})
     # The case exercised what it claims: contacts, successes and autoresets.
     assert stats["contacts"] > 0 and stats["successes"] > 0 and stats["autoresets"] > 0
+
+
+@pytest.mark.parametrize("kwargs", [{"action_space": "discrete"}, {"discrete_actions": {"stop": False}}, {"starts_per_goal": 2}])
+def test_discrete_actions_are_refused_with_several_robots(kwargs: dict) -> None:
+    name = next(iter(kwargs))
+    with pytest.raises(ValueError, match=name):
+        VectorPointNavEnv(2, n_robots=2, scene=room(), **kwargs)
