@@ -164,6 +164,7 @@ class VectorFleetEnv(VectorPointNavEnv):
         """Reset every world. ``options={"episodes": [[(start_xy, yaw, goal_xy), ...], ...]}``
         (per world, one tuple per robot) fixes each world's episode, at this reset and every
         autoreset, until a reset without it; a new ``seed`` redraws the pools."""
+        self._finish_refresh()
         a = self.arrays
         if options is not None and not isinstance(options, Mapping):
             raise ValueError(f"options must be None or a dict, got {options!r}")
