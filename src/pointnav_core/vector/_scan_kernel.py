@@ -124,7 +124,7 @@ def cast_worlds(scene, x, y, cyaw, syaw, ca, sa, present, radius, max_range, met
         n_cross = min(math.ceil(reach) + 1, max(hp, wp) + 1)
         plane = hp * wp
         look = lookup[loff : loff + 3 * plane]
-        clr = clear[coff : coff + plane]
+        clr = clear[coff : coff + 4 * plane]  # four quadrants a cell
         for i in range(n_robots):
             if not present[w, i]:
                 out[w, i, :] = max_range
