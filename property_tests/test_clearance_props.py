@@ -17,8 +17,11 @@ from hypothesis import given
 from hypothesis import strategies as st
 
 from pointnav_core.maps import TraversableMap
+from pointnav_core.scenes import Scene
 from pointnav_core.sensors import TOUCH_EPS, ScanGeometry, cast_rays, scan_angles
 from pointnav_core.sensors.clearance import QUADRANTS, quadrant_clearance
+from pointnav_core.vector.scan import ScanTables, cast_batch
+from pointnav_core.vector.xp import make_arrays
 
 
 def _brute_side(free: np.ndarray, row: int, col: int, sx: int, sy: int) -> int:
@@ -103,10 +106,6 @@ def grazing_scans(draw):
 @given(grazing_scans())
 def test_scans_that_graze_the_jumps_far_sides_equal_the_numpy_path(case):
     pytest.importorskip("numba", reason="the compiled path is the `fast` extra")
-    from pointnav_core.vector.scan import ScanTables, cast_batch
-    from pointnav_core.vector.xp import make_arrays
-    from pointnav_core.scenes import Scene
-
     tmap, origins, yaws, angles, max_range = case
     geo = ScanGeometry(tmap)
     general = cast_rays(geo, origins, yaws, angles, max_range, method="numpy")
