@@ -79,11 +79,21 @@ def grid_range(gx, gy, dx, dy, fhp, fwp, plane, lookup, clear, e, n_cross, reach
         if 0 <= col < wp and 0 <= row < hp:
             side = clear[(row * wp + col) * 4 + quad]
             if side >= 3:
-                target = min(t0x + float(kx + side - 2) * dtx, t0y + float(ky + side - 2) * dty) - margin
-                if t0x < target:
-                    kx = min(max(kx, math.ceil((target - t0x) * adx)), n_cross)
-                if t0y < target:
-                    ky = min(max(ky, math.ceil((target - t0y) * ady)), n_cross)
+                farx = t0x + float(kx + side - 2) * dtx
+                fary = t0y + float(ky + side - 2) * dty
+                # The nearer far side's family goes to it (its crossing before is a whole
+                # cell earlier, far beyond the margin); the other to its first crossing
+                # after the margin.
+                if farx <= fary:
+                    kx += side - 2
+                    target = farx - margin
+                    if t0y < target:
+                        ky = min(max(ky, math.ceil((target - t0y) * ady)), n_cross)
+                else:
+                    ky += side - 2
+                    target = fary - margin
+                    if t0x < target:
+                        kx = min(max(kx, math.ceil((target - t0x) * adx)), n_cross)
         fkx = float(kx)
         fky = float(ky)
         tx = t0x + fkx * dtx if kx < n_cross else _INF

@@ -66,11 +66,21 @@ def walk(gx, gy, dx, dy, hp, wp, look, clr, e, n_cross, reach):  # pragma: no co
         if 0 <= col < wp and 0 <= row < hp:
             side = clr[(row * wp + col) * 4 + quad]
             if side >= 3:  # far sides: crossings kx + side - 2 and ky + side - 2
-                target = min(t0x + float(kx + side - 2) * dtx, t0y + float(ky + side - 2) * dty) - margin
-                if t0x < target:
-                    kx = max(kx, math.ceil((target - t0x) * adx))
-                if t0y < target:
-                    ky = max(ky, math.ceil((target - t0y) * ady))
+                farx = t0x + float(kx + side - 2) * dtx
+                fary = t0y + float(ky + side - 2) * dty
+                # The nearer far side's family goes to it (its crossing before is a whole
+                # cell earlier, far beyond the margin); the other to its first crossing
+                # after the margin.
+                if farx <= fary:
+                    kx += side - 2
+                    target = farx - margin
+                    if t0y < target:
+                        ky = max(ky, math.ceil((target - t0y) * ady))
+                else:
+                    ky += side - 2
+                    target = fary - margin
+                    if t0x < target:
+                        kx = max(kx, math.ceil((target - t0x) * adx))
         fkx = float(kx)
         fky = float(ky)
         tx = t0x + fkx * dtx if kx < n_cross else _INF
