@@ -1,10 +1,10 @@
 """``VectorPointNavEnv``: many point-navigation worlds stepped together as arrays.
 
 Every world is a :class:`~pointnav_core.env.PointNavEnv` with one robot on the kinematic
-backend, and the batched step reproduces them (drive, contacts and sliding, the task's
-rewards, terminations, SPL and SoftSPL, the flat ``low_dim`` observation and the range
-scan) with array operations over all worlds at once: there is no Python loop over worlds
-on the step path.
+backend (several robots per world: :mod:`pointnav_core.vector.fleet_env`), and the batched
+step reproduces them (drive, contacts and sliding, the task's rewards, terminations, SPL
+and SoftSPL, the flat ``low_dim`` observation and the range scan) with array operations
+over all worlds at once: there is no Python loop over worlds on the step path.
 The same code runs on numpy (``device="numpy"``) and on torch (``"cpu"``, ``"cuda"``).
 """
 
@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Mapping, Sequence
-from typing import Any
+from typing import Any, Self
 
 import gymnasium as gym
 import numpy as np
@@ -64,7 +64,10 @@ class VectorPointNavEnv(VectorEnv):
     num_envs : int
         Worlds, >= 1.
     n_robots : int
-        Robots per world; only 1 is supported so far.
+        Robots per world, >= 1. With more than one, the engine is the multi-robot one
+        (see "Several robots per world" below), which also takes ``max_cycles`` (int,
+        default 500) and ``finished`` (``"park"``, the default, or ``"remove"``), as
+        :func:`pointnav_core.parallel.parallel_env` does.
     scene : Scene or sequence of Scene, optional
         World ``i`` runs on ``scene[i % len(scene)]``. Floors must be grid cells only (no
         obstacle polygons). Default: the single env's default house as a grid.
@@ -104,6 +107,27 @@ class VectorPointNavEnv(VectorEnv):
     ``autoreset`` (the worlds this step reset instead of stepping). Arrays are numpy with
     ``device="numpy"`` and torch tensors on the device otherwise.
 
+    **Several robots per world** (``n_robots=R > 1``; an instance of the subclass
+    :class:`~pointnav_core.vector.fleet_env.VectorFleetEnv`). Each world behaves as a
+    :func:`pointnav_core.parallel.parallel_env` with ``n_robots=R`` on the kinematic backend
+    with the same ``finished`` and ``max_cycles``: robots are solid for each other, a
+    robot-robot contact counts as a collision for both, every robot has its own task
+    (rewards, terminations, SPL), and all robots still active are truncated after
+    ``max_cycles`` steps. Every return carries the robot axis: ``step`` takes actions
+    ``(num_envs, R, 2)`` (all finite; those of inactive robots are ignored) and returns
+    observations ``(num_envs, R, 8)`` float32, rewards ``(num_envs, R)`` float64,
+    terminated and truncated ``(num_envs, R)`` bool and ``info`` arrays ``(num_envs, R)``
+    with, besides the keys above, ``active``: the robots that are still agents (PettingZoo's
+    ``agents``). A robot whose episode ended returns its last observation, reward and flags
+    in that step and is inactive from then on: its entries are zero (False) and its action
+    is ignored; with ``finished="park"`` it stays in the world as an obstacle, with
+    ``"remove"`` it leaves it (a robot that fell leaves it in both modes). A world with no
+    active robot left resets all its robots at the next step (next-step autoreset, as
+    above, with ``autoreset`` True for all of them). Episodes are drawn, per scene, by that
+    scene's ``parallel_env`` (non-overlapping starts, goals kept
+    :func:`pointnav_core.fleet.goal_separation` apart); ``reset(options={"episodes": [[
+    (start_xy, yaw, goal_xy), ...], ...]})`` fixes, per world, one tuple per robot.
+
     Examples
     --------
     >>> from pointnav_core.scenes import Scene
@@ -120,6 +144,19 @@ class VectorPointNavEnv(VectorEnv):
     """
 
     metadata = {"autoreset_mode": AutoresetMode.NEXT_STEP, "render_modes": []}
+
+    def __new__(cls, *args: Any, **kwargs: Any) -> Self:
+        # Several robots per world are their own engine (vector.fleet_env), built from here.
+        if cls is VectorPointNavEnv:
+            n_robots = kwargs.get("n_robots", args[1] if len(args) > 1 else 1)
+            if isinstance(n_robots, (int, np.integer)) and not isinstance(n_robots, bool) and n_robots > 1:
+                from pointnav_core.vector.fleet_env import VectorFleetEnv
+
+                return super().__new__(VectorFleetEnv)
+            for name in ("max_cycles", "finished"):
+                if name in kwargs:
+                    raise ValueError(f"{name} applies to several robots per world (n_robots > 1), got n_robots={n_robots!r}")
+        return super().__new__(cls)
 
     def __init__(
         self,
@@ -138,8 +175,8 @@ class VectorPointNavEnv(VectorEnv):
         from pointnav_core.env import PointNavEnv
 
         self.num_envs = validation.integer("num_envs", num_envs, minimum=1)
-        if validation.integer("n_robots", n_robots, minimum=1) != 1:
-            raise ValueError(f"n_robots must be 1: the batched engine has one robot per world so far, got {n_robots}")
+        if validation.integer("n_robots", n_robots, minimum=1) != 1:  # several: built by __new__
+            raise ValueError(f"n_robots must be 1 here, got {n_robots}: VectorPointNavEnv builds the multi-robot engine")
         scan_term = _scan_term(sensors)
         if task is not None and not isinstance(task, Mapping):
             raise ValueError(f"task must be None or a dict of PointNavigationTask arguments, got {task!r}")

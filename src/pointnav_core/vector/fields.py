@@ -80,7 +80,8 @@ class FieldTables:
         g = np.array(geo, dtype=np.float64).reshape(-1, 7)
         self.kind = a.asarray(np.concatenate(kinds), a.i64)
         self.label = a.asarray(np.concatenate(labels), a.i64)
-        lab = np.concatenate(lab_arrays) if lab_off else np.zeros((1, 9))
+        # One spare row: cells with no label point at the end of their field's labels.
+        lab = np.concatenate([*lab_arrays, np.zeros((1, 9))])
         (self.cost, self.cx, self.cy, self.side, self.phi0, self.span, self.pos,
          self.qx, self.qy) = (a.asarray(lab[:, i]) for i in range(9))
         gxy = np.array(goal, dtype=np.float64).reshape(-1, 2)

@@ -1,0 +1,102 @@
+"""Several robots per world in the batched engine against one PettingZoo env per world.
+
+For random grid scenes (clutter, walls, maybe a hole to fall into), fixed random episodes
+of 2 to 4 robots and random action sequences, ``VectorPointNavEnv(W, n_robots=R)``
+matches ``W`` separate ``parallel_env(n_robots=R, backend="kinematic")`` step for step
+(observations within 1e-4, rewards within 1e-5, the same terminated, truncated and active
+flags, success, SPL and SoftSPL) over whole episodes and their autoresets, with parked or
+removed finished robots, on numpy and on torch on the CPU.
+"""
+
+from __future__ import annotations
+
+import importlib.util
+
+import numpy as np
+import pytest
+from fleet_reference import compare_fleet, fleet_episodes
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+
+from pointnav_core.maps import FREE, OBSTACLE, VOID
+from pointnav_core.scenes import Scene
+
+DEVICES = ["numpy"] + (["cpu"] if importlib.util.find_spec("torch") else [])
+
+
+@st.composite
+def crowded_scenes(draw: st.DrawFn) -> Scene:
+    """A walled room, 16 to 30 cells a side, random obstacle cells, maybe a hole, a free 1.2 m patch."""
+    rows, cols = draw(st.integers(16, 30)), draw(st.integers(16, 30))
+    rng = np.random.default_rng(draw(st.integers(0, 2**31 - 1)))
+    grid = np.zeros((rows, cols), np.uint8)
+    grid[rng.random((rows, cols)) < draw(st.floats(0.0, 0.1))] = OBSTACLE
+    grid[0, :] = grid[-1, :] = grid[:, 0] = grid[:, -1] = OBSTACLE
+    if draw(st.booleans()):
+        r, c = draw(st.integers(1, rows - 4)), draw(st.integers(1, cols - 4))
+        grid[r : r + 3, c : c + 3] = VOID
+    # A free 12 x 12 patch, so that four robots and their goals always fit.
+    r, c = draw(st.integers(1, rows - 13)), draw(st.integers(1, cols - 13))
+    grid[r : r + 12, c : c + 12] = FREE
+    return Scene.from_array(grid, 0.1)
+
+
+@pytest.mark.parametrize("device", DEVICES)
+@settings(max_examples=10, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(
+    scene=crowded_scenes(),
+    seed=st.integers(0, 2**31 - 1),
+    n_worlds=st.integers(1, 3),
+    n_robots=st.integers(2, 4),
+    steps=st.integers(1, 120),
+    reward_type=st.sampled_from(["l2", "geodesic"]),
+    max_steps=st.integers(5, 60),
+    max_cycles=st.integers(3, 70),
+    finished=st.sampled_from(["park", "remove"]),
+)
+def test_fleet_matches_parallel_envs(
+    device: str, scene: Scene, seed: int, n_worlds: int, n_robots: int, steps: int, reward_type: str,
+    max_steps: int, max_cycles: int, finished: str,
+) -> None:
+    rng = np.random.default_rng(seed)
+    # goal_tolerance 0.2 m: the multi-robot env keeps goals max(0.4, 0.36, 0.1) m apart.
+    episodes = fleet_episodes(scene, n_worlds, n_robots, rng, goal_gap=0.4)
+    # Overshoot [-1, 1] (clipping), and drive straight ahead often, into walls and robots.
+    actions = rng.uniform(-1.2, 1.2, (steps, n_worlds, n_robots, 2)).astype(np.float32)
+    actions[rng.random((steps, n_worlds, n_robots)) < 0.4, 0] = 1.0
+    task = {"reward_type": reward_type, "goal_tolerance": 0.2,
+            "termination_config": {"max_steps": max_steps, "max_collisions": 15}}
+    compare_fleet(scene, episodes, actions, task=task, device=device, finished=finished, max_cycles=max_cycles)
+
+
+@pytest.mark.parametrize("device", DEVICES)
+@settings(max_examples=30, deadline=None)
+@given(scene=crowded_scenes(), seed=st.integers(0, 2**31 - 1), n_robots=st.integers(1, 4))
+def test_one_slow_robot_resolves_as_in_the_multi_robot_resolver(device: str, scene: Scene, seed: int, n_robots: int) -> None:
+    """The env's shortcut for a world with one slow robot (the one-robot resolver) equals
+    the multi-robot resolver with that robot the only one present."""
+    from pointnav_core.vector.contacts import advance
+    from pointnav_core.vector.floors import FloorTables
+    from pointnav_core.vector.robots import advance_robots, robot_walls
+    from pointnav_core.vector.xp import make_arrays
+
+    rng = np.random.default_rng(seed)
+    a, radius, travel, worlds = make_arrays(device), 0.18, 0.05, 32
+    floors = FloorTables([scene], 0, radius, a)
+    xy = np.array([scene.get_random_point(0, robot=radius, rng=rng)[1][:2] for _ in range(worlds * n_robots)])
+    x, y = xy[:, 0].reshape(worlds, n_robots), xy[:, 1].reshape(worlds, n_robots)
+    heading = rng.uniform(-np.pi, np.pi, (worlds, n_robots))
+    length = rng.uniform(0.0, travel, (worlds, n_robots))
+    mx, my = length * np.cos(heading), length * np.sin(heading)
+    mover = rng.integers(n_robots, size=worlds)
+    present = np.arange(n_robots)[None, :] == mover[:, None]
+    args = [a.asarray(v) for v in (x, y, mx, my)]
+    scene_ids = a.zeros((worlds, n_robots), a.i64)
+    walls = robot_walls(floors, scene_ids, *args, radius, travel)
+    got = [a.numpy(v) for v in advance_robots(a, *args, radius, present=a.asarray(present, a.boolean), walls=walls)]
+    rows = np.arange(worlds)
+    one = [a.asarray(v[rows, mover]) for v in (x, y, mx, my)]
+    want = [a.numpy(v) for v in advance(floors, a.zeros(worlds, a.i64), *one, radius, travel)]
+    np.testing.assert_allclose(got[0][rows, mover], want[0], rtol=0, atol=1e-12)
+    np.testing.assert_allclose(got[1][rows, mover], want[1], rtol=0, atol=1e-12)
+    np.testing.assert_array_equal(got[2][rows, mover], want[2])

@@ -1,0 +1,353 @@
+"""Several robots per world in the batched engine: ``VectorPointNavEnv(n, n_robots=R)``.
+
+Every world is a :class:`~pointnav_core.parallel.MultiPointNavEnv` with ``R`` robots on
+the kinematic backend (``finished="park"`` by default, or ``"remove"``), stepped as
+``(num_envs, n_robots)`` arrays: robots that could meet a wall or each other are resolved
+together by :func:`~pointnav_core.vector.robots.advance_robots` on one clock per world
+(by the one-robot :func:`~pointnav_core.vector.contacts.advance` where a world has only
+one such robot), the others move by their arc (the backend's fast path). Each robot's task accounting is
+the one-robot engine's, masked by the robots still active (PettingZoo's ``agents``).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping, Sequence
+from typing import Any
+
+import gymnasium as gym
+import numpy as np
+
+from pointnav_core import _envcommon, scenes, validation
+from pointnav_core.vector.contacts import advance
+from pointnav_core.vector.env import (
+    _FALL_SPEED,
+    _GRAVITY,
+    _MAX_TURN,
+    _MIN_FIRST_DROP,
+    VectorPointNavEnv,
+    _default_scene,
+)
+from pointnav_core.vector.fleet_pool import FleetPool, check_fixed_episode
+from pointnav_core.vector.floors import FloorTables
+from pointnav_core.vector.robots import advance_robots, robot_walls
+from pointnav_core.vector.xp import make_arrays
+
+__all__ = ["FINISHED_MODES", "VectorFleetEnv"]
+
+#: What happens to a robot whose episode ended, as in :mod:`pointnav_core.parallel`.
+FINISHED_MODES = ("park", "remove")
+
+
+class VectorFleetEnv(VectorPointNavEnv):
+    """``num_envs`` worlds of ``n_robots`` robots each, stepped as arrays.
+
+    Built by ``VectorPointNavEnv(num_envs, n_robots=R, ...)`` with ``R > 1``; see
+    :class:`~pointnav_core.vector.VectorPointNavEnv` ("Several robots per world") for the
+    interface. Parameters are those of ``VectorPointNavEnv`` plus:
+
+    Parameters
+    ----------
+    max_cycles : int
+        Steps after which every robot still active is truncated, >= 1 (the multi-robot
+        env's argument; default 500).
+    finished : {"park", "remove"}
+        A robot whose episode ended stays as an obstacle, or leaves the world.
+    """
+
+    def __init__(
+        self,
+        num_envs: int = 1,
+        n_robots: int = 2,
+        scene: scenes.Scene | Sequence[scenes.Scene] | None = None,
+        robot: Any = None,
+        task: Mapping[str, Any] | None = None,
+        sensors: Mapping[str, Any] | None = None,
+        device: str = "numpy",
+        seed: int | None = None,
+        pool_size: int = 8,
+        action_frequency: float = 10.0,
+        max_episode_steps: int | None = None,
+        max_cycles: int = 500,
+        finished: str = "park",
+    ) -> None:
+        from pointnav_core.parallel import parallel_env
+
+        self.num_envs = validation.integer("num_envs", num_envs, minimum=1)
+        self.n_robots = validation.integer("n_robots", n_robots, minimum=2)
+        self.max_cycles = validation.integer("max_cycles", max_cycles, minimum=1)
+        if not isinstance(finished, str) or finished not in FINISHED_MODES:
+            raise ValueError(f"finished must be one of {list(FINISHED_MODES)}, got {finished!r}")
+        self.finished = finished
+        if sensors is not None:  # vector.scan casts (W, R) robots, but it is not wired here yet
+            raise ValueError(f"sensors must be None with several robots per world (not supported yet), got {sensors!r}")
+        self.scan = None
+        if task is not None and not isinstance(task, Mapping):
+            raise ValueError(f"task must be None or a dict of PointNavigationTask arguments, got {task!r}")
+        for key in ("termination_conditions", "reward_functions", "observation_terms"):
+            if task is not None and task.get(key) is not None:
+                raise ValueError(f"task: {key} is not supported by the batched engine")
+        task = dict(task or {})
+        if max_episode_steps is not None:
+            steps = validation.integer("max_episode_steps", max_episode_steps, minimum=1)
+            task["termination_config"] = {**dict(task.get("termination_config") or {}), "max_steps": steps}
+        self.pool_size = validation.integer("pool_size", pool_size, minimum=1)
+        self.arrays = a = make_arrays(device)
+        self.device = device
+        scene_list = [scene] if isinstance(scene, scenes.Scene) else list(scene) if scene is not None else [_default_scene()]
+        if not scene_list or not all(isinstance(s, scenes.Scene) for s in scene_list):
+            raise ValueError(f"scene must be a Scene or a non-empty sequence of Scenes, got {scene!r}")
+        self.robot = spec = _envcommon.make_robot(robot)
+        if spec.drive != "differential":
+            raise ValueError(f"robot must have a differential drive in the batched engine, got {spec.drive!r}")
+        self.scenes = scene_list
+        # The multi-robot env of each scene samples its episodes and is the semantics.
+        self._samplers = [
+            parallel_env(scene=s, n_robots=self.n_robots, robot=spec, task=dict(task), backend="kinematic",
+                         max_cycles=self.max_cycles, finished=finished, action_frequency=action_frequency)
+            for s in scene_list
+        ]
+        first = self._samplers[0]
+        self.action_frequency = first.action_frequency
+        self.dt = 1.0 / self.action_frequency
+        self.task = t = first.tasks[0]
+        cfg, rcfg = t.termination_config, t.reward_config
+        self.max_steps, self.max_collisions = int(cfg["max_steps"]), int(cfg["max_collisions"])
+        self.fall_height, self.goal_tolerance = float(cfg["fall_height"]), t.goal_tolerance
+        self.r_potential, self.r_collision, self.r_pointgoal = (float(rcfg[k]) for k in ("r_potential", "r_collision", "r_pointgoal"))
+        self.geodesic_reward = t.reward_type == "geodesic"
+        self.goal_in_polar = t.goal_in_polar
+        if spec.max_angular_velocity * self.dt > _MAX_TURN or spec.max_linear_velocity * self.dt > 0.5 * min(
+            float(s.floors[t.floor].resolution) for s in scene_list
+        ):
+            raise ValueError(
+                f"action_frequency {self.action_frequency} Hz is too low for the batched engine: one control "
+                "step may turn at most 0.25 rad and drive at most half a cell (the kinematic backend's sub-step)"
+            )
+        self.floors = FloorTables(scene_list, t.floor, spec.radius, a)
+        self._max_travel = spec.max_linear_velocity * self.dt * (1.0 + 1e-9) + 1e-12
+        bounds = [env.tasks[0].observation_bounds for env in self._samplers]
+        self._low = a.asarray(np.stack([b[0] for b in bounds]).astype(np.float64))[:, None, :]
+        self._high = a.asarray(np.stack([b[1] for b in bounds]).astype(np.float64))[:, None, :]
+        low, high = np.min([b[0] for b in bounds], axis=0), np.max([b[1] for b in bounds], axis=0)
+        self.single_observation_space = gym.spaces.Box(low, high, dtype=np.float32)
+        self.single_action_space = first.action_space(first.possible_agents[0])
+        batch = gym.vector.utils.batch_space
+        self.observation_space = batch(batch(self.single_observation_space, self.n_robots), self.num_envs)
+        self.action_space = batch(batch(self.single_action_space, self.n_robots), self.num_envs)
+        self._rng = np.random.default_rng(seed)
+        n, r = self.num_envs, self.n_robots
+        self._world_scene = a.asarray(np.arange(n) % len(scene_list), a.i64)
+        self._robot_scene = a.asarray(np.repeat(np.arange(n) % len(scene_list), r).reshape(n, r), a.i64)
+        self._robot_ids = a.asarray(np.arange(r), a.i64).reshape(1, r)
+        self._fixed: Any = None
+        self.pool: FleetPool | None = None  # type: ignore[assignment]
+        keys = ("x", "y", "yaw", "z", "vx", "vy", "vz", "w", "gx", "gy", "d0", "pot", "path", "dist")
+        self._state = {k: a.zeros((n, r)) for k in keys}
+        self._field = a.zeros((n, r), a.i64)
+        self._geo_metric = a.zeros((n, r), a.boolean)
+        self._steps = a.zeros((n, r), a.i64)
+        self._collisions = a.zeros((n, r), a.i64)
+        self._active = a.zeros((n, r), a.boolean)
+        self._present = a.zeros((n, r), a.boolean)
+        self._cycles = a.zeros(n, a.i64)
+        self._needs_reset = a.zeros(n, a.boolean)
+        self._started = False
+
+    # ------------------------------------------------------------------ pools
+    def _build_pool(self, fixed: Sequence[Any]) -> None:
+        size = 0 if fixed else self.pool_size
+        seeds = self._rng.integers(2**31, size=size * len(self.scenes))
+        self.pool = FleetPool(self._samplers, size, seeds, self.arrays, fixed)
+
+    def reset(self, *, seed: int | None = None, options: dict[str, Any] | None = None) -> tuple[Any, dict[str, Any]]:
+        """Reset every world. ``options={"episodes": [[(start_xy, yaw, goal_xy), ...], ...]}``
+        (per world, one tuple per robot) fixes each world's episode, at this reset and every
+        autoreset, until a reset without it; a new ``seed`` redraws the pools."""
+        a = self.arrays
+        if options is not None and not isinstance(options, Mapping):
+            raise ValueError(f"options must be None or a dict, got {options!r}")
+        episodes = (options or {}).get("episodes")
+        if seed is not None:
+            self._rng = np.random.default_rng(validation.integer("seed", seed, minimum=0))
+        if episodes is not None:
+            if len(episodes) != self.num_envs:
+                raise ValueError(f"options['episodes'] must hold one episode per world ({self.num_envs}), got {len(episodes)}")
+            scene_of = a.numpy(self._world_scene)
+            fixed = []
+            for i, episode in enumerate(episodes):
+                s = int(scene_of[i])
+                fixed.append((check_fixed_episode(self._samplers[s], episode, f"options['episodes'][{i}]"), s))
+            self._build_pool(fixed)
+            self._fixed = a.asarray(self.pool.n_sampled + np.arange(self.num_envs), a.i64)
+        elif self.pool is None or seed is not None or self._fixed is not None:
+            self._fixed = None
+            self._build_pool(())
+        every = a.full(self.num_envs, True, a.boolean)
+        with np.errstate(invalid="ignore", divide="ignore"):
+            self._reset_worlds(every)
+            self._started = True
+            zero, no = a.zeros((self.num_envs, self.n_robots)), a.zeros((self.num_envs, self.n_robots), a.boolean)
+            shown = self._active.clone() if a.is_torch else self._active.copy()
+            return self._observe(shown), self._info(no, zero, zero, zero, no, shown, no)
+
+    def _reset_worlds(self, mask: Any) -> None:
+        a, xp, st, p = self.arrays, self.arrays.xp, self._state, self.pool
+        if self._fixed is not None:
+            ep = self._fixed
+        else:
+            k = a.asarray(self._rng.integers(self.pool_size, size=self.num_envs), a.i64)
+            ep = self._world_scene * p.pool_size + k
+        idx = a.nonzero(mask)
+        e = ep[idx]
+        for key, src in (("x", p.sx), ("y", p.sy), ("yaw", p.syaw), ("gx", p.gx), ("gy", p.gy), ("d0", p.d0)):
+            st[key][idx] = src[e]
+        st["z"][idx] = self.floors.height[self._world_scene[idx]][:, None] + 0.0 * st["x"][idx]
+        for key in ("vx", "vy", "vz", "w", "path"):
+            st[key][idx] = 0.0
+        field = e[:, None] * self.n_robots + self._robot_ids
+        self._field[idx] = field
+        self._steps[idx] = 0
+        self._collisions[idx] = 0
+        self._cycles[idx] = 0
+        self._active[idx] = True
+        self._present[idx] = True
+        d0 = st["d0"][idx]
+        geo = self.geodesic_reward & (d0 < math.inf)
+        self._geo_metric[idx] = geo
+        x, y = st["x"][idx], st["y"][idx]
+        dist = p.fields.distance(field, x, y)
+        st["dist"][idx] = dist
+        l2 = xp.sqrt((st["gx"][idx] - x) ** 2 + (st["gy"][idx] - y) ** 2)
+        st["pot"][idx] = xp.where(geo, xp.where(dist < math.inf, dist, d0), l2)
+        self._needs_reset[idx] = False
+
+    def check_actions(self, actions: Any) -> Any:
+        """``actions`` as a float64 array ``(num_envs, n_robots, 2)``; ValueError naming ``actions`` if bad.
+
+        Every entry must be finite, also those of inactive robots (which are ignored).
+        """
+        shape = tuple(getattr(actions, "shape", np.shape(actions)))
+        want = (self.num_envs, self.n_robots, 2)
+        if shape != want:
+            raise ValueError(f"actions must have shape {want}, got {shape}")
+        arr = self.arrays.asarray(actions)
+        if not bool(self.arrays.xp.isfinite(arr).all()):
+            raise ValueError("actions must be finite (no NaN or infinity)")
+        return arr
+
+    def _step(self, actions: Any) -> tuple[Any, Any, Any, Any, dict[str, Any]]:
+        if not self._started:
+            raise RuntimeError("call reset() before step()")
+        a, xp, st = self.arrays, self.arrays.xp, self._state
+        act = self.check_actions(actions)
+        spec, dt, radius = self.robot, self.dt, self.robot.radius
+        acting, present = self._active, self._present
+        v0, v1 = act[..., 0], act[..., 1]
+        vmax, wmax = spec.max_linear_velocity, spec.max_angular_velocity
+        zero = xp.zeros_like(v0)
+        # Robots that are not agents any more get no command (the backend's _NO_COMMAND).
+        vx = xp.where(acting, xp.where(v0 >= 1.0, vmax, xp.where(v0 <= -1.0, -vmax, v0 * vmax)), zero)
+        w = xp.where(acting, xp.where(v1 >= 1.0, wmax, xp.where(v1 <= -1.0, -wmax, v1 * wmax)), zero)
+        x0, y0, yaw0 = st["x"], st["y"], st["yaw"]
+        half = 0.5 * w * dt
+        safe = xp.where(half != 0.0, half, 1.0)
+        s = dt * xp.where(half != 0.0, xp.sin(safe) / safe, 1.0)
+        mid = yaw0 + half
+        dx = s * (vx * xp.cos(mid) - 0.0 * xp.sin(mid))
+        dy = s * (vx * xp.sin(mid) + 0.0 * xp.cos(mid))
+        travel = xp.abs(vx) * dt
+        # The backend's fast path: clearance beyond the step and no other free robot within reach.
+        scene = self._robot_scene
+        row, col, inside = self.floors.cells(scene, x0, y0)
+        budget = self.floors.fast[self.floors.flat_index(scene, row, col, inside)]
+        reach = radius + travel
+        gap = reach[:, :, None] + reach[:, None, :]
+        gap2 = (x0[:, :, None] - x0[:, None, :]) ** 2 + (y0[:, :, None] - y0[:, None, :]) ** 2
+        ids = self._robot_ids
+        others = (ids.reshape(1, -1, 1) != ids.reshape(1, 1, -1)) & present[:, None, :] & (gap2 <= gap * gap)
+        fast = present & inside & (budget > travel) & ~others.any(-1)
+        slow = present & ~fast
+        x, y, yaw = x0 + xp.where(fast, dx, zero), y0 + xp.where(fast, dy, zero), yaw0 + w * dt
+        contact = zero > 1.0
+        z, vz = st["z"], zero + 0.0
+        n_slow = slow.sum(-1)
+        # A world with one slow robot is the one-robot resolver's case (the backend's
+        # advance with a single robot): cheaper, and most busy worlds are such.
+        alone = a.nonzero((slow & (n_slow == 1)[:, None]).reshape(-1))
+        if alone.shape[0]:
+            flat = [v.reshape(-1)[alone] for v in (scene, x0, y0, dx, dy)]
+            nx, ny, c = advance(self.floors, *flat, radius, self._max_travel)
+            x.reshape(-1)[alone], y.reshape(-1)[alone], contact.reshape(-1)[alone] = nx, ny, c
+        busy = a.nonzero(n_slow > 1)
+        if busy.shape[0]:
+            bx, by, bdx, bdy = x0[busy], y0[busy], dx[busy], dy[busy]
+            walls = robot_walls(self.floors, scene[busy], bx, by, bdx, bdy, radius, self._max_travel)
+            nx, ny, c = advance_robots(a, bx, by, bdx, bdy, radius, present=slow[busy], walls=walls)
+            bslow = slow[busy]
+            x[busy] = xp.where(bslow, nx, x[busy])
+            y[busy] = xp.where(bslow, ny, y[busy])
+            contact[busy] = c & bslow
+        fall = slow & self.floors.is_void(scene, x, y)
+        drop = max(_FALL_SPEED * dt + 0.5 * _GRAVITY * dt * dt, _MIN_FIRST_DROP)
+        z = xp.where(fall, z - drop, z)
+        vz = xp.where(fall, -drop / dt, vz)
+        vel_x = xp.where(fast, dx / dt, (x - x0) / dt)
+        vel_y = xp.where(fast, dy / dt, (y - y0) / dt)
+        vel_w = xp.where(fast, w, (yaw - yaw0) / dt)
+        vel_x, vel_y, vel_w = (xp.where(present, v, zero) for v in (vel_x, vel_y, vel_w))
+        # --- each active robot's task (PointNavigationTask.step), masked by ``acting``
+        path = st["path"] + xp.where(acting, xp.sqrt((x - x0) ** 2 + (y - y0) ** 2), zero)
+        steps = self._steps + a.to_int(acting)
+        collisions = self._collisions + a.to_int(contact & acting)
+        cycles = self._cycles + 1
+        dist = self.pool.fields.distance(self._field, x, y)
+        gx, gy = st["gx"], st["gy"]
+        l2 = xp.sqrt((gx - x) ** 2 + (gy - y) ** 2)
+        pot = xp.where(self._geo_metric, xp.where(dist < math.inf, dist, st["pot"]), l2)
+        success = acting & (l2 < self.goal_tolerance)
+        fell = acting & (z < self.floors.height[self._world_scene][:, None] - self.fall_height)
+        terminated = acting & ((collisions > self.max_collisions) | fell | success)
+        truncated = acting & ((steps >= self.max_steps) | (cycles >= self.max_cycles)[:, None])
+        r_pot = xp.where(acting, self.r_potential * (st["pot"] - pot), zero)
+        r_col = xp.where(acting & contact, -self.r_collision, zero)
+        r_goal = xp.where(success, self.r_pointgoal, zero)
+        reward = ((0.0 + r_pot) + r_col) + r_goal
+        ended = terminated | truncated
+        active = acting & ~ended
+        # A robot that fell leaves its floor; with "remove" every finished robot leaves.
+        gone = (ended & fell) if self.finished == "park" else ended
+        st.update(x=x, y=y, yaw=yaw, z=z, vx=vel_x, vy=vel_y, vz=vz, w=vel_w, path=path, dist=dist,
+                  pot=xp.where(acting, pot, st["pot"]))
+        self._steps, self._collisions, self._cycles = steps, collisions, cycles
+        self._active, self._present = active, present & ~gone
+        shown = acting
+        resetting = self._needs_reset.clone() if a.is_torch else self._needs_reset.copy()
+        if a.any(resetting):
+            # Next-step autoreset: every robot of a world with no agent left starts again.
+            self._reset_worlds(resetting)
+            keep = ~resetting[:, None]
+            reward, terminated, truncated, success, contact = (
+                v & keep if v.dtype == a.boolean else xp.where(keep, v, zero)
+                for v in (reward, terminated, truncated, success, contact)
+            )
+            r_pot, r_col, r_goal = (xp.where(keep, r, zero) for r in (r_pot, r_col, r_goal))
+            shown = xp.where(keep, acting, self._active)
+        self._needs_reset = ~self._active.any(-1)
+        info = self._info(success, r_pot, r_col, r_goal, contact, shown, resetting[:, None] & shown)
+        return self._observe(shown), reward, terminated, truncated, info
+
+    # ------------------------------------------------------------------ observation and info
+    def _observe(self, shown: Any) -> Any:
+        """The robots' ``low_dim`` observations, zero where ``shown`` is False."""
+        obs = super()._observe()
+        return obs * (shown[..., None].to(obs.dtype) if self.arrays.is_torch else shown[..., None])
+
+    def _info(self, success: Any, r_pot: Any, r_col: Any, r_goal: Any, contact: Any, shown: Any, resetting: Any) -> dict[str, Any]:
+        xp = self.arrays.xp
+        info = super()._info(success, r_pot, r_col, r_goal, contact, resetting)
+        for key, value in info.items():
+            if key != "autoreset":
+                info[key] = value & shown if value.dtype == self.arrays.boolean else xp.where(shown, value, xp.zeros_like(value))
+        info["active"] = self._active.clone() if self.arrays.is_torch else self._active.copy()
+        return info

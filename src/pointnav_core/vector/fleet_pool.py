@@ -1,0 +1,124 @@
+"""Episode pools for several robots per world, drawn by the multi-robot env's own reset.
+
+Each scene gets ``pool_size`` episodes of ``n_robots`` robots, sampled by a
+:class:`~pointnav_core.parallel.MultiPointNavEnv` of that scene on the kinematic backend,
+so its rules hold: starts that do not overlap, goals kept
+:func:`~pointnav_core.fleet.goal_separation` apart, the derived ``path_range``. Every
+robot's goal field is settled into one :class:`~pointnav_core.vector.fields.FieldTables`,
+entry ``episode * n_robots + robot``.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from typing import Any
+
+import numpy as np
+
+from pointnav_core.vector.fields import FieldTables
+from pointnav_core.vector.xp import Arrays
+
+__all__ = ["FleetEpisode", "FleetPool", "check_fixed_episode"]
+
+#: One robot's fixed episode: start ``(x, y)`` (m), yaw (rad), goal ``(x, y)`` (m).
+FleetEpisode = tuple[Any, float, Any]
+
+
+def check_fixed_episode(sampler: Any, episode: Sequence[FleetEpisode], where: str) -> list[tuple[Any, float, Any]]:
+    """One world's fixed robots, checked by the multi-robot env's rules; ValueError naming ``where``.
+
+    Each start and goal must be usable by the robot, starts at least two radii apart and
+    goals :func:`~pointnav_core.fleet.goal_separation` apart.
+    """
+    n = len(sampler.tasks)
+    try:
+        robots = [(start, float(yaw), goal) for start, yaw, goal in episode]
+    except (TypeError, ValueError):
+        raise ValueError(f"{where} must hold {n} (start_xy, yaw, goal_xy) tuples, got {episode!r}") from None
+    if len(robots) != n:
+        raise ValueError(f"{where} must hold one (start_xy, yaw, goal_xy) per robot ({n}), got {len(robots)}")
+    scene, floor, spec = sampler.scene, sampler.tasks[0].floor, sampler.robots[0]
+    for r, (start, yaw, goal) in enumerate(robots):
+        if not math.isfinite(yaw):
+            raise ValueError(f"{where}[{r}]: yaw must be finite, got {yaw}")
+        for name, xy in (("start", start), ("goal", goal)):
+            if not scene.is_usable(floor, xy, spec):
+                raise ValueError(f"{where}[{r}]: {name} {list(xy)} is not usable by the robot")
+    sep = sampler._separation
+    for i in range(n):
+        for j in range(i + 1, n):
+            (si, _, gi), (sj, _, gj) = robots[i], robots[j]
+            if math.dist(si[:2], sj[:2]) < 2.0 * spec.radius:
+                raise ValueError(f"{where}: robots {i} and {j} start overlapping ({math.dist(si[:2], sj[:2]):.3g} m apart)")
+            if math.dist(gi[:2], gj[:2]) < sep[i][j]:
+                raise ValueError(
+                    f"{where}: robots {i} and {j} have goals {math.dist(gi[:2], gj[:2]):.3g} m apart, "
+                    f"closer than the multi-robot env's {sep[i][j]:.3g} m"
+                )
+    return robots
+
+
+class FleetPool:
+    """Episodes of ``n_robots`` robots as ``(episodes, n_robots)`` arrays.
+
+    Attributes ``sx, sy, syaw`` (start, m and rad), ``gx, gy`` (goal, m), ``d0`` (the
+    start's geodesic distance, m; inf if unreachable) and ``fields`` (entry
+    ``episode * n_robots + robot``). The first ``pool_size * len(samplers)`` episodes are
+    sampled, scene by scene; fixed ones follow.
+
+    Parameters
+    ----------
+    samplers : sequence of MultiPointNavEnv
+        One per scene (kinematic backend), with the robots and tasks to sample.
+    pool_size : int
+        Episodes per scene.
+    seeds : sequence of int
+        ``pool_size * len(samplers)`` reset seeds, sampler by sampler.
+    arrays : Arrays
+    fixed : sequence of (robots, scene index)
+        Given episodes (``robots`` as :func:`check_fixed_episode` returns them).
+    """
+
+    def __init__(
+        self,
+        samplers: Sequence[Any],
+        pool_size: int,
+        seeds: Sequence[int],
+        arrays: Arrays,
+        fixed: Sequence[tuple[Sequence[tuple[Any, float, Any]], int]] = (),
+    ) -> None:
+        rows: list[list[tuple[float, ...]]] = []
+        fields = []
+        k = 0
+        for env in samplers:
+            backend = env.backend
+            for _ in range(pool_size):
+                env.reset(seed=int(seeds[k]))
+                k += 1
+                episode = []
+                for i, task in enumerate(env.tasks):
+                    x, y, yaw = backend._pose(backend._robots[i])
+                    gx, gy = task.goal_xy
+                    episode.append((x, y, yaw, gx, gy, task.geodesic_dist))
+                    fields.append(task._goal_field.field)
+                rows.append(episode)
+        for robots, s in fixed:
+            env = samplers[s]
+            episode = []
+            for start, yaw, goal in robots:
+                field = env.scene.goal_field(env.tasks[0].floor, goal, robot=env.robots[0])
+                episode.append((float(start[0]), float(start[1]), yaw, float(goal[0]), float(goal[1]), field.exact_distance(start)))
+                fields.append(field.field)
+            rows.append(episode)
+        n_robots = len(samplers[0].tasks)
+        table = np.array(rows, dtype=np.float64).reshape(-1, n_robots, 6)
+        a = arrays
+        self.sx, self.sy, self.syaw, self.gx, self.gy, self.d0 = (a.asarray(table[..., i]) for i in range(6))
+        self.fields = FieldTables(fields, arrays)
+        self.n_sampled = pool_size * len(samplers)
+        self.pool_size = pool_size
+        self.n_robots = n_robots
+
+    def __len__(self) -> int:
+        return int(self.sx.shape[0])

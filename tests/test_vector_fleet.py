@@ -1,0 +1,181 @@
+"""Several robots per world in the batched engine: shapes, the active mask by hand, bad input."""
+
+from __future__ import annotations
+
+import importlib.util
+import math
+
+import numpy as np
+import pytest
+from fleet_reference import compare_fleet, fleet_episodes
+
+from pointnav_core.maps import OBSTACLE, VOID
+from pointnav_core.scenes import Scene
+from pointnav_core.vector import VectorPointNavEnv
+
+DEVICES = ["numpy"] + (["cpu"] if importlib.util.find_spec("torch") else [])
+INFO_KEYS = ("success", "spl", "soft_spl", "path_length", "geodesic_dist", "distance_to_goal", "collisions",
+             "episode_length", "in_contact", "reward_potential", "reward_collision", "reward_pointgoal",
+             "autoreset", "active")
+
+
+def room(rows: int = 30, cols: int = 40) -> Scene:
+    grid = np.zeros((rows, cols), np.uint8)
+    grid[0, :] = grid[-1, :] = grid[:, 0] = grid[:, -1] = OBSTACLE
+    return Scene.from_array(grid, 0.1)
+
+
+# Robot 0 faces its goal 0.52 m ahead (tolerance 0.2 m, 0.05 m a step): 0.17 m are left
+# after 7 steps, at x = 1.35. Robot 1 stands 0.85 m further on, facing it, with a far goal.
+HEAD_ON = [[((1.0, 1.5), 0.0, (1.52, 1.5)), ((2.2, 1.5), math.pi, (1.0, 2.5))]]
+TASK = {"goal_tolerance": 0.2}
+
+
+@pytest.mark.parametrize("device", DEVICES)
+def test_shapes_and_types(device: str) -> None:
+    env = VectorPointNavEnv(3, n_robots=4, scene=room(), task=TASK, device=device, seed=0, pool_size=2)
+    assert isinstance(env, VectorPointNavEnv)
+    assert env.observation_space.shape == (3, 4, 8) and env.action_space.shape == (3, 4, 2)
+    to_np = env.arrays.numpy
+    obs, info = env.reset()
+    assert to_np(obs).shape == (3, 4, 8) and to_np(obs).dtype == np.float32
+    assert sorted(info) == sorted(INFO_KEYS) and all(to_np(v).shape == (3, 4) for v in info.values())
+    assert to_np(info["active"]).all()
+    obs, reward, terminated, truncated, info = env.step(np.zeros((3, 4, 2)))
+    assert to_np(obs).shape == (3, 4, 8) and to_np(obs).dtype == np.float32
+    assert to_np(reward).dtype == np.float64 and to_np(reward).shape == (3, 4)
+    assert to_np(terminated).dtype == np.bool_ and to_np(truncated).dtype == np.bool_
+    assert to_np(info["active"]).dtype == np.bool_ and to_np(info["episode_length"]).tolist() == [[1] * 4] * 3
+    # Starts and goals came from the multi-robot env's sampler: apart by its rules.
+    p = env.pool
+    sx, sy, gx, gy = (to_np(v) for v in (p.sx, p.sy, p.gx, p.gy))
+    for e in range(len(p)):
+        for i in range(4):
+            for j in range(i):
+                assert math.dist((sx[e, i], sy[e, i]), (sx[e, j], sy[e, j])) >= 2 * 0.18
+                assert math.dist((gx[e, i], gy[e, i]), (gx[e, j], gy[e, j])) >= max(0.4, 0.36, 0.1)
+
+
+def test_one_robot_keeps_the_one_robot_engine() -> None:
+    env = VectorPointNavEnv(2, scene=room(), pool_size=1, seed=0)
+    assert type(env) is VectorPointNavEnv
+    assert env.reset()[0].shape == (2, 8)
+
+
+@pytest.mark.parametrize("device", DEVICES)
+def test_a_parked_robot_blocks_until_the_world_resets(device: str) -> None:
+    env = VectorPointNavEnv(1, n_robots=2, scene=room(), task=TASK, device=device, max_cycles=20)
+    to_np = env.arrays.numpy
+    first, _ = env.reset(options={"episodes": HEAD_ON})
+    arrive, drive = [[1.0, 0.0], [0.0, 0.0]], [[0.0, 0.0], [1.0, 0.0]]
+    for step in range(1, 8):
+        obs, reward, terminated, _, info = env.step(np.array([arrive]))
+        assert to_np(terminated)[0].tolist() == [step == 7, False]
+        assert to_np(info["active"])[0].tolist() == [step < 7, True]
+    assert to_np(info["success"])[0].tolist() == [True, False]
+    assert abs(float(to_np(env._state["x"])[0, 0]) - 1.35) < 1e-9
+    # Robot 0 is no agent any more: its action is ignored and its entries are zero.
+    for step in range(8, 21):
+        obs, reward, terminated, truncated, info = env.step(np.array([drive]) + [[1.0, 1.0], [0.0, 0.0]])
+        assert (to_np(obs)[0, 0] == 0.0).all() and to_np(reward)[0, 0] == 0.0
+        assert not to_np(info["active"])[0, 0] and to_np(info["episode_length"])[0, 0] == 0
+        # Robot 1 closes 0.85 m to 0.36 m (two radii) in 9.8 steps, then rests on robot 0.
+        assert bool(to_np(info["in_contact"])[0, 1]) == (step >= 17)
+    x1 = float(to_np(env._state["x"])[0, 1])
+    assert abs(x1 - (1.35 + 0.36)) < 1e-8
+    assert to_np(info["collisions"])[0, 1] == 4
+    # max_cycles = 20: robot 1 is truncated, no robot is left, the next step resets the world.
+    assert to_np(truncated)[0].tolist() == [False, True] and not to_np(info["active"]).any()
+    obs, reward, terminated, truncated, info = env.step(np.array([drive]))
+    assert to_np(info["autoreset"]).all() and to_np(info["active"]).all()
+    np.testing.assert_array_equal(to_np(obs), to_np(first))
+    assert (to_np(reward) == 0.0).all() and not to_np(terminated).any() and not to_np(truncated).any()
+
+
+@pytest.mark.parametrize("device", DEVICES)
+def test_a_removed_robot_lets_the_others_pass(device: str) -> None:
+    env = VectorPointNavEnv(1, n_robots=2, scene=room(), task=TASK, device=device, finished="remove")
+    to_np = env.arrays.numpy
+    env.reset(options={"episodes": HEAD_ON})
+    for _ in range(7):
+        env.step(np.array([[[1.0, 0.0], [0.0, 0.0]]]))
+    for _ in range(13):
+        _, _, _, _, info = env.step(np.array([[[0.0, 0.0], [1.0, 0.0]]]))
+        assert not to_np(info["in_contact"]).any()
+    assert abs(float(to_np(env._state["x"])[0, 1]) - (2.2 - 13 * 0.05)) < 1e-9  # through robot 0's place
+
+
+@pytest.mark.parametrize("device", DEVICES)
+def test_crowded_worlds_match_parallel_envs(device: str) -> None:
+    # A 1.6 x 2 m room, four robots each: they meet each other and the parked ones often;
+    # a hole at one end takes robots that drive into it out of the world.
+    rng = np.random.default_rng(1)
+    grid = np.zeros((20, 16), np.uint8)
+    grid[0, :] = grid[-1, :] = grid[:, 0] = grid[:, -1] = OBSTACLE
+    grid[5, 5] = OBSTACLE
+    grid[16:19, 1:15] = VOID
+    scene = Scene.from_array(grid, 0.1)
+    actions = rng.uniform(-1.2, 1.2, (150, 4, 4, 2)).astype(np.float32)
+    actions[rng.random((150, 4, 4)) < 0.5, 0] = 1.0
+    task = {"reward_type": "geodesic", "goal_tolerance": 0.2, "termination_config": {"max_steps": 60, "max_collisions": 10}}
+    for finished in ("park", "remove"):
+        stats = compare_fleet(scene, fleet_episodes(scene, 4, 4, rng), actions, task=task, device=device,
+                              finished=finished, max_cycles=45)
+        # The run exercised what it claims to: robot contacts, parked robots, ends, autoresets.
+        assert stats["robot_contacts"] > 10 and stats["parked_steps"] > 100
+        assert stats["successes"] > 0 and stats["autoresets"] > 0 and stats["falls"] > 0
+
+
+@pytest.mark.parametrize("device", DEVICES)
+@pytest.mark.parametrize("actions", [np.zeros((2, 2)), np.zeros((2, 3, 2)), np.zeros((2, 2, 3)), np.zeros((3, 2, 2)),
+                                     np.zeros((2, 2, 2)) + [[[np.nan, 0.0], [0.0, 0.0]]] * 2,
+                                     np.zeros((2, 2, 2)) + [[[0.0, 0.0], [0.0, np.inf]]] * 2])
+def test_bad_actions_are_refused(device: str, actions: np.ndarray) -> None:
+    env = VectorPointNavEnv(2, n_robots=2, scene=room(), task=TASK, device=device, pool_size=1, seed=0)
+    env.reset()
+    before = env.arrays.numpy(env._state["x"])
+    with pytest.raises(ValueError, match="actions"):
+        env.step(actions)
+    np.testing.assert_array_equal(env.arrays.numpy(env._state["x"]), before)
+
+
+@pytest.mark.parametrize(("kwargs", "name"), [
+    ({"n_robots": 2, "finished": "vanish"}, "finished"), ({"n_robots": 2, "max_cycles": 0}, "max_cycles"),
+    ({"max_cycles": 10}, "max_cycles"), ({"finished": "park"}, "finished"),
+    ({"n_robots": 2, "sensors": {"scan": {}}}, "sensors"), ({"n_robots": 2, "pool_size": 0}, "pool_size"),
+    ({"n_robots": 2, "robot": {"drive": "holonomic"}}, "robot"), ({"n_robots": 2, "device": "tpu"}, "device"),
+])
+def test_unsupported_arguments_are_named(kwargs: dict, name: str) -> None:
+    with pytest.raises(ValueError, match=name):
+        VectorPointNavEnv(**{"num_envs": 1, "scene": room(), "task": TASK, **kwargs})
+
+
+@pytest.mark.parametrize(("episode", "words"), [
+    ([((1.0, 1.5), 0.0, (1.5, 1.5))], "one .* per robot"),
+    ([((1.0, 1.5), 0.0, (1.5, 1.5)), ((1.2, 1.5), 0.0, (2.5, 2.5))], "start overlapping"),
+    ([((1.0, 1.5), 0.0, (1.5, 1.5)), ((2.0, 1.5), 0.0, (1.5, 1.8))], "goals"),
+    ([((1.0, 1.5), 0.0, (1.5, 1.5)), ((0.05, 1.5), 0.0, (2.5, 2.5))], "not usable"),
+])
+def test_bad_fixed_episodes_are_refused(episode: list, words: str) -> None:
+    env = VectorPointNavEnv(1, n_robots=2, scene=room(), task=TASK)
+    with pytest.raises(ValueError, match=r"options\['episodes'\]\[0\].*" + words):
+        env.reset(options={"episodes": [episode]})
+
+
+def test_fields_without_labels_after_fields_with_labels() -> None:
+    # A goal behind a wall has labels (the way round it); one in open floor has none.
+    from pointnav_core.vector.fields import FieldTables
+    from pointnav_core.vector.xp import make_arrays
+
+    grid = np.zeros((30, 30), np.uint8)
+    grid[0, :] = grid[-1, :] = grid[:, 0] = grid[:, -1] = OBSTACLE
+    grid[15, 1:25] = OBSTACLE
+    behind = Scene.from_array(grid, 0.1).goal_field(0, (0.5, 2.5), robot=0.18)
+    open_floor = room(30, 30).goal_field(0, (2.0, 0.6), robot=0.18)
+    assert len(behind.field._search.node) > 0 and len(open_floor.field._search.node) == 0
+    tables = FieldTables([behind.field, open_floor.field], make_arrays("numpy"))
+    x, y = np.array([0.5, 2.0]), np.array([0.6, 1.0])
+    got = tables.distance(np.array([0, 1]), x, y)
+    # From (0.5, 0.6) round the wall's end at x = 2.5 and back, at least the two legs' straight parts.
+    assert got[0] > math.dist((0.5, 0.6), (2.5, 1.5)) + math.dist((2.5, 1.6), (0.5, 2.5))
+    assert abs(got[1] - 0.4) < 1e-12  # straight to the goal
