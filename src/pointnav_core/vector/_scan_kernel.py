@@ -3,7 +3,7 @@
 Imported only when the compiled path runs, so the package imports without numba. One loop
 over worlds, robots and rays, inside the kernel; each ray is the single env's
 crossing walk (:func:`walk`: the crossing test of ``sensors._raycast_kernel.grid_range``
-with cheaper jumps over the clear squares) on its world's grid, then
+with cheaper jumps over the free squares ahead) on its world's grid, then
 the discs of the world's other present robots, with the same expressions as the array
 path.
 """
@@ -28,12 +28,10 @@ _jit = numba.njit(cache=True, nogil=True, error_model="numpy")
 def walk(gx, gy, dx, dy, hp, wp, look, clr, e, n_cross, reach):  # pragma: no cover
     # Nearest blocked crossing (cell units) of one ray, _INF past reach: the crossing
     # families and the crossing test of raycast._grid_hits (the same expressions, so the
-    # same decisions), walked in order of t. Where the cell under the ray is C >= 2 cells
-    # (chessboard) from the nearest blocked one, the cells within C - 1 of it are free: the
-    # walk jumps to where the ray leaves that square, less a margin for rounding and e.
+    # same decisions), walked in order of t, with integer cells and the jumps over the free
+    # squares ahead of sensors._raycast_kernel.grid_range (see there why they are safe).
     plane = hp * wp
-    fhp1 = float(hp - 1)
-    fwp1 = float(wp - 1)
+    plane2 = 2 * plane
     posx = dx >= 0.0
     sx = 1.0 if posx else -1.0
     bx = math.floor(gx) + 1.0 if posx else math.ceil(gx) - 1.0
@@ -52,27 +50,37 @@ def walk(gx, gy, dx, dy, hp, wp, look, clr, e, n_cross, reach):  # pragma: no co
     a0y = gx + t0y * dx
     sty = dty * dx
     eny = by - (0.0 if posy else 1.0)
+    isx = 1 if posx else -1
+    isy = 1 if posy else -1
+    enx_i = int(enx)
+    eny_i = int(eny)
+    col0 = enx_i - isx  # the ray's cell while kx, ky are its next crossings
+    row0 = eny_i - isy
+    quad = (0 if posx else 1) + (0 if posy else 2)
     margin = 1e-6 + 2.0 * e
     kx = 0
     ky = 0
-    t = 0.0
     while True:
-        qx = gx + t * dx
-        qy = gy + t * dy
-        cx = math.floor(qx)
-        cy = math.floor(qy)
-        if 0.0 <= cx <= fwp1 and 0.0 <= cy <= fhp1:
-            c = clr[int(cy) * wp + int(cx)]
-            if c >= 2:
-                ex = (cx + c - qx if posx else qx - (cx - c + 1.0)) * dtx
-                ey = (cy + c - qy if posy else qy - (cy - c + 1.0)) * dty
-                target = t + min(ex, ey) - margin
-                # Jump each family to its first crossing at or after target (about: the
-                # margin keeps a rounding either way inside the free square).
-                if t0x < target:
-                    kx = max(kx, math.ceil((target - t0x) * adx))
-                if t0y < target:
-                    ky = max(ky, math.ceil((target - t0y) * ady))
+        col = col0 + isx * kx
+        row = row0 + isy * ky
+        if 0 <= col < wp and 0 <= row < hp:
+            side = clr[(row * wp + col) * 4 + quad]
+            if side >= 3:  # far sides: crossings kx + side - 2 and ky + side - 2
+                farx = t0x + float(kx + side - 2) * dtx
+                fary = t0y + float(ky + side - 2) * dty
+                # The nearer far side's family goes to it (its crossing before is a whole
+                # cell earlier, far beyond the margin); the other to its first crossing
+                # after the margin.
+                if farx <= fary:
+                    kx += side - 2
+                    target = farx - margin
+                    if t0y < target:
+                        ky = max(ky, math.ceil((target - t0y) * ady))
+                else:
+                    ky += side - 2
+                    target = fary - margin
+                    if t0x < target:
+                        kx = max(kx, math.ceil((target - t0x) * adx))
         fkx = float(kx)
         fky = float(ky)
         tx = t0x + fkx * dtx if kx < n_cross else _INF
@@ -82,25 +90,23 @@ def walk(gx, gy, dx, dy, hp, wp, look, clr, e, n_cross, reach):  # pragma: no co
                 return _INF
             across = a0x + stx * fkx
             hi = math.floor(across + e)
-            graze = math.floor(across - e) < hi
-            hi = min(max(hi, 0.0), fhp1)
-            ent = min(max(enx + sx * fkx, 0.0), fwp1)
-            if look[(plane if graze else 0) + int(hi) * wp + int(ent)]:
+            graze = across - e < hi  # floor(across - e) < hi, as hi is whole
+            hi = min(max(hi, 0), hp - 1)
+            ent = min(max(enx_i + isx * kx, 0), wp - 1)
+            if look[plane * int(graze) + hi * wp + ent]:
                 return tx
             kx += 1
-            t = tx
         else:
             if ty > reach:
                 return _INF
             across = a0y + sty * fky
             hi = math.floor(across + e)
-            graze = math.floor(across - e) < hi
-            hi = min(max(hi, 0.0), fwp1)
-            ent = min(max(eny + sy * fky, 0.0), fhp1)
-            if look[(2 * plane if graze else 0) + int(hi) + int(ent) * wp]:
+            graze = across - e < hi
+            hi = min(max(hi, 0), wp - 1)
+            ent = min(max(eny_i + isy * ky, 0), hp - 1)
+            if look[plane2 * int(graze) + hi + ent * wp]:
                 return ty
             ky += 1
-            t = ty
 
 
 @_jit
@@ -128,7 +134,7 @@ def cast_worlds(scene, x, y, cyaw, syaw, ca, sa, present, radius, max_range, met
         n_cross = min(math.ceil(reach) + 1, max(hp, wp) + 1)
         plane = hp * wp
         look = lookup[loff : loff + 3 * plane]
-        clr = clear[coff : coff + plane]
+        clr = clear[coff : coff + 4 * plane]  # four quadrants a cell
         for i in range(n_robots):
             if not present[w, i]:
                 out[w, i, :] = max_range

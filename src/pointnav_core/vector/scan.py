@@ -17,8 +17,8 @@ Two paths give the same ranges (``property_tests/test_vector_scan_props.py``):
   fixed number of blocks of :data:`BLOCK` (set by ``max_range`` and the finest cell size,
   not by the scene), so that the temporaries stay small;
 - the compiled path (numpy on the CPU with numba, the ``fast`` extra): the single env's
-  kernel (``sensors._raycast_kernel.grid_range``, which jumps over the clear square of a
-  Chebyshev distance transform) ray by ray, in one compiled loop over worlds, robots and
+  kernel (``sensors._raycast_kernel.grid_range``, which jumps over the free squares ahead
+  of the ray, :mod:`pointnav_core.sensors.clearance`) ray by ray, in one compiled loop over worlds, robots and
   rays (:mod:`pointnav_core.vector._scan_kernel`).
 
 Both take the rays' directions from the same products ``cos(yaw) cos(a) - sin(yaw) sin(a)``
@@ -82,8 +82,8 @@ class ScanTables:
         self.meta = np.ascontiguousarray(meta, dtype=np.float64)
         #: The three lookup planes of every padded grid, end to end (bool, numpy).
         self.lookup = np.ascontiguousarray(np.concatenate(lookups))
-        #: Chessboard distance (cells) of every padded cell to the nearest blocked one (int32).
-        self.clearance = np.ascontiguousarray(np.concatenate(clears), dtype=np.int32)
+        #: Per padded cell and quadrant, the free square ahead (sensors.clearance, uint8).
+        self.clearance = np.ascontiguousarray(np.concatenate(clears), dtype=np.uint8)
         self.min_res = float(self.meta[:, 4].min())
         self.max_side = int(self.meta[:, 2:4].max())
         a = self.arrays = arrays
