@@ -143,6 +143,24 @@ def test_scans_see_the_other_robot_until_it_leaves(device: str, finished: str) -
     assert abs(obs[1, 2] - want) < 1e-6
 
 
+def test_noisy_scans_repeat_with_the_seed_and_change_no_episode() -> None:
+    noisy = {"scan": {"n_rays": 8, "noise_std": 0.05, "dropout": 0.1}}
+    actions = np.random.default_rng(3).uniform(-1, 1, (12, 2, 3, 2))
+
+    def run(sensors: dict) -> np.ndarray:
+        env = VectorPointNavEnv(2, n_robots=3, scene=room(), task=TASK, sensors=sensors, seed=5, pool_size=2)
+        out = [env.reset(seed=7)[0]]
+        out += [env.step(a)[0] for a in actions]
+        return np.stack(out)
+
+    first, again, exact = run(noisy), run(noisy), run({"scan": {"n_rays": 8}})
+    np.testing.assert_array_equal(first, again)
+    np.testing.assert_array_equal(first[..., :8], exact[..., :8])  # the same episodes and motion
+    seen = exact[..., 8:] < np.float32(5.6)  # noise only on returns; dropout reads max_range
+    assert (first[..., 8:][seen] != exact[..., 8:][seen]).mean() > 0.5
+    assert (first[..., 8:][~seen] == np.float32(5.6)).all()
+
+
 @pytest.mark.parametrize("sensors", [None, {"scan": {"n_rays": 12, "max_range": 2.0, "min_range": 0.05}}])
 @pytest.mark.parametrize("device", DEVICES)
 def test_crowded_worlds_match_parallel_envs(device: str, sensors: dict | None) -> None:
