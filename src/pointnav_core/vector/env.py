@@ -118,7 +118,9 @@ class VectorPointNavEnv(VectorEnv):
     (rewards, terminations, SPL), and all robots still active are truncated after
     ``max_cycles`` steps. Every return carries the robot axis: ``step`` takes actions
     ``(num_envs, R, 2)`` (all finite; those of inactive robots are ignored) and returns
-    observations ``(num_envs, R, 8)`` float32, rewards ``(num_envs, R)`` float64,
+    observations ``(num_envs, R, 8)`` float32 (``(num_envs, R, 8 + n_rays)`` with the scan,
+    which sees the other robots present in its world as the multi-robot env's scan does),
+    rewards ``(num_envs, R)`` float64,
     terminated and truncated ``(num_envs, R)`` bool and ``info`` arrays ``(num_envs, R)``
     with, besides the keys above, ``active``: the robots that are still agents (PettingZoo's
     ``agents``). A robot whose episode ended returns its last observation, reward and flags
@@ -501,13 +503,17 @@ class VectorPointNavEnv(VectorEnv):
         vx, vy = st["vx"], st["vy"]
         zero = xp.zeros_like(vx)
         obs = xp.stack([lx, ly, c * vx + s * vy, c * vy - s * vx, st["vz"], zero, zero, st["w"]], -1)
-        if self.scan is not None:  # the heading as the single env's frame gives it
-            yaw, one = xp.arctan2(s, c)[:, None], xp.ones_like(c)[:, None] > 0.0
-            ranges = self.scan.readings(self._world_scene, st["x"][:, None], st["y"][:, None], yaw, one, self.robot.radius)
-            obs = (xp.cat if a.is_torch else xp.concatenate)([obs, ranges[:, 0]], -1)
+        if self.scan is not None:
+            obs = (xp.cat if a.is_torch else xp.concatenate)([obs, self._scan_ranges(c, s)], -1)
         sc = self._world_scene
         obs = xp.minimum(xp.maximum(obs, self._low[sc]), self._high[sc])
         return obs.to(xp.float32) if a.is_torch else obs.astype(np.float32)
+
+    def _scan_ranges(self, c: Any, s: Any) -> Any:
+        """The scan's readings (m), ``(num_envs, n_rays)``, at the headings' cosines ``c`` and sines ``s``."""
+        xp, st = self.arrays.xp, self._state
+        yaw, one = xp.arctan2(s, c)[:, None], xp.ones_like(c)[:, None] > 0.0  # the single env's frame heading
+        return self.scan.readings(self._world_scene, st["x"][:, None], st["y"][:, None], yaw, one, self.robot.radius)[:, 0]
 
     def _info(self, success: Any, r_pot: Any, r_col: Any, r_goal: Any, contact: Any, resetting: Any) -> dict[str, Any]:
         xp, st = self.arrays.xp, self._state
