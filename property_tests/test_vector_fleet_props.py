@@ -5,7 +5,8 @@ of 2 to 4 robots and random action sequences, ``VectorPointNavEnv(W, n_robots=R)
 matches ``W`` separate ``parallel_env(n_robots=R, backend="kinematic")`` step for step
 (observations within 1e-4, rewards within 1e-5, the same terminated, truncated and active
 flags, success, SPL and SoftSPL) over whole episodes and their autoresets, with parked or
-removed finished robots, on numpy and on torch on the CPU.
+removed finished robots, with or without a range scan (which sees the other robots of its
+world), on numpy and on torch on the CPU.
 """
 
 from __future__ import annotations
@@ -53,10 +54,14 @@ def crowded_scenes(draw: st.DrawFn) -> Scene:
     max_steps=st.integers(5, 60),
     max_cycles=st.integers(3, 70),
     finished=st.sampled_from(["park", "remove"]),
+    scan=st.one_of(st.none(), st.fixed_dictionaries({
+        "n_rays": st.integers(1, 32), "fov": st.floats(0.5, 2 * np.pi), "max_range": st.floats(0.3, 5.6),
+        "min_range": st.sampled_from([0.0, 0.05, 0.2]),
+    })),
 )
 def test_fleet_matches_parallel_envs(
     device: str, scene: Scene, seed: int, n_worlds: int, n_robots: int, steps: int, reward_type: str,
-    max_steps: int, max_cycles: int, finished: str,
+    max_steps: int, max_cycles: int, finished: str, scan: dict | None,
 ) -> None:
     rng = np.random.default_rng(seed)
     # goal_tolerance 0.2 m: the multi-robot env keeps goals max(0.4, 0.36, 0.1) m apart.
@@ -66,7 +71,8 @@ def test_fleet_matches_parallel_envs(
     actions[rng.random((steps, n_worlds, n_robots)) < 0.4, 0] = 1.0
     task = {"reward_type": reward_type, "goal_tolerance": 0.2,
             "termination_config": {"max_steps": max_steps, "max_collisions": 15}}
-    compare_fleet(scene, episodes, actions, task=task, device=device, finished=finished, max_cycles=max_cycles)
+    compare_fleet(scene, episodes, actions, task=task, device=device, finished=finished, max_cycles=max_cycles,
+                  sensors=None if scan is None else {"scan": scan})
 
 
 @pytest.mark.parametrize("device", DEVICES)

@@ -43,7 +43,7 @@ def _grid(rng: np.random.Generator, rows: int, cols: int, density: float) -> np.
 
 
 def _paths(scenes, tables_np, scene, x, y, yaw, present, radius, angles, max_range):
-    """Ranges by every available path: array (numpy), numba, torch array."""
+    """Ranges by every available path: array (numpy), numba, torch array, torch numba."""
     out = {"array": cast_batch(tables_np, scene, x, y, yaw, present, radius, angles, max_range, "array")}
     if compiled_available():
         out["numba"] = cast_batch(tables_np, scene, x, y, yaw, present, radius, angles, max_range, "numba")
@@ -51,10 +51,10 @@ def _paths(scenes, tables_np, scene, x, y, yaw, present, radius, angles, max_ran
         import torch
 
         tables_t = ScanTables(scenes, 0, make_arrays("cpu"))
-        got = cast_batch(
-            tables_t, torch.as_tensor(scene), *(torch.as_tensor(v) for v in (x, y, yaw, present)), radius, angles, max_range
-        )
-        out["torch"] = got.numpy()
+        args = (torch.as_tensor(scene), *(torch.as_tensor(v) for v in (x, y, yaw, present)), radius, angles, max_range)
+        out["torch"] = cast_batch(tables_t, *args, "array").numpy()
+        if compiled_available():  # torch on the CPU goes through the kernel, on views
+            out["torch numba"] = cast_batch(tables_t, *args, "numba").numpy()
     return out
 
 

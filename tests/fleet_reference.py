@@ -39,25 +39,28 @@ def compare_fleet(
     device: str = "numpy",
     finished: str = "park",
     max_cycles: int = 500,
+    sensors: dict | None = None,
 ) -> dict[str, Any]:
     """Step both for ``len(actions)`` steps; return counts of what happened.
 
     ``episodes`` holds, per world, one ``(start_xy, yaw, goal_xy)`` per robot; ``actions``
-    has shape ``(steps, num_envs, n_robots, 2)``.
+    has shape ``(steps, num_envs, n_robots, 2)``. ``sensors`` (both sides) adds the scan to
+    the flat observations compared.
     """
     task = dict(task or {})
     n, r = len(episodes), len(episodes[0])
     venv = VectorPointNavEnv(n, n_robots=r, scene=scene, task=task, device=device, seed=0, pool_size=1,
-                             finished=finished, max_cycles=max_cycles)
+                             finished=finished, max_cycles=max_cycles, sensors=sensors)
+    dim = venv.single_observation_space.shape[0]
     refs = [
         parallel_env(scene=scene, n_robots=r, task=[_fixed_task(task, *rb) for rb in world], backend="kinematic",
-                     finished=finished, max_cycles=max_cycles)
+                     finished=finished, max_cycles=max_cycles, sensors=sensors)
         for world in episodes
     ]
     agents = refs[0].possible_agents
     to_np = venv.arrays.numpy
     vobs, vinfo = venv.reset(options={"episodes": episodes})
-    sobs = np.zeros((n, r, 8), np.float32)
+    sobs = np.zeros((n, r, dim), np.float32)
     for i, env in enumerate(refs):
         obs, _ = env.reset(seed=0)
         sobs[i] = [obs[a] for a in agents]
@@ -69,7 +72,7 @@ def compare_fleet(
         vobs, vrew, vterm, vtrunc, vinfo = venv.step(act)
         vrew, vterm, vtrunc, vobs_np = to_np(vrew), to_np(vterm), to_np(vtrunc), to_np(vobs)
         vinfo = {k: to_np(v) for k, v in vinfo.items()}
-        sobs = np.zeros((n, r, 8), np.float32)
+        sobs = np.zeros((n, r, dim), np.float32)
         for i, env in enumerate(refs):
             where = f"world {i}, step {t}"
             if not env.agents:

@@ -151,3 +151,19 @@ def test_discrete_actions_are_refused_with_several_robots(kwargs: dict) -> None:
     name = next(iter(kwargs))
     with pytest.raises(ValueError, match=name):
         VectorPointNavEnv(2, n_robots=2, scene=room(), **kwargs)
+
+
+@pytest.mark.parametrize("device", DEVICES)
+def test_a_refreshed_pool_keeps_each_episode_on_its_goal_field(device: str) -> None:
+    # An empty room: every geodesic is the straight line, whichever pool an episode came from.
+    env = VectorPointNavEnv(4, scene=room(), device=device, seed=2, pool_size=1, starts_per_goal=3,
+                            max_episode_steps=2, action_space="discrete", discrete_actions={"stop": False})
+    env.reset()
+    to_np = env.arrays.numpy
+    for t in range(8):
+        if t in (1, 4):
+            env.refresh_pool(wait=True)
+        _, _, _, _, info = env.step(np.full(4, FORWARD))
+        st = {k: to_np(env._state[k]) for k in ("x", "y", "gx", "gy")}
+        np.testing.assert_allclose(to_np(info["distance_to_goal"]), np.hypot(st["gx"] - st["x"], st["gy"] - st["y"]), atol=1e-9)
+    assert env.pool.pool_size == 3  # the refreshed pool holds three starts per goal too

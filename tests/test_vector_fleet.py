@@ -105,8 +105,65 @@ def test_a_removed_robot_lets_the_others_pass(device: str) -> None:
     assert abs(float(to_np(env._state["x"])[0, 1]) - (2.2 - 13 * 0.05)) < 1e-9  # through robot 0's place
 
 
+SCAN = {"scan": {"n_rays": 4, "fov": 2 * math.pi, "max_range": 5.6}}  # bearings -pi, -pi/2, 0, pi/2
+
+
 @pytest.mark.parametrize("device", DEVICES)
-def test_crowded_worlds_match_parallel_envs(device: str) -> None:
+def test_scan_shapes_and_bounds(device: str) -> None:
+    env = VectorPointNavEnv(3, n_robots=4, scene=room(), task=TASK, sensors=SCAN, device=device, seed=0, pool_size=2)
+    assert env.observation_space.shape == (3, 4, 12)
+    assert (env.single_observation_space.high[8:] == np.float32(5.6)).all()
+    assert (env.single_observation_space.low[8:] == 0.0).all()
+    obs, _ = env.reset()
+    for _ in range(3):
+        obs, *_ = env.step(np.random.default_rng(0).uniform(-1, 1, (3, 4, 2)))
+        got = env.arrays.numpy(obs)
+        assert got.shape == (3, 4, 12) and got.dtype == np.float32
+        assert (got[..., 8:] >= 0.0).all() and (got[..., 8:] <= np.float32(5.6)).all()
+
+
+@pytest.mark.parametrize("finished", ["park", "remove"])
+@pytest.mark.parametrize("device", DEVICES)
+def test_scans_see_the_other_robot_until_it_leaves(device: str, finished: str) -> None:
+    # HEAD_ON in a room whose free floor spans x, y in [0.1, 3.9] x [0.1, 2.9] m; radius 0.18 m.
+    env = VectorPointNavEnv(1, n_robots=2, scene=room(), task=TASK, sensors=SCAN, device=device, finished=finished)
+    to_np = env.arrays.numpy
+    obs = to_np(env.reset(options={"episodes": HEAD_ON})[0])[0, :, 8:]
+    # Each looks ahead at the other's disc, 1.2 m between centres; robot 0 behind at the wall
+    # 0.9 m away, robot 1 1.7 m, both 1.4 m from the side walls.
+    np.testing.assert_allclose(obs[0], [0.9, 1.4, 1.2 - 0.18, 1.4], atol=1e-6)
+    np.testing.assert_allclose(obs[1], [3.9 - 2.2, 1.4, 1.2 - 0.18, 1.4], atol=1e-6)
+    for _ in range(7):  # robot 0 arrives at x = 1.35 and finishes in the 7th step
+        obs = to_np(env.step(np.array([[[1.0, 0.0], [0.0, 0.0]]]))[0])[0, :, 8:]
+    assert abs(obs[1, 2] - (2.2 - 1.35 - 0.18)) < 1e-6  # still seen in the step it finished
+    obs = to_np(env.step(np.array([[[0.0, 0.0], [0.0, 0.0]]]))[0])[0, :, 8:]
+    assert (obs[0] == 0.0).all()  # no agent any more
+    # Parked, it is still in the way; removed, robot 1 sees the far wall at x = 0.1 m.
+    want = 2.2 - 1.35 - 0.18 if finished == "park" else 2.2 - 0.1
+    assert abs(obs[1, 2] - want) < 1e-6
+
+
+def test_noisy_scans_repeat_with_the_seed_and_change_no_episode() -> None:
+    noisy = {"scan": {"n_rays": 8, "noise_std": 0.05, "dropout": 0.1}}
+    actions = np.random.default_rng(3).uniform(-1, 1, (12, 2, 3, 2))
+
+    def run(sensors: dict) -> np.ndarray:
+        env = VectorPointNavEnv(2, n_robots=3, scene=room(), task=TASK, sensors=sensors, seed=5, pool_size=2)
+        out = [env.reset(seed=7)[0]]
+        out += [env.step(a)[0] for a in actions]
+        return np.stack(out)
+
+    first, again, exact = run(noisy), run(noisy), run({"scan": {"n_rays": 8}})
+    np.testing.assert_array_equal(first, again)
+    np.testing.assert_array_equal(first[..., :8], exact[..., :8])  # the same episodes and motion
+    seen = exact[..., 8:] < np.float32(5.6)  # noise only on returns; dropout reads max_range
+    assert (first[..., 8:][seen] != exact[..., 8:][seen]).mean() > 0.5
+    assert (first[..., 8:][~seen] == np.float32(5.6)).all()
+
+
+@pytest.mark.parametrize("sensors", [None, {"scan": {"n_rays": 12, "max_range": 2.0, "min_range": 0.05}}])
+@pytest.mark.parametrize("device", DEVICES)
+def test_crowded_worlds_match_parallel_envs(device: str, sensors: dict | None) -> None:
     # A 1.6 x 2 m room, four robots each: they meet each other and the parked ones often;
     # a hole at one end takes robots that drive into it out of the world.
     rng = np.random.default_rng(1)
@@ -120,7 +177,7 @@ def test_crowded_worlds_match_parallel_envs(device: str) -> None:
     task = {"reward_type": "geodesic", "goal_tolerance": 0.2, "termination_config": {"max_steps": 60, "max_collisions": 10}}
     for finished in ("park", "remove"):
         stats = compare_fleet(scene, fleet_episodes(scene, 4, 4, rng), actions, task=task, device=device,
-                              finished=finished, max_cycles=45)
+                              finished=finished, max_cycles=45, sensors=sensors)
         # The run exercised what it claims to: robot contacts, parked robots, ends, autoresets.
         assert stats["robot_contacts"] > 10 and stats["parked_steps"] > 100
         assert stats["successes"] > 0 and stats["autoresets"] > 0 and stats["falls"] > 0
@@ -142,7 +199,7 @@ def test_bad_actions_are_refused(device: str, actions: np.ndarray) -> None:
 @pytest.mark.parametrize(("kwargs", "name"), [
     ({"n_robots": 2, "finished": "vanish"}, "finished"), ({"n_robots": 2, "max_cycles": 0}, "max_cycles"),
     ({"max_cycles": 10}, "max_cycles"), ({"finished": "park"}, "finished"),
-    ({"n_robots": 2, "sensors": {"scan": {}}}, "sensors"), ({"n_robots": 2, "pool_size": 0}, "pool_size"),
+    ({"n_robots": 2, "sensors": {"local_map": {}}}, "sensors"), ({"n_robots": 2, "pool_size": 0}, "pool_size"),
     ({"n_robots": 2, "robot": {"drive": "holonomic"}}, "robot"), ({"n_robots": 2, "device": "tpu"}, "device"),
 ])
 def test_unsupported_arguments_are_named(kwargs: dict, name: str) -> None:

@@ -44,72 +44,83 @@ def crossings(g_along, d_along, g_across, d_across):  # pragma: no cover
     return sgn, dt, t0, g_across + t0 * d_across, dt * d_across, base - (0.0 if pos else 1.0)
 
 @_jit
-def blocked(a0, step, kf, ent0, sgn, across_max, along_max, plane_of, hi_stride,
-            entered_stride, lookup, e):  # pragma: no cover
-    # Whether the crossing kf of a family enters (or grazes) a blocked cell.
-    across = a0 + step * kf
-    hi = math.floor(across + e)
-    grazing = math.floor(across - e) < hi
-    hi = min(max(hi, 0.0), across_max)
-    entered = min(max(ent0 + sgn * kf, 0.0), along_max)
-    idx = (plane_of if grazing else 0.0) + hi * hi_stride + entered * entered_stride
-    return lookup[int(idx)]
-
-@_jit
-def skip_to(t0, dt, k, target, n_cross):  # pragma: no cover
-    # The first crossing index at or after k whose t is not below target (about).
-    if t0 < target:
-        k = max(k, math.ceil((target - t0) / dt))
-    return min(k, n_cross)
-
-@_jit
 def grid_range(gx, gy, dx, dy, fhp, fwp, plane, lookup, clear, e, n_cross, reach):  # pragma: no cover
     # Nearest blocked crossing (cell units) of one ray, _INF past reach: both crossing
-    # families of raycast._grid_hits (the same expressions), merged in order of t so the
-    # walk ends at the first blocked crossing of either.
+    # families of raycast._grid_hits (the same expressions, so the same decisions), merged
+    # in order of t so the walk ends at the first blocked crossing of either.
     sx, dtx, t0x, a0x, stx, enx = crossings(gx, dx, gy, dy)
     sy, dty, t0y, a0y, sty, eny = crossings(gy, dy, gx, dx)
+    hp = int(fhp)
     wp = int(fwp)
-    # Clear squares: if the cell under the ray's point at t is C cells (chessboard)
-    # from the nearest blocked cell, the cells within C - 1 of it are free, and so is
-    # every cell a crossing tests while the ray is inside their square; the walk jumps
-    # to where the ray leaves it (less a margin for rounding and e).
+    plane2 = 2 * plane
+    adx = 1.0 / dtx
+    ady = 1.0 / dty
+    # Integer steps and cells; the crossing k of a family enters column (row) ent + s * k,
+    # and while kx, ky are the next crossings the ray is in column col0 + isx * kx, row
+    # row0 + isy * ky (the same count of crossings passed), so no point is rounded per step.
+    isx = 1 if sx > 0.0 else -1
+    isy = 1 if sy > 0.0 else -1
+    enx_i = int(enx)
+    eny_i = int(eny)
+    col0 = enx_i - isx
+    row0 = eny_i - isy
+    quad = (0 if isx > 0 else 1) + (0 if isy > 0 else 2)
+    # Free squares ahead (sensors.clearance): if the square of side K >= 3 anchored at the
+    # cell diagonally behind the ray's cell is free, the ray stays in it up to crossings
+    # kx + K - 2 and ky + K - 2 (its far sides) and at least a cell from its near sides,
+    # so the crossings before the nearer far side (less a margin for rounding and e) touch
+    # free cells only: the walk jumps to the first crossing of each family after that.
     margin = 1e-6 + 2.0 * e
     kx = 0
     ky = 0
-    t = 0.0
     while True:
-        qx = gx + t * dx
-        qy = gy + t * dy
-        cx = math.floor(qx)
-        cy = math.floor(qy)
-        if 0.0 <= cx < fwp and 0.0 <= cy < fhp:
-            clr = clear[int(cy) * wp + int(cx)]
-            if clr >= 2:
-                # Distance along the ray to the square's sides [c - (C - 1), c + C].
-                ex_ = (cx + clr - qx if dx > 0.0 else qx - (cx - clr + 1.0)) * dtx
-                ey_ = (cy + clr - qy if dy > 0.0 else qy - (cy - clr + 1.0)) * dty
-                target = t + min(ex_, ey_) - margin
-                kx = skip_to(t0x, dtx, kx, target, n_cross)
-                ky = skip_to(t0y, dty, ky, target, n_cross)
-        tx = t0x + float(kx) * dtx if kx < n_cross else _INF
-        ty = t0y + float(ky) * dty if ky < n_cross else _INF
+        col = col0 + isx * kx
+        row = row0 + isy * ky
+        if 0 <= col < wp and 0 <= row < hp:
+            side = clear[(row * wp + col) * 4 + quad]
+            if side >= 3:
+                farx = t0x + float(kx + side - 2) * dtx
+                fary = t0y + float(ky + side - 2) * dty
+                # The nearer far side's family goes to it (its crossing before is a whole
+                # cell earlier, far beyond the margin); the other to its first crossing
+                # after the margin.
+                if farx <= fary:
+                    kx += side - 2
+                    target = farx - margin
+                    if t0y < target:
+                        ky = min(max(ky, math.ceil((target - t0y) * ady)), n_cross)
+                else:
+                    ky += side - 2
+                    target = fary - margin
+                    if t0x < target:
+                        kx = min(max(kx, math.ceil((target - t0x) * adx)), n_cross)
+        fkx = float(kx)
+        fky = float(ky)
+        tx = t0x + fkx * dtx if kx < n_cross else _INF
+        ty = t0y + fky * dty if ky < n_cross else _INF
         if tx <= ty:
             if tx > reach:  # t grows along the walk: nothing nearer is left
                 return _INF
-            if blocked(a0x, stx, float(kx), enx, sx, fhp - 1.0, fwp - 1.0, float(plane), fwp, 1.0,
-                       lookup, e):
+            # raycast._grid_hits' test: floor(across - e) < hi is across - e < hi (hi whole).
+            across = a0x + stx * fkx
+            hi = math.floor(across + e)
+            graze = across - e < hi
+            hi = min(max(hi, 0), hp - 1)
+            ent = min(max(enx_i + isx * kx, 0), wp - 1)
+            if lookup[plane * int(graze) + hi * wp + ent]:
                 return tx
             kx += 1
-            t = tx
         else:
             if ty > reach:
                 return _INF
-            if blocked(a0y, sty, float(ky), eny, sy, fwp - 1.0, fhp - 1.0, 2.0 * plane, 1.0, fwp,
-                       lookup, e):
+            across = a0y + sty * fky
+            hi = math.floor(across + e)
+            graze = across - e < hi
+            hi = min(max(hi, 0), wp - 1)
+            ent = min(max(eny_i + isy * ky, 0), hp - 1)
+            if lookup[plane2 * int(graze) + hi + ent * wp]:
                 return ty
             ky += 1
-            t = ty
 
 @_jit
 def pseudo_angle(y, x):  # pragma: no cover

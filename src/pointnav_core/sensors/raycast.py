@@ -42,10 +42,10 @@ import numpy as np
 import shapely
 import shapely.geometry
 from numpy.typing import ArrayLike, NDArray
-from scipy import ndimage
 
 from pointnav_core.maps import OBSTACLE, TraversableMap
 from pointnav_core.sensors import raycast_jit
+from pointnav_core.sensors.clearance import quadrant_clearance
 
 __all__ = ["TOUCH_EPS", "ScanGeometry", "cast_pose_compiled", "cast_rays"]
 
@@ -143,20 +143,20 @@ class ScanGeometry:
             [self.edge_a, self._edge_vec, self._edge_lo, self._edge_hi, self._edge_half_slack]
         ).reshape(-1, 9))
         self._jit_base = (self.resolution, *self.origin)
-        self._clearance_cells: NDArray[np.int32] | None = None
+        self._clearance_cells: NDArray[np.uint8] | None = None
         self._jit_params_of: dict[float, NDArray[np.float64]] = {}
 
     @property
-    def _clearance(self) -> NDArray[np.int32]:
-        """Per padded cell, the chessboard distance (cells) to the nearest blocked one.
+    def _clearance(self) -> NDArray[np.uint8]:
+        """Per padded cell and quadrant, the free square ahead of it (cells).
 
-        Flat, like the lookup planes. The compiled path skips the crossings of a ray that
-        lie in a cell's clear square (raycast_jit); built on first use.
+        Flat, ``[cell * 4 + quadrant]`` (:func:`~pointnav_core.sensors.clearance.quadrant_clearance`
+        of the free cells). The compiled path skips the crossings of a ray that lie in such
+        a square (raycast_jit); built on first use.
         """
         if self._clearance_cells is None:
             free = ~self._lookup[: self._plane].reshape(self.shape)
-            cdt = ndimage.distance_transform_cdt(free, metric="chessboard")
-            self._clearance_cells = np.ascontiguousarray(cdt, dtype=np.int32).ravel()
+            self._clearance_cells = quadrant_clearance(free)
         return self._clearance_cells
 
     def _jit_params(self, max_range: float) -> NDArray[np.float64]:

@@ -1,11 +1,9 @@
 """The compiled path of :func:`pointnav_core.vector.scan.cast_batch` (imports numba).
 
 Imported only when the compiled path runs, so the package imports without numba. One loop
-over worlds, robots and rays, inside the kernel; each ray is the single env's
-crossing walk (:func:`walk`: the crossing test of ``sensors._raycast_kernel.grid_range``
-with cheaper jumps over the clear squares) on its world's grid, then
-the discs of the world's other present robots, with the same expressions as the array
-path.
+over worlds, robots and rays, inside the kernel; each ray is the single env's crossing walk
+(``sensors._raycast_kernel.grid_range``) on its world's grid, then the discs of the world's
+other present robots, with the same expressions as the array path.
 """
 
 from __future__ import annotations
@@ -15,92 +13,13 @@ import math
 import numba
 import numpy as np
 
+from pointnav_core.sensors._raycast_kernel import grid_range
 from pointnav_core.sensors.raycast import TOUCH_EPS
 
-__all__ = ["cast_worlds", "walk"]
+__all__ = ["cast_worlds"]
 
 _INF = math.inf
-_TINY = 1e-300  # raycast._TINY
 _jit = numba.njit(cache=True, nogil=True, error_model="numpy")
-
-
-@_jit
-def walk(gx, gy, dx, dy, hp, wp, look, clr, e, n_cross, reach):  # pragma: no cover
-    # Nearest blocked crossing (cell units) of one ray, _INF past reach: the crossing
-    # families and the crossing test of raycast._grid_hits (the same expressions, so the
-    # same decisions), walked in order of t. Where the cell under the ray is C >= 2 cells
-    # (chessboard) from the nearest blocked one, the cells within C - 1 of it are free: the
-    # walk jumps to where the ray leaves that square, less a margin for rounding and e.
-    plane = hp * wp
-    fhp1 = float(hp - 1)
-    fwp1 = float(wp - 1)
-    posx = dx >= 0.0
-    sx = 1.0 if posx else -1.0
-    bx = math.floor(gx) + 1.0 if posx else math.ceil(gx) - 1.0
-    adx = max(abs(dx), _TINY)
-    dtx = 1.0 / adx
-    t0x = (bx - gx) * sx * dtx
-    a0x = gy + t0x * dy
-    stx = dtx * dy
-    enx = bx - (0.0 if posx else 1.0)
-    posy = dy >= 0.0
-    sy = 1.0 if posy else -1.0
-    by = math.floor(gy) + 1.0 if posy else math.ceil(gy) - 1.0
-    ady = max(abs(dy), _TINY)
-    dty = 1.0 / ady
-    t0y = (by - gy) * sy * dty
-    a0y = gx + t0y * dx
-    sty = dty * dx
-    eny = by - (0.0 if posy else 1.0)
-    margin = 1e-6 + 2.0 * e
-    kx = 0
-    ky = 0
-    t = 0.0
-    while True:
-        qx = gx + t * dx
-        qy = gy + t * dy
-        cx = math.floor(qx)
-        cy = math.floor(qy)
-        if 0.0 <= cx <= fwp1 and 0.0 <= cy <= fhp1:
-            c = clr[int(cy) * wp + int(cx)]
-            if c >= 2:
-                ex = (cx + c - qx if posx else qx - (cx - c + 1.0)) * dtx
-                ey = (cy + c - qy if posy else qy - (cy - c + 1.0)) * dty
-                target = t + min(ex, ey) - margin
-                # Jump each family to its first crossing at or after target (about: the
-                # margin keeps a rounding either way inside the free square).
-                if t0x < target:
-                    kx = max(kx, math.ceil((target - t0x) * adx))
-                if t0y < target:
-                    ky = max(ky, math.ceil((target - t0y) * ady))
-        fkx = float(kx)
-        fky = float(ky)
-        tx = t0x + fkx * dtx if kx < n_cross else _INF
-        ty = t0y + fky * dty if ky < n_cross else _INF
-        if tx <= ty:
-            if tx > reach:  # t grows along the walk: nothing nearer is left
-                return _INF
-            across = a0x + stx * fkx
-            hi = math.floor(across + e)
-            graze = math.floor(across - e) < hi
-            hi = min(max(hi, 0.0), fhp1)
-            ent = min(max(enx + sx * fkx, 0.0), fwp1)
-            if look[(plane if graze else 0) + int(hi) * wp + int(ent)]:
-                return tx
-            kx += 1
-            t = tx
-        else:
-            if ty > reach:
-                return _INF
-            across = a0y + sty * fky
-            hi = math.floor(across + e)
-            graze = math.floor(across - e) < hi
-            hi = min(max(hi, 0.0), fwp1)
-            ent = min(max(eny + sy * fky, 0.0), fhp1)
-            if look[(2 * plane if graze else 0) + int(hi) + int(ent) * wp]:
-                return ty
-            ky += 1
-            t = ty
 
 
 @_jit
@@ -127,8 +46,10 @@ def cast_worlds(scene, x, y, cyaw, syaw, ca, sa, present, radius, max_range, met
         reach = max_range * inv
         n_cross = min(math.ceil(reach) + 1, max(hp, wp) + 1)
         plane = hp * wp
+        fhp = float(hp)
+        fwp = float(wp)
         look = lookup[loff : loff + 3 * plane]
-        clr = clear[coff : coff + plane]
+        clr = clear[coff : coff + 4 * plane]  # four quadrants a cell
         for i in range(n_robots):
             if not present[w, i]:
                 out[w, i, :] = max_range
@@ -160,7 +81,7 @@ def cast_worlds(scene, x, y, cyaw, syaw, ca, sa, present, radius, max_range, met
             for r in range(n_rays):
                 dx = c[r]
                 dy = s[r]
-                best = min(walk(gx, gy, dx, dy, hp, wp, look, clr, e, n_cross, reach) * res, max_range)
+                best = min(grid_range(gx, gy, dx, dy, fhp, fwp, plane, look, clr, e, n_cross, reach) * res, max_range)
                 for j in range(n_near):
                     m = near[j]
                     fx = px - x[w, m]

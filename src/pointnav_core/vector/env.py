@@ -10,8 +10,10 @@ The same code runs on numpy (``device="numpy"``) and on torch (``"cpu"``, ``"cud
 
 from __future__ import annotations
 
+import functools
 import math
 from collections.abc import Mapping, Sequence
+from concurrent.futures import Executor
 from typing import Any, Self
 
 import gymnasium as gym
@@ -23,6 +25,7 @@ from pointnav_core.vector.contacts import advance
 from pointnav_core.vector.discrete import MOVED, DiscretePlan
 from pointnav_core.vector.episodes import EpisodePool
 from pointnav_core.vector.floors import FloorTables
+from pointnav_core.vector.refresh import PoolRefresh, join_pools, refresh_executor
 from pointnav_core.vector.scan import ScanTables, VectorScan
 from pointnav_core.vector.xp import make_arrays
 
@@ -89,7 +92,8 @@ class VectorPointNavEnv(VectorEnv):
     seed : int, optional
         Seeds the episode pools and the draws from them.
     pool_size : int
-        Goals prepared per scene, >= 1 (each with its settled goal field).
+        Goals prepared per scene, >= 1 (each with its settled goal field);
+        :meth:`refresh_pool` prepares fresh ones while the worlds run.
     action_frequency : float
         Control steps per second (Hz).
     action_space : str
@@ -125,7 +129,9 @@ class VectorPointNavEnv(VectorEnv):
     (rewards, terminations, SPL), and all robots still active are truncated after
     ``max_cycles`` steps. Every return carries the robot axis: ``step`` takes actions
     ``(num_envs, R, 2)`` (all finite; those of inactive robots are ignored) and returns
-    observations ``(num_envs, R, 8)`` float32, rewards ``(num_envs, R)`` float64,
+    observations ``(num_envs, R, 8)`` float32 (``(num_envs, R, 8 + n_rays)`` with the scan,
+    which sees the other robots present in its world as the multi-robot env's scan does),
+    rewards ``(num_envs, R)`` float64,
     terminated and truncated ``(num_envs, R)`` bool and ``info`` arrays ``(num_envs, R)``
     with, besides the keys above, ``active``: the robots that are still agents (PettingZoo's
     ``agents``). A robot whose episode ended returns its last observation, reward and flags
@@ -154,6 +160,12 @@ class VectorPointNavEnv(VectorEnv):
     """
 
     metadata = {"autoreset_mode": AutoresetMode.NEXT_STEP, "render_modes": []}
+    # Pool refresh (refresh_pool): the pending build and its worker, the new pool while
+    # older episodes are still run, and the field index from which they start.
+    _refresh: PoolRefresh | None = None
+    _executor: Executor | None = None
+    _fresh: Any = None
+    _old_from: int | None = None
 
     def __new__(cls, *args: Any, **kwargs: Any) -> Self:
         # Several robots per world are their own engine (vector.fleet_env), built from here.
@@ -273,11 +285,81 @@ class VectorPointNavEnv(VectorEnv):
         seeds = self._rng.integers(2**31, size=size * len(self.scenes))
         self.pool = EpisodePool(self._samplers, size, seeds, self.arrays, fixed, self.starts_per_goal)
 
+    def refresh_pool(self, wait: bool = False) -> None:
+        """Prepare fresh episodes (``pool_size`` per scene, new seeds) for the autoresets.
+
+        The new pool is built in a worker process (started at the first refresh, kept
+        until ``close()``) and swapped in at the start of the first step after it is ready;
+        from then on autoresets draw from it alone, while the worlds still in an old episode
+        finish it (their goal fields are kept until none is left). With ``wait=True`` it is
+        built here and swapped in before returning: between batches, and reproducibly (the
+        seeds come from the env's generator either way, and give the same pool, but in the
+        background the step of the swap depends on the machine).
+
+        Raises
+        ------
+        RuntimeError
+            Before the first ``reset()``.
+        ValueError
+            While the worlds run fixed episodes (``reset(options={"episodes": ...})``).
+        """
+        if self.pool is None:
+            raise RuntimeError("call reset() before refresh_pool()")
+        if self._fixed is not None:
+            raise ValueError("refresh_pool: the worlds run fixed episodes (reset(options={'episodes': ...})); reset without them first")
+        self._finish_refresh()
+        seeds = self._rng.integers(2**31, size=self.pool_size * len(self.scenes))
+        if wait:
+            self._swap_pool(self._pool_kind()(self._samplers, self.pool_size, seeds, self.arrays))
+            return
+        if self._executor is None:
+            self._executor = refresh_executor()
+        self._refresh = PoolRefresh(self._executor, self._pool_kind(), self._samplers, self.pool_size, seeds, self.arrays)
+
+    def _pool_kind(self) -> Any:
+        # The pool class with this env's starts per goal (a partial pickles for the worker);
+        # the multi-robot engine, which inherits refresh_pool, has one start per goal.
+        starts = getattr(self, "starts_per_goal", 1)
+        return type(self.pool) if starts == 1 else functools.partial(type(self.pool), starts=starts)
+
+    @property
+    def refresh_pending(self) -> bool:
+        """Whether a background refresh has not been swapped in yet."""
+        return self._refresh is not None
+
+    def _finish_refresh(self) -> None:
+        """Swap in a pending refresh, waiting for its build."""
+        if self._refresh is not None:
+            self._swap_pool(self._refresh.result())
+
+    def _swap_pool(self, new: Any) -> None:
+        self._refresh = None
+        # After the current pool (which may still hold an older one's episodes, too).
+        self._old_from = len(new.fields)
+        self.pool = join_pools(new, self.pool)
+        self._fresh = new
+        self._field = self._field + self._old_from
+
+    def _poll_pool(self) -> None:
+        """At a step's start: swap in a finished refresh; drop old episodes no world is in."""
+        if self._refresh is not None and self._refresh.done():
+            self._swap_pool(self._refresh.result())
+        if self._old_from is not None and not bool((self._field >= self._old_from).any()):
+            self.pool, self._fresh, self._old_from = self._fresh, None, None
+
+    def close_extras(self, **kwargs: Any) -> None:
+        """Stop the refresh worker process, if one was started (a pending build is dropped)."""
+        self._refresh = None
+        if self._executor is not None:
+            self._executor.shutdown(wait=True, cancel_futures=True)
+            self._executor = None
+
     # ------------------------------------------------------------------ Gymnasium API
     def reset(self, *, seed: int | None = None, options: dict[str, Any] | None = None) -> tuple[Any, dict[str, Any]]:
         """Reset every world. ``options={"episodes": [(start_xy, yaw, goal_xy), ...]}`` (one per
         world, yaw in rad) fixes each world's episode, at this reset and every autoreset, until a
         reset without it; a new ``seed`` redraws the pools."""
+        self._finish_refresh()
         a = self.arrays
         if options is not None and not isinstance(options, Mapping):
             raise ValueError(f"options must be None or a dict, got {options!r}")
@@ -357,6 +439,8 @@ class VectorPointNavEnv(VectorEnv):
 
     def step(self, actions: Any) -> tuple[Any, Any, Any, Any, dict[str, Any]]:
         """Advance every world one control step (worlds that ended last step reset instead)."""
+        if self._refresh is not None or self._old_from is not None:
+            self._poll_pool()
         with np.errstate(invalid="ignore", divide="ignore"):  # inf distances are masked by where
             return self._step(actions)
 
@@ -472,13 +556,17 @@ class VectorPointNavEnv(VectorEnv):
         vx, vy = st["vx"], st["vy"]
         zero = xp.zeros_like(vx)
         obs = xp.stack([lx, ly, c * vx + s * vy, c * vy - s * vx, st["vz"], zero, zero, st["w"]], -1)
-        if self.scan is not None:  # the heading as the single env's frame gives it
-            yaw, one = xp.arctan2(s, c)[:, None], xp.ones_like(c)[:, None] > 0.0
-            ranges = self.scan.readings(self._world_scene, st["x"][:, None], st["y"][:, None], yaw, one, self.robot.radius)
-            obs = (xp.cat if a.is_torch else xp.concatenate)([obs, ranges[:, 0]], -1)
+        if self.scan is not None:
+            obs = (xp.cat if a.is_torch else xp.concatenate)([obs, self._scan_ranges(c, s)], -1)
         sc = self._world_scene
         obs = xp.minimum(xp.maximum(obs, self._low[sc]), self._high[sc])
         return obs.to(xp.float32) if a.is_torch else obs.astype(np.float32)
+
+    def _scan_ranges(self, c: Any, s: Any) -> Any:
+        """The scan's readings (m), ``(num_envs, n_rays)``, at the headings' cosines ``c`` and sines ``s``."""
+        xp, st = self.arrays.xp, self._state
+        yaw, one = xp.arctan2(s, c)[:, None], xp.ones_like(c)[:, None] > 0.0  # the single env's frame heading
+        return self.scan.readings(self._world_scene, st["x"][:, None], st["y"][:, None], yaw, one, self.robot.radius)[:, 0]
 
     def _info(self, success: Any, r_pot: Any, r_col: Any, r_goal: Any, contact: Any, resetting: Any) -> dict[str, Any]:
         xp, st = self.arrays.xp, self._state

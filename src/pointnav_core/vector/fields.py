@@ -24,6 +24,11 @@ from pointnav_core.vector.xp import Arrays
 
 __all__ = ["FieldTables", "settle"]
 
+# Per Dijkstra label, in the order of the label table's columns.
+_PER_LABEL = ("cost", "cx", "cy", "side", "phi0", "span", "pos", "qx", "qy")
+_PER_FIELD_FLOAT = ("gx", "gy", "ox", "oy", "res", "radius")
+_INDICES = ("kind", "label", "offset", "rows", "width")
+
 
 def settle(field: GoalField) -> dict[str, Any]:
     """Check every block of ``field``'s root table and settle every cell; the table."""
@@ -48,6 +53,17 @@ class FieldTables:
         All from planners of one robot radius.
     arrays : Arrays
     """
+
+    # Per label (one spare row at the end of each field's labels): see _PER_LABEL.
+    cost: Any
+    cx: Any
+    cy: Any
+    side: Any
+    phi0: Any
+    span: Any
+    pos: Any
+    qx: Any
+    qy: Any
 
     def __init__(self, fields: Sequence[GoalField], arrays: Arrays) -> None:
         kinds, labels, goal, geo, lab_arrays = [], [], [], [], []
@@ -82,8 +98,8 @@ class FieldTables:
         self.label = a.asarray(np.concatenate(labels), a.i64)
         # One spare row: cells with no label point at the end of their field's labels.
         lab = np.concatenate([*lab_arrays, np.zeros((1, 9))])
-        (self.cost, self.cx, self.cy, self.side, self.phi0, self.span, self.pos,
-         self.qx, self.qy) = (a.asarray(lab[:, i]) for i in range(9))
+        for i, name in enumerate(_PER_LABEL):
+            setattr(self, name, a.asarray(lab[:, i]))
         gxy = np.array(goal, dtype=np.float64).reshape(-1, 2)
         self.gx, self.gy = a.asarray(gxy[:, 0]), a.asarray(gxy[:, 1])
         self.offset = a.asarray(g[:, 0], a.i64)
@@ -93,6 +109,31 @@ class FieldTables:
 
     def __len__(self) -> int:
         return int(self.gx.shape[0])
+
+    def to(self, arrays: Arrays) -> FieldTables:
+        """These tables on ``arrays``' device (numpy tables from a worker process, say)."""
+        moved = FieldTables.__new__(FieldTables)
+        moved.arrays = arrays
+        for name in _PER_LABEL + _PER_FIELD_FLOAT:
+            setattr(moved, name, arrays.asarray(self.arrays.numpy(getattr(self, name))))
+        for name in _INDICES:
+            setattr(moved, name, arrays.asarray(self.arrays.numpy(getattr(self, name)), arrays.i64))
+        return moved
+
+    @classmethod
+    def concat(cls, first: FieldTables, second: FieldTables) -> FieldTables:
+        """``first``'s fields followed by ``second``'s (field ``f`` of ``second`` becomes
+        ``len(first) + f``), on ``first``'s device."""
+        a = first.arrays
+        cat = a.xp.concatenate
+        joined = cls.__new__(cls)
+        joined.arrays = a
+        joined.kind = cat([first.kind, second.kind])
+        joined.label = cat([first.label, second.label + first.cost.shape[0]])
+        for name in _PER_LABEL + _PER_FIELD_FLOAT + ("rows", "width"):
+            setattr(joined, name, cat([getattr(first, name), getattr(second, name)]))
+        joined.offset = cat([first.offset, second.offset + first.kind.shape[0]])
+        return joined
 
     def distance(self, field: Any, x: Any, y: Any) -> Any:
         """Geodesic distance (m) from each ``(x, y)`` to the goal of its ``field`` (index array); inf if none.

@@ -6,7 +6,11 @@ the kinematic backend (``finished="park"`` by default, or ``"remove"``), stepped
 together by :func:`~pointnav_core.vector.robots.advance_robots` on one clock per world
 (by the one-robot :func:`~pointnav_core.vector.contacts.advance` where a world has only
 one such robot), the others move by their arc (the backend's fast path). Each robot's task accounting is
-the one-robot engine's, masked by the robots still active (PettingZoo's ``agents``).
+the one-robot engine's, masked by the robots still active (PettingZoo's ``agents``). With
+``sensors={"scan": {...}}`` every robot's scan sees the floor and the discs of the other
+robots of its world that the multi-robot env's scan sees when it observes the step: those
+present before the step's finished robots leave (parked, removed or fallen alike), all of
+them after a reset.
 """
 
 from __future__ import annotations
@@ -27,10 +31,12 @@ from pointnav_core.vector.env import (
     _MIN_FIRST_DROP,
     VectorPointNavEnv,
     _default_scene,
+    _scan_term,
 )
 from pointnav_core.vector.fleet_pool import FleetPool, check_fixed_episode
 from pointnav_core.vector.floors import FloorTables
 from pointnav_core.vector.robots import advance_robots, robot_walls
+from pointnav_core.vector.scan import ScanTables, VectorScan
 from pointnav_core.vector.xp import make_arrays
 
 __all__ = ["FINISHED_MODES", "VectorFleetEnv"]
@@ -79,9 +85,7 @@ class VectorFleetEnv(VectorPointNavEnv):
         if not isinstance(finished, str) or finished not in FINISHED_MODES:
             raise ValueError(f"finished must be one of {list(FINISHED_MODES)}, got {finished!r}")
         self.finished = finished
-        if sensors is not None:  # vector.scan casts (W, R) robots, but it is not wired here yet
-            raise ValueError(f"sensors must be None with several robots per world (not supported yet), got {sensors!r}")
-        self.scan = None
+        scan_term = _scan_term(sensors)
         if task is not None and not isinstance(task, Mapping):
             raise ValueError(f"task must be None or a dict of PointNavigationTask arguments, got {task!r}")
         for key in ("termination_conditions", "reward_functions", "observation_terms"):
@@ -104,7 +108,8 @@ class VectorFleetEnv(VectorPointNavEnv):
         # The multi-robot env of each scene samples its episodes and is the semantics.
         self._samplers = [
             parallel_env(scene=s, n_robots=self.n_robots, robot=spec, task=dict(task), backend="kinematic",
-                         max_cycles=self.max_cycles, finished=finished, action_frequency=action_frequency)
+                         max_cycles=self.max_cycles, finished=finished, action_frequency=action_frequency,
+                         sensors=sensors)
             for s in scene_list
         ]
         first = self._samplers[0]
@@ -150,9 +155,13 @@ class VectorFleetEnv(VectorPointNavEnv):
         self._collisions = a.zeros((n, r), a.i64)
         self._active = a.zeros((n, r), a.boolean)
         self._present = a.zeros((n, r), a.boolean)
+        self._seen = self._present  # the robots the scans see at the next observation
         self._cycles = a.zeros(n, a.i64)
         self._needs_reset = a.zeros(n, a.boolean)
         self._started = False
+        self.scan = None if scan_term is None else VectorScan(scan_term, ScanTables(scene_list, t.floor, a))
+        if self.scan is not None:
+            self.scan.seed(self._rng)
 
     # ------------------------------------------------------------------ pools
     def _build_pool(self, fixed: Sequence[Any]) -> None:
@@ -164,12 +173,15 @@ class VectorFleetEnv(VectorPointNavEnv):
         """Reset every world. ``options={"episodes": [[(start_xy, yaw, goal_xy), ...], ...]}``
         (per world, one tuple per robot) fixes each world's episode, at this reset and every
         autoreset, until a reset without it; a new ``seed`` redraws the pools."""
+        self._finish_refresh()
         a = self.arrays
         if options is not None and not isinstance(options, Mapping):
             raise ValueError(f"options must be None or a dict, got {options!r}")
         episodes = (options or {}).get("episodes")
         if seed is not None:
             self._rng = np.random.default_rng(validation.integer("seed", seed, minimum=0))
+            if self.scan is not None:
+                self.scan.seed(self._rng)
         if episodes is not None:
             if len(episodes) != self.num_envs:
                 raise ValueError(f"options['episodes'] must hold one episode per world ({self.num_envs}), got {len(episodes)}")
@@ -186,6 +198,7 @@ class VectorFleetEnv(VectorPointNavEnv):
         every = a.full(self.num_envs, True, a.boolean)
         with np.errstate(invalid="ignore", divide="ignore"):
             self._reset_worlds(every)
+            self._seen = self._present
             self._started = True
             zero, no = a.zeros((self.num_envs, self.n_robots)), a.zeros((self.num_envs, self.n_robots), a.boolean)
             shown = self._active.clone() if a.is_torch else self._active.copy()
@@ -321,6 +334,8 @@ class VectorFleetEnv(VectorPointNavEnv):
                   pot=xp.where(acting, pot, st["pot"]))
         self._steps, self._collisions, self._cycles = steps, collisions, cycles
         self._active, self._present = active, present & ~gone
+        # The multi-robot env observes every robot before its finished robots leave the world.
+        self._seen = present
         shown = acting
         resetting = self._needs_reset.clone() if a.is_torch else self._needs_reset.copy()
         if a.any(resetting):
@@ -333,11 +348,19 @@ class VectorFleetEnv(VectorPointNavEnv):
             )
             r_pot, r_col, r_goal = (xp.where(keep, r, zero) for r in (r_pot, r_col, r_goal))
             shown = xp.where(keep, acting, self._active)
+            self._seen = xp.where(keep, present, self._present)
         self._needs_reset = ~self._active.any(-1)
         info = self._info(success, r_pot, r_col, r_goal, contact, shown, resetting[:, None] & shown)
         return self._observe(shown), reward, terminated, truncated, info
 
     # ------------------------------------------------------------------ observation and info
+    def _scan_ranges(self, c: Any, s: Any) -> Any:
+        """Every robot's scan readings (m), ``(num_envs, n_robots, n_rays)``; robots outside
+        ``_seen`` neither see nor are seen (their rows are hidden by ``_observe``)."""
+        xp, st = self.arrays.xp, self._state
+        yaw = xp.arctan2(s, c)  # the heading as the multi-robot env's frame gives it
+        return self.scan.readings(self._world_scene, st["x"], st["y"], yaw, self._seen, self.robot.radius)
+
     def _observe(self, shown: Any) -> Any:
         """The robots' ``low_dim`` observations, zero where ``shown`` is False."""
         obs = super()._observe()

@@ -17,8 +17,8 @@ Two paths give the same ranges (``property_tests/test_vector_scan_props.py``):
   fixed number of blocks of :data:`BLOCK` (set by ``max_range`` and the finest cell size,
   not by the scene), so that the temporaries stay small;
 - the compiled path (numpy on the CPU with numba, the ``fast`` extra): the single env's
-  kernel (``sensors._raycast_kernel.grid_range``, which jumps over the clear square of a
-  Chebyshev distance transform) ray by ray, in one compiled loop over worlds, robots and
+  kernel (``sensors._raycast_kernel.grid_range``, which jumps over the free squares ahead
+  of the ray, :mod:`pointnav_core.sensors.clearance`) ray by ray, in one compiled loop over worlds, robots and
   rays (:mod:`pointnav_core.vector._scan_kernel`).
 
 Both take the rays' directions from the same products ``cos(yaw) cos(a) - sin(yaw) sin(a)``
@@ -82,8 +82,8 @@ class ScanTables:
         self.meta = np.ascontiguousarray(meta, dtype=np.float64)
         #: The three lookup planes of every padded grid, end to end (bool, numpy).
         self.lookup = np.ascontiguousarray(np.concatenate(lookups))
-        #: Chessboard distance (cells) of every padded cell to the nearest blocked one (int32).
-        self.clearance = np.ascontiguousarray(np.concatenate(clears), dtype=np.int32)
+        #: Per padded cell and quadrant, the free square ahead (sensors.clearance, uint8).
+        self.clearance = np.ascontiguousarray(np.concatenate(clears), dtype=np.uint8)
         self.min_res = float(self.meta[:, 4].min())
         self.max_side = int(self.meta[:, 2:4].max())
         a = self.arrays = arrays
@@ -140,7 +140,8 @@ def cast_batch(
     max_range : float
         Longest reading (m).
     method : {"auto", "array", "numba"}
-        ``"auto"``: numba for numpy arrays when installed, else the array path.
+        ``"auto"``: numba for arrays on the CPU (numpy, or torch ``"cpu"``) when installed,
+        else the array path.
 
     Returns
     -------
@@ -166,21 +167,25 @@ def cast_batch(
     if method not in _METHODS:
         raise ValueError(f"method must be one of {', '.join(map(repr, _METHODS))}, got {method!r}")
     a = tables.arrays
-    if method == "numba" and (a.is_torch or not compiled_available()):
-        raise ValueError('method="numba" needs numpy arrays and numba: pip install "pointnav-core[fast]"')
+    on_cpu = not a.is_torch or a.device == "cpu"
+    if method == "numba" and not (on_cpu and compiled_available()):
+        raise ValueError('method="numba" needs arrays on the CPU and numba: pip install "pointnav-core[fast]"')
     angles = a.asarray(angles)
-    if method != "array" and not a.is_torch and compiled_available():
+    if method != "array" and on_cpu and compiled_available():
         from pointnav_core.vector._scan_kernel import cast_worlds
 
+        # torch CPU tensors are read through numpy views of their memory (no copies).
+        view = (lambda v: v.numpy()) if a.is_torch else (lambda v: v)
+        x, y, yaw, angles = view(x), view(y), view(yaw), view(angles)
         w, r = x.shape
         out = np.empty((w, r, angles.shape[0]))
         cast_worlds(
-            np.ascontiguousarray(scene, dtype=np.int64), np.ascontiguousarray(x, dtype=np.float64),
+            np.ascontiguousarray(view(scene), dtype=np.int64), np.ascontiguousarray(x, dtype=np.float64),
             np.ascontiguousarray(y, dtype=np.float64), np.cos(yaw), np.sin(yaw), np.cos(angles), np.sin(angles),
-            np.ascontiguousarray(present, dtype=np.bool_), float(radius), float(max_range),
+            np.ascontiguousarray(view(present), dtype=np.bool_), float(radius), float(max_range),
             tables.meta, tables.lookup, tables.clearance, out,
         )
-        return out
+        return a.asarray(out) if a.is_torch else out
     c, s = directions(a, yaw, angles)
     best = _grid_ranges(tables, scene, x, y, c, s, float(max_range))
     best = a.xp.minimum(best, _disc_ranges(a, x, y, c, s, present, float(radius)))

@@ -35,6 +35,10 @@ class Arrays:
         else:
             self.f64, self.i64, self.boolean = np.float64, np.int64, np.bool_
 
+    def __reduce__(self) -> tuple[Any, tuple[str]]:
+        # Pickled by device name (a module does not pickle), e.g. into a worker process.
+        return make_arrays, (self.device,)
+
     def asarray(self, a: Any, dtype: Any = None) -> Any:
         """``a`` as an array of this namespace on this device (``dtype`` default: float64)."""
         dtype = self.f64 if dtype is None else dtype
