@@ -108,3 +108,33 @@ def test_wall_table_holds_every_wall_within_reach(scene: Scene, seed: int, reach
             square = box(c * 0.1, r * 0.1, (c + 1) * 0.1, (r + 1) * 0.1)
             if square.distance(Point(x[i], y[i])) <= reach:
                 assert (round(c * 0.1, 9), round(r * 0.1, 9)) in got
+
+
+@pytest.mark.parametrize("device", DEVICES)
+@settings(max_examples=8, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(
+    scene=cluttered_scenes(),
+    seed=st.integers(0, 2**31 - 1),
+    n=st.integers(1, 5),
+    steps=st.integers(1, 120),
+    reward_type=st.sampled_from(["l2", "geodesic"]),
+    max_steps=st.integers(3, 60),
+    forward_step=st.floats(0.02, 0.6),
+    turn_angle=st.floats(0.05, 1.5),
+    stop=st.booleans(),
+)
+def test_vector_discrete_matches_single_envs(
+    device: str, scene: Scene, seed: int, n: int, steps: int, reward_type: str, max_steps: int,
+    forward_step: float, turn_angle: float, stop: bool,
+) -> None:
+    """Discrete actions (several control steps each, cut short by contacts; STOP) as the single env runs them."""
+    rng = np.random.default_rng(seed)
+    episodes = random_episodes(scene, n, rng)
+    # Some goals at the start, so that STOP (or reaching the goal without STOP) succeeds.
+    episodes = [(s, yaw, s if rng.random() < 0.4 else g) for s, yaw, g in episodes]
+    n_actions = 4 if stop else 3
+    weights = np.array([0.5, 0.2, 0.2, 0.1][:n_actions])
+    actions = rng.choice(n_actions, size=(steps, n), p=weights / weights.sum())
+    task = {"reward_type": reward_type, "termination_config": {"max_steps": max_steps, "max_collisions": 20}}
+    discrete = {"forward_step": forward_step, "turn_angle": turn_angle, "stop": stop}
+    compare(scene, episodes, actions, task=task, device=device, action_space="discrete", discrete_actions=discrete)

@@ -22,23 +22,30 @@ INFO_KEYS = ("success", "spl", "soft_spl", "collisions", "episode_length", "path
 
 
 def compare(
-    scene: Any, episodes: list[tuple[Any, float, Any]], actions: np.ndarray, task: dict | None = None, device: str = "numpy",
+    scene: Any,
+    episodes: list[tuple[Any, float, Any]],
+    actions: np.ndarray,
+    task: dict | None = None,
+    device: str = "numpy",
     sensors: dict | None = None,
+    **env_kwargs: Any,
 ) -> dict[str, Any]:
     """Step both for ``len(actions)`` steps; return counts of what happened (ends, contacts)
     and the largest observation and reward differences seen.
 
     ``episodes`` holds one ``(start_xy, yaw, goal_xy)`` per world; ``actions`` has shape
-    ``(steps, num_envs, 2)``; ``sensors`` goes to both.
+    ``(steps, num_envs, 2)``, or ``(steps, num_envs)`` for discrete actions; ``sensors``
+    and ``env_kwargs`` (``action_space``, ``discrete_actions``) go to both engines.
     """
     task = dict(task or {})
     n = len(episodes)
-    venv = VectorPointNavEnv(n, scene=scene, task=task, device=device, seed=0, sensors=sensors)
+    venv = VectorPointNavEnv(n, scene=scene, task=task, device=device, seed=0, sensors=sensors, **env_kwargs)
     singles = [
         PointNavEnv(
             scene=scene,
             flatten_obs=True,
             sensors=sensors,
+            **env_kwargs,
             task=dict(
                 task,
                 initial_pos=[float(s[0]), float(s[1])],

@@ -10,6 +10,7 @@ The same code runs on numpy (``device="numpy"``) and on torch (``"cpu"``, ``"cud
 
 from __future__ import annotations
 
+import functools
 import math
 from collections.abc import Mapping, Sequence
 from concurrent.futures import Executor
@@ -21,6 +22,7 @@ from gymnasium.vector import AutoresetMode, VectorEnv
 
 from pointnav_core import _envcommon, scenes, validation
 from pointnav_core.vector.contacts import advance
+from pointnav_core.vector.discrete import MOVED, DiscretePlan
 from pointnav_core.vector.episodes import EpisodePool
 from pointnav_core.vector.floors import FloorTables
 from pointnav_core.vector.refresh import PoolRefresh, join_pools, refresh_executor
@@ -90,10 +92,19 @@ class VectorPointNavEnv(VectorEnv):
     seed : int, optional
         Seeds the episode pools and the draws from them.
     pool_size : int
-        Episodes prepared per scene, >= 1 (each with its settled goal field);
+        Goals prepared per scene, >= 1 (each with its settled goal field);
         :meth:`refresh_pool` prepares fresh ones while the worlds run.
     action_frequency : float
         Control steps per second (Hz).
+    action_space : str
+        ``"continuous"`` (default) or ``"discrete"``: Habitat's actions, as the single env
+        (:mod:`pointnav_core.actions`), each run as its control steps
+        (:mod:`pointnav_core.vector.discrete`).
+    discrete_actions : dict, optional
+        ``forward_step``, ``turn_angle``, ``stop``, as the single env.
+    starts_per_goal : int
+        Episodes per pool goal, >= 1: the extra starts share the goal's field, so a larger
+        pool costs next to nothing more to prepare.
     max_episode_steps : int, optional
         The task's ``max_steps``, as ``gymnasium.make(..., max_episode_steps=N)`` sets it for
         the single env (the derived ``path_range`` follows).
@@ -101,9 +112,9 @@ class VectorPointNavEnv(VectorEnv):
     Notes
     -----
     ``step`` takes actions of shape ``(num_envs, 2)`` (or ``(num_envs, 1, 2)``) in
-    ``[-1, 1]`` (clipped) and returns observations ``(num_envs, 8)`` float32
-    (``(num_envs, 8 + n_rays)`` with the scan), rewards float64, terminated and truncated
-    bool, and ``info``, a dict of arrays of shape
+    ``[-1, 1]`` (clipped), or with discrete actions integers of shape ``(num_envs,)``, and
+    returns observations ``(num_envs, 8)`` float32 (``(num_envs, 8 + n_rays)`` with the
+    scan), rewards float64, terminated and truncated bool, and ``info``, a dict of arrays of shape
     ``(num_envs,)``: ``success``, ``spl``, ``soft_spl``, ``path_length``,
     ``geodesic_dist``, ``distance_to_goal``, ``collisions``, ``episode_length``,
     ``in_contact``, ``reward_potential``, ``reward_collision``, ``reward_pointgoal`` and
@@ -163,6 +174,9 @@ class VectorPointNavEnv(VectorEnv):
             if isinstance(n_robots, (int, np.integer)) and not isinstance(n_robots, bool) and n_robots > 1:
                 from pointnav_core.vector.fleet_env import VectorFleetEnv
 
+                for name in ("action_space", "discrete_actions", "starts_per_goal"):  # one robot per world only
+                    if name in kwargs and not (name == "action_space" and kwargs[name] == "continuous"):
+                        raise ValueError(f"{name} is not supported with several robots per world yet, got n_robots={n_robots}")
                 return super().__new__(VectorFleetEnv)
             for name in ("max_cycles", "finished"):
                 if name in kwargs:
@@ -182,6 +196,9 @@ class VectorPointNavEnv(VectorEnv):
         pool_size: int = 8,
         action_frequency: float = 10.0,
         max_episode_steps: int | None = None,
+        action_space: str = "continuous",
+        discrete_actions: Mapping[str, Any] | None = None,
+        starts_per_goal: int = 1,
     ) -> None:
         from pointnav_core.env import PointNavEnv
 
@@ -195,6 +212,7 @@ class VectorPointNavEnv(VectorEnv):
             if task is not None and task.get(key) is not None:
                 raise ValueError(f"task: {key} is not supported by the batched engine")
         self.pool_size = validation.integer("pool_size", pool_size, minimum=1)
+        self.starts_per_goal = validation.integer("starts_per_goal", starts_per_goal, minimum=1)
         self.arrays = make_arrays(device)
         self.device = device
         scene_list = [scene] if isinstance(scene, scenes.Scene) else list(scene) if scene is not None else [_default_scene()]
@@ -206,7 +224,7 @@ class VectorPointNavEnv(VectorEnv):
         self.scenes = scene_list
         self._samplers = [
             PointNavEnv(scene=s, robot=self.robot, task=dict(task or {}), sensors=sensors, flatten_obs=True,
-                        action_frequency=action_frequency)
+                        action_frequency=action_frequency, action_space=action_space, discrete_actions=discrete_actions)
             for s in scene_list
         ]
         if max_episode_steps is not None:
@@ -231,6 +249,8 @@ class VectorPointNavEnv(VectorEnv):
                 "step may turn at most 0.25 rad and drive at most half a cell (the kinematic backend's sub-step)"
             )
         a = self.arrays
+        acts = first.discrete_actions
+        self._discrete = None if acts is None else DiscretePlan(acts, spec, self.action_frequency, a)
         self.floors = FloorTables(scene_list, t.floor, spec.radius, a)
         # A chord is never longer than its arc; the margin covers rounding.
         self._max_travel = spec.max_linear_velocity * self.dt * (1.0 + 1e-9) + 1e-12
@@ -263,7 +283,7 @@ class VectorPointNavEnv(VectorEnv):
     def _build_pool(self, fixed: Sequence[tuple[Any, float, Any, int]]) -> None:
         size = 0 if fixed else self.pool_size
         seeds = self._rng.integers(2**31, size=size * len(self.scenes))
-        self.pool = EpisodePool(self._samplers, size, seeds, self.arrays, fixed)
+        self.pool = EpisodePool(self._samplers, size, seeds, self.arrays, fixed, self.starts_per_goal)
 
     def refresh_pool(self, wait: bool = False) -> None:
         """Prepare fresh episodes (``pool_size`` per scene, new seeds) for the autoresets.
@@ -290,11 +310,17 @@ class VectorPointNavEnv(VectorEnv):
         self._finish_refresh()
         seeds = self._rng.integers(2**31, size=self.pool_size * len(self.scenes))
         if wait:
-            self._swap_pool(type(self.pool)(self._samplers, self.pool_size, seeds, self.arrays))
+            self._swap_pool(self._pool_kind()(self._samplers, self.pool_size, seeds, self.arrays))
             return
         if self._executor is None:
             self._executor = refresh_executor()
-        self._refresh = PoolRefresh(self._executor, type(self.pool), self._samplers, self.pool_size, seeds, self.arrays)
+        self._refresh = PoolRefresh(self._executor, self._pool_kind(), self._samplers, self.pool_size, seeds, self.arrays)
+
+    def _pool_kind(self) -> Any:
+        # The pool class with this env's starts per goal (a partial pickles for the worker);
+        # the multi-robot engine, which inherits refresh_pool, has one start per goal.
+        starts = getattr(self, "starts_per_goal", 1)
+        return type(self.pool) if starts == 1 else functools.partial(type(self.pool), starts=starts)
 
     @property
     def refresh_pending(self) -> bool:
@@ -373,7 +399,7 @@ class VectorPointNavEnv(VectorEnv):
         if self._fixed is not None:
             ep = self._fixed
         else:
-            k = a.asarray(self._rng.integers(self.pool_size, size=n), a.i64)
+            k = a.asarray(self._rng.integers(self.pool.pool_size, size=n), a.i64)
             ep = self._world_scene * self.pool.pool_size + k
         p = self.pool
         idx = a.nonzero(mask)
@@ -383,22 +409,25 @@ class VectorPointNavEnv(VectorEnv):
         st["z"][idx] = self.floors.height[self._world_scene[idx]]
         for key in ("vx", "vy", "vz", "w", "path"):
             st[key][idx] = 0.0
-        self._field[idx] = e
+        self._field[idx] = p.field[e]
         self._steps[idx] = 0
         self._collisions[idx] = 0
         d0 = st["d0"][idx]
         geo = self.geodesic_reward & (d0 < math.inf)
         self._geo_metric[idx] = geo
         x, y = st["x"][idx], st["y"][idx]
-        dist = p.fields.distance(e, x, y)
+        dist = p.fields.distance(p.field[e], x, y)
         st["dist"][idx] = dist
         l2 = xp.sqrt((st["gx"][idx] - x) ** 2 + (st["gy"][idx] - y) ** 2)
         st["pot"][idx] = xp.where(geo, xp.where(dist < math.inf, dist, d0), l2)
         self._needs_reset[idx] = False
 
     def check_actions(self, actions: Any) -> Any:
-        """``actions`` as a float64 array ``(num_envs, 2)``; ValueError naming ``actions`` if bad."""
+        """``actions`` as a float64 array ``(num_envs, 2)``, or with discrete actions an int64
+        array ``(num_envs,)``; ValueError naming ``actions`` if bad."""
         a = self.arrays
+        if self._discrete is not None:
+            return self._discrete.check(actions, self.num_envs)
         shape = tuple(getattr(actions, "shape", np.shape(actions)))
         n = self.num_envs
         if shape not in ((n, 2), (n, 1, 2)):
@@ -418,8 +447,19 @@ class VectorPointNavEnv(VectorEnv):
     def _step(self, actions: Any) -> tuple[Any, Any, Any, Any, dict[str, Any]]:
         if not self._started:
             raise RuntimeError("call reset() before step()")
-        a, xp, st = self.arrays, self.arrays.xp, self._state
+        st = self._state
         act = self.check_actions(actions)
+        if self._discrete is None:
+            moved, contact = self._drive(act, st)
+            stopped = None
+        else:
+            moved, contact, stopped = self._discrete.run(self, act)
+        return self._account(moved, contact, stopped)
+
+    def _drive(self, act: Any, state: Mapping[str, Any]) -> tuple[dict[str, Any], Any]:
+        """One control step of every world from ``state`` under commands ``act`` ``(num_envs, 2)``,
+        not committed: the new pose, height and velocities (keys ``MOVED``) and the contacts."""
+        a, xp = self.arrays, self.arrays.xp
         spec = self.robot
         one = 1.0
         v0, v1 = act[:, 0], act[:, 1]
@@ -427,7 +467,7 @@ class VectorPointNavEnv(VectorEnv):
         vx = xp.where(v0 >= one, vmax, xp.where(v0 <= -one, -vmax, v0 * vmax))
         w = xp.where(v1 >= one, wmax, xp.where(v1 <= -one, -wmax, v1 * wmax))
         dt = self.dt
-        x0, y0, yaw0 = st["x"], st["y"], st["yaw"]
+        x0, y0, yaw0 = state["x"], state["y"], state["yaw"]
         # The exact arc over the step (state.drive_arc with vy = 0).
         half = 0.5 * w * dt
         safe = xp.where(half != 0.0, half, 1.0)
@@ -444,7 +484,7 @@ class VectorPointNavEnv(VectorEnv):
         vel_x, vel_y, vel_w = dx / dt, dy / dt, w
         vz = xp.zeros_like(x)
         contact = xp.zeros_like(x) > 1.0
-        z = st["z"]
+        z = state["z"]
         slow = a.nonzero(~fast)
         if slow.shape[0]:
             sx, sy, c = advance(self.floors, scene[slow], x0[slow], y0[slow], dx[slow], dy[slow], spec.radius, self._max_travel)
@@ -459,6 +499,15 @@ class VectorPointNavEnv(VectorEnv):
             z = z.clone() if a.is_torch else z.copy()
             z[slow] = xp.where(fall, z[slow] - drop, z[slow])
             contact[slow] = c
+        moved = {"x": x, "y": y, "yaw": yaw, "z": z, "vx": vel_x, "vy": vel_y, "w": vel_w, "vz": vz}
+        return moved, contact
+
+    def _account(self, moved: Mapping[str, Any], contact: Any, stopped: Any) -> tuple[Any, Any, Any, Any, dict[str, Any]]:
+        """The task's step over the worlds' moves from the committed state: rewards, ends, info,
+        then the commit and the next-step autoresets. ``stopped``: the worlds that called STOP."""
+        a, xp, st = self.arrays, self.arrays.xp, self._state
+        x0, y0, scene = st["x"], st["y"], self._world_scene
+        x, y, yaw, z, vel_x, vel_y, vel_w, vz = (moved[k] for k in MOVED)
         # --- the task's accounting (PointNavigationTask.step)
         path = st["path"] + xp.sqrt((x - x0) ** 2 + (y - y0) ** 2)
         steps = self._steps + 1
@@ -468,8 +517,12 @@ class VectorPointNavEnv(VectorEnv):
         l2 = xp.sqrt((gx - x) ** 2 + (gy - y) ** 2)
         pot = xp.where(self._geo_metric, xp.where(dist < math.inf, dist, st["pot"]), l2)
         success = l2 < self.goal_tolerance
+        if stopped is not None:  # with STOP, success needs STOP within the tolerance (StopAtGoal)
+            success = success & stopped
         fell = z < self.floors.height[scene] - self.fall_height
         terminated = (collisions > self.max_collisions) | fell | success
+        if stopped is not None:
+            terminated = terminated | stopped
         truncated = steps >= self.max_steps
         r_pot = self.r_potential * (st["pot"] - pot)
         zero = xp.zeros_like(x)  # torch.where of two numbers would give float32

@@ -4,6 +4,11 @@ Each scene gets ``pool_size`` episodes, sampled by a :class:`~pointnav_core.env.
 of that scene (the same rules: usable start, reachable goal, ``path_range``), each with its
 goal field settled into a :class:`~pointnav_core.vector.fields.FieldTables`. An autoreset
 draws from the pool, so no reset ever samples or plans during a batched step.
+
+Settling a goal field costs seconds; a start costs next to nothing once its goal's field is
+settled. With ``starts > 1`` each sampled goal gets ``starts - 1`` more starts, drawn by
+the single env's sampler with that goal fixed (``sampling.sample_episode``: a usable start
+within reach, a random heading, the geodesic in ``path_range``), all sharing its field.
 """
 
 from __future__ import annotations
@@ -29,12 +34,21 @@ class EpisodePool:
     scene_ids : sequence of int
         For each sampler, its scene index.
     pool_size : int
-        Episodes per scene.
+        Goals per scene.
     seeds : sequence of int
         ``pool_size * len(samplers)`` reset seeds, sampler by sampler.
     fixed : sequence of (start_xy, yaw, goal_xy, scene index), optional
         Given episodes, added after the sampled ones.
     arrays : Arrays
+    starts : int
+        Episodes per sampled goal (>= 1), sharing its goal field.
+
+    Attributes
+    ----------
+    field : array of int
+        Each episode's goal field in :attr:`fields`.
+    pool_size : int
+        Episodes per scene (``pool_size * starts``).
     """
 
     def __init__(
@@ -44,8 +58,11 @@ class EpisodePool:
         seeds: Sequence[int],
         arrays: Arrays,
         fixed: Sequence[tuple[Any, float, Any, int]] = (),
+        starts: int = 1,
     ) -> None:
-        rows, fields = [], []
+        from pointnav_core.sampling import sample_episode
+
+        rows, fields, field_of = [], [], []
         k = 0
         for s, env in enumerate(samplers):
             for _ in range(pool_size):
@@ -55,20 +72,34 @@ class EpisodePool:
                 x, y, yaw = env.backend._pose(env.backend._robots[task.robot_idn])
                 gx, gy = task.goal_xy
                 rows.append((x, y, yaw, gx, gy, task.geodesic_dist, s))
+                field_of.append(len(fields))
+                cfg = task._config
+                for _ in range(starts - 1):
+                    ep = sample_episode(
+                        env, robot_idn=cfg.robot_idn, floor=cfg.floor, spec=env.robot,
+                        floor_height=task._floor_height, initial_pos=None, initial_quat=None,
+                        goal_pos=(gx, gy), goal_tolerance=cfg.goal_tolerance, path_range=cfg.path_range,
+                        max_trials=task.max_trials,
+                    )
+                    qz, qw = ep.start_quat[2], ep.start_quat[3]
+                    rows.append((ep.start_xy[0], ep.start_xy[1], 2.0 * np.arctan2(qz, qw), gx, gy, ep.geodesic, s))
+                    field_of.append(len(fields))
                 fields.append(task._goal_field.field)
         for start, yaw, goal, s in fixed:
             env = samplers[s]
             ffield = env.scene.goal_field(env.task.floor, goal, robot=env.robot)
             d0 = ffield.exact_distance(start)
             rows.append((float(start[0]), float(start[1]), float(yaw), float(goal[0]), float(goal[1]), d0, s))
+            field_of.append(len(fields))
             fields.append(ffield.field)
         table = np.array(rows, dtype=np.float64).reshape(-1, 7)
         a = arrays
         self.sx, self.sy, self.syaw, self.gx, self.gy, self.d0 = (a.asarray(table[:, i]) for i in range(6))
         self.scene = a.asarray(table[:, 6], a.i64)
+        self.field = a.asarray(field_of, a.i64)
         self.fields = FieldTables(fields, arrays)
-        self.n_sampled = pool_size * len(samplers)
-        self.pool_size = pool_size
+        self.pool_size = pool_size * starts
+        self.n_sampled = self.pool_size * len(samplers)
 
     def __len__(self) -> int:
         return int(self.sx.shape[0])

@@ -85,6 +85,8 @@ def pool_to(pool: Any, arrays: Arrays) -> Any:
     for name in _EPISODE_ARRAYS:
         if hasattr(pool, name):
             setattr(moved, name, _to(getattr(pool, name), arrays))
+    if hasattr(pool, "field"):  # each episode's goal field (an index, not an episode array to join)
+        moved.field = _to(pool.field, arrays)
     moved.fields = pool.fields.to(arrays)
     return moved
 
@@ -105,4 +107,6 @@ def join_pools(new: Any, old: Any) -> Any:
         if hasattr(new, name):
             setattr(joined, name, xp.concatenate([getattr(new, name), getattr(old, name)]))
     joined.fields = FieldTables.concat(new.fields, old.fields)
+    if hasattr(new, "field"):  # each episode's goal field, old ones after new's fields
+        joined.field = xp.concatenate([new.field, old.field + len(new.fields)])
     return joined

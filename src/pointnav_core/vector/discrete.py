@@ -1,0 +1,161 @@
+"""Discrete actions in the batched engine: Habitat's actions as batched control steps.
+
+A discrete action (:mod:`pointnav_core.actions`) is a velocity command held for a number
+of control steps, cut short by a contact. The single env runs these control steps one by
+one for its one robot; here every world runs its action's control steps together: sub-step
+``k`` advances, with one batched control step, the worlds whose action has more than ``k``
+steps and that have not touched anything yet. The others do not move in that sub-step
+(their pose, height and velocities are kept as they are), so that every world ends exactly
+where its single env ends. The loop is over sub-steps (at most five with the defaults),
+never over worlds.
+
+Examples
+--------
+>>> from pointnav_core.actions import DiscreteActions
+>>> from pointnav_core.backend import RobotSpec
+>>> from pointnav_core.vector.xp import make_arrays
+>>> plan = DiscretePlan(DiscreteActions(), RobotSpec(), 10.0, make_arrays("numpy"))
+>>> plan.steps.tolist(), plan.n, plan.max_steps
+([5, 2, 2, 1], 4, 5)
+>>> plan.check(np.array([0, 3]), 2).tolist()
+[0, 3]
+>>> plan.check(np.array([0.0, 3.0]), 2)
+Traceback (most recent call last):
+...
+ValueError: actions must be integers in [0, 4) (discrete actions), got dtype float64
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+from pointnav_core.actions import STOP, DiscreteActions
+from pointnav_core.vector.xp import Arrays
+
+__all__ = ["DiscretePlan"]
+
+_GRAVITY = 9.81  # m/s^2, the kinematic backend's
+_FALL_SPEED = 1.0  # m/s at the start of a fall, the kinematic backend's default fall_speed
+# The state a control step changes: pose, height and the backend's velocities.
+MOVED = ("x", "y", "yaw", "z", "vx", "vy", "w", "vz")
+
+
+class DiscretePlan:
+    """The discrete action set of a batched engine, as arrays indexed by action.
+
+    Parameters
+    ----------
+    actions : DiscreteActions
+        The action set (as the single env's ``discrete_actions`` makes it).
+    robot : RobotSpec
+        The robot (top speeds, differential drive).
+    action_frequency : float
+        Control steps per second (Hz).
+    arrays : Arrays
+        The engine's array namespace and device.
+
+    Attributes
+    ----------
+    commands : array, shape (n, 2)
+        Each action's command in ``[-1, 1]`` units (forward, yaw rate).
+    steps : array of int, shape (n,)
+        Each action's control steps.
+    n : int
+        Number of actions.
+    max_steps : int
+        The most control steps any action takes.
+    stop : int or None
+        The index of STOP, or None when STOP is not an action.
+    """
+
+    def __init__(self, actions: DiscreteActions, robot: Any, action_frequency: float, arrays: Arrays) -> None:
+        plan = actions.commands(robot, action_frequency)
+        self.arrays = arrays
+        self.actions = actions
+        self.commands = arrays.asarray(np.stack([command for command, _ in plan]))
+        self.steps = arrays.asarray([steps for _, steps in plan], arrays.i64)
+        self.n = len(plan)
+        self.max_steps = max(steps for _, steps in plan)
+        self.stop = STOP if actions.stop else None
+
+    def check(self, actions: Any, num_envs: int) -> Any:
+        """``actions`` as an int64 array ``(num_envs,)``; ValueError naming ``actions`` if bad.
+
+        Takes shape ``(num_envs,)`` or ``(num_envs, 1)``, of an integer dtype (numpy,
+        torch or a list of Python ints), every value in ``[0, n)``.
+        """
+        a, n = self.arrays, self.n
+        if isinstance(actions, (list, tuple)):
+            actions = np.asarray(actions)
+        shape = tuple(getattr(actions, "shape", ()))
+        if shape not in ((num_envs,), (num_envs, 1)):
+            raise ValueError(f"actions must have shape ({num_envs},) or ({num_envs}, 1) (discrete actions), got {shape}")
+        dtype = getattr(actions, "dtype", None)
+        if not _is_integer_dtype(dtype):
+            raise ValueError(f"actions must be integers in [0, {n}) (discrete actions), got dtype {dtype}")
+        arr = a.asarray(actions, a.i64).reshape(num_envs)
+        if bool(((arr < 0) | (arr >= n)).any()):
+            bad = a.numpy(arr)
+            bad = bad[(bad < 0) | (bad >= n)]
+            raise ValueError(f"actions must be integers in [0, {n}) (discrete actions), got {bad[:5].tolist()}")
+        return arr
+
+    def run(self, env: Any, index: Any) -> tuple[dict[str, Any], Any, Any]:
+        """Run each world's action as batched control steps, from ``env``'s state.
+
+        Parameters
+        ----------
+        env : VectorPointNavEnv
+            The engine; its ``_drive(commands, state)`` advances every world one control
+            step from ``state`` without committing it.
+        index : array of int, shape (num_envs,)
+            Each world's action (checked by :meth:`check`).
+
+        Returns
+        -------
+        state : dict of arrays
+            The worlds' pose, height and velocities after their actions (keys ``MOVED``).
+        contact : array of bool
+            Whether any of a world's control steps touched something.
+        stopped : array of bool or None
+            The worlds that called STOP, or None without STOP.
+        """
+        a, xp = self.arrays, self.arrays.xp
+        command, steps = self.commands[index], self.steps[index]
+        state = {key: env._state[key] for key in MOVED}
+        contact = a.zeros(index.shape[0], a.boolean)
+        z_start, dt = state["z"], env.dt
+        fall_speed = xp.zeros_like(z_start)  # m/s, of the worlds that fell in an earlier sub-step
+        zero = xp.zeros_like(z_start)
+        for k in range(self.max_steps):
+            # A world moves in sub-step k while its action lasts and it has touched nothing.
+            active = (steps > k) & ~contact
+            if not a.any(active):
+                break
+            falling = state["z"] < z_start
+            moved, touched = env._drive(command, state)
+            # A falling robot no longer drives: it only drops, faster each step (the backend's _fall).
+            drop = fall_speed * dt + 0.5 * _GRAVITY * dt * dt
+            fell = {"x": state["x"], "y": state["y"], "yaw": state["yaw"], "z": state["z"] - drop,
+                    "vx": zero, "vy": zero, "w": zero, "vz": -drop / dt}
+            moved = {key: xp.where(falling, fell[key], moved[key]) for key in MOVED}
+            state = {key: xp.where(active, moved[key], state[key]) for key in MOVED}
+            began = active & ~falling & (state["z"] < z_start)
+            fall_speed = xp.where(began, _FALL_SPEED + _GRAVITY * dt,
+                                  xp.where(active & falling, fall_speed + _GRAVITY * dt, fall_speed))
+            contact = contact | (active & touched & ~falling)
+        stopped = None if self.stop is None else index == self.stop
+        return state, contact, stopped
+
+
+def _is_integer_dtype(dtype: Any) -> bool:
+    if dtype is None:
+        return False
+    if isinstance(dtype, np.dtype):
+        return dtype.kind in "iu"
+    # torch: an integer dtype is neither floating, complex nor bool.
+    is_float = getattr(dtype, "is_floating_point", True)
+    is_complex = getattr(dtype, "is_complex", True)
+    return not is_float and not is_complex and str(dtype) != "torch.bool"
