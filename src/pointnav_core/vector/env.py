@@ -10,10 +10,8 @@ The same code runs on numpy (``device="numpy"``) and on torch (``"cpu"``, ``"cud
 
 from __future__ import annotations
 
-import functools
 import math
 from collections.abc import Mapping, Sequence
-from concurrent.futures import Executor
 from typing import Any, Self
 
 import gymnasium as gym
@@ -25,7 +23,7 @@ from pointnav_core.vector.contacts import advance
 from pointnav_core.vector.discrete import MOVED, DiscretePlan
 from pointnav_core.vector.episodes import EpisodePool
 from pointnav_core.vector.floors import FloorTables
-from pointnav_core.vector.refresh import PoolRefresh, join_pools, refresh_executor
+from pointnav_core.vector.refresh import PoolRefreshing
 from pointnav_core.vector.scan import ScanTables, VectorScan
 from pointnav_core.vector.xp import make_arrays
 
@@ -55,7 +53,7 @@ def _default_scene() -> scenes.Scene:
     return scenes.Scene.from_array(np.asarray(floor.codes), floor.resolution, origin=tuple(floor.origin))
 
 
-class VectorPointNavEnv(VectorEnv):
+class VectorPointNavEnv(PoolRefreshing, VectorEnv):
     """``num_envs`` single-robot point-navigation worlds, stepped as arrays.
 
     A ``gymnasium.vector.VectorEnv`` with next-step autoreset. Each world behaves as a
@@ -160,12 +158,6 @@ class VectorPointNavEnv(VectorEnv):
     """
 
     metadata = {"autoreset_mode": AutoresetMode.NEXT_STEP, "render_modes": []}
-    # Pool refresh (refresh_pool): the pending build and its worker, the new pool while
-    # older episodes are still run, and the field index from which they start.
-    _refresh: PoolRefresh | None = None
-    _executor: Executor | None = None
-    _fresh: Any = None
-    _old_from: int | None = None
 
     def __new__(cls, *args: Any, **kwargs: Any) -> Self:
         # Several robots per world are their own engine (vector.fleet_env), built from here.
@@ -285,80 +277,24 @@ class VectorPointNavEnv(VectorEnv):
         seeds = self._rng.integers(2**31, size=size * len(self.scenes))
         self.pool = EpisodePool(self._samplers, size, seeds, self.arrays, fixed, self.starts_per_goal)
 
-    def refresh_pool(self, wait: bool = False) -> None:
-        """Prepare fresh episodes (``pool_size`` per scene, new seeds) for the autoresets.
-
-        The new pool is built in a worker process (started at the first refresh, kept
-        until ``close()``) and swapped in at the start of the first step after it is ready;
-        from then on autoresets draw from it alone, while the worlds still in an old episode
-        finish it (their goal fields are kept until none is left). With ``wait=True`` it is
-        built here and swapped in before returning: between batches, and reproducibly (the
-        seeds come from the env's generator either way, and give the same pool, but in the
-        background the step of the swap depends on the machine).
-
-        Raises
-        ------
-        RuntimeError
-            Before the first ``reset()``.
-        ValueError
-            While the worlds run fixed episodes (``reset(options={"episodes": ...})``).
-        """
-        if self.pool is None:
-            raise RuntimeError("call reset() before refresh_pool()")
-        if self._fixed is not None:
-            raise ValueError("refresh_pool: the worlds run fixed episodes (reset(options={'episodes': ...})); reset without them first")
-        self._finish_refresh()
-        seeds = self._rng.integers(2**31, size=self.pool_size * len(self.scenes))
-        if wait:
-            self._swap_pool(self._pool_kind()(self._samplers, self.pool_size, seeds, self.arrays))
-            return
-        if self._executor is None:
-            self._executor = refresh_executor()
-        self._refresh = PoolRefresh(self._executor, self._pool_kind(), self._samplers, self.pool_size, seeds, self.arrays)
-
-    def _pool_kind(self) -> Any:
-        # The pool class with this env's starts per goal (a partial pickles for the worker);
-        # the multi-robot engine, which inherits refresh_pool, has one start per goal.
-        starts = getattr(self, "starts_per_goal", 1)
-        return type(self.pool) if starts == 1 else functools.partial(type(self.pool), starts=starts)
-
-    @property
-    def refresh_pending(self) -> bool:
-        """Whether a background refresh has not been swapped in yet."""
-        return self._refresh is not None
-
-    def _finish_refresh(self) -> None:
-        """Swap in a pending refresh, waiting for its build."""
-        if self._refresh is not None:
-            self._swap_pool(self._refresh.result())
-
-    def _swap_pool(self, new: Any) -> None:
-        self._refresh = None
-        # After the current pool (which may still hold an older one's episodes, too).
-        self._old_from = len(new.fields)
-        self.pool = join_pools(new, self.pool)
-        self._fresh = new
-        self._field = self._field + self._old_from
-
-    def _poll_pool(self) -> None:
-        """At a step's start: swap in a finished refresh; drop old episodes no world is in."""
-        if self._refresh is not None and self._refresh.done():
-            self._swap_pool(self._refresh.result())
-        if self._old_from is not None and not bool((self._field >= self._old_from).any()):
-            self.pool, self._fresh, self._old_from = self._fresh, None, None
-
-    def close_extras(self, **kwargs: Any) -> None:
-        """Stop the refresh worker process, if one was started (a pending build is dropped)."""
-        self._refresh = None
-        if self._executor is not None:
-            self._executor.shutdown(wait=True, cancel_futures=True)
-            self._executor = None
-
     # ------------------------------------------------------------------ Gymnasium API
     def reset(self, *, seed: int | None = None, options: dict[str, Any] | None = None) -> tuple[Any, dict[str, Any]]:
         """Reset every world. ``options={"episodes": [(start_xy, yaw, goal_xy), ...]}`` (one per
         world, yaw in rad) fixes each world's episode, at this reset and every autoreset, until a
         reset without it; a new ``seed`` redraws the pools."""
+        self._reset_pools(seed, options)
+        a = self.arrays
+        with np.errstate(invalid="ignore", divide="ignore"):
+            self._reset_worlds(a.full(self.num_envs, True, a.boolean))
+        self._started = True
+        obs = self._observe()
+        with np.errstate(invalid="ignore", divide="ignore"):
+            return obs, self._info(a.zeros(self.num_envs, a.boolean), a.zeros(self.num_envs), a.zeros(self.num_envs),
+                                   a.zeros(self.num_envs), a.zeros(self.num_envs, a.boolean), a.zeros(self.num_envs, a.boolean))
+
+    def _reset_pools(self, seed: int | None, options: Any) -> None:
+        """A reset's checks and pools (both engines): reseed, fix the given episodes (each
+        checked by :meth:`_fixed_episode`) or redraw the pools when needed."""
         self._finish_refresh()
         a = self.arrays
         if options is not None and not isinstance(options, Mapping):
@@ -372,26 +308,21 @@ class VectorPointNavEnv(VectorEnv):
             if len(episodes) != self.num_envs:
                 raise ValueError(f"options['episodes'] must hold one episode per world ({self.num_envs}), got {len(episodes)}")
             scene_of = a.numpy(self._world_scene)
-            fixed = []
-            for i, (start, yaw, goal) in enumerate(episodes):
-                s = int(scene_of[i])
-                env = self._samplers[s]
-                for name, xy in (("start", start), ("goal", goal)):
-                    if not env.scene.is_usable(env.task.floor, xy, self.robot):
-                        raise ValueError(f"options['episodes'][{i}]: {name} {list(xy)} is not usable by the robot")
-                fixed.append((start, float(yaw), goal, s))
+            fixed = [self._fixed_episode(i, episode, int(scene_of[i])) for i, episode in enumerate(episodes)]
             self._build_pool(fixed)
             self._fixed = a.asarray(self.pool.n_sampled + np.arange(self.num_envs), a.i64)
         elif self.pool is None or seed is not None or self._fixed is not None:
             self._fixed = None
             self._build_pool(())
-        with np.errstate(invalid="ignore", divide="ignore"):
-            self._reset_worlds(a.full(self.num_envs, True, a.boolean))
-        self._started = True
-        obs = self._observe()
-        with np.errstate(invalid="ignore", divide="ignore"):
-            return obs, self._info(a.zeros(self.num_envs, a.boolean), a.zeros(self.num_envs), a.zeros(self.num_envs),
-                                   a.zeros(self.num_envs), a.zeros(self.num_envs, a.boolean), a.zeros(self.num_envs, a.boolean))
+
+    def _fixed_episode(self, i: int, episode: Any, s: int) -> tuple[Any, float, Any, int]:
+        """World ``i``'s given episode on scene ``s``, checked; ValueError naming it."""
+        start, yaw, goal = episode
+        env = self._samplers[s]
+        for name, xy in (("start", start), ("goal", goal)):
+            if not env.scene.is_usable(env.task.floor, xy, self.robot):
+                raise ValueError(f"options['episodes'][{i}]: {name} {list(xy)} is not usable by the robot")
+        return start, float(yaw), goal, s
 
     def _reset_worlds(self, mask: Any) -> None:
         a, xp, st = self.arrays, self.arrays.xp, self._state
@@ -439,7 +370,7 @@ class VectorPointNavEnv(VectorEnv):
 
     def step(self, actions: Any) -> tuple[Any, Any, Any, Any, dict[str, Any]]:
         """Advance every world one control step (worlds that ended last step reset instead)."""
-        if self._refresh is not None or self._old_from is not None:
+        if self.refresh_active:
             self._poll_pool()
         with np.errstate(invalid="ignore", divide="ignore"):  # inf distances are masked by where
             return self._step(actions)

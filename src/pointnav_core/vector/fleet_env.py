@@ -173,28 +173,8 @@ class VectorFleetEnv(VectorPointNavEnv):
         """Reset every world. ``options={"episodes": [[(start_xy, yaw, goal_xy), ...], ...]}``
         (per world, one tuple per robot) fixes each world's episode, at this reset and every
         autoreset, until a reset without it; a new ``seed`` redraws the pools."""
-        self._finish_refresh()
+        self._reset_pools(seed, options)
         a = self.arrays
-        if options is not None and not isinstance(options, Mapping):
-            raise ValueError(f"options must be None or a dict, got {options!r}")
-        episodes = (options or {}).get("episodes")
-        if seed is not None:
-            self._rng = np.random.default_rng(validation.integer("seed", seed, minimum=0))
-            if self.scan is not None:
-                self.scan.seed(self._rng)
-        if episodes is not None:
-            if len(episodes) != self.num_envs:
-                raise ValueError(f"options['episodes'] must hold one episode per world ({self.num_envs}), got {len(episodes)}")
-            scene_of = a.numpy(self._world_scene)
-            fixed = []
-            for i, episode in enumerate(episodes):
-                s = int(scene_of[i])
-                fixed.append((check_fixed_episode(self._samplers[s], episode, f"options['episodes'][{i}]"), s))
-            self._build_pool(fixed)
-            self._fixed = a.asarray(self.pool.n_sampled + np.arange(self.num_envs), a.i64)
-        elif self.pool is None or seed is not None or self._fixed is not None:
-            self._fixed = None
-            self._build_pool(())
         every = a.full(self.num_envs, True, a.boolean)
         with np.errstate(invalid="ignore", divide="ignore"):
             self._reset_worlds(every)
@@ -203,6 +183,9 @@ class VectorFleetEnv(VectorPointNavEnv):
             zero, no = a.zeros((self.num_envs, self.n_robots)), a.zeros((self.num_envs, self.n_robots), a.boolean)
             shown = self._active.clone() if a.is_torch else self._active.copy()
             return self._observe(shown), self._info(no, zero, zero, zero, no, shown, no)
+
+    def _fixed_episode(self, i: int, episode: Any, s: int) -> Any:
+        return check_fixed_episode(self._samplers[s], episode, f"options['episodes'][{i}]"), s
 
     def _reset_worlds(self, mask: Any) -> None:
         a, xp, st, p = self.arrays, self.arrays.xp, self._state, self.pool

@@ -14,6 +14,7 @@ length). When no world is left in an old episode, the env keeps the new pool alo
 from __future__ import annotations
 
 import copy
+import functools
 import multiprocessing
 from collections.abc import Sequence
 from concurrent.futures import Executor, ProcessPoolExecutor
@@ -23,7 +24,7 @@ from typing import Any
 from pointnav_core.vector.fields import FieldTables
 from pointnav_core.vector.xp import Arrays, make_arrays
 
-__all__ = ["PoolRefresh", "build_pool", "join_pools", "pool_to", "refresh_executor"]
+__all__ = ["PoolRefresh", "PoolRefreshing", "build_pool", "join_pools", "pool_to", "refresh_executor"]
 
 # The per-episode arrays of both pool kinds (FleetPool's have a robot axis).
 _EPISODE_ARRAYS = ("sx", "sy", "syaw", "gx", "gy", "d0", "scene")
@@ -110,3 +111,91 @@ def join_pools(new: Any, old: Any) -> Any:
     if hasattr(new, "field"):  # each episode's goal field, old ones after new's fields
         joined.field = xp.concatenate([new.field, old.field + len(new.fields)])
     return joined
+
+
+class PoolRefreshing:
+    """The batched envs' ``refresh_pool``: needs ``pool``, ``pool_size``, ``scenes``,
+    ``_samplers``, ``_rng``, ``_fixed``, ``_field`` and ``arrays``; the env calls
+    :meth:`_poll_pool` at a step's start (while :attr:`refresh_active`) and
+    :meth:`_finish_refresh` at a reset."""
+
+    # The pending build and its worker, the new pool while older episodes are still run,
+    # and the field index from which they start.
+    _refresh: PoolRefresh | None = None
+    _executor: Executor | None = None
+    _fresh: Any = None
+    _old_from: int | None = None
+
+    def refresh_pool(self, wait: bool = False) -> None:
+        """Prepare fresh episodes (``pool_size`` per scene, new seeds) for the autoresets.
+
+        The new pool is built in a worker process (started at the first refresh, kept
+        until ``close()``) and swapped in at the start of the first step after it is ready;
+        from then on autoresets draw from it alone, while the worlds still in an old episode
+        finish it (their goal fields are kept until none is left). With ``wait=True`` it is
+        built here and swapped in before returning: between batches, and reproducibly (the
+        seeds come from the env's generator either way, and give the same pool, but in the
+        background the step of the swap depends on the machine).
+
+        Raises
+        ------
+        RuntimeError
+            Before the first ``reset()``.
+        ValueError
+            While the worlds run fixed episodes (``reset(options={"episodes": ...})``).
+        """
+        if self.pool is None:
+            raise RuntimeError("call reset() before refresh_pool()")
+        if self._fixed is not None:
+            raise ValueError("refresh_pool: the worlds run fixed episodes (reset(options={'episodes': ...})); reset without them first")
+        self._finish_refresh()
+        seeds = self._rng.integers(2**31, size=self.pool_size * len(self.scenes))
+        if wait:
+            self._swap_pool(self._pool_kind()(self._samplers, self.pool_size, seeds, self.arrays))
+            return
+        if self._executor is None:
+            self._executor = refresh_executor()
+        self._refresh = PoolRefresh(self._executor, self._pool_kind(), self._samplers, self.pool_size, seeds, self.arrays)
+
+    def _pool_kind(self) -> Any:
+        # The pool class with this env's starts per goal (a partial pickles for the worker);
+        # the multi-robot engine, which inherits refresh_pool, has one start per goal.
+        starts = getattr(self, "starts_per_goal", 1)
+        return type(self.pool) if starts == 1 else functools.partial(type(self.pool), starts=starts)
+
+    @property
+    def refresh_pending(self) -> bool:
+        """Whether a background refresh has not been swapped in yet."""
+        return self._refresh is not None
+
+    def _finish_refresh(self) -> None:
+        """Swap in a pending refresh, waiting for its build."""
+        if self._refresh is not None:
+            self._swap_pool(self._refresh.result())
+
+    def _swap_pool(self, new: Any) -> None:
+        self._refresh = None
+        # After the current pool (which may still hold an older one's episodes, too).
+        self._old_from = len(new.fields)
+        self.pool = join_pools(new, self.pool)
+        self._fresh = new
+        self._field = self._field + self._old_from
+
+    def _poll_pool(self) -> None:
+        """At a step's start: swap in a finished refresh; drop old episodes no world is in."""
+        if self._refresh is not None and self._refresh.done():
+            self._swap_pool(self._refresh.result())
+        if self._old_from is not None and not bool((self._field >= self._old_from).any()):
+            self.pool, self._fresh, self._old_from = self._fresh, None, None
+
+    def close_extras(self, **kwargs: Any) -> None:
+        """Stop the refresh worker process, if one was started (a pending build is dropped)."""
+        self._refresh = None
+        if self._executor is not None:
+            self._executor.shutdown(wait=True, cancel_futures=True)
+            self._executor = None
+
+    @property
+    def refresh_active(self) -> bool:
+        """Whether a refresh is pending or older episodes are still run (steps poll then)."""
+        return self._refresh is not None or self._old_from is not None
