@@ -123,6 +123,20 @@ def grid_range(gx, gy, dx, dy, fhp, fwp, plane, lookup, clear, e, n_cross, reach
             ky += 1
 
 @_jit
+def disc_range(fx, fy, dx, dy, r2):  # pragma: no cover
+    # Range along (dx, dy) from a point at (fx, fy) from a disc's centre, radius squared r2:
+    # raycast._disc_hits' expressions (0 inside, inf when missed or behind).
+    b = fx * dx + fy * dy
+    cc = fx * fx + fy * fy - r2
+    if cc <= 0.0:
+        return 0.0
+    disc = b * b - cc
+    if disc >= 0.0 and b <= 0.0:
+        denom = math.sqrt(max(disc, 0.0)) - b
+        return cc / denom if denom > 0.0 else _INF
+    return _INF
+
+@_jit
 def pseudo_angle(y, x):  # pragma: no cover
     # A monotone stand-in for atan2(y, x), in (-2, 2] (the "diamond angle"), without atan2.
     # Its slope is 1/2 to 1 per rad, so a margin of m rad is covered by a margin of m, and
@@ -182,20 +196,7 @@ def cast(p, cy, sy, ca, sa, params, lookup, clear, near_polygon, edges, discs, o
             for m in range(n_discs):
                 if own[i] == m:
                     continue
-                fx = px - discs[m, 0]
-                fy = py - discs[m, 1]
-                b = fx * dx + fy * dy
-                cc = fx * fx + fy * fy - discs[m, 2] * discs[m, 2]
-                if cc <= 0.0:
-                    t = 0.0
-                else:
-                    disc = b * b - cc
-                    if disc >= 0.0 and b <= 0.0:
-                        denom = math.sqrt(max(disc, 0.0)) - b
-                        t = cc / denom if denom > 0.0 else _INF
-                    else:
-                        t = _INF
-                best = min(best, t)
+                best = min(best, disc_range(px - discs[m, 0], py - discs[m, 1], dx, dy, discs[m, 2] * discs[m, 2]))
             out[i, r] = best
         if n_edges == 0:
             continue

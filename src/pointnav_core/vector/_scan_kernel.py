@@ -13,12 +13,11 @@ import math
 import numba
 import numpy as np
 
-from pointnav_core.sensors._raycast_kernel import grid_range
+from pointnav_core.sensors._raycast_kernel import disc_range, grid_range
 from pointnav_core.sensors.raycast import TOUCH_EPS
 
 __all__ = ["cast_worlds"]
 
-_INF = math.inf
 _jit = numba.njit(cache=True, nogil=True, error_model="numpy")
 
 
@@ -84,18 +83,5 @@ def cast_worlds(scene, x, y, cyaw, syaw, ca, sa, present, radius, max_range, met
                 best = min(grid_range(gx, gy, dx, dy, fhp, fwp, plane, look, clr, e, n_cross, reach) * res, max_range)
                 for j in range(n_near):
                     m = near[j]
-                    fx = px - x[w, m]
-                    fy = py - y[w, m]
-                    b = fx * dx + fy * dy
-                    cc = fx * fx + fy * fy - r2
-                    if cc <= 0.0:
-                        t = 0.0
-                    else:
-                        disc = b * b - cc
-                        if disc >= 0.0 and b <= 0.0:
-                            denom = math.sqrt(max(disc, 0.0)) - b
-                            t = cc / denom if denom > 0.0 else _INF
-                        else:
-                            t = _INF
-                    best = min(best, t)
+                    best = min(best, disc_range(px - x[w, m], py - y[w, m], dx, dy, r2))
                 out[w, i, r] = best
