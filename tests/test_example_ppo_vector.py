@@ -12,9 +12,9 @@ import pytest
 
 torch = pytest.importorskip("torch")
 
-from pointnav_core.maps import OBSTACLE  # noqa: E402
-from pointnav_core.scenes import Scene  # noqa: E402
-from pointnav_core.vector import VectorPointNavEnv  # noqa: E402
+from pointnav_core.maps import OBSTACLE
+from pointnav_core.scenes import Scene
+from pointnav_core.vector import VectorPointNavEnv
 
 _PATH = Path(__file__).resolve().parents[1] / "examples" / "ppo_vector.py"
 
