@@ -53,6 +53,32 @@ def _default_scene() -> scenes.Scene:
     return scenes.Scene.from_array(np.asarray(floor.codes), floor.resolution, origin=tuple(floor.origin))
 
 
+def _task_arguments(task: Mapping[str, Any] | None) -> dict[str, Any]:
+    """A copy of the ``task`` arguments; ValueError for a non-dict or a custom term."""
+    if task is not None and not isinstance(task, Mapping):
+        raise ValueError(f"task must be None or a dict of PointNavigationTask arguments, got {task!r}")
+    for key in ("termination_conditions", "reward_functions", "observation_terms"):
+        if task is not None and task.get(key) is not None:
+            raise ValueError(f"task: {key} is not supported by the batched engine")
+    return dict(task or {})
+
+
+def _scene_list(scene: scenes.Scene | Sequence[scenes.Scene] | None) -> list[scenes.Scene]:
+    """The worlds' scenes (default: the default house as a grid); ValueError if not Scenes."""
+    scene_list = [scene] if isinstance(scene, scenes.Scene) else list(scene) if scene is not None else [_default_scene()]
+    if not scene_list or not all(isinstance(s, scenes.Scene) for s in scene_list):
+        raise ValueError(f"scene must be a Scene or a non-empty sequence of Scenes, got {scene!r}")
+    return scene_list
+
+
+def _differential_robot(robot: Any) -> Any:
+    """The robot spec; ValueError unless it has a differential drive."""
+    spec = _envcommon.make_robot(robot)
+    if spec.drive != "differential":
+        raise ValueError(f"robot must have a differential drive in the batched engine, got {spec.drive!r}")
+    return spec
+
+
 class VectorPointNavEnv(PoolRefreshing, VectorEnv):
     """``num_envs`` single-robot point-navigation worlds, stepped as arrays.
 
@@ -198,24 +224,15 @@ class VectorPointNavEnv(PoolRefreshing, VectorEnv):
         if validation.integer("n_robots", n_robots, minimum=1) != 1:  # several: built by __new__
             raise ValueError(f"n_robots must be 1 here, got {n_robots}: VectorPointNavEnv builds the multi-robot engine")
         scan_term = _scan_term(sensors)
-        if task is not None and not isinstance(task, Mapping):
-            raise ValueError(f"task must be None or a dict of PointNavigationTask arguments, got {task!r}")
-        for key in ("termination_conditions", "reward_functions", "observation_terms"):
-            if task is not None and task.get(key) is not None:
-                raise ValueError(f"task: {key} is not supported by the batched engine")
+        task = _task_arguments(task)
         self.pool_size = validation.integer("pool_size", pool_size, minimum=1)
         self.starts_per_goal = validation.integer("starts_per_goal", starts_per_goal, minimum=1)
         self.arrays = make_arrays(device)
         self.device = device
-        scene_list = [scene] if isinstance(scene, scenes.Scene) else list(scene) if scene is not None else [_default_scene()]
-        if not scene_list or not all(isinstance(s, scenes.Scene) for s in scene_list):
-            raise ValueError(f"scene must be a Scene or a non-empty sequence of Scenes, got {scene!r}")
-        self.robot = _envcommon.make_robot(robot)
-        if self.robot.drive != "differential":
-            raise ValueError(f"robot must have a differential drive in the batched engine, got {self.robot.drive!r}")
-        self.scenes = scene_list
+        self.scenes = scene_list = _scene_list(scene)
+        self.robot = _differential_robot(robot)
         self._samplers = [
-            PointNavEnv(scene=s, robot=self.robot, task=dict(task or {}), sensors=sensors, flatten_obs=True,
+            PointNavEnv(scene=s, robot=self.robot, task=dict(task), sensors=sensors, flatten_obs=True,
                         action_frequency=action_frequency, action_space=action_space, discrete_actions=discrete_actions)
             for s in scene_list
         ]
@@ -223,29 +240,11 @@ class VectorPointNavEnv(PoolRefreshing, VectorEnv):
             for env in self._samplers:  # sets the task's max_steps and refits a derived path_range
                 env.max_episode_steps = max_episode_steps
         first = self._samplers[0]
-        self.action_frequency = first.action_frequency
-        self.dt = 1.0 / self.action_frequency
-        self.task = t = first.task
-        cfg, rcfg = t.termination_config, t.reward_config
-        self.max_steps, self.max_collisions = int(cfg["max_steps"]), int(cfg["max_collisions"])
-        self.fall_height, self.goal_tolerance = float(cfg["fall_height"]), t.goal_tolerance
-        self.r_potential, self.r_collision, self.r_pointgoal = (float(rcfg[k]) for k in ("r_potential", "r_collision", "r_pointgoal"))
-        self.geodesic_reward = t.reward_type == "geodesic"
-        self.goal_in_polar = t.goal_in_polar
-        spec = self.robot
-        if spec.max_angular_velocity * self.dt > _MAX_TURN or spec.max_linear_velocity * self.dt > 0.5 * min(
-            float(s.floors[t.floor].resolution) for s in scene_list
-        ):
-            raise ValueError(
-                f"action_frequency {self.action_frequency} Hz is too low for the batched engine: one control "
-                "step may turn at most 0.25 rad and drive at most half a cell (the kinematic backend's sub-step)"
-            )
-        a = self.arrays
+        self._read_task(first.task, first.action_frequency)
+        t, spec, a = self.task, self.robot, self.arrays
         acts = first.discrete_actions
         self._discrete = None if acts is None else DiscretePlan(acts, spec, self.action_frequency, a)
         self.floors = FloorTables(scene_list, t.floor, spec.radius, a)
-        # A chord is never longer than its arc; the margin covers rounding.
-        self._max_travel = spec.max_linear_velocity * self.dt * (1.0 + 1e-9) + 1e-12
         bounds = [env.task.observation_bounds for env in self._samplers]
         self._low = a.asarray(np.stack([b[0] for b in bounds]).astype(np.float64))
         self._high = a.asarray(np.stack([b[1] for b in bounds]).astype(np.float64))
@@ -270,6 +269,29 @@ class VectorPointNavEnv(PoolRefreshing, VectorEnv):
         self.scan = None if scan_term is None else VectorScan(scan_term, ScanTables(scene_list, t.floor, a))
         if self.scan is not None:
             self.scan.seed(self._rng)
+
+    def _read_task(self, t: Any, action_frequency: float) -> None:
+        """The task's settings the batched step reads (both engines), with the control
+        rate's check: ValueError if one control step needs the backend's sub-steps."""
+        self.action_frequency = action_frequency
+        self.dt = 1.0 / action_frequency
+        self.task = t
+        cfg, rcfg = t.termination_config, t.reward_config
+        self.max_steps, self.max_collisions = int(cfg["max_steps"]), int(cfg["max_collisions"])
+        self.fall_height, self.goal_tolerance = float(cfg["fall_height"]), t.goal_tolerance
+        self.r_potential, self.r_collision, self.r_pointgoal = (float(rcfg[k]) for k in ("r_potential", "r_collision", "r_pointgoal"))
+        self.geodesic_reward = t.reward_type == "geodesic"
+        self.goal_in_polar = t.goal_in_polar
+        spec = self.robot
+        if spec.max_angular_velocity * self.dt > _MAX_TURN or spec.max_linear_velocity * self.dt > 0.5 * min(
+            float(s.floors[t.floor].resolution) for s in self.scenes
+        ):
+            raise ValueError(
+                f"action_frequency {self.action_frequency} Hz is too low for the batched engine: one control "
+                "step may turn at most 0.25 rad and drive at most half a cell (the kinematic backend's sub-step)"
+            )
+        # A chord is never longer than its arc; the margin covers rounding.
+        self._max_travel = spec.max_linear_velocity * self.dt * (1.0 + 1e-9) + 1e-12
 
     # ------------------------------------------------------------------ pools
     def _build_pool(self, fixed: Sequence[tuple[Any, float, Any, int]]) -> None:

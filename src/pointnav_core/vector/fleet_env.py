@@ -22,16 +22,17 @@ from typing import Any
 import gymnasium as gym
 import numpy as np
 
-from pointnav_core import _envcommon, scenes, validation
+from pointnav_core import scenes, validation
 from pointnav_core.vector.contacts import advance
 from pointnav_core.vector.env import (
     _FALL_SPEED,
     _GRAVITY,
-    _MAX_TURN,
     _MIN_FIRST_DROP,
     VectorPointNavEnv,
-    _default_scene,
+    _differential_robot,
     _scan_term,
+    _scene_list,
+    _task_arguments,
 )
 from pointnav_core.vector.fleet_pool import FleetPool, check_fixed_episode
 from pointnav_core.vector.floors import FloorTables
@@ -86,25 +87,15 @@ class VectorFleetEnv(VectorPointNavEnv):
             raise ValueError(f"finished must be one of {list(FINISHED_MODES)}, got {finished!r}")
         self.finished = finished
         scan_term = _scan_term(sensors)
-        if task is not None and not isinstance(task, Mapping):
-            raise ValueError(f"task must be None or a dict of PointNavigationTask arguments, got {task!r}")
-        for key in ("termination_conditions", "reward_functions", "observation_terms"):
-            if task is not None and task.get(key) is not None:
-                raise ValueError(f"task: {key} is not supported by the batched engine")
-        task = dict(task or {})
+        task = _task_arguments(task)
         if max_episode_steps is not None:
             steps = validation.integer("max_episode_steps", max_episode_steps, minimum=1)
             task["termination_config"] = {**dict(task.get("termination_config") or {}), "max_steps": steps}
         self.pool_size = validation.integer("pool_size", pool_size, minimum=1)
         self.arrays = a = make_arrays(device)
         self.device = device
-        scene_list = [scene] if isinstance(scene, scenes.Scene) else list(scene) if scene is not None else [_default_scene()]
-        if not scene_list or not all(isinstance(s, scenes.Scene) for s in scene_list):
-            raise ValueError(f"scene must be a Scene or a non-empty sequence of Scenes, got {scene!r}")
-        self.robot = spec = _envcommon.make_robot(robot)
-        if spec.drive != "differential":
-            raise ValueError(f"robot must have a differential drive in the batched engine, got {spec.drive!r}")
-        self.scenes = scene_list
+        self.scenes = scene_list = _scene_list(scene)
+        self.robot = spec = _differential_robot(robot)
         # The multi-robot env of each scene samples its episodes and is the semantics.
         self._samplers = [
             parallel_env(scene=s, n_robots=self.n_robots, robot=spec, task=dict(task), backend="kinematic",
@@ -113,24 +104,9 @@ class VectorFleetEnv(VectorPointNavEnv):
             for s in scene_list
         ]
         first = self._samplers[0]
-        self.action_frequency = first.action_frequency
-        self.dt = 1.0 / self.action_frequency
-        self.task = t = first.tasks[0]
-        cfg, rcfg = t.termination_config, t.reward_config
-        self.max_steps, self.max_collisions = int(cfg["max_steps"]), int(cfg["max_collisions"])
-        self.fall_height, self.goal_tolerance = float(cfg["fall_height"]), t.goal_tolerance
-        self.r_potential, self.r_collision, self.r_pointgoal = (float(rcfg[k]) for k in ("r_potential", "r_collision", "r_pointgoal"))
-        self.geodesic_reward = t.reward_type == "geodesic"
-        self.goal_in_polar = t.goal_in_polar
-        if spec.max_angular_velocity * self.dt > _MAX_TURN or spec.max_linear_velocity * self.dt > 0.5 * min(
-            float(s.floors[t.floor].resolution) for s in scene_list
-        ):
-            raise ValueError(
-                f"action_frequency {self.action_frequency} Hz is too low for the batched engine: one control "
-                "step may turn at most 0.25 rad and drive at most half a cell (the kinematic backend's sub-step)"
-            )
+        self._read_task(first.tasks[0], first.action_frequency)
+        t = self.task
         self.floors = FloorTables(scene_list, t.floor, spec.radius, a)
-        self._max_travel = spec.max_linear_velocity * self.dt * (1.0 + 1e-9) + 1e-12
         bounds = [env.tasks[0].observation_bounds for env in self._samplers]
         self._low = a.asarray(np.stack([b[0] for b in bounds]).astype(np.float64))[:, None, :]
         self._high = a.asarray(np.stack([b[1] for b in bounds]).astype(np.float64))[:, None, :]
