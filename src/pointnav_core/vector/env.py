@@ -281,7 +281,7 @@ class VectorPointNavEnv(PoolRefreshing, VectorEnv):
         self.fall_height, self.goal_tolerance = float(cfg["fall_height"]), t.goal_tolerance
         self.r_potential, self.r_collision, self.r_pointgoal = (float(rcfg[k]) for k in ("r_potential", "r_collision", "r_pointgoal"))
         self.geodesic_reward = t.reward_type == "geodesic"
-        self.goal_in_polar = t.goal_in_polar
+        self.goal_in_polar = bool(t.goal_in_polar)
         spec = self.robot
         if spec.max_angular_velocity * self.dt > _MAX_TURN or spec.max_linear_velocity * self.dt > 0.5 * min(
             float(s.floors[t.floor].resolution) for s in self.scenes
@@ -502,10 +502,12 @@ class VectorPointNavEnv(PoolRefreshing, VectorEnv):
         c, s = xp.cos(st["yaw"]), xp.sin(st["yaw"])
         dx, dy = st["gx"] - st["x"], st["gy"] - st["y"]
         lx, ly = c * dx + s * dy, c * dy - s * dx
-        if self.goal_in_polar:
+        polar = self.goal_in_polar  # a bool, or a (1, R) mask when robots' tasks differ
+        if polar is not False:
             rho = xp.sqrt(lx * lx + ly * ly)
             phi = xp.where(rho > 0.0, xp.arctan2(ly, lx), 0.0)
-            lx, ly = rho, xp.where(phi == -math.pi, math.pi, phi)
+            phi = xp.where(phi == -math.pi, math.pi, phi)
+            lx, ly = (rho, phi) if polar is True else (xp.where(polar, rho, lx), xp.where(polar, phi, ly))
         vx, vy = st["vx"], st["vy"]
         zero = xp.zeros_like(vx)
         obs = xp.stack([lx, ly, c * vx + s * vy, c * vy - s * vx, st["vz"], zero, zero, st["w"]], -1)
