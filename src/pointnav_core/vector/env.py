@@ -100,10 +100,13 @@ class VectorPointNavEnv(PoolRefreshing, VectorEnv):
         World ``i`` runs on ``scene[i % len(scene)]``. Floors must be grid cells only (no
         obstacle polygons). Default: the single env's default house as a grid.
     robot : RobotSpec or dict, optional
-        Differential drive only.
+        Differential drive only. With several robots per world, also a list with one entry
+        per robot, as for :func:`~pointnav_core.parallel.parallel_env`: their speed limits
+        may differ, their radius may not.
     task : dict, optional
         ``PointNavigationTask`` keyword arguments, as for the single env (its default
-        ``path_range`` too). Custom terms are not supported.
+        ``path_range`` too). Custom terms are not supported. With several robots per world,
+        also a list of one dict per robot (see "Several robots per world").
     sensors : dict, optional
         ``{"scan": {...}}`` (:class:`~pointnav_core.sensors.RangeScan` arguments, as for the
         single env): the flat observation is the 8 ``low_dim`` values, then the scan's
@@ -167,6 +170,13 @@ class VectorPointNavEnv(PoolRefreshing, VectorEnv):
     scene's ``parallel_env`` (non-overlapping starts, goals kept
     :func:`pointnav_core.fleet.goal_separation` apart); ``reset(options={"episodes": [[
     (start_xy, yaw, goal_xy), ...], ...]})`` fixes, per world, one tuple per robot.
+    ``robot`` and ``task`` lists (:mod:`pointnav_core.vector.per_robot`) give robot ``i`` of
+    every world entry ``i``: its task's ``goal_tolerance``, ``reward_type``,
+    ``goal_in_polar``, ``termination_config`` (``max_steps``, ``max_collisions``,
+    ``fall_height``), ``reward_config`` and ``path_range`` and its robot's speed limits
+    (m/s, rad/s) may differ; a list whose tasks' ``floor`` or robots' ``radius`` differ
+    raises ``ValueError`` naming ``task`` or ``robot``, as does a list of the wrong length
+    or an entry of the wrong type (naming ``task[i]`` or ``robot[i]``).
 
     Examples
     --------

@@ -26,7 +26,7 @@ from typing import Any
 
 import numpy as np
 
-from pointnav_core.fleet import make_robots, per_robot, prefixed
+from pointnav_core.fleet import make_robots, per_robot
 from pointnav_core.robot_spec import RobotSpec
 from pointnav_core.vector.xp import Arrays
 
