@@ -113,3 +113,12 @@ def two_floors() -> Scene:
 def test_bad_lists_are_named(kwargs: dict, words: str) -> None:
     with pytest.raises(ValueError, match=words):
         VectorPointNavEnv(**{"num_envs": 1, "n_robots": 2, "scene": room(), "pool_size": 1, **kwargs})
+
+
+def test_max_episode_steps_sets_every_listed_task() -> None:
+    # Standing still, every robot is truncated at step 7, whatever its own task's max_steps.
+    env = VectorPointNavEnv(1, n_robots=3, scene=room(), robot=ROBOTS, task=TASKS, pool_size=1, max_episode_steps=7)
+    env.reset(options={"episodes": [EPISODE]})
+    for step in range(1, 8):
+        _, _, terminated, truncated, _ = env.step(np.zeros((1, 3, 2)))
+        assert not terminated.any() and truncated.all() == (step == 7) and truncated.any() == (step == 7)
