@@ -40,21 +40,26 @@ def compare_fleet(
     finished: str = "park",
     max_cycles: int = 500,
     sensors: dict | None = None,
+    action_space: str = "continuous",
+    discrete_actions: dict | None = None,
 ) -> dict[str, Any]:
     """Step both for ``len(actions)`` steps; return counts of what happened.
 
     ``episodes`` holds, per world, one ``(start_xy, yaw, goal_xy)`` per robot; ``actions``
-    has shape ``(steps, num_envs, n_robots, 2)``. ``sensors`` (both sides) adds the scan to
-    the flat observations compared.
+    has shape ``(steps, num_envs, n_robots, 2)``, or ``(steps, num_envs, n_robots)`` of
+    ints with ``action_space="discrete"`` (and ``discrete_actions``, both sides).
+    ``sensors`` (both sides) adds the scan to the flat observations compared.
     """
     task = dict(task or {})
     n, r = len(episodes), len(episodes[0])
     venv = VectorPointNavEnv(n, n_robots=r, scene=scene, task=task, device=device, seed=0, pool_size=1,
-                             finished=finished, max_cycles=max_cycles, sensors=sensors)
+                             finished=finished, max_cycles=max_cycles, sensors=sensors,
+                             action_space=action_space, discrete_actions=discrete_actions)
     dim = venv.single_observation_space.shape[0]
     refs = [
         parallel_env(scene=scene, n_robots=r, task=[_fixed_task(task, *rb) for rb in world], backend="kinematic",
-                     finished=finished, max_cycles=max_cycles, sensors=sensors)
+                     finished=finished, max_cycles=max_cycles, sensors=sensors, action_space=action_space,
+                     discrete_actions=discrete_actions)
         for world in episodes
     ]
     agents = refs[0].possible_agents
@@ -65,7 +70,7 @@ def compare_fleet(
         obs, _ = env.reset(seed=0)
         sobs[i] = [obs[a] for a in agents]
     stats = {"ends": 0, "successes": 0, "contacts": 0, "autoresets": 0, "robot_contacts": 0, "parked_steps": 0,
-             "falls": 0}
+             "falls": 0, "stops": 0}
     assert to_np(vinfo["active"]).all()
     for t, act in enumerate(actions):
         np.testing.assert_allclose(to_np(vobs), sobs, rtol=0, atol=OBS_TOL, err_msg=f"observations before step {t}")
@@ -101,6 +106,7 @@ def compare_fleet(
                     ref, got = info[a][key], vinfo[key][i, k]
                     assert ref == got or abs(ref - got) <= 1e-6, f"{key} {where}, robot {k}: {ref} vs {got}"
                 stats["ends"] += term[a] or trunc[a]
+                stats["stops"] += action_space == "discrete" and bool(term[a]) and int(act[i, k]) == 3
                 stats["successes"] += info[a]["success"]
                 stats["contacts"] += bool(vinfo["in_contact"][i, k])
                 stats["robot_contacts"] += bool(vinfo["in_contact"][i, k]) and _touches_robot(env, k)

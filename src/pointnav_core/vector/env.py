@@ -192,9 +192,8 @@ class VectorPointNavEnv(PoolRefreshing, VectorEnv):
             if isinstance(n_robots, (int, np.integer)) and not isinstance(n_robots, bool) and n_robots > 1:
                 from pointnav_core.vector.fleet_env import VectorFleetEnv
 
-                for name in ("action_space", "discrete_actions", "starts_per_goal"):  # one robot per world only
-                    if name in kwargs and not (name == "action_space" and kwargs[name] == "continuous"):
-                        raise ValueError(f"{name} is not supported with several robots per world yet, got n_robots={n_robots}")
+                if "starts_per_goal" in kwargs:  # one robot per world only
+                    raise ValueError(f"starts_per_goal is not supported with several robots per world yet, got n_robots={n_robots}")
                 return super().__new__(VectorFleetEnv)
             for name in ("max_cycles", "finished"):
                 if name in kwargs:
