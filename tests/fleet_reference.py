@@ -125,10 +125,13 @@ def _touches_robot(env: Any, k: int) -> bool:
 
 
 def fleet_episodes(
-    scene: Any, n_worlds: int, n_robots: int, rng: np.random.Generator, radius: float = 0.18, goal_gap: float = 0.4
+    scene: Any, n_worlds: int, n_robots: int, rng: np.random.Generator, radius: float = 0.18, goal_gap: float = 0.4,
+    at_start: float = 0.0,
 ) -> list[list[tuple[Any, float, Any]]]:
     """Random fixed episodes: starts where the robot fits, at least two radii apart; goals
-    at least ``goal_gap`` m apart (the multi-robot env's separation for the task used)."""
+    at least ``goal_gap`` m apart (the multi-robot env's separation for the task used).
+    With probability ``at_start`` a robot's goal is its start instead, where that keeps
+    the goals apart (so that STOP can succeed at once)."""
     def apart(gap: float) -> list[Any]:
         points: list[Any] = []
         for _ in range(10_000):  # rejection sampling; a scene with room for the robots ends early
@@ -142,5 +145,9 @@ def fleet_episodes(
     worlds = []
     for _ in range(n_worlds):
         starts, goals = apart(2 * radius), apart(goal_gap)
+        for k, start in enumerate(starts):
+            others = goals[:k] + goals[k + 1 :]
+            if rng.random() < at_start and all(math.dist(start, q) >= goal_gap for q in others):
+                goals[k] = start
         worlds.append([(s, float(rng.uniform(-math.pi, math.pi)), g) for s, g in zip(starts, goals)])
     return worlds
