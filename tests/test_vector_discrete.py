@@ -11,6 +11,7 @@ from __future__ import annotations
 import importlib.util
 import math
 
+import gymnasium as gym
 import numpy as np
 import pytest
 
@@ -186,6 +187,7 @@ def test_fleet_robots_run_together_for_the_longest_action_by_hand(device: str) -
     # for the other 3 (no command, as the multi-robot env steps it), so its velocity is 0.
     env = make_fleet(1, device)
     to_np = env.arrays.numpy
+    assert env.action_space == gym.spaces.MultiDiscrete(np.full((1, 2), 4))
     env.reset(options={"episodes": [[((1.0, 1.5), 0.0, (2.5, 1.5)), ((1.0, 2.5), 0.0, (1.0, 2.5))]]})
     obs, reward, terminated, truncated, info = env.step(np.array([[FORWARD, LEFT]]))
     obs = to_np(obs)

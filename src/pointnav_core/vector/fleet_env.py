@@ -127,7 +127,11 @@ class VectorFleetEnv(VectorPointNavEnv):
         self.single_action_space = first.action_space(first.possible_agents[0])
         batch = gym.vector.utils.batch_space
         self.observation_space = batch(batch(self.single_observation_space, self.n_robots), self.num_envs)
-        self.action_space = batch(batch(self.single_action_space, self.n_robots), self.num_envs)
+        if isinstance(self.single_action_space, gym.spaces.Discrete):  # batched twice it would be an int Box
+            nvec = np.full((self.num_envs, self.n_robots), int(self.single_action_space.n))
+            self.action_space = gym.spaces.MultiDiscrete(nvec)
+        else:
+            self.action_space = batch(batch(self.single_action_space, self.n_robots), self.num_envs)
         self._rng = np.random.default_rng(seed)
         n, r = self.num_envs, self.n_robots
         self._world_scene = a.asarray(np.arange(n) % len(scene_list), a.i64)
