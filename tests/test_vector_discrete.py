@@ -189,7 +189,7 @@ def test_fleet_robots_run_together_for_the_longest_action_by_hand(device: str) -
     to_np = env.arrays.numpy
     assert env.action_space == gym.spaces.MultiDiscrete(np.full((1, 2), 4))
     env.reset(options={"episodes": [[((1.0, 1.5), 0.0, (2.5, 1.5)), ((1.0, 2.5), 0.0, (1.0, 2.5))]]})
-    obs, reward, terminated, truncated, info = env.step(np.array([[FORWARD, LEFT]]))
+    obs, reward, terminated, _, info = env.step(np.array([[FORWARD, LEFT]]))
     obs = to_np(obs)
     np.testing.assert_allclose(to_np(env._state["x"])[0], [1.25, 1.0], atol=1e-12)
     np.testing.assert_allclose(to_np(env._state["yaw"])[0], [0.0, math.radians(10.0)], atol=1e-12)
@@ -198,11 +198,11 @@ def test_fleet_robots_run_together_for_the_longest_action_by_hand(device: str) -
     np.testing.assert_allclose(to_np(reward)[0], [0.25, 0.0], atol=1e-9)
     assert to_np(info["episode_length"]).tolist() == [[1, 1]]
     # Robot 1 calls STOP on its goal: a success with SPL 1; it parks and is inactive from then on.
-    obs, reward, terminated, truncated, info = env.step(np.array([[RIGHT, STOP]]))
+    _, reward, terminated, _, info = env.step(np.array([[RIGHT, STOP]]))
     assert to_np(terminated).tolist() == [[False, True]] and to_np(info["success"]).tolist() == [[False, True]]
     np.testing.assert_allclose(to_np(reward)[0, 1], 10.0, atol=1e-9)
     np.testing.assert_allclose(to_np(info["spl"])[0], [0.0, 1.0])
-    obs, reward, terminated, truncated, info = env.step(np.array([[STOP, FORWARD]]))  # robot 1's is ignored
+    obs, reward, terminated, _, info = env.step(np.array([[STOP, FORWARD]]))  # robot 1's is ignored
     assert to_np(info["active"]).tolist() == [[False, False]]
     assert to_np(terminated).tolist() == [[True, False]] and to_np(info["success"]).tolist() == [[False, False]]
     np.testing.assert_allclose(to_np(env._state["x"])[0], [1.25, 1.0], atol=1e-12)
@@ -217,7 +217,7 @@ def test_fleet_move_into_a_parked_robot_ends_at_the_contact_by_hand(device: str)
     env.reset(options={"episodes": [[((1.0, 1.5), 0.0, (1.0, 2.5)), ((1.6, 1.5), 0.0, (1.6, 1.5))]]})
     env.step(np.array([[RIGHT, STOP]]))
     env.step(np.array([[LEFT, FORWARD]]))
-    obs, reward, terminated, truncated, info = env.step(np.array([[FORWARD, FORWARD]]))
+    info = env.step(np.array([[FORWARD, FORWARD]]))[4]
     np.testing.assert_allclose(to_np(env._state["x"])[0], [1.24, 1.6], atol=1e-9)
     assert to_np(info["in_contact"]).tolist() == [[True, False]]
     assert to_np(info["collisions"]).tolist() == [[1, 0]]
