@@ -149,11 +149,11 @@ def test_discrete_matches_single_envs_in_clutter(device: str, stop: bool, sensor
     assert stats["contacts"] > 0 and stats["successes"] > 0 and stats["autoresets"] > 0
 
 
-def test_starts_per_goal_is_refused_with_several_robots() -> None:
-    with pytest.raises(ValueError, match="starts_per_goal"):
-        VectorPointNavEnv(2, n_robots=2, scene=room(), action_space="discrete", starts_per_goal=2)
+def test_fleet_discrete_actions_need_the_discrete_space() -> None:
     with pytest.raises(ValueError, match="discrete_actions"):
         VectorPointNavEnv(2, n_robots=2, scene=room(), discrete_actions={"stop": False})
+    with pytest.raises(ValueError, match="action_space"):
+        VectorPointNavEnv(2, n_robots=2, scene=room(), action_space="multi")
 
 
 @pytest.mark.parametrize("device", DEVICES)

@@ -172,7 +172,8 @@ class VectorPointNavEnv(PoolRefreshing, VectorEnv):
     steps as its robots' longest action; in each, a robot whose action lasts and has
     touched nothing drives, the others stand (and can still be touched, which counts as
     their collision); STOP ends that robot's episode (a success within ``goal_tolerance``).
-    ``starts_per_goal`` is for one robot per world only.
+    ``starts_per_goal`` gives each pool episode more sets of starts for the same goals
+    (drawn by the multi-robot env's sampler, robot by robot, clear of each other).
 
     Examples
     --------
@@ -198,8 +199,6 @@ class VectorPointNavEnv(PoolRefreshing, VectorEnv):
             if isinstance(n_robots, (int, np.integer)) and not isinstance(n_robots, bool) and n_robots > 1:
                 from pointnav_core.vector.fleet_env import VectorFleetEnv
 
-                if "starts_per_goal" in kwargs:  # one robot per world only
-                    raise ValueError(f"starts_per_goal is not supported with several robots per world yet, got n_robots={n_robots}")
                 return super().__new__(VectorFleetEnv)
             for name in ("max_cycles", "finished"):
                 if name in kwargs:

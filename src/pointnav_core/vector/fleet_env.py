@@ -68,6 +68,9 @@ class VectorFleetEnv(VectorPointNavEnv):
         (:mod:`pointnav_core.vector.discrete`).
     discrete_actions : dict, optional
         ``forward_step``, ``turn_angle``, ``stop``, as the multi-robot env.
+    starts_per_goal : int
+        Sets of starts per pool episode, >= 1: the extra sets share its goals and their
+        settled fields (:class:`~pointnav_core.vector.fleet_pool.FleetPool`).
     """
 
     def __init__(
@@ -87,6 +90,7 @@ class VectorFleetEnv(VectorPointNavEnv):
         finished: str = "park",
         action_space: str = "continuous",
         discrete_actions: Mapping[str, Any] | None = None,
+        starts_per_goal: int = 1,
     ) -> None:
         from pointnav_core.parallel import parallel_env
 
@@ -102,6 +106,7 @@ class VectorFleetEnv(VectorPointNavEnv):
             steps = validation.integer("max_episode_steps", max_episode_steps, minimum=1)
             task["termination_config"] = {**dict(task.get("termination_config") or {}), "max_steps": steps}
         self.pool_size = validation.integer("pool_size", pool_size, minimum=1)
+        self.starts_per_goal = validation.integer("starts_per_goal", starts_per_goal, minimum=1)
         self.arrays = a = make_arrays(device)
         self.device = device
         self.scenes = scene_list = _scene_list(scene)
@@ -159,7 +164,7 @@ class VectorFleetEnv(VectorPointNavEnv):
     def _build_pool(self, fixed: Sequence[Any]) -> None:
         size = 0 if fixed else self.pool_size
         seeds = self._rng.integers(2**31, size=size * len(self.scenes))
-        self.pool = FleetPool(self._samplers, size, seeds, self.arrays, fixed)
+        self.pool = FleetPool(self._samplers, size, seeds, self.arrays, fixed, self.starts_per_goal)
 
     def reset(self, *, seed: int | None = None, options: dict[str, Any] | None = None) -> tuple[Any, dict[str, Any]]:
         """Reset every world. ``options={"episodes": [[(start_xy, yaw, goal_xy), ...], ...]}``
@@ -184,7 +189,7 @@ class VectorFleetEnv(VectorPointNavEnv):
         if self._fixed is not None:
             ep = self._fixed
         else:
-            k = a.asarray(self._rng.integers(self.pool_size, size=self.num_envs), a.i64)
+            k = a.asarray(self._rng.integers(p.pool_size, size=self.num_envs), a.i64)
             ep = self._world_scene * p.pool_size + k
         idx = a.nonzero(mask)
         e = ep[idx]
@@ -193,7 +198,7 @@ class VectorFleetEnv(VectorPointNavEnv):
         st["z"][idx] = self.floors.height[self._world_scene[idx]][:, None] + 0.0 * st["x"][idx]
         for key in ("vx", "vy", "vz", "w", "path"):
             st[key][idx] = 0.0
-        field = e[:, None] * self.n_robots + self._robot_ids
+        field = p.field[e]
         self._field[idx] = field
         self._steps[idx] = 0
         self._collisions[idx] = 0
