@@ -18,10 +18,10 @@ import time
 
 os.environ.setdefault("OMP_NUM_THREADS", "1")
 
-import numpy as np  # noqa: E402
+import numpy as np
 
-from pointnav_core.scenes import Scene  # noqa: E402
-from pointnav_core.vector import VectorPointNavEnv  # noqa: E402
+from pointnav_core.scenes import Scene
+from pointnav_core.vector import VectorPointNavEnv
 
 
 def main() -> None:
