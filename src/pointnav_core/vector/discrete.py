@@ -9,6 +9,11 @@ steps and that have not touched anything yet. The others do not move in that sub
 where its single env ends. The loop is over sub-steps (at most five with the defaults),
 never over worlds.
 
+With several robots per world (``run(..., acting=...)``) the rule is the multi-robot
+env's: a world takes as many control steps as its robots' longest action; in each, the
+robots whose action lasts and that have touched nothing drive, the others get no command
+(they stand, still block, and can be touched).
+
 Examples
 --------
 >>> from pointnav_core.actions import DiscreteActions
