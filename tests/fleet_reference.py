@@ -41,22 +41,27 @@ def compare_fleet(
     max_cycles: int = 500,
     sensors: dict | None = None,
     robot: Any = None,
+    action_space: str = "continuous",
+    discrete_actions: dict | None = None,
 ) -> dict[str, Any]:
     """Step both for ``len(actions)`` steps; return counts of what happened.
 
     ``episodes`` holds, per world, one ``(start_xy, yaw, goal_xy)`` per robot; ``actions``
-    has shape ``(steps, num_envs, n_robots, 2)``. ``sensors`` (both sides) adds the scan to
-    the flat observations compared. ``task`` and ``robot`` (both sides) may be lists with
-    one entry per robot.
+    has shape ``(steps, num_envs, n_robots, 2)``, or ``(steps, num_envs, n_robots)`` of
+    ints with ``action_space="discrete"`` (and ``discrete_actions``, both sides).
+    ``sensors`` (both sides) adds the scan to the flat observations compared. ``task`` and
+    ``robot`` (both sides) may be lists with one entry per robot.
     """
     n, r = len(episodes), len(episodes[0])
     tasks = [dict(t or {}) for t in task] if isinstance(task, list) else [dict(task or {})] * r
     venv = VectorPointNavEnv(n, n_robots=r, scene=scene, task=task, device=device, seed=0, pool_size=1,
-                             finished=finished, max_cycles=max_cycles, sensors=sensors, robot=robot)
+                             finished=finished, max_cycles=max_cycles, sensors=sensors, robot=robot,
+                             action_space=action_space, discrete_actions=discrete_actions)
     dim = venv.single_observation_space.shape[0]
     refs = [
         parallel_env(scene=scene, n_robots=r, task=[_fixed_task(t, *rb) for t, rb in zip(tasks, world)],
-                     backend="kinematic", finished=finished, max_cycles=max_cycles, sensors=sensors, robot=robot)
+                     backend="kinematic", finished=finished, max_cycles=max_cycles, sensors=sensors, robot=robot,
+                     action_space=action_space, discrete_actions=discrete_actions)
         for world in episodes
     ]
     agents = refs[0].possible_agents
@@ -67,7 +72,7 @@ def compare_fleet(
         obs, _ = env.reset(seed=0)
         sobs[i] = [obs[a] for a in agents]
     stats = {"ends": 0, "successes": 0, "contacts": 0, "autoresets": 0, "robot_contacts": 0, "parked_steps": 0,
-             "falls": 0}
+             "falls": 0, "stops": 0}
     assert to_np(vinfo["active"]).all()
     for t, act in enumerate(actions):
         np.testing.assert_allclose(to_np(vobs), sobs, rtol=0, atol=OBS_TOL, err_msg=f"observations before step {t}")
@@ -103,6 +108,7 @@ def compare_fleet(
                     ref, got = info[a][key], vinfo[key][i, k]
                     assert ref == got or abs(ref - got) <= 1e-6, f"{key} {where}, robot {k}: {ref} vs {got}"
                 stats["ends"] += term[a] or trunc[a]
+                stats["stops"] += action_space == "discrete" and bool(term[a]) and int(act[i, k]) == 3
                 stats["successes"] += info[a]["success"]
                 stats["contacts"] += bool(vinfo["in_contact"][i, k])
                 stats["robot_contacts"] += bool(vinfo["in_contact"][i, k]) and _touches_robot(env, k)
@@ -121,10 +127,13 @@ def _touches_robot(env: Any, k: int) -> bool:
 
 
 def fleet_episodes(
-    scene: Any, n_worlds: int, n_robots: int, rng: np.random.Generator, radius: float = 0.18, goal_gap: float = 0.4
+    scene: Any, n_worlds: int, n_robots: int, rng: np.random.Generator, radius: float = 0.18, goal_gap: float = 0.4,
+    at_start: float = 0.0,
 ) -> list[list[tuple[Any, float, Any]]]:
     """Random fixed episodes: starts where the robot fits, at least two radii apart; goals
-    at least ``goal_gap`` m apart (the multi-robot env's separation for the task used)."""
+    at least ``goal_gap`` m apart (the multi-robot env's separation for the task used).
+    With probability ``at_start`` a robot's goal is its start instead, where that keeps
+    the goals apart (so that STOP can succeed at once)."""
     def apart(gap: float) -> list[Any]:
         points: list[Any] = []
         for _ in range(10_000):  # rejection sampling; a scene with room for the robots ends early
@@ -138,5 +147,9 @@ def fleet_episodes(
     worlds = []
     for _ in range(n_worlds):
         starts, goals = apart(2 * radius), apart(goal_gap)
+        for k, start in enumerate(starts):
+            others = goals[:k] + goals[k + 1 :]
+            if rng.random() < at_start and all(math.dist(start, q) >= goal_gap for q in others):
+                goals[k] = start
         worlds.append([(s, float(rng.uniform(-math.pi, math.pi)), g) for s, g in zip(starts, goals)])
     return worlds
