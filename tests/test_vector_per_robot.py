@@ -8,7 +8,7 @@ import math
 
 import numpy as np
 import pytest
-from fleet_reference import compare_fleet
+from fleet_reference import compare_fleet, fleet_episodes
 
 from pointnav_core.maps import OBSTACLE
 from pointnav_core.scenes import Scene
@@ -122,3 +122,22 @@ def test_max_episode_steps_sets_every_listed_task() -> None:
     for step in range(1, 8):
         _, _, terminated, truncated, _ = env.step(np.zeros((1, 3, 2)))
         assert not terminated.any() and truncated.all() == (step == 7) and truncated.any() == (step == 7)
+
+
+@pytest.mark.parametrize("device", DEVICES)
+def test_discrete_actions_take_task_lists(device: str) -> None:
+    # One plan of control steps: robots of one speed (a list of equal specs), tasks that differ.
+    rng = np.random.default_rng(5)
+    tasks = [{"goal_tolerance": 0.15, "reward_type": "geodesic", "reward_config": {"r_pointgoal": 3.0}},
+             {"goal_tolerance": 0.3, "goal_in_polar": True, "termination_config": {"max_steps": 12, "max_collisions": 2}}]
+    episodes = fleet_episodes(room(20, 16), 3, 2, rng, goal_gap=0.45, at_start=0.3)
+    actions = rng.choice(4, size=(50, 3, 2), p=[0.5, 0.2, 0.2, 0.1])
+    stats = compare_fleet(room(20, 16), episodes, actions, task=tasks, robot=[{"radius": 0.18}] * 2, device=device,
+                          action_space="discrete", discrete_actions={"forward_step": 0.1, "stop": True})
+    assert stats["ends"] > 3 and stats["successes"] > 0
+
+
+def test_discrete_actions_refuse_robots_of_different_speeds() -> None:
+    with pytest.raises(ValueError, match=r"^robot: .*speed limits differ.*discrete"):
+        VectorPointNavEnv(1, n_robots=2, scene=room(), pool_size=1, action_space="discrete",
+                          robot=[{}, {"max_linear_velocity": 0.25}])
