@@ -23,6 +23,7 @@ from pointnav_core.vector.contacts import advance
 from pointnav_core.vector.discrete import MOVED, DiscretePlan
 from pointnav_core.vector.episodes import EpisodePool
 from pointnav_core.vector.floors import FloorTables
+from pointnav_core.vector.local_map import VectorLocalMap, local_map_term
 from pointnav_core.vector.refresh import PoolRefreshing
 from pointnav_core.vector.scan import ScanTables, VectorScan
 from pointnav_core.vector.xp import make_arrays
@@ -41,9 +42,9 @@ def _scan_term(sensors: Mapping[str, Any] | None) -> Any:
 
     terms = make_sensors(sensors)  # the single envs' checks: unknown sensors and keys
     for term in terms:
-        if term.name != "scan":
-            raise ValueError(f"sensors: {term.name!r} is not supported by the batched engine (only 'scan')")
-    return terms[0] if terms else None
+        if term.name not in ("scan", "local_map"):
+            raise ValueError(f"sensors: {term.name!r} is not supported by the batched engine (only 'scan', 'local_map')")
+    return next((term for term in terms if term.name == "scan"), None)
 
 
 def _default_scene() -> scenes.Scene:
@@ -269,6 +270,8 @@ class VectorPointNavEnv(PoolRefreshing, VectorEnv):
         self.scan = None if scan_term is None else VectorScan(scan_term, ScanTables(scene_list, t.floor, a))
         if self.scan is not None:
             self.scan.seed(self._rng)
+        map_term = local_map_term(sensors)
+        self.local_map = None if map_term is None else VectorLocalMap(map_term, self.floors)
 
     def _read_task(self, t: Any, action_frequency: float) -> None:
         """The task's settings the batched step reads (both engines), with the control
@@ -511,6 +514,8 @@ class VectorPointNavEnv(PoolRefreshing, VectorEnv):
         obs = xp.stack([lx, ly, c * vx + s * vy, c * vy - s * vx, st["vz"], zero, zero, st["w"]], -1)
         if self.scan is not None:
             obs = (xp.cat if a.is_torch else xp.concatenate)([obs, self._scan_ranges(c, s)], -1)
+        if self.local_map is not None:  # after the scan: the single env's sensor order
+            obs = (xp.cat if a.is_torch else xp.concatenate)([obs, self._map_values()], -1)
         sc = self._world_scene
         obs = xp.minimum(xp.maximum(obs, self._low[sc]), self._high[sc])
         return obs.to(xp.float32) if a.is_torch else obs.astype(np.float32)
@@ -520,6 +525,13 @@ class VectorPointNavEnv(PoolRefreshing, VectorEnv):
         xp, st = self.arrays.xp, self._state
         yaw, one = xp.arctan2(s, c)[:, None], xp.ones_like(c)[:, None] > 0.0  # the single env's frame heading
         return self.scan.readings(self._world_scene, st["x"][:, None], st["y"][:, None], yaw, one, self.robot.radius)[:, 0]
+
+    def _map_values(self) -> Any:
+        """The local map's codes, ``(num_envs, cells * cells)`` float64 (one robot: no discs)."""
+        st = self._state
+        one = self.arrays.xp.ones_like(st["x"])[:, None] > 0.0
+        return self.local_map.values(self._world_scene, st["x"][:, None], st["y"][:, None], st["yaw"][:, None], one,
+                                     self.robot.radius)[:, 0]
 
     def _info(self, success: Any, r_pot: Any, r_col: Any, r_goal: Any, contact: Any, resetting: Any) -> dict[str, Any]:
         xp, st = self.arrays.xp, self._state

@@ -1,0 +1,166 @@
+"""The local map of a batch of worlds: ``(W, R, cells * cells)`` codes in one gather.
+
+Every present robot reads the single env's :class:`~pointnav_core.sensors.LocalMap`: the
+centres of a ``cells x cells`` grid of side ``size`` (m) turned by its heading, each
+mapped to the floor cell under it (``floor`` of the centre over the cell size, the
+backend's :meth:`~pointnav_core.vector.floors.FloorTables.cells`), whose code is looked up
+in the floors' flat code array (off the map: VOID); then the discs of the other robots of
+its world that are present (the scan's rule) are drawn over it as code 3. The arithmetic
+is the single term's, operation for operation, on the heading the single env's frame
+derives from the planar quaternion, so the codes are equal; a cell centre that falls
+within rounding of a cell edge or a disc's rim may read the neighbouring value where the
+two sides round differently (``docs/decisions.md``, "The batched local map").
+
+The same code runs on numpy and on torch on any device (:class:`~pointnav_core.vector.xp.Arrays`);
+its temporaries are ``(W, R, cells * cells)`` arrays, and ``(W, R, R, cells * cells)``
+for the discs when there are several robots per world.
+
+Examples
+--------
+A robot at (0.25, 0.25) m facing +x in a 0.8 x 0.5 m room with a wall from x = 0.5 m to
+0.6 m; its 4 x 4 map of 0.8 m (0.2 m cells, centres 0.1 m and 0.3 m from it) reads the
+wall in row 0 (0.3 m ahead), and off the map (VOID) beyond y = 0.5 m (column 0, on its
+left), below y = 0 (column 3) and behind x = 0 (row 3):
+
+>>> import numpy as np
+>>> from pointnav_core.scenes import Scene
+>>> from pointnav_core.sensors import LocalMap
+>>> from pointnav_core.vector.floors import FloorTables
+>>> from pointnav_core.vector.xp import make_arrays
+>>> grid = np.zeros((5, 8), np.uint8)
+>>> grid[:, 5] = 1
+>>> floors = FloorTables([Scene.from_array(grid, 0.1)], 0, 0.05, make_arrays("numpy"))
+>>> lm = VectorLocalMap(LocalMap(size=0.8, cells=4), floors)
+>>> one = np.ones((1, 1))
+>>> lm.values(np.zeros(1, np.int64), 0.25 * one, 0.25 * one, 0 * one, one > 0, 0.05).reshape(4, 4)
+array([[2., 1., 1., 2.],
+       [2., 0., 0., 2.],
+       [2., 0., 0., 2.],
+       [2., 2., 2., 2.]])
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping
+from typing import Any
+
+import numpy as np
+
+from pointnav_core.sensors.local_map import _LUT, LOCAL_ROBOT, LOCAL_VOID, LocalMap
+from pointnav_core.vector.floors import FloorTables
+
+__all__ = ["VectorLocalMap", "frame_heading", "local_map_term"]
+
+_TWO_PI = 2.0 * math.pi
+
+
+def local_map_term(sensors: Mapping[str, Any] | None) -> LocalMap | None:
+    """The :class:`~pointnav_core.sensors.LocalMap` ``sensors`` asks for, or None (the
+    single envs' checks: a bad ``cells`` or ``size`` raises their ValueError)."""
+    from pointnav_core.sensors import make_sensors
+
+    return next((t for t in make_sensors(sensors) if isinstance(t, LocalMap)), None)
+
+
+def frame_heading(xp: Any, yaw: Any) -> tuple[Any, Any]:
+    """Cosine and sine of the heading as the single env's frame reads them.
+
+    The backend reports the planar quaternion of ``remainder(yaw, 2 pi)``
+    (``backend_kit.planar_quat_floats``); :meth:`~pointnav_core.observations.Frame.set_pose`
+    takes the heading from its rotation matrix. These are the same operations on arrays.
+
+    Parameters
+    ----------
+    xp : module
+        numpy or torch.
+    yaw : float64 array
+        Headings (rad), any shape.
+
+    Returns
+    -------
+    tuple of float64 arrays
+        ``(cos, sin)``, the shape of ``yaw``.
+    """
+    half = 0.5 * (yaw - _TWO_PI * xp.round(yaw / _TWO_PI))
+    qz, qw = xp.sin(half), xp.cos(half)
+    scale = 2.0 / (qz * qz + qw * qw)
+    r00 = 1.0 - scale * (qz * qz)
+    r10 = scale * (qz * qw)
+    h = xp.sqrt(r00 * r00 + r10 * r10)  # math.hypot; |r| is 1 within rounding, never near 0
+    return r00 / h, r10 / h
+
+
+class VectorLocalMap:
+    """A :class:`~pointnav_core.sensors.LocalMap` for a batch of worlds.
+
+    Parameters
+    ----------
+    term : LocalMap
+        The configuration (``size``, ``cells``; its ``dtype`` only shapes the single env's
+        ``Dict`` observation: the flat observation holds the codes as float32 either way).
+    floors : FloorTables
+        The worlds' floors, on the arrays' device.
+
+    Raises
+    ------
+    ValueError
+        Naming ``term`` if it is not a LocalMap.
+    """
+
+    def __init__(self, term: LocalMap, floors: FloorTables) -> None:
+        if not isinstance(term, LocalMap):
+            raise ValueError(f"term must be a LocalMap, got {term!r}")
+        self.term = term
+        self.floors = floors
+        a = self.arrays = floors.arrays
+        # The single term's cell centres in the robot frame (forward u, left v), row by row.
+        self._u = a.asarray(term._u)
+        self._v = a.asarray(term._v)
+        self._lut = a.asarray(_LUT, a.i64)
+
+    @property
+    def size(self) -> int:
+        """Values per robot in the flat observation, ``cells * cells``."""
+        return self.term.size
+
+    def values(self, scene: Any, x: Any, y: Any, yaw: Any, present: Any, radius: float) -> Any:
+        """Every robot's local map, row by row, as float64 codes on the arrays' device.
+
+        Parameters
+        ----------
+        scene : int array, shape (W,)
+            Each world's scene (index into the floors).
+        x, y, yaw : float64 arrays, shape (W, R)
+            Robot centres (m) and headings (rad).
+        present : bool array, shape (W, R)
+            Robots drawn on the others' maps (an absent robot's own map is still computed;
+            the env hides it).
+        radius : float
+            Robot radius (m): the discs drawn as code 3.
+
+        Returns
+        -------
+        float64 array, shape (W, R, cells * cells)
+            Codes 0 free, 1 blocked, 2 void or off the map, 3 another robot.
+        """
+        a, xp, fl = self.arrays, self.arrays.xp, self.floors
+        c, s = frame_heading(xp, yaw)
+        c, s = c[..., None], s[..., None]
+        wx = x[..., None] + c * self._u - s * self._v
+        wy = y[..., None] + s * self._u + c * self._v
+        sc = scene[:, None, None]
+        row, col, inside = fl.cells(sc, wx, wy)
+        code = self._lut[fl.codes[fl.flat_index(sc, row, col, inside)]]
+        out = xp.where(inside, code, xp.full_like(code, LOCAL_VOID))
+        n = x.shape[1]
+        if n > 1:
+            # (W, R, M, C): robot i's cell centres against robot m's disc.
+            dx = wx[:, :, None, :] - x[:, None, :, None]
+            dy = wy[:, :, None, :] - y[:, None, :, None]
+            inside_disc = dx * dx + dy * dy <= radius * radius
+            other = a.asarray(~np.eye(n, dtype=bool), a.boolean)
+            seen = (other[None] & present[:, None, :])[..., None]
+            covered = (inside_disc & seen).any(2) if a.is_torch else (inside_disc & seen).any(axis=2)
+            out = xp.where(covered, xp.full_like(out, LOCAL_ROBOT), out)
+        return a.asarray(out)
