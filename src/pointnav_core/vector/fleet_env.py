@@ -36,8 +36,8 @@ from pointnav_core.vector.env import (
 )
 from pointnav_core.vector.fleet_pool import FleetPool, check_fixed_episode
 from pointnav_core.vector.floors import FloorTables
-from pointnav_core.vector.robots import advance_robots, robot_walls
 from pointnav_core.vector.local_map import VectorLocalMap, local_map_term
+from pointnav_core.vector.robots import advance_robots, robot_walls
 from pointnav_core.vector.scan import ScanTables, VectorScan
 from pointnav_core.vector.xp import make_arrays
 
