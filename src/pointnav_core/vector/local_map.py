@@ -12,8 +12,9 @@ within rounding of a cell edge or a disc's rim may read the neighbouring value w
 two sides round differently (``docs/decisions.md``, "The batched local map").
 
 The same code runs on numpy and on torch on any device (:class:`~pointnav_core.vector.xp.Arrays`);
-its temporaries are ``(W, R, cells * cells)`` arrays, and ``(W, R, R, cells * cells)``
-for the discs when there are several robots per world.
+its temporaries are ``(W, R, cells * cells)`` arrays, and ``(W, R, R, k * k)`` for the
+discs when there are several robots per world (``k`` cells around each other robot, about
+``2 radius / cell size + 3``).
 
 Examples
 --------
@@ -118,6 +119,8 @@ class VectorLocalMap:
         self._u = a.asarray(term._u)
         self._v = a.asarray(term._v)
         self._lut = a.asarray(_LUT, a.i64)
+        # Float copies of the grids' shapes, to index in float until one cast.
+        self._rows, self._width = a.asarray(a.numpy(floors.rows)), a.asarray(a.numpy(floors.width))
 
     @property
     def size(self) -> int:
@@ -145,22 +148,59 @@ class VectorLocalMap:
             Codes 0 free, 1 blocked, 2 void or off the map, 3 another robot.
         """
         a, xp, fl = self.arrays, self.arrays.xp, self.floors
-        c, s = frame_heading(xp, yaw)
-        c, s = c[..., None], s[..., None]
+        c0, s0 = frame_heading(xp, yaw)
+        c, s = c0[..., None], s0[..., None]
         wx = x[..., None] + c * self._u - s * self._v
         wy = y[..., None] + s * self._u + c * self._v
+        # FloorTables.cells and flat_index (the backend's cell of a point), kept in float
+        # until one cast: the same floors, fewer full-size temporaries.
         sc = scene[:, None, None]
-        row, col, inside = fl.cells(sc, wx, wy)
-        code = self._lut[fl.codes[fl.flat_index(sc, row, col, inside)]]
+        inv = fl.inv_res[sc]
+        col = xp.floor((wx - fl.ox[sc]) * inv)
+        row = xp.floor((wy - fl.oy[sc]) * inv)
+        width = self._width[sc]
+        inside = (col >= 0.0) & (col < width) & (row >= 0.0) & (row < self._rows[sc])
+        flat = a.to_int(xp.where(inside, row * width + col, 0.0)) + fl.offset[sc]
+        code = self._lut[fl.codes[flat]]
         out = xp.where(inside, code, xp.full_like(code, LOCAL_VOID))
-        n = x.shape[1]
-        if n > 1:
-            # (W, R, M, C): robot i's cell centres against robot m's disc.
-            dx = wx[:, :, None, :] - x[:, None, :, None]
-            dy = wy[:, :, None, :] - y[:, None, :, None]
-            inside_disc = dx * dx + dy * dy <= radius * radius
-            other = a.asarray(~np.eye(n, dtype=bool), a.boolean)
-            seen = (other[None] & present[:, None, :])[..., None]
-            covered = (inside_disc & seen).any(2) if a.is_torch else (inside_disc & seen).any(axis=2)
-            out = xp.where(covered, xp.full_like(out, LOCAL_ROBOT), out)
+        if x.shape[1] > 1:
+            out = self._draw_discs(out, x, y, c0, s0, present, radius)
         return a.asarray(out)
+
+    def _draw_discs(self, out: Any, x: Any, y: Any, c: Any, s: Any, present: Any, radius: float) -> Any:
+        """``out`` with code 3 where another present robot's disc covers a cell centre.
+
+        Only a window of ``k x k`` cells around each other robot (where its disc can reach)
+        is tested, with the full map's expressions for the centres, so the test is the
+        single term's on the same numbers.
+        """
+        a, xp, term = self.arrays, self.arrays.xp, self.term
+        w, n = x.shape
+        cells, cs = term.cells, term.cell_size
+        # The disc spans at most floor(2 r / cs) + 1 rows; one more each side for rounding.
+        k = min(math.ceil(2.0 * radius / cs) + 3, cells)
+        dx = x[:, None, :] - x[:, :, None]  # (W, R, M): robot m relative to robot i
+        dy = y[:, None, :] - y[:, :, None]
+        c, s = c[..., None], s[..., None]
+        fwd, left = c * dx + s * dy, c * dy - s * dx
+        # Fractional row and column of robot m in robot i's map (row i's centre: u_i).
+        half = cells / 2.0 - 0.5
+        r0 = (xp.floor(half - fwd / cs - radius / cs) - 1.0).clip(0.0, float(cells - k))
+        c0 = (xp.floor(half - left / cs - radius / cs) - 1.0).clip(0.0, float(cells - k))
+        ks = a.asarray(np.arange(k, dtype=np.float64))
+        cell = a.to_int((r0[..., None, None] + ks[:, None]) * cells + (c0[..., None, None] + ks[None, :]))
+        cell = cell.reshape(w, n, n, k * k)
+        u, v = self._u[cell], self._v[cell]
+        cx, cy = c[..., None], s[..., None]
+        wx = x[:, :, None, None] + cx * u - cy * v  # the centres of values(), operation for operation
+        wy = y[:, :, None, None] + cy * u + cx * v
+        ex = wx - x[:, None, :, None]
+        ey = wy - y[:, None, :, None]
+        other = a.asarray(~np.eye(n, dtype=bool), a.boolean)
+        seen = (other[None] & present[:, None, :])[..., None]
+        hit = (ex * ex + ey * ey <= radius * radius) & seen
+        base = a.asarray(np.arange(w * n, dtype=np.int64).reshape(w, n, 1, 1) * (cells * cells), a.i64)
+        flat = out.reshape(-1)
+        # Every write is 3, so windows overlapping on a cell need no reduction.
+        flat[(base + cell)[hit]] = LOCAL_ROBOT
+        return flat.reshape(out.shape)
