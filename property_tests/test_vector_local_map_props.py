@@ -2,7 +2,7 @@
 
 For random grid floors (obstacle cells, VOID, the map's edge), random poses of up to four
 robots per world (some absent), map sizes from a fraction of a cell to several metres and
-1 to 12 cells a side, every code of :meth:`VectorLocalMap.values` (numpy, and torch on the
+1 to 12 cells a side, computed in blocks of 1 to 6 worlds (the CPU's blocks), every code of :meth:`VectorLocalMap.values` (numpy, and torch on the
 CPU) equals ``local_map_reference.reference_map`` (shapely squares and discs), except at a
 tie: a cell centre within 1e-9 m of a cell edge or a disc's rim.
 """
@@ -10,6 +10,7 @@ tie: a cell centre within 1e-9 m of a cell edge or a disc's rim.
 from __future__ import annotations
 
 import importlib.util
+from unittest import mock
 
 import numpy as np
 import pytest
@@ -20,6 +21,7 @@ from local_map_reference import reference_map
 from pointnav_core.maps import OBSTACLE, VOID
 from pointnav_core.scenes import Scene
 from pointnav_core.sensors import LocalMap
+from pointnav_core.vector import local_map as local_map_module
 from pointnav_core.vector.floors import FloorTables
 from pointnav_core.vector.local_map import VectorLocalMap
 from pointnav_core.vector.xp import make_arrays
@@ -34,15 +36,16 @@ DEVICES = ["numpy"] + (["cpu"] if importlib.util.find_spec("torch") else [])
     rows=st.integers(1, 20),
     cols=st.integers(1, 20),
     res=st.sampled_from([0.05, 0.1, 0.25]),
-    worlds=st.integers(1, 3),
+    worlds=st.integers(1, 5),
+    block=st.integers(1, 6),
     n_robots=st.integers(1, 4),
     size=st.floats(0.01, 4.0),
     cells=st.integers(1, 12),
     radius=st.floats(0.01, 0.5),
 )
 def test_local_map_matches_shapely(
-    device: str, seed: int, rows: int, cols: int, res: float, worlds: int, n_robots: int, size: float, cells: int,
-    radius: float,
+    device: str, seed: int, rows: int, cols: int, res: float, worlds: int, block: int, n_robots: int, size: float,
+    cells: int, radius: float,
 ) -> None:
     rng = np.random.default_rng(seed)
     grid = np.zeros((rows, cols), np.uint8)
@@ -59,8 +62,10 @@ def test_local_map_matches_shapely(
     present = rng.random((worlds, n_robots)) < 0.8
     a = make_arrays(device)
     lm = VectorLocalMap(LocalMap(size=size, cells=cells), FloorTables([scene], 0, radius, a))
-    got = a.numpy(lm.values(a.asarray(np.zeros(worlds), a.i64), a.asarray(x), a.asarray(y), a.asarray(yaw),
-                            a.asarray(present, a.boolean), radius))
+    # The CPU's blocks of ``block`` worlds (one block when it is >= worlds).
+    with mock.patch.object(local_map_module, "CPU_BLOCK", block * n_robots * cells * cells):
+        got = a.numpy(lm.values(a.asarray(np.zeros(worlds), a.i64), a.asarray(x), a.asarray(y), a.asarray(yaw),
+                                a.asarray(present, a.boolean), radius))
     assert got.shape == (worlds, n_robots, cells * cells)
     for w in range(worlds):
         for i in range(n_robots):

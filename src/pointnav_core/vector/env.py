@@ -3,7 +3,7 @@
 Every world is a :class:`~pointnav_core.env.PointNavEnv` with one robot on the kinematic
 backend (several robots per world: :mod:`pointnav_core.vector.fleet_env`), and the batched
 step reproduces them (drive, contacts and sliding, the task's rewards, terminations, SPL
-and SoftSPL, the flat ``low_dim`` observation and the range scan) with array operations
+and SoftSPL, the flat ``low_dim`` observation, the range scan and the local map) with array operations
 over all worlds at once: there is no Python loop over worlds on the step path.
 The same code runs on numpy (``device="numpy"``) and on torch (``"cpu"``, ``"cuda"``).
 """
@@ -111,7 +111,11 @@ class VectorPointNavEnv(PoolRefreshing, VectorEnv):
         ``n_rays`` ranges (m, in ``[0, max_range]``), in the single env's order and bounds,
         cast by :mod:`pointnav_core.vector.scan` (compiled with numba on numpy, arrays on
         torch). Noise and dropout draw from a stream of their own, not the single env's.
-        ``local_map`` is not supported.
+        ``{"local_map": {...}}`` (:class:`~pointnav_core.sensors.LocalMap` arguments) adds
+        its ``cells * cells`` codes (0 free, 1 blocked, 2 void or off the map, 3 another
+        robot; after the scan when both are given), equal to the single env's
+        (:mod:`pointnav_core.vector.local_map`); ``dtype`` shapes only the single env's
+        ``Dict`` observation, the flat one is float32 either way.
     device : str
         ``"numpy"`` (default), or torch on ``"cpu"`` or ``"cuda[:n]"``.
     seed : int, optional
@@ -139,7 +143,7 @@ class VectorPointNavEnv(PoolRefreshing, VectorEnv):
     ``step`` takes actions of shape ``(num_envs, 2)`` (or ``(num_envs, 1, 2)``) in
     ``[-1, 1]`` (clipped), or with discrete actions integers of shape ``(num_envs,)``, and
     returns observations ``(num_envs, 8)`` float32 (``(num_envs, 8 + n_rays)`` with the
-    scan), rewards float64, terminated and truncated bool, and ``info``, a dict of arrays of shape
+    scan, plus ``cells * cells`` with the local map), rewards float64, terminated and truncated bool, and ``info``, a dict of arrays of shape
     ``(num_envs,)``: ``success``, ``spl``, ``soft_spl``, ``path_length``,
     ``geodesic_dist``, ``distance_to_goal``, ``collisions``, ``episode_length``,
     ``in_contact``, ``reward_potential``, ``reward_collision``, ``reward_pointgoal`` and
@@ -155,7 +159,8 @@ class VectorPointNavEnv(PoolRefreshing, VectorEnv):
     ``max_cycles`` steps. Every return carries the robot axis: ``step`` takes actions
     ``(num_envs, R, 2)`` (all finite; those of inactive robots are ignored) and returns
     observations ``(num_envs, R, 8)`` float32 (``(num_envs, R, 8 + n_rays)`` with the scan,
-    which sees the other robots present in its world as the multi-robot env's scan does),
+    which sees the other robots present in its world as the multi-robot env's scan does;
+    plus ``cells * cells`` with the local map, which draws the same robots as code 3),
     rewards ``(num_envs, R)`` float64,
     terminated and truncated ``(num_envs, R)`` bool and ``info`` arrays ``(num_envs, R)``
     with, besides the keys above, ``active``: the robots that are still agents (PettingZoo's

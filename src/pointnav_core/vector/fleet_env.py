@@ -10,7 +10,8 @@ the one-robot engine's, masked by the robots still active (PettingZoo's ``agents
 ``sensors={"scan": {...}}`` every robot's scan sees the floor and the discs of the other
 robots of its world that the multi-robot env's scan sees when it observes the step: those
 present before the step's finished robots leave (parked, removed or fallen alike), all of
-them after a reset.
+them after a reset; with ``sensors={"local_map": {...}}`` every robot's map draws the discs
+of the same robots as code 3.
 """
 
 from __future__ import annotations

@@ -11,7 +11,8 @@ derives from the planar quaternion, so the codes are equal; a cell centre that f
 within rounding of a cell edge or a disc's rim may read the neighbouring value where the
 two sides round differently (``docs/decisions.md``, "The batched local map").
 
-The same code runs on numpy and on torch on any device (:class:`~pointnav_core.vector.xp.Arrays`);
+The same code runs on numpy and on torch on any device (:class:`~pointnav_core.vector.xp.Arrays`),
+on a CPU in blocks of worlds of about :data:`CPU_BLOCK` cells, on a GPU in one call;
 its temporaries are ``(W, R, cells * cells)`` arrays, and ``(W, R, R, k * k)`` for the
 discs when there are several robots per world (``k`` cells around each other robot, about
 ``2 radius / cell size + 3``).
@@ -51,9 +52,11 @@ import numpy as np
 from pointnav_core.sensors.local_map import _LUT, LOCAL_ROBOT, LOCAL_VOID, LocalMap
 from pointnav_core.vector.floors import FloorTables
 
-__all__ = ["VectorLocalMap", "frame_heading", "local_map_term"]
+__all__ = ["CPU_BLOCK", "VectorLocalMap", "frame_heading", "local_map_term"]
 
 _TWO_PI = 2.0 * math.pi
+#: Map cells computed together on a CPU (worlds x robots x cells per side squared).
+CPU_BLOCK = 65_536
 
 
 def local_map_term(sensors: Mapping[str, Any] | None) -> LocalMap | None:
@@ -147,6 +150,19 @@ class VectorLocalMap:
         float64 array, shape (W, R, cells * cells)
             Codes 0 free, 1 blocked, 2 void or off the map, 3 another robot.
         """
+        a, xp = self.arrays, self.arrays.xp
+        w, n = x.shape
+        block = max(1, CPU_BLOCK // (n * self.size))
+        if w <= block or (a.is_torch and a.device != "cpu"):
+            return self._values(scene, x, y, yaw, present, radius)
+        # On a CPU, blocks of worlds whose temporaries stay in cache (about twice as fast
+        # at 1,024 x 4 robots with 32 x 32 maps as one call); a GPU takes the whole batch.
+        parts = [self._values(scene[i : i + block], x[i : i + block], y[i : i + block], yaw[i : i + block],
+                              present[i : i + block], radius) for i in range(0, w, block)]
+        return (xp.cat if a.is_torch else xp.concatenate)(parts)
+
+    def _values(self, scene: Any, x: Any, y: Any, yaw: Any, present: Any, radius: float) -> Any:
+        """:meth:`values` of one block of worlds."""
         a, xp, fl = self.arrays, self.arrays.xp, self.floors
         c0, s0 = frame_heading(xp, yaw)
         c, s = c0[..., None], s0[..., None]
