@@ -91,7 +91,7 @@ def frame_heading(xp: Any, yaw: Any) -> tuple[Any, Any]:
     scale = 2.0 / (qz * qz + qw * qw)
     r00 = 1.0 - scale * (qz * qz)
     r10 = scale * (qz * qw)
-    h = xp.sqrt(r00 * r00 + r10 * r10)  # math.hypot; |r| is 1 within rounding, never near 0
+    h = xp.hypot(r00, r10)
     return r00 / h, r10 / h
 
 
