@@ -9,7 +9,7 @@ its world that are present (the scan's rule) are drawn over it as code 3. The ar
 is the single term's, operation for operation, on the heading the single env's frame
 derives from the planar quaternion, so the codes are equal; a cell centre that falls
 within rounding of a cell edge or a disc's rim may read the neighbouring value where the
-two sides round differently (``docs/decisions.md``, "The batched local map").
+two sides round differently (``docs/decisions.md``, "The local map in the batched engine").
 
 The same code runs on numpy and on torch on any device (:class:`~pointnav_core.vector.xp.Arrays`),
 on a CPU in blocks of worlds of about :data:`CPU_BLOCK` cells, on a GPU in one call;
