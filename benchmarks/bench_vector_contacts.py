@@ -1,10 +1,13 @@
-"""Cost of the multi-robot contact resolver beside the one-robot resolver, same robots.
+"""Cost of the batched contact resolvers, array and compiled paths, on the same robots.
 
 4,096 robots of radius 0.18 m on a 20 x 15 m floor with 5 % random clutter (0.1 m cells),
 each with a 0.05 m chord (a full-speed step at 10 Hz) in a random direction: once as 4,096
 one-robot worlds through ``vector.contacts.advance`` (no robot-robot contacts), once as
 1,024 worlds x 4 robots through ``vector.robots.advance_robots`` (walls and robots, one
-event clock per world). Numpy, one thread, best of 5 calls each; the ratio is the figure.
+event clock per world), and both again through the compiled path
+(``vector.contacts_jit.advance_compiled``, numba, the ``fast`` extra) that the engines
+take on the CPU. Numpy, one thread, best of 5 calls each (process time: the machines are
+shared); the ratios are the figures.
 
 Usage: ``python benchmarks/bench_vector_contacts.py``
 """
@@ -18,6 +21,7 @@ import numpy as np
 
 from pointnav_core.scenes import Scene
 from pointnav_core.vector.contacts import advance
+from pointnav_core.vector.contacts_jit import advance_compiled
 from pointnav_core.vector.floors import FloorTables
 from pointnav_core.vector.robots import advance_robots, robot_walls
 from pointnav_core.vector.xp import make_arrays
@@ -49,18 +53,36 @@ def main() -> None:
         walls = robot_walls(floors, sc, pos[..., 0], pos[..., 1], mx, my, radius, limit)
         return advance_robots(a, pos[..., 0], pos[..., 1], mx, my, radius, walls=walls)
 
+    every = np.ones((n_worlds, n_robots), bool)
+
+    def single_compiled() -> object:
+        return advance_compiled(floors, sc.reshape(-1, 1), pos[..., 0].reshape(-1, 1), pos[..., 1].reshape(-1, 1),
+                                mx.reshape(-1, 1), my.reshape(-1, 1), every.reshape(-1, 1), radius, limit)
+
+    def multi_compiled() -> object:
+        return advance_compiled(floors, sc, pos[..., 0], pos[..., 1], mx, my, every, radius, limit)
+
+    runs = {
+        "one-robot, array path, 4,096 x 1": single,
+        "multi-robot, array path, 1,024 x 4": multi,
+        "one-robot, compiled, 4,096 x 1": single_compiled,
+        "multi-robot, compiled, 1,024 x 4": multi_compiled,
+    }
     best = {}
     with np.errstate(all="ignore"):
-        for name, f in (("one-robot resolver, 4,096 x 1", single), ("multi-robot resolver, 1,024 x 4", multi)):
+        for name, f in runs.items():
             f()
             times = []
             for _ in range(5):
-                t0 = time.perf_counter()
+                t0 = time.process_time()
                 f()
-                times.append(time.perf_counter() - t0)
+                times.append(time.process_time() - t0)
             best[name] = min(times)
-            print(f"{name}: {best[name] * 1e3:.1f} ms per call")
-    print(f"multi / one-robot: {best['multi-robot resolver, 1,024 x 4'] / best['one-robot resolver, 4,096 x 1']:.1f} x")
+            print(f"{name}: {best[name] * 1e3:.2f} ms per call")
+    one, multi_ = best["one-robot, array path, 4,096 x 1"], best["multi-robot, array path, 1,024 x 4"]
+    print(f"multi / one-robot, array path: {multi_ / one:.1f} x")
+    print(f"array / compiled: one-robot {one / best['one-robot, compiled, 4,096 x 1']:.1f} x, "
+          f"multi-robot {multi_ / best['multi-robot, compiled, 1,024 x 4']:.1f} x")
 
 
 if __name__ == "__main__":

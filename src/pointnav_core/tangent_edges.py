@@ -10,7 +10,7 @@ overhead is paid once per batch. The results are identical to the per-node const
 from __future__ import annotations
 
 import math
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from numpy.typing import NDArray
@@ -18,7 +18,7 @@ from numpy.typing import NDArray
 if TYPE_CHECKING:
     from pointnav_core.tangent_graph import Planner
 
-__all__ = ["sight_radii", "build_edges"]
+__all__ = ["build_edges", "sight_radii"]
 
 _TWO_PI = 2.0 * math.pi
 _ANG_TOL = 1e-9
@@ -41,7 +41,8 @@ def sight_radii(
     one ring) of the cells no disc point can use; a ray advances by what the nearest such
     cell leaves free and stops inside one. The bound is the longest ray plus two cells.
     Only the rays still marching are updated, so the cost is the total ray length, not
-    the longest ray times the batch.
+    the longest ray times the batch. With numba (the ``fast`` extra) the rays march in
+    compiled code (:mod:`pointnav_core._sight_kernel`), with the same expressions.
 
     Parameters
     ----------
@@ -66,13 +67,19 @@ def sight_radii(
     h, w = fb_edt.shape
     flat = fb_edt.ravel()
     ang = np.linspace(0.0, _TWO_PI, n_rays, endpoint=False)
+    start = radius / resolution + 2.0
+    limit = math.hypot(h, w) + 2.0
+    kernel = _march_kernel()
+    if kernel is not None:
+        longest = np.empty(n_pts)
+        kernel(np.ascontiguousarray(flat, dtype=np.float64), h, w, (xs - origin[0]) / resolution + 1.0,
+               (ys - origin[1]) / resolution + 1.0, np.cos(ang), np.sin(ang), start, limit, 4 * (h + w), longest)
+        return (longest + 2.0) * resolution
     ux = np.tile(np.cos(ang), n_pts)
     uy = np.tile(np.sin(ang), n_pts)
     gx0 = np.repeat((xs - origin[0]) / resolution + 1.0, n_rays)  # +1: the padding ring
     gy0 = np.repeat((ys - origin[1]) / resolution + 1.0, n_rays)
     t = np.zeros(n_pts * n_rays)
-    start = radius / resolution + 2.0
-    limit = math.hypot(h, w) + 2.0
     live = np.arange(n_pts * n_rays)
     for _ in range(4 * (h + w)):
         if not len(live):
@@ -89,6 +96,22 @@ def sight_radii(
         live = live[go]
         t[live] = tl[go] + np.maximum(d[go] - math.sqrt(2.0), 0.25)
     return (t.reshape(n_pts, n_rays).max(axis=1) + 2.0) * resolution
+
+
+_KERNEL: list = []
+
+
+def _march_kernel() -> Any:
+    """The compiled ray march (:mod:`pointnav_core._sight_kernel`), or None without numba."""
+    if not _KERNEL:
+        try:
+            from pointnav_core._sight_kernel import march
+        except ModuleNotFoundError as error:
+            if error.name not in ("numba", "llvmlite"):
+                raise
+            march = None
+        _KERNEL.append(march)
+    return _KERNEL[0]
 
 
 def build_edges(p: Planner, nodes: NDArray[np.int64]) -> None:

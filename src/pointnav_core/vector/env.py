@@ -19,6 +19,7 @@ import numpy as np
 from gymnasium.vector import AutoresetMode, VectorEnv
 
 from pointnav_core import _envcommon, scenes, validation
+from pointnav_core.vector import contacts_jit
 from pointnav_core.vector.contacts import advance
 from pointnav_core.vector.discrete import MOVED, DiscretePlan
 from pointnav_core.vector.episodes import EpisodePool
@@ -448,7 +449,8 @@ class VectorPointNavEnv(PoolRefreshing, VectorEnv):
         z = state["z"]
         slow = a.nonzero(~fast)
         if slow.shape[0]:
-            sx, sy, c = advance(self.floors, scene[slow], x0[slow], y0[slow], dx[slow], dy[slow], spec.radius, self._max_travel)
+            resolver = contacts_jit.advance_one if contacts_jit.available(self.floors) else advance
+            sx, sy, c = resolver(self.floors, scene[slow], x0[slow], y0[slow], dx[slow], dy[slow], spec.radius, self._max_travel)
             syaw = yaw0[slow] + w[slow] * dt
             fall = self.floors.is_void(scene[slow], sx, sy)
             drop = max(_FALL_SPEED * dt + 0.5 * _GRAVITY * dt * dt, _MIN_FIRST_DROP)

@@ -24,7 +24,9 @@ import gymnasium as gym
 import numpy as np
 
 from pointnav_core import scenes, validation
+from pointnav_core.vector import contacts_jit
 from pointnav_core.vector.contacts import advance
+from pointnav_core.vector.contacts_jit import advance_compiled
 from pointnav_core.vector.env import (
     _FALL_SPEED,
     _GRAVITY,
@@ -247,23 +249,12 @@ class VectorFleetEnv(VectorPointNavEnv):
         x, y, yaw = x0 + xp.where(fast, dx, zero), y0 + xp.where(fast, dy, zero), yaw0 + w * dt
         contact = zero > 1.0
         z, vz = st["z"], zero + 0.0
-        n_slow = slow.sum(-1)
-        # A world with one slow robot is the one-robot resolver's case (the backend's
-        # advance with a single robot): cheaper, and most busy worlds are such.
-        alone = a.nonzero((slow & (n_slow == 1)[:, None]).reshape(-1))
-        if alone.shape[0]:
-            flat = [v.reshape(-1)[alone] for v in (scene, x0, y0, dx, dy)]
-            nx, ny, c = advance(self.floors, *flat, radius, self._max_travel)
-            x.reshape(-1)[alone], y.reshape(-1)[alone], contact.reshape(-1)[alone] = nx, ny, c
-        busy = a.nonzero(n_slow > 1)
-        if busy.shape[0]:
-            bx, by, bdx, bdy = x0[busy], y0[busy], dx[busy], dy[busy]
-            walls = robot_walls(self.floors, scene[busy], bx, by, bdx, bdy, radius, self._max_travel)
-            nx, ny, c = advance_robots(a, bx, by, bdx, bdy, radius, present=slow[busy], walls=walls)
-            bslow = slow[busy]
-            x[busy] = xp.where(bslow, nx, x[busy])
-            y[busy] = xp.where(bslow, ny, y[busy])
-            contact[busy] = c & bslow
+        if contacts_jit.available(self.floors):  # every world in one compiled loop
+            sx, sy, c = advance_compiled(self.floors, scene, x0, y0, dx, dy, slow, radius, self._max_travel)
+            x, y = xp.where(slow, a.asarray(sx), x), xp.where(slow, a.asarray(sy), y)
+            contact = a.asarray(c, a.boolean)
+        else:
+            self._advance_slow(x0, y0, dx, dy, slow, x, y, contact)
         fall = slow & self.floors.is_void(scene, x, y)
         drop = max(_FALL_SPEED * dt + 0.5 * _GRAVITY * dt * dt, _MIN_FIRST_DROP)
         z = xp.where(fall, z - drop, z)
@@ -315,6 +306,29 @@ class VectorFleetEnv(VectorPointNavEnv):
         self._needs_reset = ~self._active.any(-1)
         info = self._info(success, r_pot, r_col, r_goal, contact, shown, resetting[:, None] & shown)
         return self._observe(shown), reward, terminated, truncated, info
+
+
+    def _advance_slow(self, x0: Any, y0: Any, dx: Any, dy: Any, slow: Any, x: Any, y: Any, contact: Any) -> None:
+        """The array path of the slow robots' contacts: writes their ends into ``x``, ``y``
+        and their flags into ``contact`` (in place)."""
+        a, xp, radius, scene = self.arrays, self.arrays.xp, self.robot.radius, self._robot_scene
+        n_slow = slow.sum(-1)
+        # A world with one slow robot is the one-robot resolver's case (the backend's
+        # advance with a single robot): cheaper, and most busy worlds are such.
+        alone = a.nonzero((slow & (n_slow == 1)[:, None]).reshape(-1))
+        if alone.shape[0]:
+            flat = [v.reshape(-1)[alone] for v in (scene, x0, y0, dx, dy)]
+            nx, ny, c = advance(self.floors, *flat, radius, self._max_travel)
+            x.reshape(-1)[alone], y.reshape(-1)[alone], contact.reshape(-1)[alone] = nx, ny, c
+        busy = a.nonzero(n_slow > 1)
+        if busy.shape[0]:
+            bx, by, bdx, bdy = x0[busy], y0[busy], dx[busy], dy[busy]
+            walls = robot_walls(self.floors, scene[busy], bx, by, bdx, bdy, radius, self._max_travel)
+            nx, ny, c = advance_robots(a, bx, by, bdx, bdy, radius, present=slow[busy], walls=walls)
+            bslow = slow[busy]
+            x[busy] = xp.where(bslow, nx, x[busy])
+            y[busy] = xp.where(bslow, ny, y[busy])
+            contact[busy] = c & bslow
 
     # ------------------------------------------------------------------ observation and info
     def _scan_ranges(self, c: Any, s: Any) -> Any:

@@ -76,6 +76,9 @@ class FloorTables:
         self.ox, self.oy, self.res, self.height = (a.asarray(m[:, i]) for i in (3, 4, 5, 6))
         self.inv_res = 1.0 / self.res  # the backend multiplies by it: the same cells at the edges
         self.min_res = float(m[:, 5].min())
+        #: Per scene, on the host: flat offset, rows, width, origin x, y, cell size, and
+        #: 1 / cell size as ``inv_res`` holds it (float64, ``(scenes, 7)``), for compiled code.
+        self.host_meta = np.ascontiguousarray(np.column_stack([m[:, :6], 1.0 / m[:, 5]]))
         self.arrays = a
 
     def wall_table(self, reach: float) -> Any:

@@ -1,0 +1,154 @@
+"""The batched contacts' compiled path equals their array path.
+
+For random grid scenes (clutter, walls), robots crowded around a point and random chords,
+driven for several rounds from where the last round left them (so that they rest against
+walls and each other), :func:`~pointnav_core.vector.contacts_jit.advance_compiled` gives
+the same end positions (bit for bit on numpy, within 1e-12 m on torch) and contact
+flags as the array path: with several robots per world
+:func:`~pointnav_core.vector.robots.advance_robots` (which the kinematic backend's resolver
+checks in ``tests/test_vector_robots.py``), with one :func:`~pointnav_core.vector.contacts.advance`.
+"""
+
+from __future__ import annotations
+
+import importlib.util
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from pointnav_core.maps import OBSTACLE
+from pointnav_core.scenes import Scene
+
+pytest.importorskip("numba")
+
+DEVICES = ["numpy"] + (["cpu"] if importlib.util.find_spec("torch") else [])
+
+
+def _assert_same(device: str, got: np.ndarray, want: np.ndarray) -> None:
+    # numpy's array path does each operation as the kernel does: the same floats. torch's
+    # vectorised CPU kernels may round an operation differently in the last place.
+    if device == "numpy":
+        np.testing.assert_array_equal(got, want)
+    else:
+        np.testing.assert_allclose(got, want, rtol=0.0, atol=1e-12)
+
+
+@st.composite
+def cluttered_scenes(draw: st.DrawFn) -> Scene:
+    """A walled room, 14 to 30 cells a side, random obstacle cells, a few bars and a free patch, 0.1 m cells."""
+    rows, cols = draw(st.integers(14, 30)), draw(st.integers(14, 30))
+    rng = np.random.default_rng(draw(st.integers(0, 2**31 - 1)))
+    grid = np.zeros((rows, cols), np.uint8)
+    grid[rng.random((rows, cols)) < draw(st.floats(0.0, 0.15))] = OBSTACLE
+    for _ in range(draw(st.integers(0, 3))):  # bars: long faces to slide along
+        r, c = rng.integers(rows), rng.integers(cols)
+        grid[r, c : c + rng.integers(2, 8)] = OBSTACLE
+    grid[0, :] = grid[-1, :] = grid[:, 0] = grid[:, -1] = OBSTACLE
+    r, c = draw(st.integers(1, rows - 9)), draw(st.integers(1, cols - 9))
+    grid[r : r + 8, c : c + 8] = 0  # a free 0.8 m patch: some robot always fits
+    return Scene.from_array(grid, 0.1)
+
+
+def _crowd(scene: Scene, worlds: int, n_robots: int, radius: float, rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray]:
+    """Robot positions as an episode can have them: each world's robots within about 0.6 m
+    of a usable point, clear of every obstacle cell and of each other (brute force)."""
+    tmap = scene.floors[0]
+    rows, cols = np.nonzero(np.asarray(tmap.codes) == OBSTACLE)
+    res, (ox, oy) = tmap.resolution, tmap.origin[:2]
+    x0, y0 = ox + cols * res, oy + rows * res
+    height, width = (n * res for n in np.asarray(tmap.codes).shape)
+
+    def clear(px: float, py: float, others: list[tuple[float, float]]) -> bool:
+        dx = np.maximum(np.maximum(x0 - px, px - (x0 + res)), 0.0)
+        dy = np.maximum(np.maximum(y0 - py, py - (y0 + res)), 0.0)
+        walls_ok = not len(dx) or float(np.sqrt(dx * dx + dy * dy).min()) >= radius
+        return walls_ok and all((px - qx) ** 2 + (py - qy) ** 2 >= (2 * radius) ** 2 for qx, qy in others)
+
+    x, y = np.empty((worlds, n_robots)), np.empty((worlds, n_robots))
+    for w in range(worlds):
+        cx, cy = scene.get_random_point(0, robot=radius, rng=rng)[1][:2]
+        placed = [(cx, cy)]
+        for _ in range(200):
+            if len(placed) == n_robots:
+                break
+            px, py = cx + rng.uniform(-0.6, 0.6), cy + rng.uniform(-0.6, 0.6)
+            if 0.0 < px - ox < width and 0.0 < py - oy < height and clear(px, py, placed):
+                placed.append((px, py))
+        while len(placed) < n_robots:  # no room near it: off the map, apart
+            placed.append((ox - 10.0 * len(placed), oy - 10.0))
+        x[w], y[w] = [p[0] for p in placed], [p[1] for p in placed]
+    return x, y
+
+
+def _chords(rng: np.random.Generator, shape: tuple[int, ...], travel: float) -> tuple[np.ndarray, np.ndarray]:
+    heading = rng.uniform(-np.pi, np.pi, shape)
+    length = rng.uniform(0.0, travel, shape)
+    length[rng.random(shape) < 0.3] = travel  # full speed, often
+    length[rng.random(shape) < 0.1] = 0.0  # standing robots still block
+    return length * np.cos(heading), length * np.sin(heading)
+
+
+@pytest.mark.parametrize("device", DEVICES)
+@settings(max_examples=25, deadline=None)
+@given(scene=cluttered_scenes(), seed=st.integers(0, 2**31 - 1), n_robots=st.integers(2, 5),
+       radius=st.sampled_from([0.0, 0.05, 0.12, 0.18]), travel=st.sampled_from([0.02, 0.05, 0.1, 0.3]))
+def test_compiled_contacts_equal_the_multi_robot_array_path(
+    device: str, scene: Scene, seed: int, n_robots: int, radius: float, travel: float
+) -> None:
+    from pointnav_core.vector.contacts_jit import advance_compiled
+    from pointnav_core.vector.floors import FloorTables
+    from pointnav_core.vector.robots import advance_robots, robot_walls
+    from pointnav_core.vector.xp import make_arrays
+
+    rng = np.random.default_rng(seed)
+    a, worlds = make_arrays(device), 12
+    floors = FloorTables([scene], 0, radius, a)
+    x, y = _crowd(scene, worlds, n_robots, radius, rng)
+    scene_ids = a.zeros((worlds, n_robots), a.i64)
+    for _ in range(6):
+        mx, my = _chords(rng, (worlds, n_robots), travel)
+        slow = rng.random((worlds, n_robots)) < 0.85
+        args = [a.asarray(v) for v in (x, y, mx, my)]
+        walls = robot_walls(floors, scene_ids, *args, radius, travel)
+        want = [a.numpy(v) for v in advance_robots(a, *args, radius, present=a.asarray(slow, a.boolean), walls=walls)]
+        got = advance_compiled(floors, scene_ids, *args, a.asarray(slow, a.boolean), radius, travel)
+        _assert_same(device, got[0][slow], want[0][slow])
+        _assert_same(device, got[1][slow], want[1][slow])
+        np.testing.assert_array_equal(got[2][slow], want[2][slow])
+        # The robots not resolved stay where they were and touch nothing.
+        np.testing.assert_array_equal(got[0][~slow], x[~slow])
+        assert not got[2][~slow].any()
+        x, y = want[0], want[1]
+
+
+@pytest.mark.parametrize("device", DEVICES)
+@settings(max_examples=25, deadline=None)
+@given(scene=cluttered_scenes(), seed=st.integers(0, 2**31 - 1),
+       radius=st.sampled_from([0.0, 0.05, 0.12, 0.18]), travel=st.sampled_from([0.02, 0.05, 0.1, 0.3]))
+def test_compiled_contacts_equal_the_one_robot_array_path(
+    device: str, scene: Scene, seed: int, radius: float, travel: float
+) -> None:
+    from pointnav_core.vector.contacts import advance
+    from pointnav_core.vector.contacts_jit import advance_compiled
+    from pointnav_core.vector.floors import FloorTables
+    from pointnav_core.vector.xp import make_arrays
+
+    rng = np.random.default_rng(seed)
+    a, worlds = make_arrays(device), 48
+    limit = travel * (1.0 + 1e-9) + 1e-12  # the env's max_travel: a chord's rounding fits
+    floors = FloorTables([scene], 0, radius, a)
+    x, y = _crowd(scene, worlds, 1, radius, rng)
+    x, y = x[:, 0], y[:, 0]
+    scene_ids = a.zeros(worlds, a.i64)
+    for _ in range(6):
+        mx, my = _chords(rng, (worlds,), travel)
+        args = [a.asarray(v) for v in (x, y, mx, my)]
+        want = [a.numpy(v) for v in advance(floors, scene_ids, *args, radius, limit)]
+        got = advance_compiled(floors, scene_ids[:, None], *(v[:, None] for v in args),
+                               a.asarray(np.ones((worlds, 1), bool), a.boolean), radius, limit)
+        _assert_same(device, got[0][:, 0], want[0])
+        _assert_same(device, got[1][:, 0], want[1])
+        np.testing.assert_array_equal(got[2][:, 0], want[2])
+        x, y = want[0], want[1]

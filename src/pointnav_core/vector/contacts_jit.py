@@ -1,0 +1,94 @@
+"""The compiled path of the batched contacts: every world's slow robots in one numba loop.
+
+The array path (:func:`~pointnav_core.vector.contacts.advance` for one robot per world,
+:func:`~pointnav_core.vector.robots.advance_robots` for several) runs every contact round
+for every robot of the batch as whole arrays: about a hundred array calls a step, each on
+``robots x walls`` or ``robots x walls x tangents`` elements, most of them for robots that
+resolve nothing. On the CPU this module does the same arithmetic one world, robot and wall
+at a time in a numba kernel (:mod:`~pointnav_core.vector._contact_kernel`), stopping where
+each world stops, with the same expressions in the same order, so both paths give the same
+positions and contact flags; ``property_tests/test_vector_contacts_props.py`` checks that
+they are equal.
+
+numba is optional (the ``fast`` extra): without it, or for arrays on a GPU, the engines
+take the array path. torch tensors on the CPU are read and written through numpy views of
+their memory.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+from pointnav_core.vector.floors import FloorTables
+
+__all__ = ["advance_compiled", "advance_one", "available"]
+
+# The walls a robot may meet are within this (m) of its chord, beyond its radius
+# (4 x the backend's _ACTIVE, as vector.contacts.window is called).
+_WALL_MARGIN = 4.0 * 2.0e-9
+
+
+def available(floors: FloorTables) -> bool:
+    """Whether the compiled path can run for these floors' arrays (CPU, numba importable)."""
+    a = floors.arrays
+    if a.is_torch and a.device != "cpu":
+        return False
+    from pointnav_core.sensors import raycast_jit
+
+    return raycast_jit.available()
+
+
+def advance_compiled(
+    floors: FloorTables, scene: Any, x: Any, y: Any, mx: Any, my: Any, slow: Any, radius: float, max_travel: float
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Move the ``slow`` robots by their chords with contacts; the others stay.
+
+    Parameters
+    ----------
+    floors : FloorTables
+    scene : int array (W, R)
+        Each robot's scene index.
+    x, y, mx, my : float arrays (W, R)
+        Start positions and chords over the step (m).
+    slow : bool array (W, R)
+        The robots to resolve: within a world they move together and block each other;
+        the others neither move nor block (the caller moves them: they are out of reach).
+    radius : float
+        Every robot's radius (m).
+    max_travel : float
+        The longest chord any step may have (m): the wall table is built for it.
+
+    Returns
+    -------
+    x, y : float64 numpy arrays (W, R)
+        End positions (m): the start for robots not ``slow``.
+    contact : bool numpy array (W, R)
+        Whether each slow robot was blocked by a wall or another robot, or blocked one.
+    """
+    from pointnav_core.vector._contact_kernel import advance_worlds
+
+    a = floors.arrays
+    view = (lambda v: v.numpy()) if a.is_torch else (lambda v: v)
+    table = floors.wall_table(radius + max_travel + _WALL_MARGIN)
+    x, y = np.ascontiguousarray(view(x), np.float64), np.ascontiguousarray(view(y), np.float64)
+    x_out, y_out = x.copy(), y.copy()
+    contact = np.zeros(x.shape, np.bool_)
+    advance_worlds(
+        x, y, np.ascontiguousarray(view(mx), np.float64), np.ascontiguousarray(view(my), np.float64),
+        np.ascontiguousarray(view(slow), np.bool_), np.ascontiguousarray(view(scene), np.int64), float(radius),
+        floors.host_meta, np.ascontiguousarray(view(table), np.int64), x_out, y_out, contact,
+    )
+    return x_out, y_out, contact
+
+
+def advance_one(
+    floors: FloorTables, scene: Any, x: Any, y: Any, mx: Any, my: Any, radius: float, max_travel: float
+) -> tuple[Any, Any, Any]:
+    """:func:`advance_compiled` for one robot per world, with the arguments and results of
+    :func:`~pointnav_core.vector.contacts.advance`: ``(M,)`` arrays in the floors' namespace."""
+    a = floors.arrays
+    out = advance_compiled(floors, scene[:, None], x[:, None], y[:, None], mx[:, None], my[:, None],
+                           a.xp.ones_like(x[:, None]) > 0.0, radius, max_travel)
+    return tuple(a.asarray(v[:, 0], a.boolean if v.dtype == np.bool_ else None) for v in out)  # type: ignore[return-value]
