@@ -521,11 +521,12 @@ class VectorPointNavEnv(PoolRefreshing, VectorEnv):
         obs = xp.stack([lx, ly, c * vx + s * vy, c * vy - s * vx, st["vz"], zero, zero, st["w"]], -1)
         if self.scan is not None:
             obs = (xp.cat if a.is_torch else xp.concatenate)([obs, self._scan_ranges(c, s)], -1)
-        if self.local_map is not None:  # after the scan: the single env's sensor order
+        sc, width = self._world_scene, obs.shape[-1]
+        obs = xp.minimum(xp.maximum(obs, self._low[..., :width][sc]), self._high[..., :width][sc])
+        obs = obs.to(xp.float32) if a.is_torch else obs.astype(np.float32)
+        if self.local_map is not None:  # after the scan (the single env's order); codes within their bounds
             obs = (xp.cat if a.is_torch else xp.concatenate)([obs, self._map_values()], -1)
-        sc = self._world_scene
-        obs = xp.minimum(xp.maximum(obs, self._low[sc]), self._high[sc])
-        return obs.to(xp.float32) if a.is_torch else obs.astype(np.float32)
+        return obs
 
     def _scan_ranges(self, c: Any, s: Any) -> Any:
         """The scan's readings (m), ``(num_envs, n_rays)``, at the headings' cosines ``c`` and sines ``s``."""
@@ -534,7 +535,7 @@ class VectorPointNavEnv(PoolRefreshing, VectorEnv):
         return self.scan.readings(self._world_scene, st["x"][:, None], st["y"][:, None], yaw, one, self.robot.radius)[:, 0]
 
     def _map_values(self) -> Any:
-        """The local map's codes, ``(num_envs, cells * cells)`` float64 (one robot: no discs)."""
+        """The local map's codes, ``(num_envs, cells * cells)`` float32 (one robot: no discs)."""
         st = self._state
         one = self.arrays.xp.ones_like(st["x"])[:, None] > 0.0
         return self.local_map.values(self._world_scene, st["x"][:, None], st["y"][:, None], st["yaw"][:, None], one,

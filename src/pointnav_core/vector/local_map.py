@@ -38,7 +38,7 @@ left), below y = 0 (column 3) and behind x = 0 (row 3):
 array([[2., 1., 1., 2.],
        [2., 0., 0., 2.],
        [2., 0., 0., 2.],
-       [2., 2., 2., 2.]])
+       [2., 2., 2., 2.]], dtype=float32)
 """
 
 from __future__ import annotations
@@ -131,7 +131,7 @@ class VectorLocalMap:
         return self.term.size
 
     def values(self, scene: Any, x: Any, y: Any, yaw: Any, present: Any, radius: float) -> Any:
-        """Every robot's local map, row by row, as float64 codes on the arrays' device.
+        """Every robot's local map, row by row, as float32 codes on the arrays' device.
 
         Parameters
         ----------
@@ -147,7 +147,7 @@ class VectorLocalMap:
 
         Returns
         -------
-        float64 array, shape (W, R, cells * cells)
+        float32 array, shape (W, R, cells * cells)
             Codes 0 free, 1 blocked, 2 void or off the map, 3 another robot.
         """
         a, xp = self.arrays, self.arrays.xp
@@ -181,7 +181,7 @@ class VectorLocalMap:
         out = xp.where(inside, code, xp.full_like(code, LOCAL_VOID))
         if x.shape[1] > 1:
             out = self._draw_discs(out, x, y, c0, s0, present, radius)
-        return a.asarray(out)
+        return out.to(xp.float32) if a.is_torch else out.astype(np.float32)
 
     def _draw_discs(self, out: Any, x: Any, y: Any, c: Any, s: Any, present: Any, radius: float) -> Any:
         """``out`` with code 3 where another present robot's disc covers a cell centre.
