@@ -121,7 +121,8 @@ class VectorLocalMap:
         # The single term's cell centres in the robot frame (forward u, left v), row by row.
         self._u = a.asarray(term._u)
         self._v = a.asarray(term._v)
-        self._lut = a.asarray(_LUT, a.i64)
+        # The floors' codes as local map codes, once (one gather per cell, not two).
+        self._codes = a.asarray(_LUT[a.numpy(floors.codes)], a.i64)
         # Float copies of the grids' shapes, to index in float until one cast.
         self._rows, self._width = a.asarray(a.numpy(floors.rows)), a.asarray(a.numpy(floors.width))
 
@@ -177,7 +178,7 @@ class VectorLocalMap:
         width = self._width[sc]
         inside = (col >= 0.0) & (col < width) & (row >= 0.0) & (row < self._rows[sc])
         flat = a.to_int(xp.where(inside, row * width + col, 0.0)) + fl.offset[sc]
-        code = self._lut[fl.codes[flat]]
+        code = self._codes[flat]
         out = xp.where(inside, code, xp.full_like(code, LOCAL_VOID))
         if x.shape[1] > 1:
             out = self._draw_discs(out, x, y, c0, s0, present, radius)
