@@ -7,7 +7,9 @@ matches ``W`` separate ``parallel_env(n_robots=R, backend="kinematic")`` step fo
 flags, success, SPL and SoftSPL) over whole episodes and their autoresets, with parked or
 removed finished robots, with or without a range scan and a local map (both see the other
 robots of its world; the map's codes are equal, except at a cell centre on a cell edge or
-a disc's rim, ``local_map_reference``), on numpy and on torch on the CPU.
+a disc's rim, ``local_map_reference``), on numpy and on torch on the CPU; and the same with
+discrete actions (``action_space="discrete"``, random ``forward_step``, ``turn_angle`` and
+STOP, with or without a scan and a local map).
 """
 
 from __future__ import annotations
@@ -111,3 +113,42 @@ def test_one_slow_robot_resolves_as_in_the_multi_robot_resolver(device: str, sce
     np.testing.assert_allclose(got[0][rows, mover], want[0], rtol=0, atol=1e-12)
     np.testing.assert_allclose(got[1][rows, mover], want[1], rtol=0, atol=1e-12)
     np.testing.assert_array_equal(got[2][rows, mover], want[2])
+
+
+@pytest.mark.parametrize("device", DEVICES)
+@settings(max_examples=10, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(
+    scene=crowded_scenes(),
+    seed=st.integers(0, 2**31 - 1),
+    n_worlds=st.integers(1, 3),
+    n_robots=st.integers(2, 4),
+    steps=st.integers(1, 80),
+    reward_type=st.sampled_from(["l2", "geodesic"]),
+    max_steps=st.integers(5, 40),
+    max_cycles=st.integers(3, 50),
+    finished=st.sampled_from(["park", "remove"]),
+    forward_step=st.floats(0.02, 0.4),
+    turn_angle=st.floats(0.05, 1.5),
+    stop=st.booleans(),
+    scan=st.one_of(st.none(), st.fixed_dictionaries({"n_rays": st.integers(1, 16), "max_range": st.floats(0.3, 3.0)})),
+    local_map=st.one_of(st.none(), st.fixed_dictionaries({"size": st.floats(0.2, 4.0), "cells": st.integers(1, 12)})),
+)
+def test_fleet_discrete_matches_parallel_envs(
+    device: str, scene: Scene, seed: int, n_worlds: int, n_robots: int, steps: int, reward_type: str,
+    max_steps: int, max_cycles: int, finished: str, forward_step: float, turn_angle: float, stop: bool,
+    scan: dict | None, local_map: dict | None,
+) -> None:
+    """Discrete actions (each robot's for its control steps, all robots of a world together,
+    cut short by contacts; STOP) as the multi-robot env runs them."""
+    rng = np.random.default_rng(seed)
+    # Some goals at the start, so that STOP (or reaching the goal without STOP) succeeds.
+    episodes = fleet_episodes(scene, n_worlds, n_robots, rng, goal_gap=0.4, at_start=0.4)
+    n_actions = 4 if stop else 3
+    weights = np.array([0.5, 0.2, 0.2, 0.1][:n_actions])
+    actions = rng.choice(n_actions, size=(steps, n_worlds, n_robots), p=weights / weights.sum())
+    task = {"reward_type": reward_type, "goal_tolerance": 0.2,
+            "termination_config": {"max_steps": max_steps, "max_collisions": 15}}
+    discrete = {"forward_step": forward_step, "turn_angle": turn_angle, "stop": stop}
+    sensors = {k: v for k, v in (("scan", scan), ("local_map", local_map)) if v is not None}
+    compare_fleet(scene, episodes, actions, task=task, device=device, finished=finished, max_cycles=max_cycles,
+                  sensors=sensors or None, action_space="discrete", discrete_actions=discrete)

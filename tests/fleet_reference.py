@@ -41,21 +41,26 @@ def compare_fleet(
     finished: str = "park",
     max_cycles: int = 500,
     sensors: dict | None = None,
+    action_space: str = "continuous",
+    discrete_actions: dict | None = None,
 ) -> dict[str, Any]:
     """Step both for ``len(actions)`` steps; return counts of what happened.
 
     ``episodes`` holds, per world, one ``(start_xy, yaw, goal_xy)`` per robot; ``actions``
-    has shape ``(steps, num_envs, n_robots, 2)``. ``sensors`` (both sides) adds the scan to
-    the flat observations compared.
+    has shape ``(steps, num_envs, n_robots, 2)``, or ``(steps, num_envs, n_robots)`` of
+    ints with ``action_space="discrete"`` (and ``discrete_actions``, both sides).
+    ``sensors`` (both sides) adds the scan to the flat observations compared.
     """
     task = dict(task or {})
     n, r = len(episodes), len(episodes[0])
     venv = VectorPointNavEnv(n, n_robots=r, scene=scene, task=task, device=device, seed=0, pool_size=1,
-                             finished=finished, max_cycles=max_cycles, sensors=sensors)
+                             finished=finished, max_cycles=max_cycles, sensors=sensors,
+                             action_space=action_space, discrete_actions=discrete_actions)
     dim = venv.single_observation_space.shape[0]
     refs = [
         parallel_env(scene=scene, n_robots=r, task=[_fixed_task(task, *rb) for rb in world], backend="kinematic",
-                     finished=finished, max_cycles=max_cycles, sensors=sensors)
+                     finished=finished, max_cycles=max_cycles, sensors=sensors, action_space=action_space,
+                     discrete_actions=discrete_actions)
         for world in episodes
     ]
     agents = refs[0].possible_agents
@@ -69,7 +74,7 @@ def compare_fleet(
         sobs[i] = [obs[a] for a in agents]
         ties[i] = [obs_ties(env, k, sensors, dim) for k in range(r)]
     stats = {"ends": 0, "successes": 0, "contacts": 0, "autoresets": 0, "robot_contacts": 0, "parked_steps": 0,
-             "falls": 0, "map_ties": 0}
+             "falls": 0, "stops": 0, "map_ties": 0}
     assert to_np(vinfo["active"]).all()
     for t, act in enumerate(actions):
         stats["map_ties"] += assert_obs(to_np(vobs), sobs, ties, OBS_TOL, f"observations before step {t}")
@@ -108,6 +113,7 @@ def compare_fleet(
                     ref, got = info[a][key], vinfo[key][i, k]
                     assert ref == got or abs(ref - got) <= 1e-6, f"{key} {where}, robot {k}: {ref} vs {got}"
                 stats["ends"] += term[a] or trunc[a]
+                stats["stops"] += action_space == "discrete" and bool(term[a]) and int(act[i, k]) == 3
                 stats["successes"] += info[a]["success"]
                 stats["contacts"] += bool(vinfo["in_contact"][i, k])
                 stats["robot_contacts"] += bool(vinfo["in_contact"][i, k]) and _touches_robot(env, k)
@@ -126,10 +132,13 @@ def _touches_robot(env: Any, k: int) -> bool:
 
 
 def fleet_episodes(
-    scene: Any, n_worlds: int, n_robots: int, rng: np.random.Generator, radius: float = 0.18, goal_gap: float = 0.4
+    scene: Any, n_worlds: int, n_robots: int, rng: np.random.Generator, radius: float = 0.18, goal_gap: float = 0.4,
+    at_start: float = 0.0,
 ) -> list[list[tuple[Any, float, Any]]]:
     """Random fixed episodes: starts where the robot fits, at least two radii apart; goals
-    at least ``goal_gap`` m apart (the multi-robot env's separation for the task used)."""
+    at least ``goal_gap`` m apart (the multi-robot env's separation for the task used).
+    With probability ``at_start`` a robot's goal is its start instead, where that keeps
+    the goals apart (so that STOP can succeed at once)."""
     def apart(gap: float) -> list[Any]:
         points: list[Any] = []
         for _ in range(10_000):  # rejection sampling; a scene with room for the robots ends early
@@ -143,5 +152,9 @@ def fleet_episodes(
     worlds = []
     for _ in range(n_worlds):
         starts, goals = apart(2 * radius), apart(goal_gap)
+        for k, start in enumerate(starts):
+            others = goals[:k] + goals[k + 1 :]
+            if rng.random() < at_start and all(math.dist(start, q) >= goal_gap for q in others):
+                goals[k] = start
         worlds.append([(s, float(rng.uniform(-math.pi, math.pi)), g) for s, g in zip(starts, goals)])
     return worlds

@@ -1,7 +1,9 @@
-"""Discrete actions in the batched engine: hand-calculated moves, turns, contacts, STOP, bad input.
+"""Discrete actions in the batched engine: hand-calculated moves, turns, contacts, STOP, bad input,
+one robot per world and several.
 
-The step-for-step comparison with ``PointNavEnv(action_space="discrete")`` over random
-scenes is in ``property_tests/test_vector_props.py``.
+The step-for-step comparisons with ``PointNavEnv(action_space="discrete")`` and with
+``parallel_env(action_space="discrete")`` over random scenes are in
+``property_tests/test_vector_props.py`` and ``property_tests/test_vector_fleet_props.py``.
 """
 
 from __future__ import annotations
@@ -9,6 +11,7 @@ from __future__ import annotations
 import importlib.util
 import math
 
+import gymnasium as gym
 import numpy as np
 import pytest
 
@@ -146,11 +149,11 @@ def test_discrete_matches_single_envs_in_clutter(device: str, stop: bool, sensor
     assert stats["contacts"] > 0 and stats["successes"] > 0 and stats["autoresets"] > 0
 
 
-@pytest.mark.parametrize("kwargs", [{"action_space": "discrete"}, {"discrete_actions": {"stop": False}}, {"starts_per_goal": 2}])
-def test_discrete_actions_are_refused_with_several_robots(kwargs: dict) -> None:
-    name = next(iter(kwargs))
-    with pytest.raises(ValueError, match=name):
-        VectorPointNavEnv(2, n_robots=2, scene=room(), **kwargs)
+def test_fleet_discrete_actions_need_the_discrete_space() -> None:
+    with pytest.raises(ValueError, match="discrete_actions"):
+        VectorPointNavEnv(2, n_robots=2, scene=room(), discrete_actions={"stop": False})
+    with pytest.raises(ValueError, match="action_space"):
+        VectorPointNavEnv(2, n_robots=2, scene=room(), action_space="multi")
 
 
 @pytest.mark.parametrize("device", DEVICES)
@@ -167,3 +170,96 @@ def test_a_refreshed_pool_keeps_each_episode_on_its_goal_field(device: str) -> N
         st = {k: to_np(env._state[k]) for k in ("x", "y", "gx", "gy")}
         np.testing.assert_allclose(to_np(info["distance_to_goal"]), np.hypot(st["gx"] - st["x"], st["gy"] - st["y"]), atol=1e-9)
     assert env.pool.pool_size == 3  # the refreshed pool holds three starts per goal too
+
+
+# ---------------------------------------------------------------- several robots per world
+
+
+def make_fleet(n: int, device: str, stop: bool = True, **kwargs: object) -> VectorPointNavEnv:
+    return VectorPointNavEnv(n, n_robots=2, scene=room(), device=device, action_space="discrete",
+                             discrete_actions={"stop": stop}, task={"goal_in_polar": True}, pool_size=1, seed=0,
+                             **kwargs)
+
+
+@pytest.mark.parametrize("device", DEVICES)
+def test_fleet_robots_run_together_for_the_longest_action_by_hand(device: str) -> None:
+    # Robot 0 moves 0.25 m in 5 control steps; robot 1 turns 10 deg in 2 and then stands
+    # for the other 3 (no command, as the multi-robot env steps it), so its velocity is 0.
+    env = make_fleet(1, device)
+    to_np = env.arrays.numpy
+    assert env.action_space == gym.spaces.MultiDiscrete(np.full((1, 2), 4))
+    env.reset(options={"episodes": [[((1.0, 1.5), 0.0, (2.5, 1.5)), ((1.0, 2.5), 0.0, (1.0, 2.5))]]})
+    obs, reward, terminated, _, info = env.step(np.array([[FORWARD, LEFT]]))
+    obs = to_np(obs)
+    np.testing.assert_allclose(to_np(env._state["x"])[0], [1.25, 1.0], atol=1e-12)
+    np.testing.assert_allclose(to_np(env._state["yaw"])[0], [0.0, math.radians(10.0)], atol=1e-12)
+    np.testing.assert_allclose(obs[0, 0, [2, 7]], [0.5, 0.0], atol=1e-6)  # 0.05 m in the last 0.1 s
+    np.testing.assert_allclose(obs[0, 1, 2:], 0.0, atol=1e-7)  # stood still in the last control steps
+    np.testing.assert_allclose(to_np(reward)[0], [0.25, 0.0], atol=1e-9)
+    assert to_np(info["episode_length"]).tolist() == [[1, 1]]
+    # Robot 1 calls STOP on its goal: a success with SPL 1; it parks and is inactive from then on.
+    _, reward, terminated, _, info = env.step(np.array([[RIGHT, STOP]]))
+    assert to_np(terminated).tolist() == [[False, True]] and to_np(info["success"]).tolist() == [[False, True]]
+    np.testing.assert_allclose(to_np(reward)[0, 1], 10.0, atol=1e-9)
+    np.testing.assert_allclose(to_np(info["spl"])[0], [0.0, 1.0])
+    obs, reward, terminated, _, info = env.step(np.array([[STOP, FORWARD]]))  # robot 1's is ignored
+    assert to_np(info["active"]).tolist() == [[False, False]]
+    assert to_np(terminated).tolist() == [[True, False]] and to_np(info["success"]).tolist() == [[False, False]]
+    np.testing.assert_allclose(to_np(env._state["x"])[0], [1.25, 1.0], atol=1e-12)
+
+
+@pytest.mark.parametrize("device", DEVICES)
+def test_fleet_move_into_a_parked_robot_ends_at_the_contact_by_hand(device: str) -> None:
+    # Robot 1 parks at x = 1.6 m (STOP on its goal); robot 0, at x = 1.0 m facing it, has
+    # 0.6 - 2 x 0.18 = 0.24 m of free travel: four control steps of 0.05 m, then the touch.
+    env = make_fleet(1, device)
+    to_np = env.arrays.numpy
+    env.reset(options={"episodes": [[((1.0, 1.5), 0.0, (1.0, 2.5)), ((1.6, 1.5), 0.0, (1.6, 1.5))]]})
+    env.step(np.array([[RIGHT, STOP]]))
+    env.step(np.array([[LEFT, FORWARD]]))
+    info = env.step(np.array([[FORWARD, FORWARD]]))[4]
+    np.testing.assert_allclose(to_np(env._state["x"])[0], [1.24, 1.6], atol=1e-9)
+    assert to_np(info["in_contact"]).tolist() == [[True, False]]
+    assert to_np(info["collisions"]).tolist() == [[1, 0]]
+    np.testing.assert_allclose(to_np(info["path_length"])[0, 0], 0.24, atol=1e-9)
+
+
+@pytest.mark.parametrize("device", DEVICES)
+@pytest.mark.parametrize(
+    "actions",
+    [np.array([[0, 0], [0, 3]]), np.array([[-1, 0], [0, 0]]), np.zeros(2, np.int64), np.zeros((2, 2, 1), np.int64),
+     np.zeros((3, 2), np.int64), np.array([[0.0, 1.0], [0.0, 0.0]]), np.array([[True, False], [False, True]]),
+     np.full((2, 2), np.nan), [[0.5, 1.0], [0.0, 0.0]], [[0, 1], [2, 5]]],
+)
+def test_fleet_bad_discrete_actions_are_refused(device: str, actions: object) -> None:
+    env = make_fleet(2, device, stop=False)
+    env.reset()
+    before = env.arrays.numpy(env._state["x"])
+    with pytest.raises(ValueError, match="actions"):
+        env.step(actions)
+    np.testing.assert_array_equal(env.arrays.numpy(env._state["x"]), before)
+
+
+@pytest.mark.parametrize("device", DEVICES)
+def test_fleet_discrete_matches_parallel_envs_in_a_crowded_room(device: str) -> None:
+    # A 1.6 x 2 m room with a hole at one end, four robots a world: they meet each other,
+    # the parked ones and the walls; some fall, some stop on their goal.
+    from fleet_reference import compare_fleet, fleet_episodes
+
+    from pointnav_core.maps import VOID
+
+    rng = np.random.default_rng(3)
+    grid = np.zeros((20, 16), np.uint8)
+    grid[0, :] = grid[-1, :] = grid[:, 0] = grid[:, -1] = OBSTACLE
+    grid[5, 5] = OBSTACLE
+    grid[16:19, 1:15] = VOID
+    scene = Scene.from_array(grid, 0.1)
+    actions = rng.choice(4, size=(120, 4, 4), p=[0.6, 0.15, 0.15, 0.1])
+    task = {"reward_type": "geodesic", "goal_tolerance": 0.2, "termination_config": {"max_steps": 40, "max_collisions": 10}}
+    for finished in ("park", "remove"):
+        stats = compare_fleet(scene, fleet_episodes(scene, 4, 4, rng, goal_gap=0.4, at_start=0.5), actions, task=task, device=device,
+                              finished=finished, max_cycles=45, action_space="discrete",
+                              discrete_actions={"forward_step": 0.15})
+        # The run exercised what it claims to: robot contacts, parked robots, STOP, falls, autoresets.
+        assert stats["robot_contacts"] > 0 and stats["parked_steps"] > 100 and stats["stops"] > 0
+        assert stats["successes"] > 0 and stats["autoresets"] > 0 and stats["falls"] > 0

@@ -236,3 +236,46 @@ def test_fields_without_labels_after_fields_with_labels() -> None:
     # From (0.5, 0.6) round the wall's end at x = 2.5 and back, at least the two legs' straight parts.
     assert got[0] > math.dist((0.5, 0.6), (2.5, 1.5)) + math.dist((2.5, 1.6), (0.5, 2.5))
     assert abs(got[1] - 0.4) < 1e-12  # straight to the goal
+
+
+def test_starts_per_goal_share_each_episodes_goals_with_exact_geodesics() -> None:
+    env = VectorPointNavEnv(3, n_robots=3, scene=room(), seed=1, pool_size=2, starts_per_goal=4, task=TASK)
+    env.reset()
+    pool, r = env.pool, 3
+    assert len(pool) == 8 and pool.pool_size == 8
+    sx, sy, gx, gy, d0, field = (np.asarray(v) for v in (pool.sx, pool.sy, pool.gx, pool.gy, pool.d0, pool.field))
+    for g in range(2):  # each goal set's four episodes share its goals and goal fields
+        block = slice(4 * g, 4 * g + 4)
+        assert (gx[block] == gx[4 * g]).all() and (gy[block] == gy[4 * g]).all()
+        assert (field[block] == field[4 * g]).all()
+    assert len(set(field.ravel().tolist())) == 2 * r  # one field per sampled robot goal
+    # Every set of starts is clear: the robots' discs do not overlap.
+    for e in range(8):
+        for i in range(r):
+            for j in range(i + 1, r):
+                assert math.hypot(sx[e, i] - sx[e, j], sy[e, i] - sy[e, j]) >= 2 * 0.18 - 1e-9
+    # An empty room: the geodesic is the straight line; each robot's within its path_range.
+    np.testing.assert_allclose(d0, np.hypot(gx - sx, gy - sy), atol=1e-9)
+    for i, task in enumerate(env._samplers[0].tasks):
+        low, high = task.path_range
+        assert (d0[:, i] > low).all() and (d0[:, i] < high).all()
+    assert len({(round(x, 9), round(y, 9)) for x, y in zip(sx.ravel(), sy.ravel())}) == 8 * r  # distinct starts
+
+
+@pytest.mark.parametrize("device", DEVICES)
+def test_starts_per_goal_episodes_play_on_their_goal_fields(device: str) -> None:
+    # An empty room: every geodesic is the straight line, whichever start set or refreshed
+    # pool an episode came from.
+    env = VectorPointNavEnv(4, n_robots=2, scene=room(), device=device, seed=2, pool_size=1, starts_per_goal=3,
+                            task={**TASK, "reward_type": "geodesic"}, max_cycles=2)
+    env.reset()
+    to_np = env.arrays.numpy
+    for t in range(8):
+        if t in (1, 4):
+            env.refresh_pool(wait=True)
+        _, _, _, _, info = env.step(np.tile([1.0, 0.3], (4, 2, 1)))
+        st = {k: to_np(env._state[k]) for k in ("x", "y", "gx", "gy")}
+        active = to_np(info["active"]) | to_np(info["autoreset"])
+        want = np.hypot(st["gx"] - st["x"], st["gy"] - st["y"])
+        np.testing.assert_allclose(to_np(info["distance_to_goal"])[active], want[active], atol=1e-9)
+    assert env.pool.pool_size == 3  # the refreshed pool holds three sets of starts per goal set too

@@ -9,6 +9,11 @@ steps and that have not touched anything yet. The others do not move in that sub
 where its single env ends. The loop is over sub-steps (at most five with the defaults),
 never over worlds.
 
+With several robots per world (``run(..., acting=...)``) the rule is the multi-robot
+env's: a world takes as many control steps as its robots' longest action; in each, the
+robots whose action lasts and that have touched nothing drive, the others get no command
+(they stand, still block, and can be touched).
+
 Examples
 --------
 >>> from pointnav_core.actions import DiscreteActions
@@ -80,62 +85,83 @@ class DiscretePlan:
         self.max_steps = max(steps for _, steps in plan)
         self.stop = STOP if actions.stop else None
 
-    def check(self, actions: Any, num_envs: int) -> Any:
-        """``actions`` as an int64 array ``(num_envs,)``; ValueError naming ``actions`` if bad.
+    def check(self, actions: Any, num_envs: int, n_robots: int | None = None) -> Any:
+        """``actions`` as an int64 array ``(num_envs,)``, or ``(num_envs, n_robots)`` with
+        several robots per world; ValueError naming ``actions`` if bad.
 
-        Takes shape ``(num_envs,)`` or ``(num_envs, 1)``, of an integer dtype (numpy,
-        torch or a list of Python ints), every value in ``[0, n)``.
+        Takes shape ``(num_envs,)`` or ``(num_envs, 1)`` (``(num_envs, n_robots)`` when
+        ``n_robots`` is given), of an integer dtype (numpy, torch or a list of Python ints),
+        every value in ``[0, n)``.
         """
         a, n = self.arrays, self.n
         if isinstance(actions, (list, tuple)):
             actions = np.asarray(actions)
         shape = tuple(getattr(actions, "shape", ()))
-        if shape not in ((num_envs,), (num_envs, 1)):
-            raise ValueError(f"actions must have shape ({num_envs},) or ({num_envs}, 1) (discrete actions), got {shape}")
+        if n_robots is None:
+            want: tuple[tuple[int, ...], ...] = ((num_envs,), (num_envs, 1))
+            words = f"({num_envs},) or ({num_envs}, 1)"
+        else:
+            want, words = ((num_envs, n_robots),), f"({num_envs}, {n_robots})"
+        if shape not in want:
+            raise ValueError(f"actions must have shape {words} (discrete actions), got {shape}")
         dtype = getattr(actions, "dtype", None)
         if not _is_integer_dtype(dtype):
             raise ValueError(f"actions must be integers in [0, {n}) (discrete actions), got dtype {dtype}")
-        arr = a.asarray(actions, a.i64).reshape(num_envs)
+        arr = a.asarray(actions, a.i64).reshape(want[0])
         if bool(((arr < 0) | (arr >= n)).any()):
             bad = a.numpy(arr)
             bad = bad[(bad < 0) | (bad >= n)]
             raise ValueError(f"actions must be integers in [0, {n}) (discrete actions), got {bad[:5].tolist()}")
         return arr
 
-    def run(self, env: Any, index: Any) -> tuple[dict[str, Any], Any, Any]:
-        """Run each world's action as batched control steps, from ``env``'s state.
+    def run(self, env: Any, index: Any, acting: Any = None) -> tuple[dict[str, Any], Any, Any]:
+        """Run each world's action (or each robot's) as batched control steps, from ``env``'s state.
 
         Parameters
         ----------
         env : VectorPointNavEnv
             The engine; its ``_drive(commands, state)`` advances every world one control
-            step from ``state`` without committing it.
-        index : array of int, shape (num_envs,)
-            Each world's action (checked by :meth:`check`).
+            step from ``state`` without committing it (commands in ``[-1, 1]`` units, one
+            per world, or per robot with several robots per world).
+        index : array of int, shape (num_envs,) or (num_envs, n_robots)
+            Each world's (robot's) action (checked by :meth:`check`).
+        acting : array of bool, shape (num_envs, n_robots), optional
+            With several robots per world: the robots that are agents. Then, as in the
+            multi-robot env, a world runs as many control steps as its longest action;
+            in each, the robots whose action lasts and has touched nothing get its
+            command, the others none (they stand, and can still be touched), and a
+            robot's contact counts in any of them.
 
         Returns
         -------
         state : dict of arrays
-            The worlds' pose, height and velocities after their actions (keys ``MOVED``).
+            The worlds' (robots') pose, height and velocities after their actions (keys ``MOVED``).
         contact : array of bool
-            Whether any of a world's control steps touched something.
+            Whether any of a world's (robot's) control steps touched something.
         stopped : array of bool or None
-            The worlds that called STOP, or None without STOP.
+            The worlds (robots) that called STOP, or None without STOP.
         """
         a, xp = self.arrays, self.arrays.xp
         command, steps = self.commands[index], self.steps[index]
         state = {key: env._state[key] for key in MOVED}
-        contact = a.zeros(index.shape[0], a.boolean)
+        contact = xp.zeros_like(index) > 0
         z_start, dt = state["z"], env.dt
         fall_speed = xp.zeros_like(z_start)  # m/s, of the worlds that fell in an earlier sub-step
         zero = xp.zeros_like(z_start)
         for k in range(self.max_steps):
-            # A world moves in sub-step k while its action lasts and it has touched nothing.
-            active = (steps > k) & ~contact
+            lasts = steps > k
+            if acting is None:
+                # A world moves in sub-step k while its action lasts and it has touched nothing.
+                active = running = lasts & ~contact
+            else:
+                # A world steps while any robot's action lasts; only those not yet in contact drive.
+                lasts = lasts & acting
+                running = lasts & ~contact
+                active = lasts.any(-1)[:, None]
             if not a.any(active):
                 break
             falling = state["z"] < z_start
-            moved, touched = env._drive(command, state)
+            moved, touched = env._drive(xp.where(running[..., None], command, 0.0 * command), state)
             # A falling robot no longer drives: it only drops, faster each step (the backend's _fall).
             drop = fall_speed * dt + 0.5 * _GRAVITY * dt * dt
             fell = {"x": state["x"], "y": state["y"], "yaw": state["yaw"], "z": state["z"] - drop,

@@ -158,7 +158,8 @@ class VectorPointNavEnv(PoolRefreshing, VectorEnv):
     robot-robot contact counts as a collision for both, every robot has its own task
     (rewards, terminations, SPL), and all robots still active are truncated after
     ``max_cycles`` steps. Every return carries the robot axis: ``step`` takes actions
-    ``(num_envs, R, 2)`` (all finite; those of inactive robots are ignored) and returns
+    ``(num_envs, R, 2)`` (all finite; those of inactive robots are ignored), or with
+    ``action_space="discrete"`` integers ``(num_envs, R)`` (all in range), and returns
     observations ``(num_envs, R, 8)`` float32 (``(num_envs, R, 8 + n_rays)`` with the scan,
     which sees the other robots present in its world as the multi-robot env's scan does;
     plus ``cells * cells`` with the local map, which draws the same robots as code 3),
@@ -174,6 +175,12 @@ class VectorPointNavEnv(PoolRefreshing, VectorEnv):
     scene's ``parallel_env`` (non-overlapping starts, goals kept
     :func:`pointnav_core.fleet.goal_separation` apart); ``reset(options={"episodes": [[
     (start_xy, yaw, goal_xy), ...], ...]})`` fixes, per world, one tuple per robot.
+    Discrete actions run as the multi-robot env runs them: a world takes as many control
+    steps as its robots' longest action; in each, a robot whose action lasts and has
+    touched nothing drives, the others stand (and can still be touched, which counts as
+    their collision); STOP ends that robot's episode (a success within ``goal_tolerance``).
+    ``starts_per_goal`` gives each pool episode more sets of starts for the same goals
+    (drawn by the multi-robot env's sampler, robot by robot, clear of each other).
 
     Examples
     --------
@@ -199,9 +206,6 @@ class VectorPointNavEnv(PoolRefreshing, VectorEnv):
             if isinstance(n_robots, (int, np.integer)) and not isinstance(n_robots, bool) and n_robots > 1:
                 from pointnav_core.vector.fleet_env import VectorFleetEnv
 
-                for name in ("action_space", "discrete_actions", "starts_per_goal"):  # one robot per world only
-                    if name in kwargs and not (name == "action_space" and kwargs[name] == "continuous"):
-                        raise ValueError(f"{name} is not supported with several robots per world yet, got n_robots={n_robots}")
                 return super().__new__(VectorFleetEnv)
             for name in ("max_cycles", "finished"):
                 if name in kwargs:

@@ -27,6 +27,7 @@ from pointnav_core import scenes, validation
 from pointnav_core.vector import contacts_jit
 from pointnav_core.vector.contacts import advance
 from pointnav_core.vector.contacts_jit import advance_compiled
+from pointnav_core.vector.discrete import MOVED, DiscretePlan
 from pointnav_core.vector.env import (
     _FALL_SPEED,
     _GRAVITY,
@@ -64,6 +65,16 @@ class VectorFleetEnv(VectorPointNavEnv):
         env's argument; default 500).
     finished : {"park", "remove"}
         A robot whose episode ended stays as an obstacle, or leaves the world.
+    action_space : {"continuous", "discrete"}
+        With ``"discrete"``, every robot acts with an integer (``discrete_actions`` as for
+        the multi-robot env), run as the multi-robot env runs them: the robots of a world
+        together, for as many control steps as its longest action
+        (:mod:`pointnav_core.vector.discrete`).
+    discrete_actions : dict, optional
+        ``forward_step``, ``turn_angle``, ``stop``, as the multi-robot env.
+    starts_per_goal : int
+        Sets of starts per pool episode, >= 1: the extra sets share its goals and their
+        settled fields (:class:`~pointnav_core.vector.fleet_pool.FleetPool`).
     """
 
     def __init__(
@@ -81,6 +92,9 @@ class VectorFleetEnv(VectorPointNavEnv):
         max_episode_steps: int | None = None,
         max_cycles: int = 500,
         finished: str = "park",
+        action_space: str = "continuous",
+        discrete_actions: Mapping[str, Any] | None = None,
+        starts_per_goal: int = 1,
     ) -> None:
         from pointnav_core.parallel import parallel_env
 
@@ -96,6 +110,7 @@ class VectorFleetEnv(VectorPointNavEnv):
             steps = validation.integer("max_episode_steps", max_episode_steps, minimum=1)
             task["termination_config"] = {**dict(task.get("termination_config") or {}), "max_steps": steps}
         self.pool_size = validation.integer("pool_size", pool_size, minimum=1)
+        self.starts_per_goal = validation.integer("starts_per_goal", starts_per_goal, minimum=1)
         self.arrays = a = make_arrays(device)
         self.device = device
         self.scenes = scene_list = _scene_list(scene)
@@ -104,12 +119,14 @@ class VectorFleetEnv(VectorPointNavEnv):
         self._samplers = [
             parallel_env(scene=s, n_robots=self.n_robots, robot=spec, task=dict(task), backend="kinematic",
                          max_cycles=self.max_cycles, finished=finished, action_frequency=action_frequency,
-                         sensors=sensors)
+                         sensors=sensors, action_space=action_space, discrete_actions=discrete_actions)
             for s in scene_list
         ]
         first = self._samplers[0]
         self._read_task(first.tasks[0], first.action_frequency)
         t = self.task
+        acts = first.discrete_actions
+        self._discrete = None if acts is None else DiscretePlan(acts, spec, self.action_frequency, a)
         self.floors = FloorTables(scene_list, t.floor, spec.radius, a)
         bounds = [env.tasks[0].observation_bounds for env in self._samplers]
         self._low = a.asarray(np.stack([b[0] for b in bounds]).astype(np.float64))[:, None, :]
@@ -119,7 +136,11 @@ class VectorFleetEnv(VectorPointNavEnv):
         self.single_action_space = first.action_space(first.possible_agents[0])
         batch = gym.vector.utils.batch_space
         self.observation_space = batch(batch(self.single_observation_space, self.n_robots), self.num_envs)
-        self.action_space = batch(batch(self.single_action_space, self.n_robots), self.num_envs)
+        if isinstance(self.single_action_space, gym.spaces.Discrete):  # batched twice it would be an int Box
+            nvec = np.full((self.num_envs, self.n_robots), int(self.single_action_space.n))
+            self.action_space = gym.spaces.MultiDiscrete(nvec)
+        else:
+            self.action_space = batch(batch(self.single_action_space, self.n_robots), self.num_envs)
         self._rng = np.random.default_rng(seed)
         n, r = self.num_envs, self.n_robots
         self._world_scene = a.asarray(np.arange(n) % len(scene_list), a.i64)
@@ -149,7 +170,7 @@ class VectorFleetEnv(VectorPointNavEnv):
     def _build_pool(self, fixed: Sequence[Any]) -> None:
         size = 0 if fixed else self.pool_size
         seeds = self._rng.integers(2**31, size=size * len(self.scenes))
-        self.pool = FleetPool(self._samplers, size, seeds, self.arrays, fixed)
+        self.pool = FleetPool(self._samplers, size, seeds, self.arrays, fixed, self.starts_per_goal)
 
     def reset(self, *, seed: int | None = None, options: dict[str, Any] | None = None) -> tuple[Any, dict[str, Any]]:
         """Reset every world. ``options={"episodes": [[(start_xy, yaw, goal_xy), ...], ...]}``
@@ -174,7 +195,7 @@ class VectorFleetEnv(VectorPointNavEnv):
         if self._fixed is not None:
             ep = self._fixed
         else:
-            k = a.asarray(self._rng.integers(self.pool_size, size=self.num_envs), a.i64)
+            k = a.asarray(self._rng.integers(p.pool_size, size=self.num_envs), a.i64)
             ep = self._world_scene * p.pool_size + k
         idx = a.nonzero(mask)
         e = ep[idx]
@@ -183,7 +204,7 @@ class VectorFleetEnv(VectorPointNavEnv):
         st["z"][idx] = self.floors.height[self._world_scene[idx]][:, None] + 0.0 * st["x"][idx]
         for key in ("vx", "vy", "vz", "w", "path"):
             st[key][idx] = 0.0
-        field = e[:, None] * self.n_robots + self._robot_ids
+        field = p.field[e]
         self._field[idx] = field
         self._steps[idx] = 0
         self._collisions[idx] = 0
@@ -201,10 +222,14 @@ class VectorFleetEnv(VectorPointNavEnv):
         self._needs_reset[idx] = False
 
     def check_actions(self, actions: Any) -> Any:
-        """``actions`` as a float64 array ``(num_envs, n_robots, 2)``; ValueError naming ``actions`` if bad.
+        """``actions`` as a float64 array ``(num_envs, n_robots, 2)``, or with discrete actions
+        an int64 array ``(num_envs, n_robots)``; ValueError naming ``actions`` if bad.
 
-        Every entry must be finite, also those of inactive robots (which are ignored).
+        Every entry must be valid (finite; with discrete actions an integer in range), also
+        those of inactive robots (which are ignored).
         """
+        if self._discrete is not None:
+            return self._discrete.check(actions, self.num_envs, self.n_robots)
         shape = tuple(getattr(actions, "shape", np.shape(actions)))
         want = (self.num_envs, self.n_robots, 2)
         if shape != want:
@@ -217,17 +242,27 @@ class VectorFleetEnv(VectorPointNavEnv):
     def _step(self, actions: Any) -> tuple[Any, Any, Any, Any, dict[str, Any]]:
         if not self._started:
             raise RuntimeError("call reset() before step()")
-        a, xp, st = self.arrays, self.arrays.xp, self._state
         act = self.check_actions(actions)
+        if self._discrete is not None:
+            return self._account(*self._discrete.run(self, act, acting=self._active))
+        # Robots that are not agents any more get no command (the backend's _NO_COMMAND).
+        moved, contact = self._drive(self.arrays.xp.where(self._active[..., None], act, 0.0 * act), self._state)
+        return self._account(moved, contact, None)
+
+    def _drive(self, act: Any, state: Mapping[str, Any]) -> tuple[dict[str, Any], Any]:
+        """One control step of every world from ``state`` under commands ``act``
+        ``(num_envs, n_robots, 2)`` in ``[-1, 1]`` units, not committed: the new pose, height
+        and velocities (keys ``MOVED``) and the contacts. Robots that began to fall since the
+        committed state (inside a discrete action) neither move nor block."""
+        a, xp = self.arrays, self.arrays.xp
         spec, dt, radius = self.robot, self.dt, self.robot.radius
-        acting, present = self._active, self._present
+        present = self._present & ~(state["z"] < self._state["z"])
         v0, v1 = act[..., 0], act[..., 1]
         vmax, wmax = spec.max_linear_velocity, spec.max_angular_velocity
         zero = xp.zeros_like(v0)
-        # Robots that are not agents any more get no command (the backend's _NO_COMMAND).
-        vx = xp.where(acting, xp.where(v0 >= 1.0, vmax, xp.where(v0 <= -1.0, -vmax, v0 * vmax)), zero)
-        w = xp.where(acting, xp.where(v1 >= 1.0, wmax, xp.where(v1 <= -1.0, -wmax, v1 * wmax)), zero)
-        x0, y0, yaw0 = st["x"], st["y"], st["yaw"]
+        vx = xp.where(v0 >= 1.0, vmax, xp.where(v0 <= -1.0, -vmax, v0 * vmax))
+        w = xp.where(v1 >= 1.0, wmax, xp.where(v1 <= -1.0, -wmax, v1 * wmax))
+        x0, y0, yaw0 = state["x"], state["y"], state["yaw"]
         half = 0.5 * w * dt
         safe = xp.where(half != 0.0, half, 1.0)
         s = dt * xp.where(half != 0.0, xp.sin(safe) / safe, 1.0)
@@ -248,7 +283,7 @@ class VectorFleetEnv(VectorPointNavEnv):
         slow = present & ~fast
         x, y, yaw = x0 + xp.where(fast, dx, zero), y0 + xp.where(fast, dy, zero), yaw0 + w * dt
         contact = zero > 1.0
-        z, vz = st["z"], zero + 0.0
+        z, vz = state["z"], zero + 0.0
         if contacts_jit.available(self.floors):  # every world in one compiled loop
             sx, sy, c = advance_compiled(self.floors, scene, x0, y0, dx, dy, slow, radius, self._max_travel)
             x, y = xp.where(slow, a.asarray(sx), x), xp.where(slow, a.asarray(sy), y)
@@ -263,7 +298,18 @@ class VectorFleetEnv(VectorPointNavEnv):
         vel_y = xp.where(fast, dy / dt, (y - y0) / dt)
         vel_w = xp.where(fast, w, (yaw - yaw0) / dt)
         vel_x, vel_y, vel_w = (xp.where(present, v, zero) for v in (vel_x, vel_y, vel_w))
-        # --- each active robot's task (PointNavigationTask.step), masked by ``acting``
+        moved = {"x": x, "y": y, "yaw": yaw, "z": z, "vx": vel_x, "vy": vel_y, "w": vel_w, "vz": vz}
+        return moved, contact
+
+    def _account(self, moved: Mapping[str, Any], contact: Any, stopped: Any) -> tuple[Any, Any, Any, Any, dict[str, Any]]:
+        """Each active robot's task step (``PointNavigationTask.step``, masked by the robots
+        still acting) over the moves from the committed state, then the commit and the
+        next-step autoresets. ``stopped``: the robots that called STOP (None without STOP)."""
+        a, xp, st = self.arrays, self.arrays.xp, self._state
+        acting, present = self._active, self._present
+        x0, y0 = st["x"], st["y"]
+        x, y, yaw, z, vel_x, vel_y, vel_w, vz = (moved[k] for k in MOVED)
+        zero = xp.zeros_like(x)
         path = st["path"] + xp.where(acting, xp.sqrt((x - x0) ** 2 + (y - y0) ** 2), zero)
         steps = self._steps + a.to_int(acting)
         collisions = self._collisions + a.to_int(contact & acting)
@@ -273,8 +319,12 @@ class VectorFleetEnv(VectorPointNavEnv):
         l2 = xp.sqrt((gx - x) ** 2 + (gy - y) ** 2)
         pot = xp.where(self._geo_metric, xp.where(dist < math.inf, dist, st["pot"]), l2)
         success = acting & (l2 < self.goal_tolerance)
+        if stopped is not None:  # with STOP, success needs STOP within the tolerance (StopAtGoal)
+            success = success & stopped
         fell = acting & (z < self.floors.height[self._world_scene][:, None] - self.fall_height)
         terminated = acting & ((collisions > self.max_collisions) | fell | success)
+        if stopped is not None:
+            terminated = terminated | (acting & stopped)
         truncated = acting & ((steps >= self.max_steps) | (cycles >= self.max_cycles)[:, None])
         r_pot = xp.where(acting, self.r_potential * (st["pot"] - pot), zero)
         r_col = xp.where(acting & contact, -self.r_collision, zero)

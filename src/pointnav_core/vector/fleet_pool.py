@@ -4,8 +4,13 @@ Each scene gets ``pool_size`` episodes of ``n_robots`` robots, sampled by a
 :class:`~pointnav_core.parallel.MultiPointNavEnv` of that scene on the kinematic backend,
 so its rules hold: starts that do not overlap, goals kept
 :func:`~pointnav_core.fleet.goal_separation` apart, the derived ``path_range``. Every
-robot's goal field is settled into one :class:`~pointnav_core.vector.fields.FieldTables`,
-entry ``episode * n_robots + robot``.
+robot's goal field is settled into one :class:`~pointnav_core.vector.fields.FieldTables`
+(``field[episode, robot]`` is its entry).
+
+With ``starts > 1`` each sampled episode gets ``starts - 1`` more sets of starts for the
+same goals (and goal fields), drawn robot by robot in the multi-robot env's reset order by
+its sampler with the goal fixed (``sampling.sample_episode``: a start usable and clear of
+the robots placed before it, a random heading, the geodesic in ``path_range``).
 """
 
 from __future__ import annotations
@@ -63,9 +68,11 @@ class FleetPool:
     """Episodes of ``n_robots`` robots as ``(episodes, n_robots)`` arrays.
 
     Attributes ``sx, sy, syaw`` (start, m and rad), ``gx, gy`` (goal, m), ``d0`` (the
-    start's geodesic distance, m; inf if unreachable) and ``fields`` (entry
-    ``episode * n_robots + robot``). The first ``pool_size * len(samplers)`` episodes are
-    sampled, scene by scene; fixed ones follow.
+    start's geodesic distance, m; inf if unreachable), ``fields`` and ``field`` (each
+    robot's entry in ``fields``), all ``(episodes, n_robots)`` but ``fields``. The first
+    ``pool_size * starts * len(samplers)`` episodes are sampled, scene by scene (each
+    goal set's extra starts right after it); fixed ones follow, and ``pool_size`` counts
+    the sampled episodes per scene (``pool_size * starts``).
 
     Parameters
     ----------
@@ -78,6 +85,8 @@ class FleetPool:
     arrays : Arrays
     fixed : sequence of (robots, scene index)
         Given episodes (``robots`` as :func:`check_fixed_episode` returns them).
+    starts : int
+        Sets of starts per sampled set of goals (>= 1), sharing its goal fields.
     """
 
     def __init__(
@@ -87,9 +96,11 @@ class FleetPool:
         seeds: Sequence[int],
         arrays: Arrays,
         fixed: Sequence[tuple[Sequence[tuple[Any, float, Any]], int]] = (),
+        starts: int = 1,
     ) -> None:
         rows: list[list[tuple[float, ...]]] = []
         fields = []
+        field_of: list[list[int]] = []
         k = 0
         for env in samplers:
             backend = env.backend
@@ -97,15 +108,18 @@ class FleetPool:
                 env.reset(seed=int(seeds[k]))
                 k += 1
                 episode = []
+                field_of.extend([[len(fields) + i for i in range(len(env.tasks))]] * starts)
                 for i, task in enumerate(env.tasks):
                     x, y, yaw = backend._pose(backend._robots[i])
                     gx, gy = task.goal_xy
                     episode.append((x, y, yaw, gx, gy, task.geodesic_dist))
                     fields.append(task._goal_field.field)
                 rows.append(episode)
+                rows.extend(_more_starts(env, [row[3:5] for row in episode]) for _ in range(starts - 1))
         for robots, s in fixed:
             env = samplers[s]
             episode = []
+            field_of.append([len(fields) + i for i in range(len(robots))])
             for start, yaw, goal in robots:
                 field = env.scene.goal_field(env.tasks[0].floor, goal, robot=env.robots[0])
                 episode.append((float(start[0]), float(start[1]), yaw, float(goal[0]), float(goal[1]), field.exact_distance(start)))
@@ -116,9 +130,31 @@ class FleetPool:
         a = arrays
         self.sx, self.sy, self.syaw, self.gx, self.gy, self.d0 = (a.asarray(table[..., i]) for i in range(6))
         self.fields = FieldTables(fields, arrays)
-        self.n_sampled = pool_size * len(samplers)
-        self.pool_size = pool_size
+        self.field = a.asarray(np.array(field_of, dtype=np.int64).reshape(-1, n_robots), a.i64)
+        self.pool_size = pool_size * starts
+        self.n_sampled = self.pool_size * len(samplers)
         self.n_robots = n_robots
 
     def __len__(self) -> int:
         return int(self.sx.shape[0])
+
+
+def _more_starts(env: Any, goals: Sequence[tuple[float, float]]) -> list[tuple[float, ...]]:
+    """One more set of starts for ``goals`` (one per robot), by ``env``'s own sampler: the
+    robots are placed one by one in its reset order, each clear of those placed before."""
+    from pointnav_core.sampling import sample_episode
+
+    env.backend.reset()  # every robot unplaced: none blocks until it lands
+    rows: dict[int, tuple[float, ...]] = {}
+    for i in env._reset_order:
+        task = env.tasks[i]
+        cfg = task._config
+        gx, gy = goals[i]
+        ep = sample_episode(
+            env, robot_idn=cfg.robot_idn, floor=cfg.floor, spec=env.robots[i], floor_height=task._floor_height,
+            initial_pos=None, initial_quat=None, goal_pos=(gx, gy), goal_tolerance=cfg.goal_tolerance,
+            path_range=cfg.path_range, max_trials=task.max_trials,
+        )
+        yaw = 2.0 * math.atan2(ep.start_quat[2], ep.start_quat[3])
+        rows[i] = (float(ep.start_xy[0]), float(ep.start_xy[1]), yaw, gx, gy, ep.geodesic)
+    return [rows[i] for i in range(len(env.tasks))]
