@@ -12,15 +12,19 @@ process time, since the machines are shared), on one thread:
 - ``single, one robot``: the single env's compiled scan of one robot without discs
   (``cast_pose_compiled``, what ``RangeScan`` runs for one robot), once per robot;
 - ``single, per world``: the single env's compiled ``cast_rays`` of one world's robots in one
-  call with their discs (what a multi-robot env's ``ScanShare`` runs), once per world.
+  call with their discs (what a multi-robot env's ``ScanShare`` runs), once per world;
+- ``batched local map``, ``batched local map torch``: a ``--map-cells`` square local map of
+  ``--map-size`` m (:class:`pointnav_core.vector.local_map.VectorLocalMap`, numpy and torch
+  on the CPU) of every robot in one call, with the other robots' discs;
+- ``single local map``: the single env's ``LocalMap.grid`` of one robot (no discs), once per robot.
 
 Every row is in microseconds per robot-scan; the last column is that row over
 ``batched numba``. With ``--engine``, also ``VectorPointNavEnv`` steps (numpy, geodesic
 reward, random actions, ``worlds x robots`` one-robot worlds) without and with a 32-ray
-scan, in microseconds of process time per agent-step (process time, not wall time: the
-machines are shared).
+scan, and with the local map alone and after the scan, in microseconds of process time
+per agent-step (process time, not wall time: the machines are shared).
 
-Run: ``python benchmarks/bench_vector_scan.py [--worlds 1024] [--robots 4] [--rays 32] [--rounds 5] [--engine]``
+Run: ``python benchmarks/bench_vector_scan.py [--worlds 1024] [--robots 4] [--rays 32] [--map-cells 32] [--map-size 5] [--rounds 5] [--engine]``
 """
 
 from __future__ import annotations
@@ -33,8 +37,12 @@ from collections.abc import Callable
 import numpy as np
 
 from pointnav_core import scenes
-from pointnav_core.sensors import ScanGeometry, cast_rays, scan_angles
+from pointnav_core.backend_kit.checks import planar_quat_floats
+from pointnav_core.observations import Frame
+from pointnav_core.sensors import LocalMap, ScanGeometry, cast_rays, scan_angles
 from pointnav_core.sensors.raycast import cast_pose_compiled
+from pointnav_core.vector.floors import FloorTables
+from pointnav_core.vector.local_map import VectorLocalMap
 from pointnav_core.vector.scan import ScanTables, cast_batch, compiled_available
 from pointnav_core.vector.xp import make_arrays
 
@@ -46,6 +54,8 @@ def main() -> None:
     parser.add_argument("--worlds", type=int, default=1024)
     parser.add_argument("--robots", type=int, default=4)
     parser.add_argument("--rays", type=int, default=32)
+    parser.add_argument("--map-cells", type=int, default=32)
+    parser.add_argument("--map-size", type=float, default=5.0)
     parser.add_argument("--rounds", type=int, default=5)
     parser.add_argument("--engine", action="store_true", help="also time the engine's step without and with the scan")
     args = parser.parse_args()
@@ -102,6 +112,23 @@ def main() -> None:
 
     rows["single, one robot"] = single_one
     rows["single, per world"] = single_world
+    term = LocalMap(size=args.map_size, cells=args.map_cells)
+    lmap = VectorLocalMap(term, FloorTables([scene], 0, 0.18, make_arrays("numpy")))
+    rows["batched local map"] = lambda: lmap.values(world_scene, x, y, yaw, present, 0.18)
+    if "batched torch" in rows:
+        tmap = VectorLocalMap(term, FloorTables([scene], 0, 0.18, make_arrays("cpu")))
+        rows["batched local map torch"] = lambda: tmap.values(ts, tx, ty, tyaw, tp, 0.18)
+    frame, env = Frame(), type("OneRobot", (), {"scene": scene, "robots": [None], "backend": None})()
+    frame.task, frame.env = type("Task", (), {"floor": 0, "robot_idn": 0})(), env
+    quats = [[planar_quat_floats(float(v)) for v in row] for row in yaw]
+
+    def single_map() -> None:  # LocalMap.grid of one robot, as PointNavEnv observes it
+        for i in range(w):
+            for j in range(r):
+                frame.set_pose(float(x[i, j]), float(y[i, j]), 0.0, quats[i][j])
+                term.grid(frame)
+
+    rows["single local map"] = single_map
     # Both batched paths agree before anything is timed.
     np.testing.assert_allclose(rows["batched numba"](), rows["batched array"](), rtol=0, atol=1e-9)
     best = dict.fromkeys(rows, np.inf)
@@ -117,15 +144,21 @@ def main() -> None:
     for name, sec in best.items():
         print(f"{name:22s}{sec / (w * r) * 1e6:16.3f}{sec / base:17.2f}")
     if args.engine:
-        _engine(w * r, args.rays, args.rounds)
+        _engine(w * r, args.rays, args.rounds, {"size": args.map_size, "cells": args.map_cells})
 
 
-def _engine(n: int, rays: int, rounds: int) -> None:
+def _engine(n: int, rays: int, rounds: int, local_map: dict) -> None:
     from pointnav_core.vector import VectorPointNavEnv
 
+    scan, cells = {"n_rays": rays}, local_map["cells"]
+    configs = (
+        ("engine, no scan", None), (f"engine, {rays}-ray scan", {"scan": scan}),
+        (f"engine, {cells}x{cells} map", {"local_map": local_map}),
+        ("engine, scan + map", {"scan": scan, "local_map": local_map}),
+    )
     envs = {
         label: VectorPointNavEnv(n, seed=0, pool_size=2, task={"reward_type": "geodesic"}, sensors=sensors)
-        for label, sensors in (("engine, no scan", None), (f"engine, {rays}-ray scan", {"scan": {"n_rays": rays}}))
+        for label, sensors in configs
     }
     actions = np.random.default_rng(0).uniform(-1.0, 1.0, (20, n, 2))
     for env in envs.values():

@@ -10,28 +10,15 @@ without it). The numpy path itself is checked against shapely in
 
 from __future__ import annotations
 
-from collections.abc import Iterator
-from contextlib import contextmanager
-
 import numpy as np
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from pointnav_core import collision
+from pointnav_core._compiled import kernel, numpy_paths
 from pointnav_core.collision import FloorCollision
 
 pytest.importorskip("numba")
-
-
-@contextmanager
-def _numpy_path() -> Iterator[None]:
-    kept = list(collision._KERNEL)
-    collision._KERNEL[:] = [None]
-    try:
-        yield
-    finally:
-        collision._KERNEL[:] = kept
 
 
 @settings(max_examples=80, deadline=None)
@@ -63,7 +50,8 @@ def test_compiled_cell_test_equals_the_numpy_path(
     b[on_lines] = origin + np.round((b[on_lines] - origin) / resolution) * resolution
     a[kind == 4] += 50.0 * size  # far off the map
     got = geo.segments_clear(a, b, radius)
-    with _numpy_path():
+    with numpy_paths():
+        assert kernel("pointnav_core._collision_kernel", "cells_hit") is None
         want = geo.segments_clear(a, b, radius)
     np.testing.assert_array_equal(got, want)
-    assert collision._cells_kernel() is not None
+    assert kernel("pointnav_core._collision_kernel", "cells_hit") is not None

@@ -9,8 +9,6 @@ gives the same bounds, bit for bit, with its numba kernel and with its numpy loo
 from __future__ import annotations
 
 import math
-from collections.abc import Iterator
-from contextlib import contextmanager
 
 import numpy as np
 import pytest
@@ -19,18 +17,9 @@ from hypothesis import strategies as st
 from scipy import ndimage
 
 from pointnav_core import tangent_edges
+from pointnav_core._compiled import kernel, numpy_paths
 
 pytest.importorskip("numba")
-
-
-@contextmanager
-def _numpy_path() -> Iterator[None]:
-    kept = list(tangent_edges._KERNEL)
-    tangent_edges._KERNEL[:] = [None]
-    try:
-        yield
-    finally:
-        tangent_edges._KERNEL[:] = kept
 
 
 @settings(max_examples=60, deadline=None)
@@ -55,9 +44,10 @@ def test_compiled_sight_radii_equal_the_numpy_loop(
     xs = origin[0] + rng.uniform(-0.2, 1.2, n_points) * cols * resolution
     ys = origin[1] + rng.uniform(-0.2, 1.2, n_points) * rows * resolution
     xs[: n_points // 4] = origin[0] + np.round(xs[: n_points // 4] - origin[0], 1)
-    assert tangent_edges._march_kernel() is not None
+    assert kernel("pointnav_core._sight_kernel", "march") is not None
     got = tangent_edges.sight_radii(edt, xs, ys, origin, resolution, radius, n_rays)
-    with _numpy_path():
+    with numpy_paths():
+        assert kernel("pointnav_core._sight_kernel", "march") is None
         want = tangent_edges.sight_radii(edt, xs, ys, origin, resolution, radius, n_rays)
     np.testing.assert_array_equal(got, want)
     assert got.shape == (n_points,) and not np.isnan(got).any()

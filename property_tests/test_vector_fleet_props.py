@@ -5,10 +5,12 @@ of 2 to 4 robots and random action sequences, ``VectorPointNavEnv(W, n_robots=R)
 matches ``W`` separate ``parallel_env(n_robots=R, backend="kinematic")`` step for step
 (observations within 1e-4, rewards within 1e-5, the same terminated, truncated and active
 flags, success, SPL and SoftSPL) over whole episodes and their autoresets, with parked or
-removed finished robots, with or without a range scan (which sees the other robots of its
-world), on numpy and on torch on the CPU; the same with discrete actions
-(``action_space="discrete"``, random ``forward_step``, ``turn_angle`` and STOP) and with
-per-robot ``task`` and ``robot`` lists.
+removed finished robots, with or without a range scan and a local map (both see the other
+robots of its world; the map's codes are equal, except at a cell centre on a cell edge or
+a disc's rim, ``local_map_reference``), on numpy and on torch on the CPU; and the same with
+discrete actions (``action_space="discrete"``, random ``forward_step``, ``turn_angle`` and
+STOP, with or without a scan and a local map); and with per-robot
+``task`` and ``robot`` lists.
 """
 
 from __future__ import annotations
@@ -60,10 +62,13 @@ def crowded_scenes(draw: st.DrawFn) -> Scene:
         "n_rays": st.integers(1, 32), "fov": st.floats(0.5, 2 * np.pi), "max_range": st.floats(0.3, 5.6),
         "min_range": st.sampled_from([0.0, 0.05, 0.2]),
     })),
+    local_map=st.one_of(st.none(), st.fixed_dictionaries({
+        "size": st.floats(0.2, 4.0), "cells": st.integers(1, 12), "dtype": st.sampled_from(["uint8", "float32"]),
+    })),
 )
 def test_fleet_matches_parallel_envs(
     device: str, scene: Scene, seed: int, n_worlds: int, n_robots: int, steps: int, reward_type: str,
-    max_steps: int, max_cycles: int, finished: str, scan: dict | None,
+    max_steps: int, max_cycles: int, finished: str, scan: dict | None, local_map: dict | None,
 ) -> None:
     rng = np.random.default_rng(seed)
     # goal_tolerance 0.2 m: the multi-robot env keeps goals max(0.4, 0.36, 0.1) m apart.
@@ -73,8 +78,9 @@ def test_fleet_matches_parallel_envs(
     actions[rng.random((steps, n_worlds, n_robots)) < 0.4, 0] = 1.0
     task = {"reward_type": reward_type, "goal_tolerance": 0.2,
             "termination_config": {"max_steps": max_steps, "max_collisions": 15}}
+    sensors = {k: v for k, v in (("scan", scan), ("local_map", local_map)) if v is not None}
     compare_fleet(scene, episodes, actions, task=task, device=device, finished=finished, max_cycles=max_cycles,
-                  sensors=None if scan is None else {"scan": scan})
+                  sensors=sensors or None)
 
 
 @st.composite
@@ -178,11 +184,12 @@ def test_one_slow_robot_resolves_as_in_the_multi_robot_resolver(device: str, sce
     turn_angle=st.floats(0.05, 1.5),
     stop=st.booleans(),
     scan=st.one_of(st.none(), st.fixed_dictionaries({"n_rays": st.integers(1, 16), "max_range": st.floats(0.3, 3.0)})),
+    local_map=st.one_of(st.none(), st.fixed_dictionaries({"size": st.floats(0.2, 4.0), "cells": st.integers(1, 12)})),
 )
 def test_fleet_discrete_matches_parallel_envs(
     device: str, scene: Scene, seed: int, n_worlds: int, n_robots: int, steps: int, reward_type: str,
     max_steps: int, max_cycles: int, finished: str, forward_step: float, turn_angle: float, stop: bool,
-    scan: dict | None,
+    scan: dict | None, local_map: dict | None,
 ) -> None:
     """Discrete actions (each robot's for its control steps, all robots of a world together,
     cut short by contacts; STOP) as the multi-robot env runs them."""
@@ -195,5 +202,6 @@ def test_fleet_discrete_matches_parallel_envs(
     task = {"reward_type": reward_type, "goal_tolerance": 0.2,
             "termination_config": {"max_steps": max_steps, "max_collisions": 15}}
     discrete = {"forward_step": forward_step, "turn_angle": turn_angle, "stop": stop}
+    sensors = {k: v for k, v in (("scan", scan), ("local_map", local_map)) if v is not None}
     compare_fleet(scene, episodes, actions, task=task, device=device, finished=finished, max_cycles=max_cycles,
-                  sensors=None if scan is None else {"scan": scan}, action_space="discrete", discrete_actions=discrete)
+                  sensors=sensors or None, action_space="discrete", discrete_actions=discrete)

@@ -4,7 +4,8 @@ For random grid scenes (clutter, walls, a hole to fall into), fixed random episo
 random action sequences, ``VectorPointNavEnv`` matches separate ``PointNavEnv``s on the
 kinematic backend step for step (observations within 1e-4, rewards within 1e-5, the same
 flags, success, SPL and SoftSPL) over whole episodes and their autoresets, on numpy and
-on torch on the CPU.
+on torch on the CPU; with a local map, its codes equal the single env's except at a cell
+centre on a cell edge (``local_map_reference``).
 """
 
 from __future__ import annotations
@@ -58,6 +59,35 @@ def test_vector_matches_single_envs(device: str, scene: Scene, seed: int, n: int
     actions[rng.random((steps, n)) < 0.4, 0] = 1.0
     task = {"reward_type": reward_type, "termination_config": {"max_steps": max_steps, "max_collisions": 20}}
     compare(scene, episodes, actions, task=task, device=device)
+
+
+@pytest.mark.parametrize("device", DEVICES)
+@settings(max_examples=8, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(
+    scene=cluttered_scenes(),
+    seed=st.integers(0, 2**31 - 1),
+    n=st.integers(1, 4),
+    steps=st.integers(1, 100),
+    max_steps=st.integers(5, 60),
+    size=st.floats(0.2, 4.0),
+    cells=st.integers(1, 12),
+    dtype=st.sampled_from(["uint8", "float32"]),
+    scan=st.booleans(),
+)
+def test_vector_local_map_matches_single_envs(
+    device: str, scene: Scene, seed: int, n: int, steps: int, max_steps: int, size: float, cells: int, dtype: str,
+    scan: bool,
+) -> None:
+    """With a local map (after a scan or alone) the codes are the single env's, exactly but at ties."""
+    rng = np.random.default_rng(seed)
+    episodes = random_episodes(scene, n, rng)
+    actions = rng.uniform(-1.2, 1.2, (steps, n, 2)).astype(np.float32)
+    actions[rng.random((steps, n)) < 0.4, 0] = 1.0
+    task = {"termination_config": {"max_steps": max_steps, "max_collisions": 20}}
+    sensors = {"local_map": {"size": size, "cells": cells, "dtype": dtype}}
+    if scan:
+        sensors["scan"] = {"n_rays": 7, "max_range": 2.0}
+    compare(scene, episodes, actions, task=task, device=device, sensors=sensors)
 
 
 @settings(max_examples=30, deadline=None)

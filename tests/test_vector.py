@@ -130,7 +130,7 @@ def test_bad_actions_are_refused(device: str, actions: np.ndarray) -> None:
     np.testing.assert_array_equal(env.arrays.numpy(env._state["x"]), before)
 
 
-@pytest.mark.parametrize(("kwargs", "name"), [({"n_robots": 0}, "n_robots"), ({"sensors": {"local_map": {}}}, "sensors"),
+@pytest.mark.parametrize(("kwargs", "name"), [({"n_robots": 0}, "n_robots"), ({"sensors": {"lidar": {}}}, "sensors"),
                                              ({"num_envs": 0}, "num_envs"), ({"pool_size": 0}, "pool_size"),
                                              ({"robot": {"drive": "holonomic"}}, "robot")])
 def test_unsupported_arguments_are_named(kwargs: dict, name: str) -> None:

@@ -87,8 +87,8 @@ def test_torch_observation_is_float32_on_the_device() -> None:
 @pytest.mark.parametrize(
     ("sensors", "message"),
     [
-        ({"local_map": {}}, "'local_map' is not supported"),
-        ({"scan": {}, "local_map": None}, "'local_map' is not supported"),
+        ({"local_map": {"cells": 0}}, "cells must be an integer"),
+        ({"scan": {}, "local_map": {"size": -1.0}}, "size"),
         ({"lidar": {}}, "unknown sensor 'lidar'"),
         ({"scan": {"rays": 8}}, "unknown key 'rays'"),
         ({"scan": {"n_rays": 0}}, "n_rays"),

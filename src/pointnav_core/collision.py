@@ -34,6 +34,8 @@ import numpy as np
 import shapely
 from numpy.typing import ArrayLike, NDArray
 
+from pointnav_core import _compiled
+
 __all__ = ["TOUCH_TOL", "FloorCollision", "convex_corners"]
 
 #: Metres by which a disc may overlap the blocked set and still count as touching. Absorbs
@@ -190,7 +192,7 @@ class FloorCollision:
         # A point robot is a disc of radius TOUCH_TOL: it may not squeeze through the corner
         # two diagonal squares share.
         rho = max(radius - TOUCH_TOL, TOUCH_TOL) * inv
-        kernel = _cells_kernel()
+        kernel = _compiled.kernel("pointnav_core._collision_kernel", "cells_hit")
         if kernel is not None:  # the same test, segment by segment, in compiled code
             out = np.empty(len(a), dtype=np.bool_)
             kernel(ax, ay, bx, by, rho, self._rowcum, self.outside_blocked, out)
@@ -236,22 +238,6 @@ class FloorCollision:
             hit |= nonempty & (~inside_row | (c_lo < 0) | (c_hi >= w))
         # bincount, not logical_or.at: the unbuffered ufunc loop is far slower.
         return np.bincount(seg[hit], minlength=len(a)) > 0
-
-
-_KERNEL: list[Any] = []
-
-
-def _cells_kernel() -> Any:
-    """The compiled cell test (:mod:`pointnav_core._collision_kernel`), or None without numba."""
-    if not _KERNEL:
-        try:
-            from pointnav_core._collision_kernel import cells_hit
-        except ModuleNotFoundError as error:
-            if error.name not in ("numba", "llvmlite"):
-                raise
-            cells_hit = None
-        _KERNEL.append(cells_hit)
-    return _KERNEL[0]
 
 
 def _stadium_row(

@@ -10,10 +10,12 @@ overhead is paid once per batch. The results are identical to the per-node const
 from __future__ import annotations
 
 import math
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
 
 import numpy as np
 from numpy.typing import NDArray
+
+from pointnav_core import _compiled
 
 if TYPE_CHECKING:
     from pointnav_core.tangent_graph import Planner
@@ -69,7 +71,7 @@ def sight_radii(
     ang = np.linspace(0.0, _TWO_PI, n_rays, endpoint=False)
     start = radius / resolution + 2.0
     limit = math.hypot(h, w) + 2.0
-    kernel = _march_kernel()
+    kernel = _compiled.kernel("pointnav_core._sight_kernel", "march")
     if kernel is not None:
         longest = np.empty(n_pts)
         kernel(np.ascontiguousarray(flat, dtype=np.float64), h, w, (xs - origin[0]) / resolution + 1.0,
@@ -96,22 +98,6 @@ def sight_radii(
         live = live[go]
         t[live] = tl[go] + np.maximum(d[go] - math.sqrt(2.0), 0.25)
     return (t.reshape(n_pts, n_rays).max(axis=1) + 2.0) * resolution
-
-
-_KERNEL: list = []
-
-
-def _march_kernel() -> Any:
-    """The compiled ray march (:mod:`pointnav_core._sight_kernel`), or None without numba."""
-    if not _KERNEL:
-        try:
-            from pointnav_core._sight_kernel import march
-        except ModuleNotFoundError as error:
-            if error.name not in ("numba", "llvmlite"):
-                raise
-            march = None
-        _KERNEL.append(march)
-    return _KERNEL[0]
 
 
 def build_edges(p: Planner, nodes: NDArray[np.int64]) -> None:

@@ -3,7 +3,7 @@
 Every world is a :class:`~pointnav_core.env.PointNavEnv` with one robot on the kinematic
 backend (several robots per world: :mod:`pointnav_core.vector.fleet_env`), and the batched
 step reproduces them (drive, contacts and sliding, the task's rewards, terminations, SPL
-and SoftSPL, the flat ``low_dim`` observation and the range scan) with array operations
+and SoftSPL, the flat ``low_dim`` observation, the range scan and the local map) with array operations
 over all worlds at once: there is no Python loop over worlds on the step path.
 The same code runs on numpy (``device="numpy"``) and on torch (``"cpu"``, ``"cuda"``).
 """
@@ -24,6 +24,7 @@ from pointnav_core.vector.contacts import advance
 from pointnav_core.vector.discrete import MOVED, DiscretePlan
 from pointnav_core.vector.episodes import EpisodePool
 from pointnav_core.vector.floors import FloorTables
+from pointnav_core.vector.local_map import VectorLocalMap, local_map_term
 from pointnav_core.vector.refresh import PoolRefreshing
 from pointnav_core.vector.scan import ScanTables, VectorScan
 from pointnav_core.vector.xp import make_arrays
@@ -42,9 +43,9 @@ def _scan_term(sensors: Mapping[str, Any] | None) -> Any:
 
     terms = make_sensors(sensors)  # the single envs' checks: unknown sensors and keys
     for term in terms:
-        if term.name != "scan":
-            raise ValueError(f"sensors: {term.name!r} is not supported by the batched engine (only 'scan')")
-    return terms[0] if terms else None
+        if term.name not in ("scan", "local_map"):
+            raise ValueError(f"sensors: {term.name!r} is not supported by the batched engine (only 'scan', 'local_map')")
+    return next((term for term in terms if term.name == "scan"), None)
 
 
 def _default_scene() -> scenes.Scene:
@@ -114,7 +115,11 @@ class VectorPointNavEnv(PoolRefreshing, VectorEnv):
         ``n_rays`` ranges (m, in ``[0, max_range]``), in the single env's order and bounds,
         cast by :mod:`pointnav_core.vector.scan` (compiled with numba on numpy, arrays on
         torch). Noise and dropout draw from a stream of their own, not the single env's.
-        ``local_map`` is not supported.
+        ``{"local_map": {...}}`` (:class:`~pointnav_core.sensors.LocalMap` arguments) adds
+        its ``cells * cells`` codes (0 free, 1 blocked, 2 void or off the map, 3 another
+        robot; after the scan when both are given), equal to the single env's
+        (:mod:`pointnav_core.vector.local_map`); ``dtype`` shapes only the single env's
+        ``Dict`` observation, the flat one is float32 either way.
     device : str
         ``"numpy"`` (default), or torch on ``"cpu"`` or ``"cuda[:n]"``.
     seed : int, optional
@@ -142,7 +147,7 @@ class VectorPointNavEnv(PoolRefreshing, VectorEnv):
     ``step`` takes actions of shape ``(num_envs, 2)`` (or ``(num_envs, 1, 2)``) in
     ``[-1, 1]`` (clipped), or with discrete actions integers of shape ``(num_envs,)``, and
     returns observations ``(num_envs, 8)`` float32 (``(num_envs, 8 + n_rays)`` with the
-    scan), rewards float64, terminated and truncated bool, and ``info``, a dict of arrays of shape
+    scan, plus ``cells * cells`` with the local map), rewards float64, terminated and truncated bool, and ``info``, a dict of arrays of shape
     ``(num_envs,)``: ``success``, ``spl``, ``soft_spl``, ``path_length``,
     ``geodesic_dist``, ``distance_to_goal``, ``collisions``, ``episode_length``,
     ``in_contact``, ``reward_potential``, ``reward_collision``, ``reward_pointgoal`` and
@@ -159,7 +164,8 @@ class VectorPointNavEnv(PoolRefreshing, VectorEnv):
     ``(num_envs, R, 2)`` (all finite; those of inactive robots are ignored), or with
     ``action_space="discrete"`` integers ``(num_envs, R)`` (all in range), and returns
     observations ``(num_envs, R, 8)`` float32 (``(num_envs, R, 8 + n_rays)`` with the scan,
-    which sees the other robots present in its world as the multi-robot env's scan does),
+    which sees the other robots present in its world as the multi-robot env's scan does;
+    plus ``cells * cells`` with the local map, which draws the same robots as code 3),
     rewards ``(num_envs, R)`` float64,
     terminated and truncated ``(num_envs, R)`` bool and ``info`` arrays ``(num_envs, R)``
     with, besides the keys above, ``active``: the robots that are still agents (PettingZoo's
@@ -284,6 +290,8 @@ class VectorPointNavEnv(PoolRefreshing, VectorEnv):
         self.scan = None if scan_term is None else VectorScan(scan_term, ScanTables(scene_list, t.floor, a))
         if self.scan is not None:
             self.scan.seed(self._rng)
+        map_term = local_map_term(sensors)
+        self.local_map = None if map_term is None else VectorLocalMap(map_term, self.floors)
 
     def _read_task(self, t: Any, action_frequency: float) -> None:
         """The task's settings the batched step reads (both engines), with the control
@@ -529,15 +537,25 @@ class VectorPointNavEnv(PoolRefreshing, VectorEnv):
         obs = xp.stack([lx, ly, c * vx + s * vy, c * vy - s * vx, st["vz"], zero, zero, st["w"]], -1)
         if self.scan is not None:
             obs = (xp.cat if a.is_torch else xp.concatenate)([obs, self._scan_ranges(c, s)], -1)
-        sc = self._world_scene
-        obs = xp.minimum(xp.maximum(obs, self._low[sc]), self._high[sc])
-        return obs.to(xp.float32) if a.is_torch else obs.astype(np.float32)
+        sc, width = self._world_scene, obs.shape[-1]
+        obs = xp.minimum(xp.maximum(obs, self._low[..., :width][sc]), self._high[..., :width][sc])
+        obs = obs.to(xp.float32) if a.is_torch else obs.astype(np.float32)
+        if self.local_map is not None:  # after the scan (the single env's order); codes within their bounds
+            obs = (xp.cat if a.is_torch else xp.concatenate)([obs, self._map_values()], -1)
+        return obs
 
     def _scan_ranges(self, c: Any, s: Any) -> Any:
         """The scan's readings (m), ``(num_envs, n_rays)``, at the headings' cosines ``c`` and sines ``s``."""
         xp, st = self.arrays.xp, self._state
         yaw, one = xp.arctan2(s, c)[:, None], xp.ones_like(c)[:, None] > 0.0  # the single env's frame heading
         return self.scan.readings(self._world_scene, st["x"][:, None], st["y"][:, None], yaw, one, self.robot.radius)[:, 0]
+
+    def _map_values(self) -> Any:
+        """The local map's codes, ``(num_envs, cells * cells)`` float32 (one robot: no discs)."""
+        st = self._state
+        one = self.arrays.xp.ones_like(st["x"])[:, None] > 0.0
+        return self.local_map.values(self._world_scene, st["x"][:, None], st["y"][:, None], st["yaw"][:, None], one,
+                                     self.robot.radius)[:, 0]
 
     def _info(self, success: Any, r_pot: Any, r_col: Any, r_goal: Any, contact: Any, resetting: Any) -> dict[str, Any]:
         xp, st = self.arrays.xp, self._state

@@ -10,7 +10,8 @@ the one-robot engine's, masked by the robots still active (PettingZoo's ``agents
 ``sensors={"scan": {...}}`` every robot's scan sees the floor and the discs of the other
 robots of its world that the multi-robot env's scan sees when it observes the step: those
 present before the step's finished robots leave (parked, removed or fallen alike), all of
-them after a reset.
+them after a reset; with ``sensors={"local_map": {...}}`` every robot's map draws the discs
+of the same robots as code 3.
 """
 
 from __future__ import annotations
@@ -37,6 +38,7 @@ from pointnav_core.vector.env import (
 )
 from pointnav_core.vector.fleet_pool import FleetPool, check_fixed_episode
 from pointnav_core.vector.floors import FloorTables
+from pointnav_core.vector.local_map import VectorLocalMap, local_map_term
 from pointnav_core.vector.per_robot import (
     envelope,
     read_tasks,
@@ -170,6 +172,8 @@ class VectorFleetEnv(VectorPointNavEnv):
         self.scan = None if scan_term is None else VectorScan(scan_term, ScanTables(scene_list, t.floor, a))
         if self.scan is not None:
             self.scan.seed(self._rng)
+        map_term = local_map_term(sensors)
+        self.local_map = None if map_term is None else VectorLocalMap(map_term, self.floors)
 
     # ------------------------------------------------------------------ pools
     def _build_pool(self, fixed: Sequence[Any]) -> None:
@@ -392,6 +396,12 @@ class VectorFleetEnv(VectorPointNavEnv):
         xp, st = self.arrays.xp, self._state
         yaw = xp.arctan2(s, c)  # the heading as the multi-robot env's frame gives it
         return self.scan.readings(self._world_scene, st["x"], st["y"], yaw, self._seen, self.robot.radius)
+
+    def _map_values(self) -> Any:
+        """Every robot's local map, ``(num_envs, n_robots, cells * cells)``, with the discs of
+        the robots in ``_seen`` (the scan's rule); rows outside it are hidden by ``_observe``."""
+        st = self._state
+        return self.local_map.values(self._world_scene, st["x"], st["y"], st["yaw"], self._seen, self.robot.radius)
 
     def _observe(self, shown: Any) -> Any:
         """The robots' ``low_dim`` observations, zero where ``shown`` is False."""
