@@ -9,7 +9,8 @@ removed finished robots, with or without a range scan and a local map (both see 
 robots of its world; the map's codes are equal, except at a cell centre on a cell edge or
 a disc's rim, ``local_map_reference``), on numpy and on torch on the CPU; and the same with
 discrete actions (``action_space="discrete"``, random ``forward_step``, ``turn_angle`` and
-STOP, with or without a scan and a local map).
+STOP, with or without a scan and a local map); and with per-robot
+``task`` and ``robot`` lists.
 """
 
 from __future__ import annotations
@@ -80,6 +81,58 @@ def test_fleet_matches_parallel_envs(
     sensors = {k: v for k, v in (("scan", scan), ("local_map", local_map)) if v is not None}
     compare_fleet(scene, episodes, actions, task=task, device=device, finished=finished, max_cycles=max_cycles,
                   sensors=sensors or None)
+
+
+@st.composite
+def robot_tasks(draw: st.DrawFn) -> dict:
+    """Task arguments for one robot: every number the engine takes per robot, drawn."""
+    return {
+        "reward_type": draw(st.sampled_from(["l2", "geodesic"])),
+        "goal_tolerance": draw(st.floats(0.05, 0.2)),
+        "goal_in_polar": draw(st.booleans()),
+        "termination_config": {"max_steps": draw(st.integers(5, 60)), "max_collisions": draw(st.integers(0, 20)),
+                               "fall_height": draw(st.sampled_from([0.01, 0.03, 0.2]))},
+        "reward_config": {"r_potential": draw(st.floats(0.0, 2.0)), "r_collision": draw(st.floats(0.0, 1.0)),
+                          "r_pointgoal": draw(st.floats(0.0, 20.0))},
+    }
+
+
+# Speed limits the batched engine takes at 10 Hz: at most half a 0.1 m cell and 0.25 rad a step.
+robot_specs = st.fixed_dictionaries({"radius": st.just(0.18), "max_linear_velocity": st.floats(0.05, 0.5),
+                                     "max_angular_velocity": st.floats(0.2, 2.5)})
+
+
+@pytest.mark.parametrize("device", DEVICES)
+@settings(max_examples=10, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(
+    scene=crowded_scenes(),
+    seed=st.integers(0, 2**31 - 1),
+    n_worlds=st.integers(1, 3),
+    lists=st.integers(2, 4).flatmap(lambda r: st.tuples(
+        st.one_of(robot_tasks(), st.lists(robot_tasks(), min_size=r, max_size=r)),
+        st.one_of(st.none(), robot_specs, st.lists(robot_specs, min_size=r, max_size=r)),
+        st.just(r),
+    )),
+    steps=st.integers(1, 120),
+    max_cycles=st.integers(3, 70),
+    finished=st.sampled_from(["park", "remove"]),
+    scan=st.booleans(),
+)
+def test_fleet_with_per_robot_lists_matches_parallel_envs(
+    device: str, scene: Scene, seed: int, n_worlds: int, lists: tuple, steps: int, max_cycles: int,
+    finished: str, scan: bool,
+) -> None:
+    """Per-robot ``task`` and ``robot`` lists (or one shared value) give each robot its own
+    rewards, tolerance, limits, goal frame and speed limits, as in the multi-robot env."""
+    task, robot, n_robots = lists
+    rng = np.random.default_rng(seed)
+    # The multi-robot env keeps goals max(tol_i + tol_j, r_i + r_j, cell) apart: 0.4 m at most here.
+    episodes = fleet_episodes(scene, n_worlds, n_robots, rng, goal_gap=0.4)
+    actions = rng.uniform(-1.2, 1.2, (steps, n_worlds, n_robots, 2)).astype(np.float32)
+    actions[rng.random((steps, n_worlds, n_robots)) < 0.4, 0] = 1.0
+    sensors = {"scan": {"n_rays": 8, "max_range": 2.0}} if scan else None
+    compare_fleet(scene, episodes, actions, task=task, robot=robot, device=device, finished=finished,
+                  max_cycles=max_cycles, sensors=sensors)
 
 
 @pytest.mark.parametrize("device", DEVICES)

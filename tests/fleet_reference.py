@@ -36,11 +36,12 @@ def compare_fleet(
     scene: Any,
     episodes: list[list[tuple[Any, float, Any]]],
     actions: np.ndarray,
-    task: dict | None = None,
+    task: dict | list[dict] | None = None,
     device: str = "numpy",
     finished: str = "park",
     max_cycles: int = 500,
     sensors: dict | None = None,
+    robot: Any = None,
     action_space: str = "continuous",
     discrete_actions: dict | None = None,
 ) -> dict[str, Any]:
@@ -49,18 +50,19 @@ def compare_fleet(
     ``episodes`` holds, per world, one ``(start_xy, yaw, goal_xy)`` per robot; ``actions``
     has shape ``(steps, num_envs, n_robots, 2)``, or ``(steps, num_envs, n_robots)`` of
     ints with ``action_space="discrete"`` (and ``discrete_actions``, both sides).
-    ``sensors`` (both sides) adds the scan to the flat observations compared.
+    ``sensors`` (both sides) adds the scan to the flat observations compared. ``task`` and
+    ``robot`` (both sides) may be lists with one entry per robot.
     """
-    task = dict(task or {})
     n, r = len(episodes), len(episodes[0])
+    tasks = [dict(t or {}) for t in task] if isinstance(task, list) else [dict(task or {})] * r
     venv = VectorPointNavEnv(n, n_robots=r, scene=scene, task=task, device=device, seed=0, pool_size=1,
-                             finished=finished, max_cycles=max_cycles, sensors=sensors,
+                             finished=finished, max_cycles=max_cycles, sensors=sensors, robot=robot,
                              action_space=action_space, discrete_actions=discrete_actions)
     dim = venv.single_observation_space.shape[0]
     refs = [
-        parallel_env(scene=scene, n_robots=r, task=[_fixed_task(task, *rb) for rb in world], backend="kinematic",
-                     finished=finished, max_cycles=max_cycles, sensors=sensors, action_space=action_space,
-                     discrete_actions=discrete_actions)
+        parallel_env(scene=scene, n_robots=r, task=[_fixed_task(t, *rb) for t, rb in zip(tasks, world)],
+                     backend="kinematic", finished=finished, max_cycles=max_cycles, sensors=sensors, robot=robot,
+                     action_space=action_space, discrete_actions=discrete_actions)
         for world in episodes
     ]
     agents = refs[0].possible_agents

@@ -102,10 +102,13 @@ class VectorPointNavEnv(PoolRefreshing, VectorEnv):
         World ``i`` runs on ``scene[i % len(scene)]``. Floors must be grid cells only (no
         obstacle polygons). Default: the single env's default house as a grid.
     robot : RobotSpec or dict, optional
-        Differential drive only.
+        Differential drive only. With several robots per world, also a list with one entry
+        per robot, as for :func:`~pointnav_core.parallel.parallel_env`: their speed limits
+        may differ, their radius may not.
     task : dict, optional
         ``PointNavigationTask`` keyword arguments, as for the single env (its default
-        ``path_range`` too). Custom terms are not supported.
+        ``path_range`` too). Custom terms are not supported. With several robots per world,
+        also a list of one dict per robot (see "Several robots per world").
     sensors : dict, optional
         ``{"scan": {...}}`` (:class:`~pointnav_core.sensors.RangeScan` arguments, as for the
         single env): the flat observation is the 8 ``low_dim`` values, then the scan's
@@ -181,6 +184,13 @@ class VectorPointNavEnv(PoolRefreshing, VectorEnv):
     their collision); STOP ends that robot's episode (a success within ``goal_tolerance``).
     ``starts_per_goal`` gives each pool episode more sets of starts for the same goals
     (drawn by the multi-robot env's sampler, robot by robot, clear of each other).
+    ``robot`` and ``task`` lists (:mod:`pointnav_core.vector.per_robot`) give robot ``i`` of
+    every world entry ``i``: its task's ``goal_tolerance``, ``reward_type``,
+    ``goal_in_polar``, ``termination_config`` (``max_steps``, ``max_collisions``,
+    ``fall_height``), ``reward_config`` and ``path_range`` and its robot's speed limits
+    (m/s, rad/s) may differ; a list whose tasks' ``floor`` or robots' ``radius`` differ
+    raises ``ValueError`` naming ``task`` or ``robot``, as does a list of the wrong length
+    or an entry of the wrong type (naming ``task[i]`` or ``robot[i]``).
 
     Examples
     --------
@@ -294,7 +304,7 @@ class VectorPointNavEnv(PoolRefreshing, VectorEnv):
         self.fall_height, self.goal_tolerance = float(cfg["fall_height"]), t.goal_tolerance
         self.r_potential, self.r_collision, self.r_pointgoal = (float(rcfg[k]) for k in ("r_potential", "r_collision", "r_pointgoal"))
         self.geodesic_reward = t.reward_type == "geodesic"
-        self.goal_in_polar = t.goal_in_polar
+        self.goal_in_polar = bool(t.goal_in_polar)
         spec = self.robot
         if spec.max_angular_velocity * self.dt > _MAX_TURN or spec.max_linear_velocity * self.dt > 0.5 * min(
             float(s.floors[t.floor].resolution) for s in self.scenes
@@ -516,10 +526,12 @@ class VectorPointNavEnv(PoolRefreshing, VectorEnv):
         c, s = xp.cos(st["yaw"]), xp.sin(st["yaw"])
         dx, dy = st["gx"] - st["x"], st["gy"] - st["y"]
         lx, ly = c * dx + s * dy, c * dy - s * dx
-        if self.goal_in_polar:
+        polar = self.goal_in_polar  # a bool, or a (1, R) mask when robots' tasks differ
+        if polar is not False:
             rho = xp.sqrt(lx * lx + ly * ly)
             phi = xp.where(rho > 0.0, xp.arctan2(ly, lx), 0.0)
-            lx, ly = rho, xp.where(phi == -math.pi, math.pi, phi)
+            phi = xp.where(phi == -math.pi, math.pi, phi)
+            lx, ly = (rho, phi) if polar is True else (xp.where(polar, rho, lx), xp.where(polar, phi, ly))
         vx, vy = st["vx"], st["vy"]
         zero = xp.zeros_like(vx)
         obs = xp.stack([lx, ly, c * vx + s * vy, c * vy - s * vx, st["vz"], zero, zero, st["w"]], -1)

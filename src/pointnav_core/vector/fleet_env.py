@@ -33,14 +33,18 @@ from pointnav_core.vector.env import (
     _GRAVITY,
     _MIN_FIRST_DROP,
     VectorPointNavEnv,
-    _differential_robot,
     _scan_term,
     _scene_list,
-    _task_arguments,
 )
 from pointnav_core.vector.fleet_pool import FleetPool, check_fixed_episode
 from pointnav_core.vector.floors import FloorTables
 from pointnav_core.vector.local_map import VectorLocalMap, local_map_term
+from pointnav_core.vector.per_robot import (
+    envelope,
+    read_tasks,
+    robot_specs,
+    task_arguments,
+)
 from pointnav_core.vector.robots import advance_robots, robot_walls
 from pointnav_core.vector.scan import ScanTables, VectorScan
 from pointnav_core.vector.xp import make_arrays
@@ -105,33 +109,38 @@ class VectorFleetEnv(VectorPointNavEnv):
             raise ValueError(f"finished must be one of {list(FINISHED_MODES)}, got {finished!r}")
         self.finished = finished
         scan_term = _scan_term(sensors)
-        task = _task_arguments(task)
         if max_episode_steps is not None:
-            steps = validation.integer("max_episode_steps", max_episode_steps, minimum=1)
-            task["termination_config"] = {**dict(task.get("termination_config") or {}), "max_steps": steps}
+            max_episode_steps = validation.integer("max_episode_steps", max_episode_steps, minimum=1)
+        task = task_arguments(task, self.n_robots, max_episode_steps)  # one dict, or one per robot
         self.pool_size = validation.integer("pool_size", pool_size, minimum=1)
         self.starts_per_goal = validation.integer("starts_per_goal", starts_per_goal, minimum=1)
         self.arrays = a = make_arrays(device)
         self.device = device
         self.scenes = scene_list = _scene_list(scene)
-        self.robot = spec = _differential_robot(robot)
+        #: One spec per robot; ``robot`` is their envelope (shared radius, highest speeds).
+        self.robots = robot_specs(robot, self.n_robots)
+        self.robot = spec = envelope(self.robots)
         # The multi-robot env of each scene samples its episodes and is the semantics.
         self._samplers = [
-            parallel_env(scene=s, n_robots=self.n_robots, robot=spec, task=dict(task), backend="kinematic",
+            parallel_env(scene=s, n_robots=self.n_robots, robot=list(self.robots),
+                         task=[dict(t) for t in task] if isinstance(task, list) else dict(task), backend="kinematic",
                          max_cycles=self.max_cycles, finished=finished, action_frequency=action_frequency,
                          sensors=sensors, action_space=action_space, discrete_actions=discrete_actions)
             for s in scene_list
         ]
         first = self._samplers[0]
-        self._read_task(first.tasks[0], first.action_frequency)
+        self._read_task(first.tasks[0], first.action_frequency)  # rate check on the envelope
+        read_tasks(self, first.tasks, self.robots, a)  # then the per-robot settings, (1, R)
         t = self.task
         acts = first.discrete_actions
+        if acts is not None and len(set(self.robots)) > 1:  # one plan of control steps for all robots
+            raise ValueError("robot: a list of robots whose speed limits differ is not supported with discrete actions")
         self._discrete = None if acts is None else DiscretePlan(acts, spec, self.action_frequency, a)
         self.floors = FloorTables(scene_list, t.floor, spec.radius, a)
-        bounds = [env.tasks[0].observation_bounds for env in self._samplers]
-        self._low = a.asarray(np.stack([b[0] for b in bounds]).astype(np.float64))[:, None, :]
-        self._high = a.asarray(np.stack([b[1] for b in bounds]).astype(np.float64))[:, None, :]
-        low, high = np.min([b[0] for b in bounds], axis=0), np.max([b[1] for b in bounds], axis=0)
+        bounds = [[t.observation_bounds for t in env.tasks] for env in self._samplers]  # (scene, robot)
+        lows, highs = (np.array([[b[k] for b in row] for row in bounds], np.float64) for k in (0, 1))
+        self._low, self._high = a.asarray(lows), a.asarray(highs)
+        low, high = lows.min(axis=(0, 1)).astype(np.float32), highs.max(axis=(0, 1)).astype(np.float32)
         self.single_observation_space = gym.spaces.Box(low, high, dtype=np.float32)
         self.single_action_space = first.action_space(first.possible_agents[0])
         batch = gym.vector.utils.batch_space
@@ -255,10 +264,10 @@ class VectorFleetEnv(VectorPointNavEnv):
         and velocities (keys ``MOVED``) and the contacts. Robots that began to fall since the
         committed state (inside a discrete action) neither move nor block."""
         a, xp = self.arrays, self.arrays.xp
-        spec, dt, radius = self.robot, self.dt, self.robot.radius
+        dt, radius = self.dt, self.robot.radius
         present = self._present & ~(state["z"] < self._state["z"])
         v0, v1 = act[..., 0], act[..., 1]
-        vmax, wmax = spec.max_linear_velocity, spec.max_angular_velocity
+        vmax, wmax = self._vmax, self._wmax  # (1, R): each robot's speed limits
         zero = xp.zeros_like(v0)
         vx = xp.where(v0 >= 1.0, vmax, xp.where(v0 <= -1.0, -vmax, v0 * vmax))
         w = xp.where(v1 >= 1.0, wmax, xp.where(v1 <= -1.0, -wmax, v1 * wmax))

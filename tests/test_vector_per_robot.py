@@ -1,0 +1,143 @@
+"""Per-robot ``task`` and ``robot`` lists in the batched engine (several robots per world):
+each robot's own speed, tolerance, rewards and limits by hand, and bad lists named."""
+
+from __future__ import annotations
+
+import importlib.util
+import math
+
+import numpy as np
+import pytest
+from fleet_reference import compare_fleet, fleet_episodes
+
+from pointnav_core.maps import OBSTACLE
+from pointnav_core.scenes import Scene
+from pointnav_core.task import PointNavigationTask
+from pointnav_core.vector import VectorPointNavEnv
+
+DEVICES = ["numpy"] + (["cpu"] if importlib.util.find_spec("torch") else [])
+
+
+def room(rows: int = 30, cols: int = 40) -> Scene:
+    grid = np.zeros((rows, cols), np.uint8)
+    grid[0, :] = grid[-1, :] = grid[:, 0] = grid[:, -1] = OBSTACLE
+    return Scene.from_array(grid, 0.1)
+
+
+# Three robots in a 4 x 3 m room, 1 m apart, each facing its goal along +x.
+# robot 0: 0.5 m/s, goal 0.52 m ahead, tolerance 0.1 m -> 0.05 m a step, inside at step 9 (0.07 m).
+# robot 1: 0.25 m/s, goal 0.52 m ahead, tolerance 0.2 m -> 0.025 m a step, inside at step 13 (0.195 m).
+# robot 2: 0.5 m/s, far goal, max_steps 5 -> truncated at step 5.
+EPISODE = [((0.5, 0.5), 0.0, (1.02, 0.5)), ((0.5, 1.5), 0.0, (1.02, 1.5)), ((0.5, 2.5), 0.0, (3.5, 2.5))]
+ROBOTS = [{"max_linear_velocity": 0.5}, {"max_linear_velocity": 0.25}, {"max_linear_velocity": 0.5}]
+TASKS = [
+    {"goal_tolerance": 0.1, "reward_config": {"r_potential": 1.0, "r_pointgoal": 10.0}},
+    {"goal_tolerance": 0.2, "reward_config": {"r_potential": 2.0, "r_pointgoal": 5.0}},
+    {"goal_tolerance": 0.1, "termination_config": {"max_steps": 5}},
+]
+
+
+@pytest.mark.parametrize("device", DEVICES)
+def test_each_robot_drives_and_scores_by_its_own_settings(device: str) -> None:
+    env = VectorPointNavEnv(2, n_robots=3, scene=room(), robot=ROBOTS, task=TASKS, device=device, pool_size=1)
+    obs, _ = env.reset(options={"episodes": [EPISODE, EPISODE]})
+    np_ = env.arrays.numpy
+    speed = [0.5, 0.25, 0.5]
+    ends = {}
+    for step in range(1, 15):
+        obs, reward, terminated, truncated, info = env.step(np.tile([1.0, 0.0], (2, 3, 1)))
+        obs, reward, terminated, truncated = np_(obs), np_(reward), np_(terminated), np_(truncated)
+        active_before = [k not in ends for k in range(3)]
+        for k in range(3):
+            if not active_before[k]:
+                assert reward[0, k] == 0.0 and not terminated[0, k] and not truncated[0, k]
+                continue
+            left = EPISODE[k][2][0] - EPISODE[k][0][0] - speed[k] * 0.1 * step
+            # Forward speed (robot frame) and the goal ahead, by hand.
+            np.testing.assert_allclose(obs[:, k, :3], [[left, 0.0, speed[k]]] * 2, atol=1e-6)
+            progress = TASKS[k].get("reward_config", {}).get("r_potential", 1.0) * speed[k] * 0.1
+            bonus = TASKS[k].get("reward_config", {}).get("r_pointgoal", 10.0) if terminated[0, k] else 0.0
+            np.testing.assert_allclose(reward[:, k], progress + bonus, atol=1e-9)
+            if terminated[0, k] or truncated[0, k]:
+                ends[k] = (step, bool(terminated[0, k]), bool(truncated[0, k]), bool(np_(info["success"])[0, k]))
+    assert ends == {0: (9, True, False, True), 1: (13, True, False, True), 2: (5, False, True, False)}
+
+
+@pytest.mark.parametrize("device", DEVICES)
+def test_goal_frame_and_lists_match_parallel_envs(device: str) -> None:
+    # Robot 1 sees its goal in polar coordinates, robot 0 in Cartesian ones, by hand at reset.
+    tasks = [{"goal_tolerance": 0.1}, {"goal_tolerance": 0.1, "goal_in_polar": True}]
+    episode = [((0.5, 0.5), 0.0, (0.8, 0.9)), ((0.5, 1.5), 0.0, (0.8, 1.9))]
+    env = VectorPointNavEnv(1, n_robots=2, scene=room(), task=tasks, device=device, pool_size=1)
+    obs, _ = env.reset(options={"episodes": [episode]})
+    np.testing.assert_allclose(env.arrays.numpy(obs)[0, :, :2], [[0.3, 0.4], [0.5, math.atan2(0.4, 0.3)]], atol=1e-6)
+    # And step for step as the multi-robot env with the same lists (robots meet, too).
+    rng = np.random.default_rng(3)
+    actions = rng.uniform(-1.2, 1.2, (60, 1, 2, 2))
+    actions[..., 0] = np.abs(actions[..., 0])
+    compare_fleet(room(), [episode], actions, task=tasks, robot=[{"max_angular_velocity": 2.5}, None], device=device)
+
+
+def test_a_list_of_equal_entries_is_the_shared_value() -> None:
+    def run(task: object, robot: object) -> list[np.ndarray]:
+        env = VectorPointNavEnv(3, n_robots=2, scene=room(), task=task, robot=robot, pool_size=2, seed=4)
+        out = [env.reset()[0]]
+        rng = np.random.default_rng(0)
+        for _ in range(40):
+            obs, reward, terminated, truncated, _ = env.step(rng.uniform(-1, 1, (3, 2, 2)))
+            out += [obs, reward, terminated, truncated]
+        return out
+
+    task, robot = {"goal_tolerance": 0.3, "reward_type": "geodesic"}, {"max_linear_velocity": 0.4}
+    for got, want in zip(run([task, task], [robot, robot]), run(task, robot), strict=True):
+        np.testing.assert_array_equal(got, want)
+
+
+def two_floors() -> Scene:
+    return Scene([room().floors[0], room().floors[0]])
+
+
+@pytest.mark.parametrize(("kwargs", "words"), [
+    ({"task": [{}, {}, {}]}, r"^task must be one value for all robots or a list .*got a list of 3"),
+    ({"task": [{}, 3]}, r"^task\[1\] must be None or a dict"),
+    ({"task": [PointNavigationTask(), {}]}, r"^task\[0\] must be None or a dict"),
+    ({"task": [{}, {"reward_functions": [object()]}]}, r"^task\[1\]: reward_functions"),
+    ({"task": [{}, {"goal_tolerance": -1.0}]}, r"^task\[1\]"),
+    ({"task": [{"floor": 0}, {"floor": 1}], "scene": two_floors()}, r"^task: .*same floor"),
+    ({"robot": [{}]}, r"^robot must be one value for all robots or a list .*got a list of 1"),
+    ({"robot": [{}, "fast"]}, r"^robot\[1\] must be a RobotSpec"),
+    ({"robot": [{}, {"drive": "holonomic"}]}, r"^robot\[1\] must have a differential drive"),
+    ({"robot": [{"radius": 0.18}, {"radius": 0.2}]}, r"^robot: .*same radius.*\[0\.18, 0\.2\]"),
+    ({"robot": [{}, {"max_linear_velocity": 0.8}]}, r"^action_frequency"),
+])
+def test_bad_lists_are_named(kwargs: dict, words: str) -> None:
+    with pytest.raises(ValueError, match=words):
+        VectorPointNavEnv(**{"num_envs": 1, "n_robots": 2, "scene": room(), "pool_size": 1, **kwargs})
+
+
+def test_max_episode_steps_sets_every_listed_task() -> None:
+    # Standing still, every robot is truncated at step 7, whatever its own task's max_steps.
+    env = VectorPointNavEnv(1, n_robots=3, scene=room(), robot=ROBOTS, task=TASKS, pool_size=1, max_episode_steps=7)
+    env.reset(options={"episodes": [EPISODE]})
+    for step in range(1, 8):
+        _, _, terminated, truncated, _ = env.step(np.zeros((1, 3, 2)))
+        assert not terminated.any() and truncated.all() == (step == 7) and truncated.any() == (step == 7)
+
+
+@pytest.mark.parametrize("device", DEVICES)
+def test_discrete_actions_take_task_lists(device: str) -> None:
+    # One plan of control steps: robots of one speed (a list of equal specs), tasks that differ.
+    rng = np.random.default_rng(5)
+    tasks = [{"goal_tolerance": 0.15, "reward_type": "geodesic", "reward_config": {"r_pointgoal": 3.0}},
+             {"goal_tolerance": 0.3, "goal_in_polar": True, "termination_config": {"max_steps": 12, "max_collisions": 2}}]
+    episodes = fleet_episodes(room(20, 16), 3, 2, rng, goal_gap=0.45, at_start=0.3)
+    actions = rng.choice(4, size=(50, 3, 2), p=[0.5, 0.2, 0.2, 0.1])
+    stats = compare_fleet(room(20, 16), episodes, actions, task=tasks, robot=[{"radius": 0.18}] * 2, device=device,
+                          action_space="discrete", discrete_actions={"forward_step": 0.1, "stop": True})
+    assert stats["ends"] > 3 and stats["successes"] > 0
+
+
+def test_discrete_actions_refuse_robots_of_different_speeds() -> None:
+    with pytest.raises(ValueError, match=r"^robot: .*speed limits differ.*discrete"):
+        VectorPointNavEnv(1, n_robots=2, scene=room(), pool_size=1, action_space="discrete",
+                          robot=[{}, {"max_linear_velocity": 0.25}])
