@@ -152,7 +152,10 @@ class VectorPointNavEnv(PoolRefreshing, VectorEnv):
     ``geodesic_dist``, ``distance_to_goal``, ``collisions``, ``episode_length``,
     ``in_contact``, ``reward_potential``, ``reward_collision``, ``reward_pointgoal`` and
     ``autoreset`` (the worlds this step reset instead of stepping). Arrays are numpy with
-    ``device="numpy"`` and torch tensors on the device otherwise.
+    ``device="numpy"`` and torch tensors on the device otherwise. On the CPU (numpy, or
+    torch on ``"cpu"``) with the ``fast`` extra (numba), the contacts
+    (:mod:`pointnav_core.vector.contacts_jit`) and the scan run as compiled loops over the
+    worlds, proven equal to the array code that runs on a GPU.
 
     **Several robots per world** (``n_robots=R > 1``; an instance of the subclass
     :class:`~pointnav_core.vector.fleet_env.VectorFleetEnv`). Each world behaves as a
