@@ -167,3 +167,29 @@ def test_field_path_with_max_length_draws_the_whole_paths_beginning(max_length):
     # And stops at the first arc that gets there: dropping that arc falls short.
     if len(part) < len(whole):
         assert steps.sum() - steps[-1] < max_length + 2 * math.pi * 0.3
+
+
+def test_a_drawn_arc_through_a_passage_exactly_as_wide_as_the_robot_keeps_clear_of_both_sides():
+    # Corners (0.7, 1.0) and (1.0, 0.6) are exactly 0.5 m = 2 r apart: the path must pass
+    # the midpoint touching both. An arc around one corner drawn with vertices outside its
+    # circle put one 3.6e-6 m into the other corner's square before (found by hypothesis).
+    shapely = pytest.importorskip("shapely")
+    grid = np.zeros((11, 16), np.uint8)
+    grid[0, 0] = OBSTACLE
+    grid[0:6, 10] = OBSTACLE
+    grid[10, 0:7] = OBSTACLE
+    tmap = TraversableMap(grid, resolution=0.1)
+    scene = Scene([tmap])
+    radius = 0.25
+    path, dist = scene.get_shortest_path(0, (0.35, 0.25), (1.35, 0.25), entire_path=True, robot=radius)
+    assert path is not None
+    # Independent reference: the blocked squares and the map's outside, as shapely geometry.
+    squares = [shapely.box(c * 0.1, r * 0.1, (c + 1) * 0.1, (r + 1) * 0.1) for r, c in np.argwhere(grid != 0)]
+    outside = shapely.box(-10, -10, 11.6, 11.1).difference(shapely.box(0, 0, 1.6, 1.1))
+    blocked = shapely.union_all([*squares, outside])
+    touch = 1e-9
+    assert all(blocked.distance(shapely.Point(p)) >= radius - touch for p in path)
+    assert all(blocked.distance(shapely.LineString([p, q])) >= radius - touch for p, q in zip(path[:-1], path[1:]))
+    # Through the passage's midpoint, and as long as reported (arcs drawn outside the circle).
+    assert min(math.dist(p, (0.85, 0.8)) for p in path) < 1e-6
+    assert dist - 1e-9 <= path_length(path) <= dist * (1 + 1.1e-4) + 1e-9
