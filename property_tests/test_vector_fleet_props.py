@@ -91,7 +91,7 @@ def robot_tasks(draw: st.DrawFn) -> dict:
         "goal_tolerance": draw(st.floats(0.05, 0.2)),
         "goal_in_polar": draw(st.booleans()),
         "termination_config": {"max_steps": draw(st.integers(5, 60)), "max_collisions": draw(st.integers(0, 20)),
-                               "fall_height": draw(st.sampled_from([0.01, 0.03, 0.2]))},
+                               "fall_height": draw(st.sampled_from([0.01, 0.03, 0.1]))},
         "reward_config": {"r_potential": draw(st.floats(0.0, 2.0)), "r_collision": draw(st.floats(0.0, 1.0)),
                           "r_pointgoal": draw(st.floats(0.0, 20.0))},
     }

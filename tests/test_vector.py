@@ -103,6 +103,18 @@ def test_make_vec_builds_the_batched_engine() -> None:
     assert reward.dtype == np.float64 and terminated.dtype == truncated.dtype == np.bool_ and env.observation_space.contains(obs)
 
 
+@pytest.mark.parametrize("n_robots", [1, 3])
+@pytest.mark.parametrize(("frequency", "fall_height"), [(10.0, 0.15), (10.0, 0.2), (30.0, 0.05)])
+def test_a_fall_height_a_fall_would_not_pass_in_one_step_is_refused(n_robots: int, frequency: float, fall_height: float) -> None:
+    # A fall's first drop (the backend's): max(1 m/s x dt + 9.81 m/s^2 x dt^2 / 2, 0.05 m),
+    # 0.14905 m at 10 Hz and 0.05 m at 30 Hz; the batched engines end a fall in that step.
+    task = {"termination_config": {"fall_height": fall_height}}
+    with pytest.raises(ValueError, match=r"task: fall_height must be below a fall's first drop"):
+        VectorPointNavEnv(2, n_robots=n_robots, scene=room(), task=task, action_frequency=frequency, pool_size=1)
+    ok = {"termination_config": {"fall_height": 0.149 if frequency == 10.0 else 0.0499}}
+    VectorPointNavEnv(2, n_robots=n_robots, scene=room(), task=ok, action_frequency=frequency, pool_size=1)
+
+
 @pytest.mark.parametrize("device", ["gpu", "cuda:x", 0, "numpy "])
 def test_unknown_device_is_refused(device: object) -> None:
     with pytest.raises(ValueError, match="device"):

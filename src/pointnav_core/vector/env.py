@@ -65,6 +65,22 @@ def _task_arguments(task: Mapping[str, Any] | None) -> dict[str, Any]:
     return dict(task or {})
 
 
+def check_fall_height(fall_height: float, dt: float, name: str = "task") -> None:
+    """ValueError naming ``name`` unless a fall ends the episode in the step it begins.
+
+    The batched engines drop a robot that starts to fall by the backend's first drop
+    (``max(fall_speed dt + g dt^2 / 2, 0.05 m)``) and end its episode there; they do not
+    carry a fall over later steps, so a ``fall_height`` (m) it does not pass is refused
+    rather than stepped differently from the single envs.
+    """
+    drop = max(_FALL_SPEED * dt + 0.5 * _GRAVITY * dt * dt, _MIN_FIRST_DROP)
+    if not fall_height < drop:
+        raise ValueError(
+            f"{name}: fall_height must be below a fall's first drop, {drop:.6g} m at {1.0 / dt:g} Hz, in the "
+            f"batched engine (it ends a fall in the step it begins), got {fall_height!r}"
+        )
+
+
 def _scene_list(scene: scenes.Scene | Sequence[scenes.Scene] | None) -> list[scenes.Scene]:
     """The worlds' scenes (default: the default house as a grid); ValueError if not Scenes."""
     scene_list = [scene] if isinstance(scene, scenes.Scene) else list(scene) if scene is not None else [_default_scene()]
@@ -107,8 +123,10 @@ class VectorPointNavEnv(PoolRefreshing, VectorEnv):
         may differ, their radius may not.
     task : dict, optional
         ``PointNavigationTask`` keyword arguments, as for the single env (its default
-        ``path_range`` too). Custom terms are not supported. With several robots per world,
-        also a list of one dict per robot (see "Several robots per world").
+        ``path_range`` too). Custom terms are not supported. A fall ends in the step it
+        begins, so ``fall_height`` must be below a fall's first drop (0.149 m at 10 Hz;
+        :func:`check_fall_height`). With several robots per world, also a list of one dict
+        per robot (see "Several robots per world").
     sensors : dict, optional
         ``{"scan": {...}}`` (:class:`~pointnav_core.sensors.RangeScan` arguments, as for the
         single env): the flat observation is the 8 ``low_dim`` values, then the scan's
@@ -305,6 +323,7 @@ class VectorPointNavEnv(PoolRefreshing, VectorEnv):
         cfg, rcfg = t.termination_config, t.reward_config
         self.max_steps, self.max_collisions = int(cfg["max_steps"]), int(cfg["max_collisions"])
         self.fall_height, self.goal_tolerance = float(cfg["fall_height"]), t.goal_tolerance
+        check_fall_height(self.fall_height, self.dt)
         self.r_potential, self.r_collision, self.r_pointgoal = (float(rcfg[k]) for k in ("r_potential", "r_collision", "r_pointgoal"))
         self.geodesic_reward = t.reward_type == "geodesic"
         self.goal_in_polar = bool(t.goal_in_polar)
