@@ -1,7 +1,8 @@
 """Optional compiled kernels: numba is the ``fast`` extra, and without it the numpy paths run.
 
 A module with a compiled path asks :func:`kernel` for its numba function; the kernel
-modules (``_collision_kernel``, ``_sight_kernel``) import numba at their top, so they are
+modules (``_collision_kernel``, ``_sight_kernel``, ``vector._contact_kernel``) import
+numba at their top, so they are
 imported only here, on first use. Inside :func:`numpy_paths` every such module takes its
 numpy path, which is how the property tests compare the two.
 """

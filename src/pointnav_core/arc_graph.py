@@ -194,7 +194,7 @@ class FieldLabels:
         tracing stops at the first arc whose end lies ``max_length`` or more along the
         path from ``start``. Returns the points and whether the trace reached the source.
         """
-        from pointnav_core.tangent_graph import _arc_points
+        from pointnav_core.tangent_arcs import arc_points
 
         p = self.graph.p
         pts: list[NDArray[np.float64]] = []
@@ -205,7 +205,7 @@ class FieldLabels:
             # Follow the arc back to where the path arrived on it.
             while par[label] >= 0 and grp[par[label]] == grp[label]:
                 label = int(par[label])
-            arc = _arc_points(p, int(self.node[label]), int(self.side[label]), dep, float(self.pos[label]))
+            arc = arc_points(p, int(self.node[label]), int(self.side[label]), dep, float(self.pos[label]))
             pts += arc
             label = int(par[label])
             if label >= 0:

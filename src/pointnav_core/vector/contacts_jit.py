@@ -21,6 +21,7 @@ from typing import Any
 
 import numpy as np
 
+from pointnav_core import _compiled
 from pointnav_core.vector.floors import FloorTables
 
 __all__ = ["advance_compiled", "advance_one", "available"]
@@ -33,11 +34,11 @@ _WALL_MARGIN = 4.0 * 2.0e-9
 def available(floors: FloorTables) -> bool:
     """Whether the compiled path can run for these floors' arrays (CPU, numba importable)."""
     a = floors.arrays
-    if a.is_torch and a.device != "cpu":
-        return False
-    from pointnav_core.sensors import raycast_jit
+    return (not a.is_torch or a.device == "cpu") and _kernel() is not None
 
-    return raycast_jit.available()
+
+def _kernel() -> Any:
+    return _compiled.kernel("pointnav_core.vector._contact_kernel", "advance_worlds")
 
 
 def advance_compiled(
@@ -67,8 +68,7 @@ def advance_compiled(
     contact : bool numpy array (W, R)
         Whether each slow robot was blocked by a wall or another robot, or blocked one.
     """
-    from pointnav_core.vector._contact_kernel import advance_worlds
-
+    advance_worlds = _kernel()
     a = floors.arrays
     view = (lambda v: v.numpy()) if a.is_torch else (lambda v: v)
     table = floors.wall_table(radius + max_travel + _WALL_MARGIN)

@@ -65,6 +65,12 @@ def _task_arguments(task: Mapping[str, Any] | None) -> dict[str, Any]:
     return dict(task or {})
 
 
+def first_drop(dt: float) -> float:
+    """How far (m) a robot drops in the control step of ``dt`` (s) in which it begins to
+    fall: the kinematic backend's ``max(fall_speed dt + g dt^2 / 2, 0.05 m)``."""
+    return max(_FALL_SPEED * dt + 0.5 * _GRAVITY * dt * dt, _MIN_FIRST_DROP)
+
+
 def check_fall_height(fall_height: float, dt: float, name: str = "task") -> None:
     """ValueError naming ``name`` unless a fall ends the episode in the step it begins.
 
@@ -73,7 +79,7 @@ def check_fall_height(fall_height: float, dt: float, name: str = "task") -> None
     carry a fall over later steps, so a ``fall_height`` (m) it does not pass is refused
     rather than stepped differently from the single envs.
     """
-    drop = max(_FALL_SPEED * dt + 0.5 * _GRAVITY * dt * dt, _MIN_FIRST_DROP)
+    drop = first_drop(dt)
     if not fall_height < drop:
         raise ValueError(
             f"{name}: fall_height must be below a fall's first drop, {drop:.6g} m at {1.0 / dt:g} Hz, in the "
@@ -489,7 +495,7 @@ class VectorPointNavEnv(PoolRefreshing, VectorEnv):
             sx, sy, c = resolver(self.floors, scene[slow], x0[slow], y0[slow], dx[slow], dy[slow], spec.radius, self._max_travel)
             syaw = yaw0[slow] + w[slow] * dt
             fall = self.floors.is_void(scene[slow], sx, sy)
-            drop = max(_FALL_SPEED * dt + 0.5 * _GRAVITY * dt * dt, _MIN_FIRST_DROP)
+            drop = first_drop(dt)
             x[slow], y[slow], yaw[slow] = sx, sy, syaw
             vel_x[slow] = (sx - x0[slow]) / dt
             vel_y[slow] = (sy - y0[slow]) / dt

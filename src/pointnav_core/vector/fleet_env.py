@@ -29,12 +29,10 @@ from pointnav_core.vector.contacts import advance
 from pointnav_core.vector.contacts_jit import advance_compiled
 from pointnav_core.vector.discrete import MOVED, DiscretePlan
 from pointnav_core.vector.env import (
-    _FALL_SPEED,
-    _GRAVITY,
-    _MIN_FIRST_DROP,
     VectorPointNavEnv,
     _scan_term,
     _scene_list,
+    first_drop,
 )
 from pointnav_core.vector.fleet_pool import FleetPool, check_fixed_episode
 from pointnav_core.vector.floors import FloorTables
@@ -300,7 +298,7 @@ class VectorFleetEnv(VectorPointNavEnv):
         else:
             self._advance_slow(x0, y0, dx, dy, slow, x, y, contact)
         fall = slow & self.floors.is_void(scene, x, y)
-        drop = max(_FALL_SPEED * dt + 0.5 * _GRAVITY * dt * dt, _MIN_FIRST_DROP)
+        drop = first_drop(dt)
         z = xp.where(fall, z - drop, z)
         vz = xp.where(fall, -drop / dt, vz)
         vel_x = xp.where(fast, dx / dt, (x - x0) / dt)

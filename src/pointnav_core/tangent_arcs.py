@@ -1,0 +1,105 @@
+"""The tangent graph's arcs drawn as polylines, for ``entire_path=True``.
+
+A shortest path of the tangent-graph planner (:mod:`pointnav_core.tangent_graph`) bends
+around blocked corners along arcs of the robot's radius. :func:`arc_points` draws such an
+arc as pieces of at most :data:`ARC_PIECE` whose vertices lie outside the circle, so that
+every piece is tangent to it and keeps the full radius from the corner; where a passage is
+exactly as wide as the robot it splits the arc at the passage's narrowest line, so that no
+vertex overlaps the other side.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import TYPE_CHECKING
+
+import numpy as np
+from numpy.typing import NDArray
+
+from pointnav_core.tangent_edges import _ANG_TOL, _TWO_PI
+
+if TYPE_CHECKING:
+    from pointnav_core.tangent_graph import Planner
+
+__all__ = ["ARC_PIECE", "arc_points"]
+
+#: Largest angle (rad) of one piece of a drawn arc.
+ARC_PIECE = math.radians(2.0)
+
+
+def arc_points(p: Planner, node: int, s: int, pos_from: float, pos_to: float, splits: int = 4) -> list[NDArray[np.float64]]:
+    """Drawn arc of ``node`` from position ``pos_from`` back to ``pos_to`` (both ends on it).
+
+    Intermediate vertices lie outside the circle, so that every drawn piece is tangent to
+    it and keeps the full radius from the corner. Where an obstacle is exactly ``2 r`` from
+    this corner (a passage exactly as wide as the robot), a vertex outside the circle near
+    the passage's narrowest line overlaps it; the arc is then drawn in two parts that meet
+    on the circle at that line (touching both sides, as the path does), so the vertices on
+    either side point away from it (``splits`` bounds how often this may recur).
+    """
+    out = _drawn_arc(p, node, s, pos_from, pos_to)
+    if len(out) <= 2 or splits <= 0:
+        return out
+    inner = np.array(out[1:-1])
+    bad = np.flatnonzero(~p.geo.points_clear(inner, p.radius))
+    if not len(bad):
+        return out
+    pos = _pinch_position(p, node, s, inner[bad[0]])
+    if pos is None or not pos_to + _ANG_TOL < pos < pos_from - _ANG_TOL:
+        return out
+    first = arc_points(p, node, s, pos_from, pos, splits - 1)
+    return first + arc_points(p, node, s, pos, pos_to, splits - 1)[1:]
+
+
+def _drawn_arc(p: Planner, node: int, s: int, pos_from: float, pos_to: float) -> list[NDArray[np.float64]]:
+    """The arc's ends on the circle and, between them, vertices of pieces of at most
+    :data:`ARC_PIECE` tangent to it (each at ``r / cos(piece / 2)`` from the corner)."""
+    a = p.node_point(node, s, pos_from)
+    delta = pos_from - pos_to
+    out = [np.array(a)]
+    if delta <= _ANG_TOL or p.radius == 0.0:
+        return out
+    n = max(1, math.ceil(delta / ARC_PIECE))
+    piece = delta / n
+    reach = p.radius / math.cos(piece / 2)
+    cx, cy = p._cx[node], p._cy[node]
+    for k in range(n):
+        pos = pos_from - piece * (k + 0.5)
+        ccw = pos if s > 0 else p._span[node] - pos
+        ang = p._phi0[node] + ccw
+        out.append(np.array([cx + reach * math.cos(ang), cy + reach * math.sin(ang)]))
+    out.append(np.array(p.node_point(node, s, pos_to)))
+    return out
+
+
+def _pinch_position(p: Planner, node: int, s: int, vertex: NDArray[np.float64]) -> float | None:
+    """Arc position (rad) of the narrowest line from ``node``'s corner to the blocked cells
+    ``vertex`` overlaps: towards the nearest such cell corner, or along the normal of the
+    nearest such cell face (cells are axis-aligned). None if there is none on the grid."""
+    geo, r = p.geo, p.radius
+    cx, cy = p._cx[node], p._cy[node]
+    res, (ox, oy) = geo.resolution, geo.origin
+    col, row = math.floor((vertex[0] - ox) / res), math.floor((vertex[1] - oy) / res)
+    k = math.ceil(r / res) + 1
+    rows, cols = np.mgrid[max(row - k, 0) : row + k + 1, max(col - k, 0) : col + k + 1]
+    inside = (rows < geo.shape[0]) & (cols < geo.shape[1])
+    rows, cols = rows[inside], cols[inside]
+    keep = geo.blocked[rows, cols]
+    x0, y0 = ox + cols[keep] * res, oy + rows[keep] * res
+    qx = np.clip(vertex[0], x0, x0 + res)
+    qy = np.clip(vertex[1], y0, y0 + res)
+    # The other side of the passage: farther than 1.5 r from this corner (about 2 r).
+    far = np.hypot(qx - cx, qy - cy) > 1.5 * r
+    if not far.any():
+        return None
+    i = np.flatnonzero(far)[np.argmin(np.hypot(qx[far] - vertex[0], qy[far] - vertex[1]))]
+    on_x = qx[i] in (x0[i], x0[i] + res)  # the nearest point is on a vertical face
+    on_y = qy[i] in (y0[i], y0[i] + res)
+    if on_x and on_y:  # a corner
+        ang = math.atan2(qy[i] - cy, qx[i] - cx)
+    elif on_x:
+        ang = 0.0 if qx[i] > cx else math.pi
+    else:
+        ang = 0.5 * math.pi if qy[i] > cy else -0.5 * math.pi
+    ccw = (ang - p._phi0[node]) % _TWO_PI
+    return ccw if s > 0 else p._span[node] - ccw
