@@ -115,10 +115,6 @@ def read_tasks(env: Any, tasks: Sequence[Any], specs: Sequence[RobotSpec], array
     rcfg = [t.reward_config for t in tasks]
     env.max_steps = row([int(c["max_steps"]) for c in cfg], arrays.i64)
     env.max_collisions = row([int(c["max_collisions"]) for c in cfg], arrays.i64)
-    from pointnav_core.vector.env import check_fall_height
-
-    for c in cfg:
-        check_fall_height(float(c["fall_height"]), env.dt)
     env.fall_height = row([float(c["fall_height"]) for c in cfg])
     env.goal_tolerance = row([float(t.goal_tolerance) for t in tasks])
     env.r_potential, env.r_collision, env.r_pointgoal = (row([float(c[k]) for c in rcfg]) for k in ("r_potential", "r_collision", "r_pointgoal"))
