@@ -191,7 +191,8 @@ class VectorPointNavEnv(PoolRefreshing, VectorEnv):
     every world entry ``i``: its task's ``goal_tolerance``, ``reward_type``,
     ``goal_in_polar``, ``termination_config`` (``max_steps``, ``max_collisions``,
     ``fall_height``), ``reward_config`` and ``path_range`` and its robot's speed limits
-    (m/s, rad/s) may differ; a list whose tasks' ``floor`` or robots' ``radius`` differ
+    (m/s, rad/s; with discrete actions, each robot's actions then last its own number of
+    control steps) may differ; a list whose tasks' ``floor`` or robots' ``radius`` differ
     raises ``ValueError`` naming ``task`` or ``robot``, as does a list of the wrong length
     or an entry of the wrong type (naming ``task[i]`` or ``robot[i]``).
 

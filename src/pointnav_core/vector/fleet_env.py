@@ -73,7 +73,9 @@ class VectorFleetEnv(VectorPointNavEnv):
         together, for as many control steps as its longest action
         (:mod:`pointnav_core.vector.discrete`).
     discrete_actions : dict, optional
-        ``forward_step``, ``turn_angle``, ``stop``, as the multi-robot env.
+        ``forward_step``, ``turn_angle``, ``stop``, as the multi-robot env; each robot's
+        actions are planned with its own speed limits (a slower robot holds an action for
+        more control steps).
     starts_per_goal : int
         Sets of starts per pool episode, >= 1: the extra sets share its goals and their
         settled fields (:class:`~pointnav_core.vector.fleet_pool.FleetPool`).

@@ -11,7 +11,8 @@ robot axis ``(1, R)`` that the step broadcasts over its ``(num_envs, R)`` state:
   ``r_pointgoal``); ``path_range``, ``initial_pos``, ``initial_quat`` and ``goal_pos``
   only shape the episodes, which each scene's multi-robot env draws;
 - from each robot: ``max_linear_velocity`` and ``max_angular_velocity`` (the drive's
-  scaling and the observations' bounds).
+  scaling, the observations' bounds and, with discrete actions, each action's control
+  steps).
 
 What the engine cannot vary per robot is refused with a ``ValueError`` naming it: the
 task's ``floor`` (the floor tables are built for one floor) and the robots' radii (the
