@@ -91,7 +91,7 @@ def robot_tasks(draw: st.DrawFn) -> dict:
         "goal_tolerance": draw(st.floats(0.05, 0.2)),
         "goal_in_polar": draw(st.booleans()),
         "termination_config": {"max_steps": draw(st.integers(5, 60)), "max_collisions": draw(st.integers(0, 20)),
-                               "fall_height": draw(st.sampled_from([0.01, 0.03, 0.1]))},
+                               "fall_height": draw(st.sampled_from([0.01, 0.03, 0.1, 0.2, 0.7, 2.0]))},
         "reward_config": {"r_potential": draw(st.floats(0.0, 2.0)), "r_collision": draw(st.floats(0.0, 1.0)),
                           "r_pointgoal": draw(st.floats(0.0, 20.0))},
     }
@@ -205,3 +205,41 @@ def test_fleet_discrete_matches_parallel_envs(
     sensors = {k: v for k, v in (("scan", scan), ("local_map", local_map)) if v is not None}
     compare_fleet(scene, episodes, actions, task=task, device=device, finished=finished, max_cycles=max_cycles,
                   sensors=sensors or None, action_space="discrete", discrete_actions=discrete)
+
+
+@pytest.mark.parametrize("device", DEVICES)
+@settings(max_examples=10, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(
+    scene=crowded_scenes(),
+    seed=st.integers(0, 2**31 - 1),
+    n_worlds=st.integers(1, 3),
+    lists=st.integers(2, 4).flatmap(lambda r: st.tuples(
+        st.one_of(robot_tasks(), st.lists(robot_tasks(), min_size=r, max_size=r)),
+        st.lists(robot_specs, min_size=r, max_size=r),
+        st.just(r),
+    )),
+    steps=st.integers(1, 60),
+    max_cycles=st.integers(3, 50),
+    finished=st.sampled_from(["park", "remove"]),
+    forward_step=st.floats(0.02, 0.4),
+    turn_angle=st.floats(0.05, 1.5),
+    stop=st.booleans(),
+)
+def test_fleet_discrete_with_per_robot_speeds_matches_parallel_envs(
+    device: str, scene: Scene, seed: int, n_worlds: int, lists: tuple, steps: int, max_cycles: int,
+    finished: str, forward_step: float, turn_angle: float, stop: bool,
+) -> None:
+    """Discrete actions of robots whose speed limits differ: each robot holds its action for
+    its own number of control steps, and a world runs as many as its longest action, as in
+    the multi-robot env."""
+    task, robot, n_robots = lists
+    rng = np.random.default_rng(seed)
+    # No goal at a start: after a straight MOVE_FORWARD from it the goal lies exactly behind,
+    # where a polar goal's angle is +pi or -pi by the last bit of a cosine (torch's or math's).
+    episodes = fleet_episodes(scene, n_worlds, n_robots, rng, goal_gap=0.4)
+    n_actions = 4 if stop else 3
+    weights = np.array([0.5, 0.2, 0.2, 0.1][:n_actions])
+    actions = rng.choice(n_actions, size=(steps, n_worlds, n_robots), p=weights / weights.sum())
+    discrete = {"forward_step": forward_step, "turn_angle": turn_angle, "stop": stop}
+    compare_fleet(scene, episodes, actions, task=task, robot=robot, device=device, finished=finished,
+                  max_cycles=max_cycles, action_space="discrete", discrete_actions=discrete)

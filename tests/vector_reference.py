@@ -64,7 +64,7 @@ def compare(
     ties = np.array([obs_ties(env, 0, sensors, dim) for env in singles])
     ended = [False] * n
     stats = {"ends": 0, "successes": 0, "contacts": 0, "autoresets": 0, "obs_diff": 0.0, "reward_diff": 0.0,
-             "map_ties": 0}
+             "map_ties": 0, "falling_steps": 0}
     for t, act in enumerate(actions):
         stats["map_ties"] += assert_obs(to_np(vobs), sobs, ties, OBS_TOL, f"observations before step {t}")
         stats["obs_diff"] = max(stats["obs_diff"], float(np.where(ties, 0.0, np.abs(to_np(vobs) - sobs)).max()))
@@ -81,6 +81,10 @@ def compare(
                 obs, reward, term, trunc, info = env.step(act[i])
             ended[i] = term or trunc
             sobs[i] = obs
+            # The robot's height, falls over several steps included (the engine's state).
+            z = float(env.backend.get_pose(0)[0][2])
+            assert abs(z - float(to_np(venv._state["z"])[i])) <= 1e-9, f"z world {i}, step {t}"
+            stats["falling_steps"] += info is not None and z < env.task.floor_height and not term
             ties[i] = obs_ties(env, 0, sensors, dim)
             where = f"world {i}, step {t}"
             assert abs(reward - vrew[i]) <= REWARD_TOL, f"reward {where}: {reward} vs {vrew[i]}"

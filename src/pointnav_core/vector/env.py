@@ -23,17 +23,15 @@ from pointnav_core.vector import contacts_jit
 from pointnav_core.vector.contacts import advance
 from pointnav_core.vector.discrete import MOVED, DiscretePlan
 from pointnav_core.vector.episodes import EpisodePool
+from pointnav_core.vector.falls import apply_falls, first_drop
 from pointnav_core.vector.floors import FloorTables
 from pointnav_core.vector.local_map import VectorLocalMap, local_map_term
 from pointnav_core.vector.refresh import PoolRefreshing
 from pointnav_core.vector.scan import ScanTables, VectorScan
 from pointnav_core.vector.xp import make_arrays
 
-__all__ = ["VectorPointNavEnv"]
+__all__ = ["VectorPointNavEnv", "first_drop"]
 
-_GRAVITY = 9.81
-_MIN_FIRST_DROP = 0.05
-_FALL_SPEED = 1.0  # the kinematic backend's default fall_speed (m/s)
 _MAX_TURN = 0.25  # rad per control step the backend resolves without sub-steps
 
 
@@ -63,28 +61,6 @@ def _task_arguments(task: Mapping[str, Any] | None) -> dict[str, Any]:
         if task is not None and task.get(key) is not None:
             raise ValueError(f"task: {key} is not supported by the batched engine")
     return dict(task or {})
-
-
-def first_drop(dt: float) -> float:
-    """How far (m) a robot drops in the control step of ``dt`` (s) in which it begins to
-    fall: the kinematic backend's ``max(fall_speed dt + g dt^2 / 2, 0.05 m)``."""
-    return max(_FALL_SPEED * dt + 0.5 * _GRAVITY * dt * dt, _MIN_FIRST_DROP)
-
-
-def check_fall_height(fall_height: float, dt: float, name: str = "task") -> None:
-    """ValueError naming ``name`` unless a fall ends the episode in the step it begins.
-
-    The batched engines drop a robot that starts to fall by the backend's first drop
-    (``max(fall_speed dt + g dt^2 / 2, 0.05 m)``) and end its episode there; they do not
-    carry a fall over later steps, so a ``fall_height`` (m) it does not pass is refused
-    rather than stepped differently from the single envs.
-    """
-    drop = first_drop(dt)
-    if not fall_height < drop:
-        raise ValueError(
-            f"{name}: fall_height must be below a fall's first drop, {drop:.6g} m at {1.0 / dt:g} Hz, in the "
-            f"batched engine (it ends a fall in the step it begins), got {fall_height!r}"
-        )
 
 
 def _scene_list(scene: scenes.Scene | Sequence[scenes.Scene] | None) -> list[scenes.Scene]:
@@ -129,10 +105,10 @@ class VectorPointNavEnv(PoolRefreshing, VectorEnv):
         may differ, their radius may not.
     task : dict, optional
         ``PointNavigationTask`` keyword arguments, as for the single env (its default
-        ``path_range`` too). Custom terms are not supported. A fall ends in the step it
-        begins, so ``fall_height`` must be below a fall's first drop (0.149 m at 10 Hz;
-        :func:`check_fall_height`). With several robots per world, also a list of one dict
-        per robot (see "Several robots per world").
+        ``path_range`` too). Custom terms are not supported. Any ``fall_height`` (m):
+        a fall goes on over as many control steps as it takes to pass it, as in the
+        single env (:mod:`pointnav_core.vector.falls`). With several robots per world,
+        also a list of one dict per robot (see "Several robots per world").
     sensors : dict, optional
         ``{"scan": {...}}`` (:class:`~pointnav_core.sensors.RangeScan` arguments, as for the
         single env): the flat observation is the 8 ``low_dim`` values, then the scan's
@@ -215,7 +191,8 @@ class VectorPointNavEnv(PoolRefreshing, VectorEnv):
     every world entry ``i``: its task's ``goal_tolerance``, ``reward_type``,
     ``goal_in_polar``, ``termination_config`` (``max_steps``, ``max_collisions``,
     ``fall_height``), ``reward_config`` and ``path_range`` and its robot's speed limits
-    (m/s, rad/s) may differ; a list whose tasks' ``floor`` or robots' ``radius`` differ
+    (m/s, rad/s; with discrete actions, each robot's actions then last its own number of
+    control steps) may differ; a list whose tasks' ``floor`` or robots' ``radius`` differ
     raises ``ValueError`` naming ``task`` or ``robot``, as does a list of the wrong length
     or an entry of the wrong type (naming ``task[i]`` or ``robot[i]``).
 
@@ -307,7 +284,8 @@ class VectorPointNavEnv(PoolRefreshing, VectorEnv):
         self._fixed: Any = None
         self.pool: EpisodePool | None = None  # sampled at the first reset that needs it
         n = self.num_envs
-        self._state = {k: a.zeros(n) for k in ("x", "y", "yaw", "z", "vx", "vy", "vz", "w", "gx", "gy", "d0", "pot", "path", "dist")}
+        # "fs": the fall speed (m/s), 0 while the robot stands (vector.falls).
+        self._state = {k: a.zeros(n) for k in ("x", "y", "yaw", "z", "vx", "vy", "vz", "w", "fs", "gx", "gy", "d0", "pot", "path", "dist")}
         self._field = a.zeros(n, a.i64)
         self._geo_metric = a.zeros(n, a.boolean)
         self._steps = a.zeros(n, a.i64)
@@ -329,7 +307,6 @@ class VectorPointNavEnv(PoolRefreshing, VectorEnv):
         cfg, rcfg = t.termination_config, t.reward_config
         self.max_steps, self.max_collisions = int(cfg["max_steps"]), int(cfg["max_collisions"])
         self.fall_height, self.goal_tolerance = float(cfg["fall_height"]), t.goal_tolerance
-        check_fall_height(self.fall_height, self.dt)
         self.r_potential, self.r_collision, self.r_pointgoal = (float(rcfg[k]) for k in ("r_potential", "r_collision", "r_pointgoal"))
         self.geodesic_reward = t.reward_type == "geodesic"
         self.goal_in_polar = bool(t.goal_in_polar)
@@ -411,7 +388,7 @@ class VectorPointNavEnv(PoolRefreshing, VectorEnv):
         for key, src in (("x", p.sx), ("y", p.sy), ("yaw", p.syaw), ("gx", p.gx), ("gy", p.gy), ("d0", p.d0)):
             st[key][idx] = src[e]
         st["z"][idx] = self.floors.height[self._world_scene[idx]]
-        for key in ("vx", "vy", "vz", "w", "path"):
+        for key in ("vx", "vy", "vz", "w", "fs", "path"):
             st[key][idx] = 0.0
         self._field[idx] = p.field[e]
         self._steps[idx] = 0
@@ -462,7 +439,8 @@ class VectorPointNavEnv(PoolRefreshing, VectorEnv):
 
     def _drive(self, act: Any, state: Mapping[str, Any]) -> tuple[dict[str, Any], Any]:
         """One control step of every world from ``state`` under commands ``act`` ``(num_envs, 2)``,
-        not committed: the new pose, height and velocities (keys ``MOVED``) and the contacts."""
+        not committed: the new pose, height, velocities and fall speed (keys ``MOVED``) and the
+        contacts. A falling robot ignores its command and drops (:func:`~pointnav_core.vector.falls.apply_falls`)."""
         a, xp = self.arrays, self.arrays.xp
         spec = self.robot
         one = 1.0
@@ -483,28 +461,25 @@ class VectorPointNavEnv(PoolRefreshing, VectorEnv):
         scene = self._world_scene
         row, col, inside = self.floors.cells(scene, x0, y0)
         budget = self.floors.fast[self.floors.flat_index(scene, row, col, inside)]
+        standing = ~(state["fs"] > 0.0)
         fast = inside & (budget > travel)
         x, y, yaw = x0 + dx, y0 + dy, yaw0 + w * dt
         vel_x, vel_y, vel_w = dx / dt, dy / dt, w
-        vz = xp.zeros_like(x)
         contact = xp.zeros_like(x) > 1.0
-        z = state["z"]
-        slow = a.nonzero(~fast)
+        began = contact
+        slow = a.nonzero(~fast & standing)
         if slow.shape[0]:
             resolver = contacts_jit.advance_one if contacts_jit.available(self.floors) else advance
             sx, sy, c = resolver(self.floors, scene[slow], x0[slow], y0[slow], dx[slow], dy[slow], spec.radius, self._max_travel)
             syaw = yaw0[slow] + w[slow] * dt
-            fall = self.floors.is_void(scene[slow], sx, sy)
-            drop = first_drop(dt)
             x[slow], y[slow], yaw[slow] = sx, sy, syaw
             vel_x[slow] = (sx - x0[slow]) / dt
             vel_y[slow] = (sy - y0[slow]) / dt
             vel_w = xp.where(fast, vel_w, (yaw - yaw0) / dt)
-            vz[slow] = xp.where(fall, -drop / dt, xp.zeros_like(sx))
-            z = z.clone() if a.is_torch else z.copy()
-            z[slow] = xp.where(fall, z[slow] - drop, z[slow])
+            began = began.clone() if a.is_torch else began.copy()
+            began[slow] = self.floors.is_void(scene[slow], sx, sy)
             contact[slow] = c
-        moved = {"x": x, "y": y, "yaw": yaw, "z": z, "vx": vel_x, "vy": vel_y, "w": vel_w, "vz": vz}
+        moved = apply_falls(xp, state, {"x": x, "y": y, "yaw": yaw, "vx": vel_x, "vy": vel_y, "w": vel_w}, began, dt)
         return moved, contact
 
     def _account(self, moved: Mapping[str, Any], contact: Any, stopped: Any) -> tuple[Any, Any, Any, Any, dict[str, Any]]:
@@ -512,7 +487,7 @@ class VectorPointNavEnv(PoolRefreshing, VectorEnv):
         then the commit and the next-step autoresets. ``stopped``: the worlds that called STOP."""
         a, xp, st = self.arrays, self.arrays.xp, self._state
         x0, y0, scene = st["x"], st["y"], self._world_scene
-        x, y, yaw, z, vel_x, vel_y, vel_w, vz = (moved[k] for k in MOVED)
+        x, y, z = moved["x"], moved["y"], moved["z"]
         # --- the task's accounting (PointNavigationTask.step)
         path = st["path"] + xp.sqrt((x - x0) ** 2 + (y - y0) ** 2)
         steps = self._steps + 1
@@ -535,7 +510,7 @@ class VectorPointNavEnv(PoolRefreshing, VectorEnv):
         r_goal = xp.where(success, self.r_pointgoal, zero)
         reward = ((0.0 + r_pot) + r_col) + r_goal
         # Commit, then reset the worlds that ended on the previous step (next-step autoreset).
-        st.update(x=x, y=y, yaw=yaw, z=z, vx=vel_x, vy=vel_y, vz=vz, w=vel_w, path=path, dist=dist, pot=pot)
+        st.update({key: moved[key] for key in MOVED}, path=path, dist=dist, pot=pot)
         self._steps, self._collisions = steps, collisions
         resetting = self._needs_reset.clone() if a.is_torch else self._needs_reset.copy()
         if a.any(resetting):

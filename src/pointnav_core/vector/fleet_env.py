@@ -32,8 +32,8 @@ from pointnav_core.vector.env import (
     VectorPointNavEnv,
     _scan_term,
     _scene_list,
-    first_drop,
 )
+from pointnav_core.vector.falls import apply_falls
 from pointnav_core.vector.fleet_pool import FleetPool, check_fixed_episode
 from pointnav_core.vector.floors import FloorTables
 from pointnav_core.vector.local_map import VectorLocalMap, local_map_term
@@ -73,7 +73,9 @@ class VectorFleetEnv(VectorPointNavEnv):
         together, for as many control steps as its longest action
         (:mod:`pointnav_core.vector.discrete`).
     discrete_actions : dict, optional
-        ``forward_step``, ``turn_angle``, ``stop``, as the multi-robot env.
+        ``forward_step``, ``turn_angle``, ``stop``, as the multi-robot env; each robot's
+        actions are planned with its own speed limits (a slower robot holds an action for
+        more control steps).
     starts_per_goal : int
         Sets of starts per pool episode, >= 1: the extra sets share its goals and their
         settled fields (:class:`~pointnav_core.vector.fleet_pool.FleetPool`).
@@ -131,9 +133,8 @@ class VectorFleetEnv(VectorPointNavEnv):
         read_tasks(self, first.tasks, self.robots, a)  # then the per-robot settings, (1, R)
         t = self.task
         acts = first.discrete_actions
-        if acts is not None and len(set(self.robots)) > 1:  # one plan of control steps for all robots
-            raise ValueError("robot: a list of robots whose speed limits differ is not supported with discrete actions")
-        self._discrete = None if acts is None else DiscretePlan(acts, spec, self.action_frequency, a)
+        # Each robot's own commands and control steps (its speed limits), as the multi-robot env plans them.
+        self._discrete = None if acts is None else DiscretePlan(acts, list(self.robots), self.action_frequency, a)
         self.floors = FloorTables(scene_list, t.floor, spec.radius, a)
         bounds = [[t.observation_bounds for t in env.tasks] for env in self._samplers]  # (scene, robot)
         lows, highs = (np.array([[b[k] for b in row] for row in bounds], np.float64) for k in (0, 1))
@@ -155,7 +156,8 @@ class VectorFleetEnv(VectorPointNavEnv):
         self._robot_ids = a.asarray(np.arange(r), a.i64).reshape(1, r)
         self._fixed: Any = None
         self.pool: FleetPool | None = None  # type: ignore[assignment]
-        keys = ("x", "y", "yaw", "z", "vx", "vy", "vz", "w", "gx", "gy", "d0", "pot", "path", "dist")
+        # "fs": the fall speed (m/s), 0 while the robot stands (vector.falls).
+        keys = ("x", "y", "yaw", "z", "vx", "vy", "vz", "w", "fs", "gx", "gy", "d0", "pot", "path", "dist")
         self._state = {k: a.zeros((n, r)) for k in keys}
         self._field = a.zeros((n, r), a.i64)
         self._geo_metric = a.zeros((n, r), a.boolean)
@@ -209,7 +211,7 @@ class VectorFleetEnv(VectorPointNavEnv):
         for key, src in (("x", p.sx), ("y", p.sy), ("yaw", p.syaw), ("gx", p.gx), ("gy", p.gy), ("d0", p.d0)):
             st[key][idx] = src[e]
         st["z"][idx] = self.floors.height[self._world_scene[idx]][:, None] + 0.0 * st["x"][idx]
-        for key in ("vx", "vy", "vz", "w", "path"):
+        for key in ("vx", "vy", "vz", "w", "fs", "path"):
             st[key][idx] = 0.0
         field = p.field[e]
         self._field[idx] = field
@@ -259,11 +261,13 @@ class VectorFleetEnv(VectorPointNavEnv):
     def _drive(self, act: Any, state: Mapping[str, Any]) -> tuple[dict[str, Any], Any]:
         """One control step of every world from ``state`` under commands ``act``
         ``(num_envs, n_robots, 2)`` in ``[-1, 1]`` units, not committed: the new pose, height
-        and velocities (keys ``MOVED``) and the contacts. Robots that began to fall since the
-        committed state (inside a discrete action) neither move nor block."""
+        velocities and fall speed (keys ``MOVED``) and the contacts. A falling robot present in
+        the world drops (:func:`~pointnav_core.vector.falls.apply_falls`); it neither drives
+        nor blocks. A robot out of the world stays as it is."""
         a, xp = self.arrays, self.arrays.xp
         dt, radius = self.dt, self.robot.radius
-        present = self._present & ~(state["z"] < self._state["z"])
+        falling = state["fs"] > 0.0
+        present = self._present & ~falling
         v0, v1 = act[..., 0], act[..., 1]
         vmax, wmax = self._vmax, self._wmax  # (1, R): each robot's speed limits
         zero = xp.zeros_like(v0)
@@ -290,23 +294,23 @@ class VectorFleetEnv(VectorPointNavEnv):
         slow = present & ~fast
         x, y, yaw = x0 + xp.where(fast, dx, zero), y0 + xp.where(fast, dy, zero), yaw0 + w * dt
         contact = zero > 1.0
-        z, vz = state["z"], zero + 0.0
         if contacts_jit.available(self.floors):  # every world in one compiled loop
             sx, sy, c = advance_compiled(self.floors, scene, x0, y0, dx, dy, slow, radius, self._max_travel)
             x, y = xp.where(slow, a.asarray(sx), x), xp.where(slow, a.asarray(sy), y)
             contact = a.asarray(c, a.boolean)
         else:
             self._advance_slow(x0, y0, dx, dy, slow, x, y, contact)
-        fall = slow & self.floors.is_void(scene, x, y)
-        drop = first_drop(dt)
-        z = xp.where(fall, z - drop, z)
-        vz = xp.where(fall, -drop / dt, vz)
+        began = slow & self.floors.is_void(scene, x, y)
         vel_x = xp.where(fast, dx / dt, (x - x0) / dt)
         vel_y = xp.where(fast, dy / dt, (y - y0) / dt)
         vel_w = xp.where(fast, w, (yaw - yaw0) / dt)
         vel_x, vel_y, vel_w = (xp.where(present, v, zero) for v in (vel_x, vel_y, vel_w))
-        moved = {"x": x, "y": y, "yaw": yaw, "z": z, "vx": vel_x, "vy": vel_y, "w": vel_w, "vz": vz}
-        return moved, contact
+        moved = apply_falls(xp, state, {"x": x, "y": y, "yaw": yaw, "vx": vel_x, "vy": vel_y, "w": vel_w}, began, dt)
+        # A robot out of the world (removed, or fallen and gone) is not moved by the backend.
+        out = ~self._present
+        moved = {key: xp.where(out, state[key], value) if key in ("z", "fs") else value for key, value in moved.items()}
+        moved["vz"] = xp.where(out, zero, moved["vz"])
+        return moved, contact & ~falling
 
     def _account(self, moved: Mapping[str, Any], contact: Any, stopped: Any) -> tuple[Any, Any, Any, Any, dict[str, Any]]:
         """Each active robot's task step (``PointNavigationTask.step``, masked by the robots
@@ -315,7 +319,7 @@ class VectorFleetEnv(VectorPointNavEnv):
         a, xp, st = self.arrays, self.arrays.xp, self._state
         acting, present = self._active, self._present
         x0, y0 = st["x"], st["y"]
-        x, y, yaw, z, vel_x, vel_y, vel_w, vz = (moved[k] for k in MOVED)
+        x, y, z = moved["x"], moved["y"], moved["z"]
         zero = xp.zeros_like(x)
         path = st["path"] + xp.where(acting, xp.sqrt((x - x0) ** 2 + (y - y0) ** 2), zero)
         steps = self._steps + a.to_int(acting)
@@ -341,8 +345,7 @@ class VectorFleetEnv(VectorPointNavEnv):
         active = acting & ~ended
         # A robot that fell leaves its floor; with "remove" every finished robot leaves.
         gone = (ended & fell) if self.finished == "park" else ended
-        st.update(x=x, y=y, yaw=yaw, z=z, vx=vel_x, vy=vel_y, vz=vz, w=vel_w, path=path, dist=dist,
-                  pot=xp.where(acting, pot, st["pot"]))
+        st.update({key: moved[key] for key in MOVED}, path=path, dist=dist, pot=xp.where(acting, pot, st["pot"]))
         self._steps, self._collisions, self._cycles = steps, collisions, cycles
         self._active, self._present = active, present & ~gone
         # The multi-robot env observes every robot before its finished robots leave the world.

@@ -11,7 +11,8 @@ robot axis ``(1, R)`` that the step broadcasts over its ``(num_envs, R)`` state:
   ``r_pointgoal``); ``path_range``, ``initial_pos``, ``initial_quat`` and ``goal_pos``
   only shape the episodes, which each scene's multi-robot env draws;
 - from each robot: ``max_linear_velocity`` and ``max_angular_velocity`` (the drive's
-  scaling and the observations' bounds).
+  scaling, the observations' bounds and, with discrete actions, each action's control
+  steps).
 
 What the engine cannot vary per robot is refused with a ``ValueError`` naming it: the
 task's ``floor`` (the floor tables are built for one floor) and the robots' radii (the
@@ -115,10 +116,6 @@ def read_tasks(env: Any, tasks: Sequence[Any], specs: Sequence[RobotSpec], array
     rcfg = [t.reward_config for t in tasks]
     env.max_steps = row([int(c["max_steps"]) for c in cfg], arrays.i64)
     env.max_collisions = row([int(c["max_collisions"]) for c in cfg], arrays.i64)
-    from pointnav_core.vector.env import check_fall_height
-
-    for c in cfg:
-        check_fall_height(float(c["fall_height"]), env.dt)
     env.fall_height = row([float(c["fall_height"]) for c in cfg])
     env.goal_tolerance = row([float(t.goal_tolerance) for t in tasks])
     env.r_potential, env.r_collision, env.r_pointgoal = (row([float(c[k]) for c in rcfg]) for k in ("r_potential", "r_collision", "r_pointgoal"))
