@@ -55,7 +55,7 @@ class DiscretePlan:
     actions : DiscreteActions
         The action set (as the single env's ``discrete_actions`` makes it).
     robot : RobotSpec
-        The robot (top speeds, differential drive).
+        The robot (top speeds and drive; a holonomic command is ``(vx, 0, w)``).
     action_frequency : float
         Control steps per second (Hz).
     arrays : Arrays
@@ -63,8 +63,9 @@ class DiscretePlan:
 
     Attributes
     ----------
-    commands : array, shape (n, 2)
-        Each action's command in ``[-1, 1]`` units (forward, yaw rate).
+    commands : array, shape (n, action_dim)
+        Each action's command in ``[-1, 1]`` units (forward, yaw rate; a holonomic robot's
+        has a zero sideways speed between them).
     steps : array of int, shape (n,)
         Each action's control steps.
     n : int

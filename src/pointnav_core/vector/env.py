@@ -22,6 +22,7 @@ from pointnav_core import _envcommon, scenes, validation
 from pointnav_core.vector import contacts_jit
 from pointnav_core.vector.contacts import advance
 from pointnav_core.vector.discrete import MOVED, DiscretePlan
+from pointnav_core.vector.drive import arc, body_command, sub_steps, substep_drive, travel
 from pointnav_core.vector.episodes import EpisodePool
 from pointnav_core.vector.floors import FloorTables
 from pointnav_core.vector.local_map import VectorLocalMap, local_map_term
@@ -93,14 +94,6 @@ def _scene_list(scene: scenes.Scene | Sequence[scenes.Scene] | None) -> list[sce
     if not scene_list or not all(isinstance(s, scenes.Scene) for s in scene_list):
         raise ValueError(f"scene must be a Scene or a non-empty sequence of Scenes, got {scene!r}")
     return scene_list
-
-
-def _differential_robot(robot: Any) -> Any:
-    """The robot spec; ValueError unless it has a differential drive."""
-    spec = _envcommon.make_robot(robot)
-    if spec.drive != "differential":
-        raise ValueError(f"robot must have a differential drive in the batched engine, got {spec.drive!r}")
-    return spec
 
 
 class VectorPointNavEnv(PoolRefreshing, VectorEnv):
@@ -278,7 +271,7 @@ class VectorPointNavEnv(PoolRefreshing, VectorEnv):
         self.arrays = make_arrays(device)
         self.device = device
         self.scenes = scene_list = _scene_list(scene)
-        self.robot = _differential_robot(robot)
+        self.robot = _envcommon.make_robot(robot)  # either drive (vector.drive)
         self._samplers = [
             PointNavEnv(scene=s, robot=self.robot, task=dict(task), sensors=sensors, flatten_obs=True,
                         action_frequency=action_frequency, action_space=action_space, discrete_actions=discrete_actions)
@@ -341,8 +334,11 @@ class VectorPointNavEnv(PoolRefreshing, VectorEnv):
                 f"action_frequency {self.action_frequency} Hz is too low for the batched engine: one control "
                 "step may turn at most 0.25 rad and drive at most half a cell (the kinematic backend's sub-step)"
             )
-        # A chord is never longer than its arc; the margin covers rounding.
-        self._max_travel = spec.max_linear_velocity * self.dt * (1.0 + 1e-9) + 1e-12
+        self.holonomic = spec.drive == "holonomic"
+        # A chord is never longer than its arc (a holonomic one: the diagonal of its two
+        # top speeds); the margin covers rounding.
+        top = math.hypot(spec.max_linear_velocity, spec.max_linear_velocity) if self.holonomic else spec.max_linear_velocity
+        self._max_travel = top * self.dt * (1.0 + 1e-9) + 1e-12
 
     # ------------------------------------------------------------------ pools
     def _build_pool(self, fixed: Sequence[tuple[Any, float, Any, int]]) -> None:
@@ -427,16 +423,17 @@ class VectorPointNavEnv(PoolRefreshing, VectorEnv):
         self._needs_reset[idx] = False
 
     def check_actions(self, actions: Any) -> Any:
-        """``actions`` as a float64 array ``(num_envs, 2)``, or with discrete actions an int64
-        array ``(num_envs,)``; ValueError naming ``actions`` if bad."""
+        """``actions`` as a float64 array ``(num_envs, action_dim)`` (2 for a differential
+        drive, 3 for a holonomic one), or with discrete actions an int64 array
+        ``(num_envs,)``; ValueError naming ``actions`` if bad."""
         a = self.arrays
         if self._discrete is not None:
             return self._discrete.check(actions, self.num_envs)
         shape = tuple(getattr(actions, "shape", np.shape(actions)))
-        n = self.num_envs
-        if shape not in ((n, 2), (n, 1, 2)):
-            raise ValueError(f"actions must have shape ({n}, 2) or ({n}, 1, 2), got {shape}")
-        arr = a.asarray(actions).reshape(n, 2)
+        n, dim = self.num_envs, self.robot.action_dim
+        if shape not in ((n, dim), (n, 1, dim)):
+            raise ValueError(f"actions must have shape ({n}, {dim}) or ({n}, 1, {dim}) for a {self.robot.drive} drive, got {shape}")
+        arr = a.asarray(actions).reshape(n, dim)
         if not bool(a.xp.isfinite(arr).all()):
             raise ValueError("actions must be finite (no NaN or infinity)")
         return arr
@@ -461,29 +458,19 @@ class VectorPointNavEnv(PoolRefreshing, VectorEnv):
         return self._account(moved, contact, stopped)
 
     def _drive(self, act: Any, state: Mapping[str, Any]) -> tuple[dict[str, Any], Any]:
-        """One control step of every world from ``state`` under commands ``act`` ``(num_envs, 2)``,
-        not committed: the new pose, height and velocities (keys ``MOVED``) and the contacts."""
+        """One control step of every world from ``state`` under commands ``act``
+        ``(num_envs, action_dim)``, not committed: the new pose, height and velocities (keys
+        ``MOVED``) and the contacts."""
         a, xp = self.arrays, self.arrays.xp
-        spec = self.robot
-        one = 1.0
-        v0, v1 = act[:, 0], act[:, 1]
-        vmax, wmax = spec.max_linear_velocity, spec.max_angular_velocity
-        vx = xp.where(v0 >= one, vmax, xp.where(v0 <= -one, -vmax, v0 * vmax))
-        w = xp.where(v1 >= one, wmax, xp.where(v1 <= -one, -wmax, v1 * wmax))
-        dt = self.dt
+        spec, dt = self.robot, self.dt
+        vx, vy, w = body_command(xp, act, spec.max_linear_velocity, spec.max_angular_velocity, self.holonomic)
         x0, y0, yaw0 = state["x"], state["y"], state["yaw"]
-        # The exact arc over the step (state.drive_arc with vy = 0).
-        half = 0.5 * w * dt
-        safe = xp.where(half != 0.0, half, 1.0)
-        s = dt * xp.where(half != 0.0, xp.sin(safe) / safe, 1.0)
-        mid = yaw0 + half
-        dx = s * (vx * xp.cos(mid) - 0.0 * xp.sin(mid))
-        dy = s * (vx * xp.sin(mid) + 0.0 * xp.cos(mid))
-        travel = xp.abs(vx) * dt
+        dx, dy = arc(xp, yaw0, vx, vy, w, dt)  # the exact arc over the step (drive_arc)
+        length = travel(xp, vx, vy, dt)
         scene = self._world_scene
         row, col, inside = self.floors.cells(scene, x0, y0)
         budget = self.floors.fast[self.floors.flat_index(scene, row, col, inside)]
-        fast = inside & (budget > travel)
+        fast = inside & (budget > length)
         x, y, yaw = x0 + dx, y0 + dy, yaw0 + w * dt
         vel_x, vel_y, vel_w = dx / dt, dy / dt, w
         vz = xp.zeros_like(x)
@@ -491,10 +478,24 @@ class VectorPointNavEnv(PoolRefreshing, VectorEnv):
         z = state["z"]
         slow = a.nonzero(~fast)
         if slow.shape[0]:
+            sc = scene[slow]
             resolver = contacts_jit.advance_one if contacts_jit.available(self.floors) else advance
-            sx, sy, c = resolver(self.floors, scene[slow], x0[slow], y0[slow], dx[slow], dy[slow], spec.radius, self._max_travel)
-            syaw = yaw0[slow] + w[slow] * dt
-            fall = self.floors.is_void(scene[slow], sx, sy)
+
+            def move(px: Any, py: Any, mx: Any, my: Any, part: Any) -> tuple[Any, Any, Any]:
+                # The worlds of ``part`` by their chords; a later sub-step has fewer of them.
+                if bool(part.all()):
+                    return resolver(self.floors, sc, px, py, mx, my, spec.radius, self._max_travel)
+                idx = a.nonzero(part)
+                ix, iy, ic = resolver(self.floors, sc[idx], px[idx], py[idx], mx[idx], my[idx], spec.radius, self._max_travel)
+                nx, ny, c = px + 0.0, py + 0.0, xp.zeros_like(part)
+                nx[idx], ny[idx], c[idx] = ix, iy, ic
+                return nx, ny, c
+
+            n_sub = sub_steps(xp, length[slow], w[slow], dt, self.floors.res[sc])
+            sx, sy, syaw, fall, c = substep_drive(
+                xp, (x0[slow], y0[slow], yaw0[slow]), (vx[slow], vy[slow], w[slow]), n_sub, dt, move,
+                lambda px, py: self.floors.is_void(sc, px, py),
+            )
             drop = first_drop(dt)
             x[slow], y[slow], yaw[slow] = sx, sy, syaw
             vel_x[slow] = (sx - x0[slow]) / dt
