@@ -19,8 +19,8 @@ Examples
 --------
 >>> import numpy as np
 >>> vx, vy, w = body_command(np, np.array([[1.0, 0.0, 0.0]]), 0.5, 1.5, holonomic=True)
->>> [float(v[0]) for v in arc(np, np.array([np.pi / 2]), vx, vy, w, 0.1)]  # +y at yaw 90 deg
-[3.061616997868383e-18, 0.05]
+>>> [round(float(v[0]), 12) for v in arc(np, np.array([np.pi / 2]), vx, vy, w, 0.1)]  # +y at yaw 90 deg
+[0.0, 0.05]
 >>> body_command(np, np.array([[2.0, -0.5]]), 0.5, 1.5, holonomic=False)[2].tolist()
 [-0.75]
 """

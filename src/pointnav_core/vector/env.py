@@ -35,7 +35,7 @@ __all__ = ["VectorPointNavEnv"]
 _GRAVITY = 9.81
 _MIN_FIRST_DROP = 0.05
 _FALL_SPEED = 1.0  # the kinematic backend's default fall_speed (m/s)
-_MAX_TURN = 0.25  # rad per control step the backend resolves without sub-steps
+_MAX_TURN = 0.25  # rad per control step the rate check allows: the backend's sub-step turn
 
 
 def _scan_term(sensors: Mapping[str, Any] | None) -> Any:
@@ -117,9 +117,12 @@ class VectorPointNavEnv(PoolRefreshing, VectorEnv):
         World ``i`` runs on ``scene[i % len(scene)]``. Floors must be grid cells only (no
         obstacle polygons). Default: the single env's default house as a grid.
     robot : RobotSpec or dict, optional
-        Differential drive only. With several robots per world, also a list with one entry
-        per robot, as for :func:`~pointnav_core.parallel.parallel_env`: their speed limits
-        may differ, their radius may not.
+        As for the single env: a differential drive (actions ``(v, w)``) or a holonomic one
+        (actions ``(vx, vy, w)`` in the robot frame, +x ahead, +y to the left), scaled and
+        integrated as the kinematic backend does (:mod:`pointnav_core.vector.drive`). With
+        several robots per world, also a list with one entry per robot, as for
+        :func:`~pointnav_core.parallel.parallel_env`: their speed limits may differ, their
+        radius and drive may not (the actions are one array).
     task : dict, optional
         ``PointNavigationTask`` keyword arguments, as for the single env (its default
         ``path_range`` too). Custom terms are not supported. A fall ends in the step it
@@ -162,7 +165,8 @@ class VectorPointNavEnv(PoolRefreshing, VectorEnv):
     Notes
     -----
     ``step`` takes actions of shape ``(num_envs, 2)`` (or ``(num_envs, 1, 2)``) in
-    ``[-1, 1]`` (clipped), or with discrete actions integers of shape ``(num_envs,)``, and
+    ``[-1, 1]`` (clipped), ``(num_envs, 3)`` (or ``(num_envs, 1, 3)``) for a holonomic
+    robot, or with discrete actions integers of shape ``(num_envs,)``, and
     returns observations ``(num_envs, 8)`` float32 (``(num_envs, 8 + n_rays)`` with the
     scan, plus ``cells * cells`` with the local map), rewards float64, terminated and truncated bool, and ``info``, a dict of arrays of shape
     ``(num_envs,)``: ``success``, ``spl``, ``soft_spl``, ``path_length``,
@@ -181,7 +185,8 @@ class VectorPointNavEnv(PoolRefreshing, VectorEnv):
     robot-robot contact counts as a collision for both, every robot has its own task
     (rewards, terminations, SPL), and all robots still active are truncated after
     ``max_cycles`` steps. Every return carries the robot axis: ``step`` takes actions
-    ``(num_envs, R, 2)`` (all finite; those of inactive robots are ignored), or with
+    ``(num_envs, R, 2)`` (``(num_envs, R, 3)`` for holonomic robots; all finite, those of
+    inactive robots are ignored), or with
     ``action_space="discrete"`` integers ``(num_envs, R)`` (all in range), and returns
     observations ``(num_envs, R, 8)`` float32 (``(num_envs, R, 8 + n_rays)`` with the scan,
     which sees the other robots present in its world as the multi-robot env's scan does;
@@ -327,6 +332,8 @@ class VectorPointNavEnv(PoolRefreshing, VectorEnv):
         self.geodesic_reward = t.reward_type == "geodesic"
         self.goal_in_polar = bool(t.goal_in_polar)
         spec = self.robot
+        # Top speed on one axis: a holonomic robot's diagonal step may travel sqrt(2) times
+        # that, which the backend splits into sub-steps near walls, and so does vector.drive.
         if spec.max_angular_velocity * self.dt > _MAX_TURN or spec.max_linear_velocity * self.dt > 0.5 * min(
             float(s.floors[t.floor].resolution) for s in self.scenes
         ):
