@@ -54,7 +54,9 @@ def drive_of(specs: Sequence[RobotSpec], name: str = "robot") -> str:
     """
     drives = sorted({spec.drive for spec in specs})
     if len(drives) > 1:
-        raise ValueError(f"{name}: every robot must have the same drive in the batched engine (one action array), got {drives}")
+        raise ValueError(
+            f"{name}: every robot must have the same drive in the batched engine (one action array), got {drives}"
+        )
     return drives[0]
 
 

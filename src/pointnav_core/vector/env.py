@@ -344,7 +344,7 @@ class VectorPointNavEnv(PoolRefreshing, VectorEnv):
         self.holonomic = spec.drive == "holonomic"
         # A chord is never longer than its arc (a holonomic one: the diagonal of its two
         # top speeds); the margin covers rounding.
-        top = math.hypot(spec.max_linear_velocity, spec.max_linear_velocity) if self.holonomic else spec.max_linear_velocity
+        top = spec.max_linear_velocity * (math.sqrt(2.0) if self.holonomic else 1.0)
         self._max_travel = top * self.dt * (1.0 + 1e-9) + 1e-12
 
     # ------------------------------------------------------------------ pools
@@ -439,7 +439,9 @@ class VectorPointNavEnv(PoolRefreshing, VectorEnv):
         shape = tuple(getattr(actions, "shape", np.shape(actions)))
         n, dim = self.num_envs, self.robot.action_dim
         if shape not in ((n, dim), (n, 1, dim)):
-            raise ValueError(f"actions must have shape ({n}, {dim}) or ({n}, 1, {dim}) for a {self.robot.drive} drive, got {shape}")
+            raise ValueError(
+                f"actions must have shape ({n}, {dim}) or ({n}, 1, {dim}) for a {self.robot.drive} drive, got {shape}"
+            )
         arr = a.asarray(actions).reshape(n, dim)
         if not bool(a.xp.isfinite(arr).all()):
             raise ValueError("actions must be finite (no NaN or infinity)")
