@@ -5,7 +5,7 @@ of 2 to 4 robots and random action sequences, ``VectorPointNavEnv(W, n_robots=R)
 matches ``W`` separate ``parallel_env(n_robots=R, backend="kinematic")`` step for step
 (observations within 1e-4, rewards within 1e-5, the same terminated, truncated and active
 flags, success, SPL and SoftSPL) over whole episodes and their autoresets, with parked or
-removed finished robots, with or without a range scan and a local map (both see the other
+removed finished robots, differential or holonomic, with or without a range scan and a local map (both see the other
 robots of its world; the map's codes are equal, except at a cell centre on a cell edge or
 a disc's rim, ``local_map_reference``), on numpy and on torch on the CPU; and the same with
 discrete actions (``action_space="discrete"``, random ``forward_step``, ``turn_angle`` and
@@ -22,6 +22,7 @@ import pytest
 from fleet_reference import compare_fleet, fleet_episodes
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
+from vector_reference import random_actions
 
 from pointnav_core.maps import FREE, OBSTACLE, VOID
 from pointnav_core.scenes import Scene
@@ -65,22 +66,22 @@ def crowded_scenes(draw: st.DrawFn) -> Scene:
     local_map=st.one_of(st.none(), st.fixed_dictionaries({
         "size": st.floats(0.2, 4.0), "cells": st.integers(1, 12), "dtype": st.sampled_from(["uint8", "float32"]),
     })),
+    drive=st.sampled_from(["differential", "holonomic"]),
 )
 def test_fleet_matches_parallel_envs(
     device: str, scene: Scene, seed: int, n_worlds: int, n_robots: int, steps: int, reward_type: str,
-    max_steps: int, max_cycles: int, finished: str, scan: dict | None, local_map: dict | None,
+    max_steps: int, max_cycles: int, finished: str, scan: dict | None, local_map: dict | None, drive: str,
 ) -> None:
     rng = np.random.default_rng(seed)
     # goal_tolerance 0.2 m: the multi-robot env keeps goals max(0.4, 0.36, 0.1) m apart.
     episodes = fleet_episodes(scene, n_worlds, n_robots, rng, goal_gap=0.4)
-    # Overshoot [-1, 1] (clipping), and drive straight ahead often, into walls and robots.
-    actions = rng.uniform(-1.2, 1.2, (steps, n_worlds, n_robots, 2)).astype(np.float32)
-    actions[rng.random((steps, n_worlds, n_robots)) < 0.4, 0] = 1.0
+    # Overshoot [-1, 1] (clipping), and drive straight ahead (and diagonally) often, into walls and robots.
+    actions = random_actions(rng, (steps, n_worlds, n_robots), drive)
     task = {"reward_type": reward_type, "goal_tolerance": 0.2,
             "termination_config": {"max_steps": max_steps, "max_collisions": 15}}
     sensors = {k: v for k, v in (("scan", scan), ("local_map", local_map)) if v is not None}
     compare_fleet(scene, episodes, actions, task=task, device=device, finished=finished, max_cycles=max_cycles,
-                  sensors=sensors or None)
+                  sensors=sensors or None, robot={"drive": drive})
 
 
 @st.composite
@@ -117,19 +118,22 @@ robot_specs = st.fixed_dictionaries({"radius": st.just(0.18), "max_linear_veloci
     max_cycles=st.integers(3, 70),
     finished=st.sampled_from(["park", "remove"]),
     scan=st.booleans(),
+    drive=st.sampled_from(["differential", "holonomic"]),
 )
 def test_fleet_with_per_robot_lists_matches_parallel_envs(
     device: str, scene: Scene, seed: int, n_worlds: int, lists: tuple, steps: int, max_cycles: int,
-    finished: str, scan: bool,
+    finished: str, scan: bool, drive: str,
 ) -> None:
     """Per-robot ``task`` and ``robot`` lists (or one shared value) give each robot its own
-    rewards, tolerance, limits, goal frame and speed limits, as in the multi-robot env."""
+    rewards, tolerance, limits, goal frame and speed limits, as in the multi-robot env
+    (every robot of one drive)."""
     task, robot, n_robots = lists
+    if drive == "holonomic":
+        robot = [{**r, "drive": drive} for r in robot] if isinstance(robot, list) else {**(robot or {}), "drive": drive}
     rng = np.random.default_rng(seed)
     # The multi-robot env keeps goals max(tol_i + tol_j, r_i + r_j, cell) apart: 0.4 m at most here.
     episodes = fleet_episodes(scene, n_worlds, n_robots, rng, goal_gap=0.4)
-    actions = rng.uniform(-1.2, 1.2, (steps, n_worlds, n_robots, 2)).astype(np.float32)
-    actions[rng.random((steps, n_worlds, n_robots)) < 0.4, 0] = 1.0
+    actions = random_actions(rng, (steps, n_worlds, n_robots), drive)
     sensors = {"scan": {"n_rays": 8, "max_range": 2.0}} if scan else None
     compare_fleet(scene, episodes, actions, task=task, robot=robot, device=device, finished=finished,
                   max_cycles=max_cycles, sensors=sensors)
@@ -185,11 +189,12 @@ def test_one_slow_robot_resolves_as_in_the_multi_robot_resolver(device: str, sce
     stop=st.booleans(),
     scan=st.one_of(st.none(), st.fixed_dictionaries({"n_rays": st.integers(1, 16), "max_range": st.floats(0.3, 3.0)})),
     local_map=st.one_of(st.none(), st.fixed_dictionaries({"size": st.floats(0.2, 4.0), "cells": st.integers(1, 12)})),
+    drive=st.sampled_from(["differential", "holonomic"]),
 )
 def test_fleet_discrete_matches_parallel_envs(
     device: str, scene: Scene, seed: int, n_worlds: int, n_robots: int, steps: int, reward_type: str,
     max_steps: int, max_cycles: int, finished: str, forward_step: float, turn_angle: float, stop: bool,
-    scan: dict | None, local_map: dict | None,
+    scan: dict | None, local_map: dict | None, drive: str,
 ) -> None:
     """Discrete actions (each robot's for its control steps, all robots of a world together,
     cut short by contacts; STOP) as the multi-robot env runs them."""
@@ -204,7 +209,7 @@ def test_fleet_discrete_matches_parallel_envs(
     discrete = {"forward_step": forward_step, "turn_angle": turn_angle, "stop": stop}
     sensors = {k: v for k, v in (("scan", scan), ("local_map", local_map)) if v is not None}
     compare_fleet(scene, episodes, actions, task=task, device=device, finished=finished, max_cycles=max_cycles,
-                  sensors=sensors or None, action_space="discrete", discrete_actions=discrete)
+                  sensors=sensors or None, action_space="discrete", discrete_actions=discrete, robot={"drive": drive})
 
 
 @pytest.mark.parametrize("device", DEVICES)

@@ -173,7 +173,7 @@ def test_bad_actions_are_refused(device: str, actions: np.ndarray) -> None:
 
 @pytest.mark.parametrize(("kwargs", "name"), [({"n_robots": 0}, "n_robots"), ({"sensors": {"lidar": {}}}, "sensors"),
                                              ({"num_envs": 0}, "num_envs"), ({"pool_size": 0}, "pool_size"),
-                                             ({"robot": {"drive": "holonomic"}}, "robot")])
+                                             ({"robot": {"drive": "tank"}}, "drive")])
 def test_unsupported_arguments_are_named(kwargs: dict, name: str) -> None:
     args = {"num_envs": 1, "scene": room(), **kwargs}
     with pytest.raises(ValueError, match=name):

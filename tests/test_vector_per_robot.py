@@ -106,7 +106,7 @@ def two_floors() -> Scene:
     ({"task": [{"floor": 0}, {"floor": 1}], "scene": two_floors()}, r"^task: .*same floor"),
     ({"robot": [{}]}, r"^robot must be one value for all robots or a list .*got a list of 1"),
     ({"robot": [{}, "fast"]}, r"^robot\[1\] must be a RobotSpec"),
-    ({"robot": [{}, {"drive": "holonomic"}]}, r"^robot\[1\] must have a differential drive"),
+    ({"robot": [{}, {"drive": "holonomic"}]}, r"^robot: every robot must have the same drive .*\['differential', 'holonomic'\]"),
     ({"robot": [{"radius": 0.18}, {"radius": 0.2}]}, r"^robot: .*same radius.*\[0\.18, 0\.2\]"),
     ({"robot": [{}, {"max_linear_velocity": 0.8}]}, r"^action_frequency"),
 ])

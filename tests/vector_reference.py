@@ -109,3 +109,17 @@ def random_episodes(scene: Any, n: int, rng: np.random.Generator, radius: float 
         _, goal = scene.get_random_point(0, robot=radius, rng=rng)
         out.append((start[:2], float(rng.uniform(-math.pi, math.pi)), goal[:2]))
     return out
+
+
+def random_actions(rng: np.random.Generator, shape: tuple[int, ...], drive: str = "differential") -> np.ndarray:
+    """Float32 actions of ``shape + (action_dim,)`` for ``drive``: uniform in [-1.2, 1.2]
+    (clipping), full speed ahead 40 % of the time (into walls and robots), and for a
+    holonomic robot full speed diagonally 30 % of the time (a step of sqrt(2) times the top
+    speed: the backend's two sub-steps)."""
+    dim = 3 if drive == "holonomic" else 2
+    actions = rng.uniform(-1.2, 1.2, (*shape, dim)).astype(np.float32)
+    actions[rng.random(shape) < 0.4, 0] = 1.0
+    if dim == 3:
+        diagonal = rng.random(shape) < 0.3
+        actions[diagonal, :2] = rng.choice([-1.0, 1.0], size=(int(diagonal.sum()), 2))
+    return actions

@@ -54,9 +54,9 @@ class DiscretePlan:
     actions : DiscreteActions
         The action set (as the single env's ``discrete_actions`` makes it).
     robot : RobotSpec or sequence of RobotSpec
-        The robot (top speeds, differential drive), or one per robot of a world: then
-        every robot has its own commands and control steps per action (a slower robot
-        holds MOVE_FORWARD for more steps), as in the multi-robot env.
+        The robot (top speeds and drive; a holonomic command is ``(vx, 0, w)``), or one
+        per robot of a world: then every robot has its own commands and control steps per
+        action (a slower robot holds MOVE_FORWARD for more steps), as in the multi-robot env.
     action_frequency : float
         Control steps per second (Hz).
     arrays : Arrays
@@ -64,8 +64,9 @@ class DiscretePlan:
 
     Attributes
     ----------
-    commands : array, shape (n, 2), or (R, n, 2) with one robot spec per robot
-        Each action's command in ``[-1, 1]`` units (forward, yaw rate).
+    commands : array, shape (n, action_dim), or (R, n, action_dim) with one robot spec per robot
+        Each action's command in ``[-1, 1]`` units (forward, yaw rate; a holonomic robot's
+        has a zero sideways speed between them).
     steps : array of int, shape (n,), or (R, n) with one robot spec per robot
         Each action's control steps.
     n : int

@@ -22,6 +22,7 @@ from pointnav_core import _envcommon, scenes, validation
 from pointnav_core.vector import contacts_jit
 from pointnav_core.vector.contacts import advance
 from pointnav_core.vector.discrete import MOVED, DiscretePlan
+from pointnav_core.vector.drive import arc, body_command, sub_steps, substep_drive, travel
 from pointnav_core.vector.episodes import EpisodePool
 from pointnav_core.vector.falls import apply_falls, first_drop
 from pointnav_core.vector.floors import FloorTables
@@ -32,7 +33,7 @@ from pointnav_core.vector.xp import make_arrays
 
 __all__ = ["VectorPointNavEnv", "first_drop"]
 
-_MAX_TURN = 0.25  # rad per control step the backend resolves without sub-steps
+_MAX_TURN = 0.25  # rad per control step the rate check allows: the backend's sub-step turn
 
 
 def _scan_term(sensors: Mapping[str, Any] | None) -> Any:
@@ -71,14 +72,6 @@ def _scene_list(scene: scenes.Scene | Sequence[scenes.Scene] | None) -> list[sce
     return scene_list
 
 
-def _differential_robot(robot: Any) -> Any:
-    """The robot spec; ValueError unless it has a differential drive."""
-    spec = _envcommon.make_robot(robot)
-    if spec.drive != "differential":
-        raise ValueError(f"robot must have a differential drive in the batched engine, got {spec.drive!r}")
-    return spec
-
-
 class VectorPointNavEnv(PoolRefreshing, VectorEnv):
     """``num_envs`` single-robot point-navigation worlds, stepped as arrays.
 
@@ -100,9 +93,12 @@ class VectorPointNavEnv(PoolRefreshing, VectorEnv):
         World ``i`` runs on ``scene[i % len(scene)]``. Floors must be grid cells only (no
         obstacle polygons). Default: the single env's default house as a grid.
     robot : RobotSpec or dict, optional
-        Differential drive only. With several robots per world, also a list with one entry
-        per robot, as for :func:`~pointnav_core.parallel.parallel_env`: their speed limits
-        may differ, their radius may not.
+        As for the single env: a differential drive (actions ``(v, w)``) or a holonomic one
+        (actions ``(vx, vy, w)`` in the robot frame, +x ahead, +y to the left), scaled and
+        integrated as the kinematic backend does (:mod:`pointnav_core.vector.drive`). With
+        several robots per world, also a list with one entry per robot, as for
+        :func:`~pointnav_core.parallel.parallel_env`: their speed limits may differ, their
+        radius and drive may not (the actions are one array).
     task : dict, optional
         ``PointNavigationTask`` keyword arguments, as for the single env (its default
         ``path_range`` too). Custom terms are not supported. Any ``fall_height`` (m):
@@ -145,7 +141,8 @@ class VectorPointNavEnv(PoolRefreshing, VectorEnv):
     Notes
     -----
     ``step`` takes actions of shape ``(num_envs, 2)`` (or ``(num_envs, 1, 2)``) in
-    ``[-1, 1]`` (clipped), or with discrete actions integers of shape ``(num_envs,)``, and
+    ``[-1, 1]`` (clipped), ``(num_envs, 3)`` (or ``(num_envs, 1, 3)``) for a holonomic
+    robot, or with discrete actions integers of shape ``(num_envs,)``, and
     returns observations ``(num_envs, 8)`` float32 (``(num_envs, 8 + n_rays)`` with the
     scan, plus ``cells * cells`` with the local map), rewards float64, terminated and truncated bool, and ``info``, a dict of arrays of shape
     ``(num_envs,)``: ``success``, ``spl``, ``soft_spl``, ``path_length``,
@@ -164,7 +161,8 @@ class VectorPointNavEnv(PoolRefreshing, VectorEnv):
     robot-robot contact counts as a collision for both, every robot has its own task
     (rewards, terminations, SPL), and all robots still active are truncated after
     ``max_cycles`` steps. Every return carries the robot axis: ``step`` takes actions
-    ``(num_envs, R, 2)`` (all finite; those of inactive robots are ignored), or with
+    ``(num_envs, R, 2)`` (``(num_envs, R, 3)`` for holonomic robots; all finite, those of
+    inactive robots are ignored), or with
     ``action_space="discrete"`` integers ``(num_envs, R)`` (all in range), and returns
     observations ``(num_envs, R, 8)`` float32 (``(num_envs, R, 8 + n_rays)`` with the scan,
     which sees the other robots present in its world as the multi-robot env's scan does;
@@ -255,7 +253,7 @@ class VectorPointNavEnv(PoolRefreshing, VectorEnv):
         self.arrays = make_arrays(device)
         self.device = device
         self.scenes = scene_list = _scene_list(scene)
-        self.robot = _differential_robot(robot)
+        self.robot = _envcommon.make_robot(robot)  # either drive (vector.drive)
         self._samplers = [
             PointNavEnv(scene=s, robot=self.robot, task=dict(task), sensors=sensors, flatten_obs=True,
                         action_frequency=action_frequency, action_space=action_space, discrete_actions=discrete_actions)
@@ -311,6 +309,8 @@ class VectorPointNavEnv(PoolRefreshing, VectorEnv):
         self.geodesic_reward = t.reward_type == "geodesic"
         self.goal_in_polar = bool(t.goal_in_polar)
         spec = self.robot
+        # Top speed on one axis: a holonomic robot's diagonal step may travel sqrt(2) times
+        # that, which the backend splits into sub-steps near walls, and so does vector.drive.
         if spec.max_angular_velocity * self.dt > _MAX_TURN or spec.max_linear_velocity * self.dt > 0.5 * min(
             float(s.floors[t.floor].resolution) for s in self.scenes
         ):
@@ -318,8 +318,11 @@ class VectorPointNavEnv(PoolRefreshing, VectorEnv):
                 f"action_frequency {self.action_frequency} Hz is too low for the batched engine: one control "
                 "step may turn at most 0.25 rad and drive at most half a cell (the kinematic backend's sub-step)"
             )
-        # A chord is never longer than its arc; the margin covers rounding.
-        self._max_travel = spec.max_linear_velocity * self.dt * (1.0 + 1e-9) + 1e-12
+        self.holonomic = spec.drive == "holonomic"
+        # A chord is never longer than its arc (a holonomic one: the diagonal of its two
+        # top speeds); the margin covers rounding.
+        top = spec.max_linear_velocity * (math.sqrt(2.0) if self.holonomic else 1.0)
+        self._max_travel = top * self.dt * (1.0 + 1e-9) + 1e-12
 
     # ------------------------------------------------------------------ pools
     def _build_pool(self, fixed: Sequence[tuple[Any, float, Any, int]]) -> None:
@@ -404,16 +407,19 @@ class VectorPointNavEnv(PoolRefreshing, VectorEnv):
         self._needs_reset[idx] = False
 
     def check_actions(self, actions: Any) -> Any:
-        """``actions`` as a float64 array ``(num_envs, 2)``, or with discrete actions an int64
-        array ``(num_envs,)``; ValueError naming ``actions`` if bad."""
+        """``actions`` as a float64 array ``(num_envs, action_dim)`` (2 for a differential
+        drive, 3 for a holonomic one), or with discrete actions an int64 array
+        ``(num_envs,)``; ValueError naming ``actions`` if bad."""
         a = self.arrays
         if self._discrete is not None:
             return self._discrete.check(actions, self.num_envs)
         shape = tuple(getattr(actions, "shape", np.shape(actions)))
-        n = self.num_envs
-        if shape not in ((n, 2), (n, 1, 2)):
-            raise ValueError(f"actions must have shape ({n}, 2) or ({n}, 1, 2), got {shape}")
-        arr = a.asarray(actions).reshape(n, 2)
+        n, dim = self.num_envs, self.robot.action_dim
+        if shape not in ((n, dim), (n, 1, dim)):
+            raise ValueError(
+                f"actions must have shape ({n}, {dim}) or ({n}, 1, {dim}) for a {self.robot.drive} drive, got {shape}"
+            )
+        arr = a.asarray(actions).reshape(n, dim)
         if not bool(a.xp.isfinite(arr).all()):
             raise ValueError("actions must be finite (no NaN or infinity)")
         return arr
@@ -438,46 +444,51 @@ class VectorPointNavEnv(PoolRefreshing, VectorEnv):
         return self._account(moved, contact, stopped)
 
     def _drive(self, act: Any, state: Mapping[str, Any]) -> tuple[dict[str, Any], Any]:
-        """One control step of every world from ``state`` under commands ``act`` ``(num_envs, 2)``,
-        not committed: the new pose, height, velocities and fall speed (keys ``MOVED``) and the
-        contacts. A falling robot ignores its command and drops (:func:`~pointnav_core.vector.falls.apply_falls`)."""
+        """One control step of every world from ``state`` under commands ``act``
+        ``(num_envs, action_dim)``, not committed: the new pose, height, velocities and fall
+        speed (keys ``MOVED``) and the contacts. A falling robot ignores its command and drops
+        (:func:`~pointnav_core.vector.falls.apply_falls`)."""
         a, xp = self.arrays, self.arrays.xp
-        spec = self.robot
-        one = 1.0
-        v0, v1 = act[:, 0], act[:, 1]
-        vmax, wmax = spec.max_linear_velocity, spec.max_angular_velocity
-        vx = xp.where(v0 >= one, vmax, xp.where(v0 <= -one, -vmax, v0 * vmax))
-        w = xp.where(v1 >= one, wmax, xp.where(v1 <= -one, -wmax, v1 * wmax))
-        dt = self.dt
+        spec, dt = self.robot, self.dt
+        vx, vy, w = body_command(xp, act, spec.max_linear_velocity, spec.max_angular_velocity, self.holonomic)
         x0, y0, yaw0 = state["x"], state["y"], state["yaw"]
-        # The exact arc over the step (state.drive_arc with vy = 0).
-        half = 0.5 * w * dt
-        safe = xp.where(half != 0.0, half, 1.0)
-        s = dt * xp.where(half != 0.0, xp.sin(safe) / safe, 1.0)
-        mid = yaw0 + half
-        dx = s * (vx * xp.cos(mid) - 0.0 * xp.sin(mid))
-        dy = s * (vx * xp.sin(mid) + 0.0 * xp.cos(mid))
-        travel = xp.abs(vx) * dt
+        dx, dy = arc(xp, yaw0, vx, vy, w, dt)  # the exact arc over the step (drive_arc)
+        length = travel(xp, vx, vy, dt)
         scene = self._world_scene
         row, col, inside = self.floors.cells(scene, x0, y0)
         budget = self.floors.fast[self.floors.flat_index(scene, row, col, inside)]
         standing = ~(state["fs"] > 0.0)
-        fast = inside & (budget > travel)
+        fast = inside & (budget > length)
         x, y, yaw = x0 + dx, y0 + dy, yaw0 + w * dt
         vel_x, vel_y, vel_w = dx / dt, dy / dt, w
         contact = xp.zeros_like(x) > 1.0
         began = contact
         slow = a.nonzero(~fast & standing)
         if slow.shape[0]:
+            sc = scene[slow]
             resolver = contacts_jit.advance_one if contacts_jit.available(self.floors) else advance
-            sx, sy, c = resolver(self.floors, scene[slow], x0[slow], y0[slow], dx[slow], dy[slow], spec.radius, self._max_travel)
-            syaw = yaw0[slow] + w[slow] * dt
+
+            def move(px: Any, py: Any, mx: Any, my: Any, part: Any) -> tuple[Any, Any, Any]:
+                # The worlds of ``part`` by their chords; a later sub-step has fewer of them.
+                if bool(part.all()):
+                    return resolver(self.floors, sc, px, py, mx, my, spec.radius, self._max_travel)
+                idx = a.nonzero(part)
+                ix, iy, ic = resolver(self.floors, sc[idx], px[idx], py[idx], mx[idx], my[idx], spec.radius, self._max_travel)
+                nx, ny, c = px + 0.0, py + 0.0, xp.zeros_like(part)
+                nx[idx], ny[idx], c[idx] = ix, iy, ic
+                return nx, ny, c
+
+            n_sub = sub_steps(xp, length[slow], w[slow], dt, self.floors.res[sc])
+            sx, sy, syaw, fall, c = substep_drive(
+                xp, (x0[slow], y0[slow], yaw0[slow]), (vx[slow], vy[slow], w[slow]), n_sub, dt, move,
+                lambda px, py: self.floors.is_void(sc, px, py),
+            )
             x[slow], y[slow], yaw[slow] = sx, sy, syaw
             vel_x[slow] = (sx - x0[slow]) / dt
             vel_y[slow] = (sy - y0[slow]) / dt
             vel_w = xp.where(fast, vel_w, (yaw - yaw0) / dt)
             began = began.clone() if a.is_torch else began.copy()
-            began[slow] = self.floors.is_void(scene[slow], sx, sy)
+            began[slow] = fall
             contact[slow] = c
         moved = apply_falls(xp, state, {"x": x, "y": y, "yaw": yaw, "vx": vel_x, "vy": vel_y, "w": vel_w}, began, dt)
         return moved, contact

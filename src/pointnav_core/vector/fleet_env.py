@@ -28,6 +28,7 @@ from pointnav_core.vector import contacts_jit
 from pointnav_core.vector.contacts import advance
 from pointnav_core.vector.contacts_jit import advance_compiled
 from pointnav_core.vector.discrete import MOVED, DiscretePlan
+from pointnav_core.vector.drive import arc, body_command, sub_steps, substep_drive, travel
 from pointnav_core.vector.env import (
     VectorPointNavEnv,
     _scan_term,
@@ -231,8 +232,9 @@ class VectorFleetEnv(VectorPointNavEnv):
         self._needs_reset[idx] = False
 
     def check_actions(self, actions: Any) -> Any:
-        """``actions`` as a float64 array ``(num_envs, n_robots, 2)``, or with discrete actions
-        an int64 array ``(num_envs, n_robots)``; ValueError naming ``actions`` if bad.
+        """``actions`` as a float64 array ``(num_envs, n_robots, action_dim)`` (2 for a
+        differential drive, 3 for a holonomic one), or with discrete actions an int64 array
+        ``(num_envs, n_robots)``; ValueError naming ``actions`` if bad.
 
         Every entry must be valid (finite; with discrete actions an integer in range), also
         those of inactive robots (which are ignored).
@@ -240,9 +242,9 @@ class VectorFleetEnv(VectorPointNavEnv):
         if self._discrete is not None:
             return self._discrete.check(actions, self.num_envs, self.n_robots)
         shape = tuple(getattr(actions, "shape", np.shape(actions)))
-        want = (self.num_envs, self.n_robots, 2)
+        want = (self.num_envs, self.n_robots, self.robot.action_dim)
         if shape != want:
-            raise ValueError(f"actions must have shape {want}, got {shape}")
+            raise ValueError(f"actions must have shape {want} for a {self.robot.drive} drive, got {shape}")
         arr = self.arrays.asarray(actions)
         if not bool(self.arrays.xp.isfinite(arr).all()):
             raise ValueError("actions must be finite (no NaN or infinity)")
@@ -260,47 +262,45 @@ class VectorFleetEnv(VectorPointNavEnv):
 
     def _drive(self, act: Any, state: Mapping[str, Any]) -> tuple[dict[str, Any], Any]:
         """One control step of every world from ``state`` under commands ``act``
-        ``(num_envs, n_robots, 2)`` in ``[-1, 1]`` units, not committed: the new pose, height
-        velocities and fall speed (keys ``MOVED``) and the contacts. A falling robot present in
-        the world drops (:func:`~pointnav_core.vector.falls.apply_falls`); it neither drives
-        nor blocks. A robot out of the world stays as it is."""
+        ``(num_envs, n_robots, action_dim)`` in ``[-1, 1]`` units, not committed: the new pose,
+        height, velocities and fall speed (keys ``MOVED``) and the contacts. A falling robot
+        present in the world drops (:func:`~pointnav_core.vector.falls.apply_falls`); it
+        neither drives nor blocks. A robot out of the world stays as it is."""
         a, xp = self.arrays, self.arrays.xp
         dt, radius = self.dt, self.robot.radius
         falling = state["fs"] > 0.0
         present = self._present & ~falling
-        v0, v1 = act[..., 0], act[..., 1]
         vmax, wmax = self._vmax, self._wmax  # (1, R): each robot's speed limits
-        zero = xp.zeros_like(v0)
-        vx = xp.where(v0 >= 1.0, vmax, xp.where(v0 <= -1.0, -vmax, v0 * vmax))
-        w = xp.where(v1 >= 1.0, wmax, xp.where(v1 <= -1.0, -wmax, v1 * wmax))
+        vx, vy, w = body_command(xp, act, vmax, wmax, self.holonomic)
+        zero = xp.zeros_like(vx)
         x0, y0, yaw0 = state["x"], state["y"], state["yaw"]
-        half = 0.5 * w * dt
-        safe = xp.where(half != 0.0, half, 1.0)
-        s = dt * xp.where(half != 0.0, xp.sin(safe) / safe, 1.0)
-        mid = yaw0 + half
-        dx = s * (vx * xp.cos(mid) - 0.0 * xp.sin(mid))
-        dy = s * (vx * xp.sin(mid) + 0.0 * xp.cos(mid))
-        travel = xp.abs(vx) * dt
+        dx, dy = arc(xp, yaw0, vx, vy, w, dt)
+        length = travel(xp, vx, vy, dt)
         # The backend's fast path: clearance beyond the step and no other free robot within reach.
         scene = self._robot_scene
         row, col, inside = self.floors.cells(scene, x0, y0)
         budget = self.floors.fast[self.floors.flat_index(scene, row, col, inside)]
-        reach = radius + travel
+        reach = radius + length
         gap = reach[:, :, None] + reach[:, None, :]
         gap2 = (x0[:, :, None] - x0[:, None, :]) ** 2 + (y0[:, :, None] - y0[:, None, :]) ** 2
         ids = self._robot_ids
         others = (ids.reshape(1, -1, 1) != ids.reshape(1, 1, -1)) & present[:, None, :] & (gap2 <= gap * gap)
-        fast = present & inside & (budget > travel) & ~others.any(-1)
+        fast = present & inside & (budget > length) & ~others.any(-1)
         slow = present & ~fast
         x, y, yaw = x0 + xp.where(fast, dx, zero), y0 + xp.where(fast, dy, zero), yaw0 + w * dt
         contact = zero > 1.0
-        if contacts_jit.available(self.floors):  # every world in one compiled loop
-            sx, sy, c = advance_compiled(self.floors, scene, x0, y0, dx, dy, slow, radius, self._max_travel)
-            x, y = xp.where(slow, a.asarray(sx), x), xp.where(slow, a.asarray(sy), y)
-            contact = a.asarray(c, a.boolean)
-        else:
-            self._advance_slow(x0, y0, dx, dy, slow, x, y, contact)
-        began = slow & self.floors.is_void(scene, x, y)
+        began = contact
+        if a.any(slow):
+            # Every slow robot of a world takes the world's sub-steps (the backend's _slow_step).
+            n_sub = sub_steps(xp, length, w, dt, self.floors.res[scene])
+            n_sub = xp.where(slow, n_sub, zero).amax(-1) if a.is_torch else xp.where(slow, n_sub, zero).max(-1)
+            n_sub = xp.where(slow, n_sub[:, None], zero)
+            sx, sy, syaw, fall, contact = substep_drive(
+                xp, (x0, y0, yaw0), (vx, vy, w), n_sub, dt, self._move_slow,
+                lambda px, py: self.floors.is_void(scene, px, py),
+            )
+            x, y, yaw = xp.where(slow, sx, x), xp.where(slow, sy, y), xp.where(slow, syaw, yaw)
+            began = slow & fall
         vel_x = xp.where(fast, dx / dt, (x - x0) / dt)
         vel_y = xp.where(fast, dy / dt, (y - y0) / dt)
         vel_w = xp.where(fast, w, (yaw - yaw0) / dt)
@@ -367,6 +367,18 @@ class VectorFleetEnv(VectorPointNavEnv):
         info = self._info(success, r_pot, r_col, r_goal, contact, shown, resetting[:, None] & shown)
         return self._observe(shown), reward, terminated, truncated, info
 
+
+    def _move_slow(self, x0: Any, y0: Any, dx: Any, dy: Any, slow: Any) -> tuple[Any, Any, Any]:
+        """The ``slow`` robots moved together by their chords ``(dx, dy)`` (m) with contacts,
+        the others where they are: ``x``, ``y`` and the contact flags, ``(num_envs, n_robots)``."""
+        a = self.arrays
+        if contacts_jit.available(self.floors):  # every world in one compiled loop
+            sx, sy, c = advance_compiled(self.floors, self._robot_scene, x0, y0, dx, dy, slow, self.robot.radius,
+                                         self._max_travel)
+            return a.asarray(sx), a.asarray(sy), a.asarray(c, a.boolean)
+        x, y, contact = x0 + 0.0, y0 + 0.0, a.xp.zeros_like(slow)
+        self._advance_slow(x0, y0, dx, dy, slow, x, y, contact)
+        return x, y, contact
 
     def _advance_slow(self, x0: Any, y0: Any, dx: Any, dy: Any, slow: Any, x: Any, y: Any, contact: Any) -> None:
         """The array path of the slow robots' contacts: writes their ends into ``x``, ``y``

@@ -15,8 +15,9 @@ robot axis ``(1, R)`` that the step broadcasts over its ``(num_envs, R)`` state:
   steps).
 
 What the engine cannot vary per robot is refused with a ``ValueError`` naming it: the
-task's ``floor`` (the floor tables are built for one floor) and the robots' radii (the
-contact step's tables and resolvers take one radius; see ``docs/decisions.md``).
+task's ``floor`` (the floor tables are built for one floor), the robots' radii (the
+contact step's tables and resolvers take one radius; see ``docs/decisions.md``) and their
+drives (the actions are one array, of one ``action_dim``).
 """
 
 from __future__ import annotations
@@ -29,6 +30,7 @@ import numpy as np
 
 from pointnav_core.fleet import make_robots, per_robot
 from pointnav_core.robot_spec import RobotSpec
+from pointnav_core.vector.drive import drive_of
 from pointnav_core.vector.xp import Arrays
 
 __all__ = ["envelope", "read_tasks", "robot_specs", "task_arguments"]
@@ -66,19 +68,16 @@ def task_arguments(task: Any, n_robots: int, max_episode_steps: int | None) -> d
 
 
 def robot_specs(robot: Any, n_robots: int) -> tuple[RobotSpec, ...]:
-    """One differential-drive :class:`RobotSpec` per robot, all of one radius.
+    """One :class:`RobotSpec` per robot, all of one radius and one drive.
 
     Raises
     ------
     ValueError
-        Naming ``robot`` (a list of the wrong length, radii that differ, a drive that is
-        not differential) or ``robot[i]`` (an entry that is not a spec, dict or None).
+        Naming ``robot`` (a list of the wrong length, radii or drives that differ) or
+        ``robot[i]`` (an entry that is not a spec, dict or None).
     """
     specs = make_robots(robot, n_robots)
-    for i, spec in enumerate(specs):
-        if spec.drive != "differential":
-            name = "robot" if per_robot(robot, n_robots, "robot") is None else f"robot[{i}]"
-            raise ValueError(f"{name} must have a differential drive in the batched engine, got {spec.drive!r}")
+    drive_of(specs)  # one action array, of one action_dim, for every robot
     radii = sorted({spec.radius for spec in specs})
     if len(radii) > 1:
         raise ValueError(
