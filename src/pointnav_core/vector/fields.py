@@ -38,8 +38,7 @@ def settle(field: GoalField) -> dict[str, Any]:
         for c0 in range(0, w, _BLOCK):
             if not t["done"][(r0 // _BLOCK) * t["blocks_w"] + c0 // _BLOCK]:
                 field._check_block(r0 * w + c0)
-    for i in np.flatnonzero(t["kind"] == 3):
-        field._settle_cell(int(i))
+    field._settle_cells(np.flatnonzero(t["kind"] == 3))
     assert not (t["kind"] == _UNCHECKED).any()
     return t
 
