@@ -43,8 +43,8 @@ __all__ = ["CHUNK", "cell_roots"]
 
 #: Cells settled together: bounds the (cell, node) and (link, label) arrays of one pass.
 CHUNK = 256
-#: Links per cell whose visibility the first round tests; each later round doubles it.
-_FIRST_ROUND = 4
+#: Links per cell that the first round evaluates; each later round doubles it.
+_FIRST_ROUND = 8
 
 
 class _ArcTables:
@@ -61,6 +61,11 @@ class _ArcTables:
         order = np.argsort(group, kind="stable")
         self.labels = labs[order]
         self.start = np.searchsorted(group[order], np.arange(2 * planner.n_nodes + 1), side="left")
+        # The cheapest reached label of each arc group (inf where none is reached).
+        self.cheapest = np.full(2 * planner.n_nodes, math.inf)
+        some = np.flatnonzero(self.start[1:] > self.start[:-1])
+        if len(some):
+            self.cheapest[some] = np.minimum.reduceat(search.cost[self.labels], self.start[some])
         lists = planner._blocked_ccw
         widest = max((len(b) for b in lists), default=0)
         self.blocked = np.full((planner.n_nodes, max(widest, 1)), np.nan)
@@ -141,14 +146,45 @@ def _chunk_roots(
     if links is None:
         return kind, label
     cell, node, s, dep, length, ang, order = links
-    value, lab = _link_values(field, tables, node, s, dep, length)
-    # Only links strictly shorter than the direct segment can win; sort by (value, order).
-    keep = np.flatnonzero(value < direct[cell])
-    srt = keep[np.lexsort((order[keep], value[keep], cell[keep]))]
-    win = _first_visible(p, pts, cell[srt], node[srt], ang[srt], n)
-    got = np.flatnonzero(win >= 0)
+    # A link's total is at least its arc's cheapest reached label plus its tangent (rounding
+    # is monotone, so in floats too); a link not below the direct segment cannot win.
+    bound = tables.cheapest[2 * node + (s > 0)] + length
+    keep = np.flatnonzero(bound < direct[cell])
+    srt = keep[np.lexsort((order[keep], bound[keep], cell[keep]))]
+    best, best_order, best_lab = direct.copy(), np.full(n, -1, dtype=np.int64), np.full(n, -1, dtype=np.int64)
+    cell, bound = cell[srt], bound[srt]
+    start = np.searchsorted(cell, np.arange(n), side="left")
+    end = np.searchsorted(cell, np.arange(n), side="right")
+    at = start.copy()
+    live = np.flatnonzero(at < end)
+    size = _FIRST_ROUND
+    while len(live):
+        # The next links of each live cell, in bound order: exact totals, then the
+        # visibility of those that beat the cell's best so far.
+        take = np.minimum(end[live] - at[live], size)
+        owner = np.repeat(live, take)
+        k = srt[np.repeat(at[live], take) + (np.arange(int(take.sum())) - np.repeat(np.cumsum(take) - take, take))]
+        value, lab = _link_values(field, tables, node[k], s[k], dep[k], length[k])
+        beat = np.flatnonzero((value < best[owner]) | ((value == best[owner]) & (order[k] < best_order[owner])))
+        if len(beat):
+            c = node[k[beat]]
+            arrive = ang[k[beat]]
+            q = np.stack([p.cx[c] + r * np.cos(arrive), p.cy[c] + r * np.sin(arrive)], axis=1)
+            seen = beat[geo.segments_clear(pts[owner[beat]], q, r)]
+            # Each cell's smallest (total, order) among its visible links of this round.
+            seen = seen[np.lexsort((order[k[seen]], value[seen], owner[seen]))]
+            seen = seen[_run_heads(owner[seen])]
+            who = owner[seen]
+            best[who], best_order[who], best_lab[who] = value[seen], order[k[seen]], lab[seen]
+        at[live] += take
+        # Links further on have totals of at least their bounds: stop past the best.
+        more = at[live] < end[live]
+        more[more] = bound[at[live[more]]] <= best[live[more]]
+        live = live[more]
+        size *= 2
+    got = np.flatnonzero(best_lab >= 0)
     kind[got] = 2
-    label[got] = lab[srt[win[got]]]
+    label[got] = best_lab[got]
     return kind, label
 
 
@@ -225,38 +261,6 @@ def _link_values(
     hit = hit[_run_heads(link[hit])]
     lab[link[hit]] = labs[hit]
     return value, lab
-
-
-def _first_visible(
-    p: Planner,
-    pts: NDArray[np.float64],
-    cell: NDArray[np.int64],
-    node: NDArray[np.int64],
-    ang: NDArray[np.float64],
-    n_cells: int,
-) -> NDArray[np.int64]:
-    """Per cell, the index of its first link (links grouped by cell, in order) whose tangent
-    segment is clear; -1 where none is. Tested in rounds of growing size per cell."""
-    r = p.radius
-    start = np.searchsorted(cell, np.arange(n_cells), side="left")
-    end = np.searchsorted(cell, np.arange(n_cells), side="right")
-    win = np.full(n_cells, -1, dtype=np.int64)
-    at = start.copy()
-    live = np.flatnonzero(at < end)
-    size = _FIRST_ROUND
-    while len(live):
-        take = np.minimum(end[live] - at[live], size)
-        owner = np.repeat(live, take)
-        idx = np.repeat(at[live], take) + (np.arange(int(take.sum())) - np.repeat(np.cumsum(take) - take, take))
-        c = node[idx]
-        q = np.stack([p.cx[c] + r * np.cos(ang[idx]), p.cy[c] + r * np.sin(ang[idx])], axis=1)
-        vis = np.flatnonzero(p.geo.segments_clear(pts[owner], q, r))
-        vis = vis[_run_heads(owner[vis])]
-        win[owner[vis]] = idx[vis]
-        at[live] += take
-        live = live[(win[live] < 0) & (at[live] < end[live])]
-        size *= 2
-    return win
 
 
 def _run_heads(keys: NDArray[np.int64]) -> NDArray[np.bool_]:
