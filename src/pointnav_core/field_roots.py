@@ -10,16 +10,17 @@ the one-point code gives it:
 - the candidate nodes are the kd-tree's ball around each centre (radius: the centre's sight
   bound plus the robot radius), in the order the one-point query returns them;
 - each (centre, node) pair gets its tangent and arc position, on both winding sides;
-- each such link is expanded to the reached labels on the arc it departs along (in
-  ``FieldLabels.on_arc``'s order, from a table built once per call); a label counts where
-  it lies at or before the departure and the arc between is clear; the link's value is its
-  best label's total, the first of equal totals;
-- the one-point code keeps, of the direct segment to the goal first and then every
-  visible link in order, the first with the smallest total (strict ``<``). That is the
-  smallest ``(total, order)`` over visible candidates, the direct segment ordered first. So
-  links are sorted by that key, and only their visibility is tested lazily, in rounds of
-  growing size: a cell's answer is its first visible link (none beats the direct segment
-  when it is not strictly shorter), and the segments behind it are never tested.
+- the one-point code keeps, of the direct segment to the goal first and then every visible
+  link's labels in order, the first with the smallest total (strict ``<``): the smallest
+  ``(total, order)`` over the visible candidates, the direct segment ordered first;
+- a link's total is at least the cheapest reached label on its arc plus its tangent's
+  length, in floats too (rounding is monotone). Links are taken in the order of that bound,
+  in rounds of growing size per cell: each is expanded to the reached labels on the arc it
+  departs along (``FieldLabels.on_arc``'s order, from a table built once per call; a label
+  counts where it lies at or before the departure and the arc between is clear), its total
+  is its best label's (the first of equal totals), and only a link that beats the cell's
+  best so far has its segment tested. A cell is done when its next bound exceeds its best:
+  no link further on can win, so neither their labels nor their segments are looked at.
 
 Everything is in world metres and radians.
 """
