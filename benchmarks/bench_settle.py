@@ -66,7 +66,8 @@ def main() -> None:
         field._settle_cell(i)
     loop = time.perf_counter() - start
     same = np.array_equal(kind, t["kind"]) and np.array_equal(label, t["label"])
-    print(f"loop {loop:.2f} s ({loop / max(len(cells), 1) * 1e3:.3f} ms per cell), {loop / batched:.1f}x; tables equal: {same}")
+    per = loop / max(len(cells), 1) * 1e3
+    print(f"loop {loop:.2f} s ({per:.3f} ms per cell), {loop / batched:.1f}x; tables equal: {same}")
 
 
 if __name__ == "__main__":

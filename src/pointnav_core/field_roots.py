@@ -76,7 +76,12 @@ class _ArcTables:
         self.has_blocked = np.fromiter((bool(b) for b in lists), dtype=bool, count=planner.n_nodes)
 
     def arcs_free(
-        self, planner: Planner, node: NDArray[np.int64], s: NDArray[np.int64], p1: NDArray[np.float64], p2: NDArray[np.float64]
+        self,
+        planner: Planner,
+        node: NDArray[np.int64],
+        s: NDArray[np.int64],
+        p1: NDArray[np.float64],
+        p2: NDArray[np.float64],
     ) -> NDArray[np.bool_]:
         """:meth:`Planner._arc_free` of each ``(node, s, p1, p2)``, with its expressions."""
         out = np.ones(len(node), dtype=bool)
@@ -137,7 +142,9 @@ def _chunk_roots(
     pts = np.stack([x, y], axis=1)
     gx, gy = float(field.goal[0]), float(field.goal[1])
     # The direct segment: math.hypot, as the one-point code (numpy's may differ in the last bit).
-    direct = np.fromiter((math.hypot(gx - a, gy - b) for a, b in zip(x.tolist(), y.tolist())), dtype=np.float64, count=n)
+    direct = np.fromiter(
+        (math.hypot(gx - a, gy - b) for a, b in zip(x.tolist(), y.tolist())), dtype=np.float64, count=n
+    )
     direct[~geo.segments_clear(pts, np.array([gx, gy]), r)] = math.inf
     kind = np.where(np.isfinite(direct), 1, 0).astype(np.int8)
     label = np.full(n, -1, dtype=np.int32)
@@ -189,9 +196,13 @@ def _chunk_roots(
     return kind, label
 
 
-def _links(
-    p: Planner, x: NDArray[np.float64], y: NDArray[np.float64]
-) -> tuple[NDArray[np.int64], NDArray[np.int64], NDArray[np.int64], NDArray[np.float64], NDArray[np.float64], NDArray[np.float64], NDArray[np.int64]] | None:
+_Links = tuple[
+    NDArray[np.int64], NDArray[np.int64], NDArray[np.int64], NDArray[np.float64], NDArray[np.float64],
+    NDArray[np.float64], NDArray[np.int64],
+]
+
+
+def _links(p: Planner, x: NDArray[np.float64], y: NDArray[np.float64]) -> _Links | None:
     """Every tangent from the centres to a candidate node that lands on its arc (visible or not).
 
     Returns per link its centre, node, side ``s``, departure position of the reverse path
