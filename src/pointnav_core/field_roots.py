@@ -44,8 +44,10 @@ __all__ = ["CHUNK", "cell_roots"]
 
 #: Cells settled together: bounds the (cell, node) and (link, label) arrays of one pass.
 CHUNK = 256
-#: Links per cell that the first round evaluates; each later round doubles it.
-_FIRST_ROUND = 8
+#: Width (cells) of the first band of candidate bounds evaluated per cell; each round doubles it.
+_FIRST_BAND = 8
+#: Relative loosening of the candidate bounds (m per m), far above rounding error.
+_SLACK = 1e-9
 
 
 class _ArcTables:
@@ -150,72 +152,66 @@ def _chunk_roots(
     label = np.full(n, -1, dtype=np.int32)
     if tables is None:
         return kind, label
-    links = _links(p, x, y)
-    if links is None:
+    found = _candidates(p, x, y)
+    if found is None:
         return kind, label
-    cell, node, s, dep, length, ang, order = links
-    # A link's total is at least its arc's cheapest reached label plus its tangent (rounding
-    # is monotone, so in floats too); a link not below the direct segment cannot win.
-    bound = tables.cheapest[2 * node + (s > 0)] + length
-    keep = np.flatnonzero(bound < direct[cell])
-    srt = keep[np.lexsort((order[keep], bound[keep], cell[keep]))]
+    owner, cand, rank, total = found
+    # Any link to a node totals at least the cheaper of its two arcs' cheapest reached labels
+    # plus the tangent, and the tangent is at least the distance to the node less r: a lower
+    # bound per candidate, loosened by far more than rounding can move either side.
+    cheap = np.minimum(tables.cheapest[2 * cand], tables.cheapest[2 * cand + 1])
+    k = np.flatnonzero(np.isfinite(cheap))
+    owner, cand, rank, cheap = owner[k], cand[k], rank[k], cheap[k]
+    dist = np.hypot(p.cx[cand] - x[owner], p.cy[cand] - y[owner])
+    low = cheap + (dist - r) - _SLACK * (1.0 + cheap + dist)
+    # A link that is not below the direct segment cannot win (the direct segment comes first).
+    k = np.flatnonzero(low < direct[owner])
+    owner, cand, rank, low = owner[k], cand[k], rank[k], low[k]
     best, best_order, best_lab = direct.copy(), np.full(n, -1, dtype=np.int64), np.full(n, -1, dtype=np.int64)
-    cell, bound = cell[srt], bound[srt]
-    start = np.searchsorted(cell, np.arange(n), side="left")
-    end = np.searchsorted(cell, np.arange(n), side="right")
-    at = start.copy()
-    live = np.flatnonzero(at < end)
-    size = _FIRST_ROUND
-    while len(live):
-        # The next links of each live cell, in bound order: exact totals, then the
-        # visibility of those that beat the cell's best so far.
-        take = np.minimum(end[live] - at[live], size)
-        owner = np.repeat(live, take)
-        k = srt[np.repeat(at[live], take) + (np.arange(int(take.sum())) - np.repeat(np.cumsum(take) - take, take))]
-        value, lab = _link_values(field, tables, node[k], s[k], dep[k], length[k])
-        beat = np.flatnonzero((value < best[owner]) | ((value == best[owner]) & (order[k] < best_order[owner])))
-        if len(beat):
-            c = node[k[beat]]
-            arrive = ang[k[beat]]
-            q = np.stack([p.cx[c] + r * np.cos(arrive), p.cy[c] + r * np.sin(arrive)], axis=1)
-            seen = beat[geo.segments_clear(pts[owner[beat]], q, r)]
-            # Each cell's smallest (total, order) among its visible links of this round.
-            seen = seen[np.lexsort((order[k[seen]], value[seen], owner[seen]))]
-            seen = seen[_run_heads(owner[seen])]
-            who = owner[seen]
-            best[who], best_order[who], best_lab[who] = value[seen], order[k[seen]], lab[seen]
-        at[live] += take
-        # Links further on have totals of at least their bounds: stop past the best.
-        more = at[live] < end[live]
-        more[more] = bound[at[live[more]]] <= best[live[more]]
-        live = live[more]
-        size *= 2
+    floor = np.full(n, math.inf)
+    np.minimum.at(floor, owner, low)
+    band = _FIRST_BAND * geo.resolution
+    while len(owner):
+        # The candidates of each cell whose bound lies within the band above its lowest:
+        # their links' exact totals, then the visibility of those that beat the best so far.
+        top = floor + band
+        now = low <= top[owner]
+        k = np.flatnonzero(now)
+        links = _tangents(p, x, y, owner[k], cand[k], rank[k], total) if len(k) else None
+        if links is not None:
+            cell, node, s, dep, length, ang, order = links
+            value, lab = _link_values(field, tables, node, s, dep, length)
+            beat = np.flatnonzero((value < best[cell]) | ((value == best[cell]) & (order < best_order[cell])))
+            if len(beat):
+                c = node[beat]
+                q = np.stack([p.cx[c] + r * np.cos(ang[beat]), p.cy[c] + r * np.sin(ang[beat])], axis=1)
+                seen = beat[geo.segments_clear(pts[cell[beat]], q, r)]
+                # Each cell's smallest (total, order) among its visible links of this round.
+                seen = seen[np.lexsort((order[seen], value[seen], cell[seen]))]
+                seen = seen[_run_heads(cell[seen])]
+                who = cell[seen]
+                best[who], best_order[who], best_lab[who] = value[seen], order[seen], lab[seen]
+        # What is left lies above the band: a cell whose best the band reached is done.
+        rest = np.flatnonzero(~now & (top[owner] < best[owner]))
+        owner, cand, rank, low = owner[rest], cand[rest], rank[rest], low[rest]
+        band *= 2
     got = np.flatnonzero(best_lab >= 0)
     kind[got] = 2
     label[got] = best_lab[got]
     return kind, label
 
 
-_Links = tuple[
-    NDArray[np.int64], NDArray[np.int64], NDArray[np.int64], NDArray[np.float64], NDArray[np.float64],
-    NDArray[np.float64], NDArray[np.int64],
-]
-
-
-def _links(p: Planner, x: NDArray[np.float64], y: NDArray[np.float64]) -> _Links | None:
-    """Every tangent from the centres to a candidate node that lands on its arc (visible or not).
-
-    Returns per link its centre, node, side ``s``, departure position of the reverse path
-    ``dep`` (rad), tangent length (m), arrival angle (rad) and its rank in
-    :meth:`Planner.point_links`'s order among the centre's links; None when there are none.
-    """
+def _candidates(
+    p: Planner, x: NDArray[np.float64], y: NDArray[np.float64]
+) -> tuple[NDArray[np.int64], NDArray[np.int64], NDArray[np.int64], int] | None:
+    """The nodes each centre's one-point query finds: per candidate its centre, node and rank
+    in the query's order, and their number; None when there are none."""
     geo = p.geo
     res = geo.resolution
-    r = p.radius
     # Planner.sight_radius of each centre: its cell's centre's rays, widened by a half diagonal.
     scx = geo.origin[0] + (np.floor((x - geo.origin[0]) / res) + 0.5) * res
     scy = geo.origin[1] + (np.floor((y - geo.origin[1]) / res) + 0.5) * res
-    reach = (p._sight_radii(scx, scy) + res * math.sqrt(0.5)) + r
+    reach = (p._sight_radii(scx, scy) + res * math.sqrt(0.5)) + p.radius
     # Unsorted, as a one-point query returns them (the same tree walk per point).
     balls = p._tree.query_ball_point(np.stack([x, y], axis=1), reach, return_sorted=False)
     counts = np.fromiter((len(b) for b in balls), dtype=np.int64, count=len(balls))
@@ -225,6 +221,32 @@ def _links(p: Planner, x: NDArray[np.float64], y: NDArray[np.float64]) -> _Links
     cand = np.fromiter(itertools.chain.from_iterable(balls), dtype=np.int64, count=total)
     owner = np.repeat(np.arange(len(x)), counts)
     rank = np.arange(total) - np.repeat(np.cumsum(counts) - counts, counts)
+    return owner, cand, rank, total
+
+
+_Links = tuple[
+    NDArray[np.int64], NDArray[np.int64], NDArray[np.int64], NDArray[np.float64], NDArray[np.float64],
+    NDArray[np.float64], NDArray[np.int64],
+]
+
+
+def _tangents(
+    p: Planner,
+    x: NDArray[np.float64],
+    y: NDArray[np.float64],
+    owner: NDArray[np.int64],
+    cand: NDArray[np.int64],
+    rank: NDArray[np.int64],
+    total: int,
+) -> _Links | None:
+    """The tangents from centres to candidate nodes that land on the nodes' arcs (visible or not).
+
+    Returns per link its centre, node, side ``s``, departure position of the reverse path
+    ``dep`` (rad), tangent length (m), arrival angle (rad) and a key that orders a centre's
+    links as :meth:`Planner.point_links` does (side +1 first, then the query's order,
+    ``rank < total``); None when there are none.
+    """
+    r = p.radius
     parts = []
     for side_rank, s in enumerate((1, -1)):
         ang, length, _, ok = _tangent_from_point(x[owner], y[owner], p.cx[cand], p.cy[cand], r, s)
