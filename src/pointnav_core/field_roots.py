@@ -111,7 +111,8 @@ def cell_roots(field: GoalField, cells: NDArray[np.int64]) -> tuple[NDArray[np.i
     Returns
     -------
     kind : ndarray of int8, shape (N,)
-        0: the goal is not reachable from the centre, 1: straight to the goal, 2: by a label.
+        0: the robot does not fit at the centre or nothing reaches the goal from it, 1: straight
+        to the goal, 2: by a label.
     label : ndarray of int32, shape (N,)
         The label for kind 2, else -1.
     """
