@@ -115,6 +115,25 @@ def cell_roots(field: GoalField, cells: NDArray[np.int64]) -> tuple[NDArray[np.i
         to the goal, 2: by a label.
     label : ndarray of int32, shape (N,)
         The label for kind 2, else -1.
+
+    See Also
+    --------
+    pointnav_core.tangent_field.GoalField._settle_cells : writes these into the root table.
+
+    Examples
+    --------
+    A walled room cut by a wall with gaps at both ends; the goal is left of the wall. A cell
+    on the left sees it (1), one on the right goes round an end of the wall (2), a wall
+    cell gets none (0):
+
+    >>> from pointnav_core.scenes import Scene
+    >>> grid = np.zeros((12, 12), np.uint8)
+    >>> grid[[0, -1], :] = grid[:, [0, -1]] = 1
+    >>> grid[2:10, 6] = 1
+    >>> field = Scene.from_array(grid, 0.1).planner(0, 0.0).goal_field((0.35, 0.65))
+    >>> kind, label = cell_roots(field, np.array([6 * 12 + 2, 6 * 12 + 9, 0]))
+    >>> kind.tolist()
+    [1, 2, 0]
     """
     p = field.planner
     geo = p.geo
