@@ -99,3 +99,36 @@ def test_settle_cells_rejects_bad_cells_and_leaves_the_table(cells: np.ndarray, 
     with pytest.raises(ValueError, match=match):
         field._settle_cells(cells)
     assert np.array_equal(t["kind"], kind) and np.array_equal(t["label"], label)
+
+
+def test_the_ball_query_orders_many_points_as_it_orders_one() -> None:
+    """The batch takes each centre's candidates from one many-point query; the one-point code
+    keeps the first of equal totals in its query's order, so the orders must be the same."""
+    rng = np.random.default_rng(3)
+    grid = (rng.random((40, 40)) < 0.15).astype(np.uint8)
+    planner = Scene.from_array(grid, RES).planner(0, 0.1)
+    pts = rng.uniform(0.0, 4.0, (200, 2))
+    radii = rng.uniform(0.0, 3.0, 200)
+    many = planner._tree.query_ball_point(pts, radii, return_sorted=False)
+    for p, r, got in zip(pts, radii, many):
+        assert list(got) == list(planner._tree.query_ball_point((float(p[0]), float(p[1])), float(r)))
+
+
+def _mod_two_pi(a: np.ndarray) -> np.ndarray:
+    return np.mod(a, 2.0 * math.pi)
+
+
+@pytest.mark.parametrize("fn", [np.arcsin, np.sin, np.cos, np.hypot, np.arctan2, np.sqrt, _mod_two_pi])
+def test_array_math_gives_the_same_bits_for_any_length(fn) -> None:
+    """The batch evaluates the one-point code's tangents on longer arrays than it does: numpy's
+    vectorised loops must round each element alike whatever the length or the stride."""
+    rng = np.random.default_rng(4)
+    args = [rng.uniform(-1.0, 1.0, 1001)] if fn is np.arcsin else [rng.uniform(-9.0, 9.0, 1001)]
+    if fn in (np.hypot, np.arctan2):
+        args.append(rng.uniform(-9.0, 9.0, 1001))
+    if fn is np.sqrt:
+        args = [np.abs(args[0])]
+    whole = fn(*args)
+    one = np.array([fn(*(a[i : i + 1] for a in args))[0] for i in range(len(whole))])
+    strided = fn(*(np.repeat(a, 2)[::2] for a in args))
+    assert np.array_equal(whole, one) and np.array_equal(whole, strided)
