@@ -3,24 +3,28 @@
 A goal field's root table leaves a few cells (kind 3) to be settled exactly: the best way
 to the goal from the cell centre, as :meth:`GoalField._best
 <pointnav_core.tangent_field.GoalField._best>` finds it one point at a time. :func:`cell_roots`
-makes the same decision for whole arrays of cells, in chunks of :data:`CHUNK` cells, with
-the same floating-point expressions, so that each cell gets exactly the kind and label
-the one-point code gives it:
+makes the same decision for whole arrays of cells, in chunks of at most :data:`CHUNK`
+cells, with the same floating-point expressions, so that each cell gets exactly the kind
+and label the one-point code gives it:
 
 - the candidate nodes are the kd-tree's ball around each centre (radius: the centre's sight
   bound plus the robot radius), in the order the one-point query returns them;
-- each (centre, node) pair gets its tangent and arc position, on both winding sides;
+- a link (a tangent from the centre landing on a node's arc, either winding side) is
+  expanded to the reached labels on the arc it departs along (``FieldLabels.on_arc``'s
+  order, from a table built once per call); a label counts where it lies at or before the
+  departure and the arc between is clear, and the link's total is its best label's (the
+  first of equal totals);
 - the one-point code keeps, of the direct segment to the goal first and then every visible
   link's labels in order, the first with the smallest total (strict ``<``): the smallest
   ``(total, order)`` over the visible candidates, the direct segment ordered first;
-- a link's total is at least the cheapest reached label on its arc plus its tangent's
-  length, in floats too (rounding is monotone). Links are taken in the order of that bound,
-  in rounds of growing size per cell: each is expanded to the reached labels on the arc it
-  departs along (``FieldLabels.on_arc``'s order, from a table built once per call; a label
-  counts where it lies at or before the departure and the arc between is clear), its total
-  is its best label's (the first of equal totals), and only a link that beats the cell's
-  best so far has its segment tested. A cell is done when its next bound exceeds its best:
-  no link further on can win, so neither their labels nor their segments are looked at.
+- every link to a node totals at least the cheapest reached label on either of its arcs
+  plus the distance to the node less the radius (loosened by :data:`_SLACK`, far above
+  rounding; rounding is monotone, so the bound holds in floats). A cell's candidates are
+  taken in bands of that bound, :data:`_FIRST_BAND` cells wide above the cell's lowest and
+  doubling: their links get exact totals, and only a link that beats the cell's best so
+  far has its segment tested. A cell is done once the band passes its best: no candidate
+  further on can win, so neither its tangents, nor its labels, nor its segments are looked
+  at.
 
 Everything is in world metres and radians.
 """
@@ -42,8 +46,10 @@ if TYPE_CHECKING:
 
 __all__ = ["CHUNK", "cell_roots"]
 
-#: Cells settled together: bounds the (cell, node) and (link, label) arrays of one pass.
+#: Most cells settled together: bounds the (cell, node) and (link, label) arrays of one pass.
 CHUNK = 256
+#: Most (cell, node) candidates a chunk may hold when every node falls in every ball.
+_CANDIDATES = 2**20
 #: Width (cells) of the first band of candidate bounds evaluated per cell; each round doubles it.
 _FIRST_BAND = 8
 #: Relative loosening of the candidate bounds (m per m), far above rounding error.
@@ -147,8 +153,10 @@ def cell_roots(field: GoalField, cells: NDArray[np.int64]) -> tuple[NDArray[np.i
     ys = geo.origin[1] + (rows + 0.5) * geo.resolution
     clear = np.flatnonzero(geo.points_clear(np.stack([xs, ys], axis=1), p.radius))
     tables = _ArcTables(p, field._search) if p.n_nodes else None
-    for i in range(0, len(clear), CHUNK):
-        sub = clear[i : i + CHUNK]
+    # Fewer cells per chunk where many nodes could fall in a centre's ball.
+    chunk = max(16, min(CHUNK, _CANDIDATES // max(p.n_nodes, 1)))
+    for i in range(0, len(clear), chunk):
+        sub = clear[i : i + chunk]
         kind[sub], label[sub] = _chunk_roots(field, tables, xs[sub], ys[sub])
     return kind, label
 
