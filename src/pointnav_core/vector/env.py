@@ -325,10 +325,21 @@ class VectorPointNavEnv(PoolRefreshing, VectorEnv):
         self._max_travel = top * self.dt * (1.0 + 1e-9) + 1e-12
 
     # ------------------------------------------------------------------ pools
+    @property
+    def _reach(self) -> float:
+        """How far (m) a robot's centre can get from its start in one episode: its steps (the
+        most of any robot's ``max_steps``, and at most ``max_cycles`` with several robots)
+        times the longest chord of a step (of each of a discrete action's control steps).
+        Goal fields keep only the cells within it of their starts (``FieldTables``)."""
+        steps = self.max_steps if isinstance(self.max_steps, int) else int(self.arrays.numpy(self.max_steps).max())
+        steps = min(steps, getattr(self, "max_cycles", steps))
+        per_step = self._max_travel * (1 if self._discrete is None else self._discrete.max_steps)
+        return steps * per_step
+
     def _build_pool(self, fixed: Sequence[tuple[Any, float, Any, int]]) -> None:
         size = 0 if fixed else self.pool_size
         seeds = self._rng.integers(2**31, size=size * len(self.scenes))
-        self.pool = EpisodePool(self._samplers, size, seeds, self.arrays, fixed, self.starts_per_goal)
+        self.pool = EpisodePool(self._samplers, size, seeds, self.arrays, fixed, self.starts_per_goal, self._reach)
 
     # ------------------------------------------------------------------ Gymnasium API
     def reset(self, *, seed: int | None = None, options: dict[str, Any] | None = None) -> tuple[Any, dict[str, Any]]:

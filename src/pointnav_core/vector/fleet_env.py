@@ -180,7 +180,7 @@ class VectorFleetEnv(VectorPointNavEnv):
     def _build_pool(self, fixed: Sequence[Any]) -> None:
         size = 0 if fixed else self.pool_size
         seeds = self._rng.integers(2**31, size=size * len(self.scenes))
-        self.pool = FleetPool(self._samplers, size, seeds, self.arrays, fixed, self.starts_per_goal)
+        self.pool = FleetPool(self._samplers, size, seeds, self.arrays, fixed, self.starts_per_goal, self._reach)
 
     def reset(self, *, seed: int | None = None, options: dict[str, Any] | None = None) -> tuple[Any, dict[str, Any]]:
         """Reset every world. ``options={"episodes": [[(start_xy, yaw, goal_xy), ...], ...]}``

@@ -87,6 +87,9 @@ class FleetPool:
         Given episodes (``robots`` as :func:`check_fixed_episode` returns them).
     starts : int
         Sets of starts per sampled set of goals (>= 1), sharing its goal fields.
+    reach : float
+        How far (m) a robot gets from its start in one episode: each field keeps the cells
+        within it of its robots' starts (:class:`~pointnav_core.vector.fields.FieldTables`).
     """
 
     def __init__(
@@ -97,6 +100,7 @@ class FleetPool:
         arrays: Arrays,
         fixed: Sequence[tuple[Sequence[tuple[Any, float, Any]], int]] = (),
         starts: int = 1,
+        reach: float = math.inf,
     ) -> None:
         rows: list[list[tuple[float, ...]]] = []
         fields = []
@@ -129,8 +133,10 @@ class FleetPool:
         table = np.array(rows, dtype=np.float64).reshape(-1, n_robots, 6)
         a = arrays
         self.sx, self.sy, self.syaw, self.gx, self.gy, self.d0 = (a.asarray(table[..., i]) for i in range(6))
-        self.fields = FieldTables(fields, arrays)
-        self.field = a.asarray(np.array(field_of, dtype=np.int64).reshape(-1, n_robots), a.i64)
+        field_index = np.array(field_of, dtype=np.int64).reshape(-1, n_robots)
+        per_field = [table[field_index == f][:, :2] for f in range(len(fields))]
+        self.fields = FieldTables(fields, arrays, per_field, reach)
+        self.field = a.asarray(field_index, a.i64)
         self.pool_size = pool_size * starts
         self.n_sampled = self.pool_size * len(samplers)
         self.n_robots = n_robots
