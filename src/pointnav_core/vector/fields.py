@@ -50,7 +50,8 @@ class FieldTables:
     Parameters
     ----------
     fields : sequence of GoalField
-        All from planners of one robot radius.
+        Each keeps its planner's robot radius (``radius``, per field), so fields of robots
+        of different radii share the tables.
     arrays : Arrays
     """
 
