@@ -126,7 +126,7 @@ class VectorPointNavEnv(PoolRefreshing, VectorEnv):
     robot : RobotSpec or dict, optional
         Differential drive only. With several robots per world, also a list with one entry
         per robot, as for :func:`~pointnav_core.parallel.parallel_env`: their speed limits
-        may differ, their radius may not.
+        and radii may differ.
     task : dict, optional
         ``PointNavigationTask`` keyword arguments, as for the single env (its default
         ``path_range`` too). Custom terms are not supported. A fall ends in the step it
@@ -215,9 +215,10 @@ class VectorPointNavEnv(PoolRefreshing, VectorEnv):
     every world entry ``i``: its task's ``goal_tolerance``, ``reward_type``,
     ``goal_in_polar``, ``termination_config`` (``max_steps``, ``max_collisions``,
     ``fall_height``), ``reward_config`` and ``path_range`` and its robot's speed limits
-    (m/s, rad/s) may differ; a list whose tasks' ``floor`` or robots' ``radius`` differ
-    raises ``ValueError`` naming ``task`` or ``robot``, as does a list of the wrong length
-    or an entry of the wrong type (naming ``task[i]`` or ``robot[i]``).
+    (m/s, rad/s) and radius (m: walls at its radius, another robot at the sum of the two
+    radii, its disc in the others' scans and maps) may differ; a list whose tasks'
+    ``floor`` differ raises ``ValueError`` naming ``task``, as does a list of the wrong
+    length or an entry of the wrong type (naming ``task[i]`` or ``robot[i]``).
 
     Examples
     --------

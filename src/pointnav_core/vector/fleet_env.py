@@ -11,7 +11,9 @@ the one-robot engine's, masked by the robots still active (PettingZoo's ``agents
 robots of its world that the multi-robot env's scan sees when it observes the step: those
 present before the step's finished robots leave (parked, removed or fallen alike), all of
 them after a reset; with ``sensors={"local_map": {...}}`` every robot's map draws the discs
-of the same robots as code 3.
+of the same robots as code 3. Robots may differ in radius (a ``robot`` list): each takes
+the fast path by the clearance table of its radius, meets walls at its radius and another
+robot at the sum of their radii, and is a disc of its radius in the scans and maps.
 """
 
 from __future__ import annotations

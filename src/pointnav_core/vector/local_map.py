@@ -15,7 +15,7 @@ The same code runs on numpy and on torch on any device (:class:`~pointnav_core.v
 on a CPU in blocks of worlds of about :data:`CPU_BLOCK` cells, on a GPU in one call;
 its temporaries are ``(W, R, cells * cells)`` arrays, and ``(W, R, R, k * k)`` for the
 discs when there are several robots per world (``k`` cells around each other robot, about
-``2 radius / cell size + 3``).
+``2 radius / cell size + 3`` for the largest radius; each disc has its robot's radius).
 
 Examples
 --------
