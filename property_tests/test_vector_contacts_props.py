@@ -37,9 +37,10 @@ def _assert_same(device: str, got: np.ndarray, want: np.ndarray) -> None:
 
 
 @st.composite
-def cluttered_scenes(draw: st.DrawFn) -> Scene:
-    """A walled room, 14 to 30 cells a side, random obstacle cells, a few bars and a free patch, 0.1 m cells."""
-    rows, cols = draw(st.integers(14, 30)), draw(st.integers(14, 30))
+def cluttered_scenes(draw: st.DrawFn, patch: int = 8) -> Scene:
+    """A walled room, 14 to 30 cells a side, random obstacle cells, a few bars and a free
+    ``patch`` x ``patch`` cell patch, 0.1 m cells."""
+    rows, cols = draw(st.integers(patch + 6, 30)), draw(st.integers(patch + 6, 30))
     rng = np.random.default_rng(draw(st.integers(0, 2**31 - 1)))
     grid = np.zeros((rows, cols), np.uint8)
     grid[rng.random((rows, cols)) < draw(st.floats(0.0, 0.15))] = OBSTACLE
@@ -47,8 +48,8 @@ def cluttered_scenes(draw: st.DrawFn) -> Scene:
         r, c = rng.integers(rows), rng.integers(cols)
         grid[r, c : c + rng.integers(2, 8)] = OBSTACLE
     grid[0, :] = grid[-1, :] = grid[:, 0] = grid[:, -1] = OBSTACLE
-    r, c = draw(st.integers(1, rows - 9)), draw(st.integers(1, cols - 9))
-    grid[r : r + 8, c : c + 8] = 0  # a free 0.8 m patch: some robot always fits
+    r, c = draw(st.integers(1, rows - patch - 1)), draw(st.integers(1, cols - patch - 1))
+    grid[r : r + patch, c : c + patch] = 0  # a free patch: some robot (a 1.2 m one: three of them) always fits
     return Scene.from_array(grid, 0.1)
 
 
@@ -159,3 +160,49 @@ def test_compiled_contacts_equal_the_one_robot_array_path(
         _assert_same(device, got[1][:, 0], want[1])
         np.testing.assert_array_equal(got[2][:, 0], want[2])
         x, y = want[0], want[1]
+
+
+@pytest.mark.parametrize("device", DEVICES)
+@settings(max_examples=10, deadline=None)
+@given(scene=cluttered_scenes(patch=12), seed=st.integers(0, 2**31 - 1), n_robots=st.integers(1, 3),
+       drive=st.sampled_from(["holonomic", "differential"]))
+def test_engines_step_alike_on_the_compiled_and_array_contact_paths(
+    device: str, scene: Scene, seed: int, n_robots: int, drive: str
+) -> None:
+    """Whole engines, sub-steps included (a holonomic robot's diagonal step takes two), give
+    the same poses, contacts and rewards with the compiled contacts as with the array path
+    (the path a GPU takes; on torch it runs on the CPU here)."""
+    from unittest import mock
+
+    from fleet_reference import fleet_episodes
+    from vector_reference import random_actions, random_episodes
+
+    from pointnav_core.vector import VectorPointNavEnv, contacts_jit
+
+    rng = np.random.default_rng(seed)
+    worlds, steps = 6, 40
+    if n_robots == 1:
+        episodes = random_episodes(scene, worlds, rng)
+    else:
+        episodes = fleet_episodes(scene, worlds, n_robots, rng, goal_gap=0.4)
+    actions = random_actions(rng, (steps, worlds) if n_robots == 1 else (steps, worlds, n_robots), drive)
+    kwargs = {"scene": scene, "robot": {"drive": drive}, "seed": seed, "pool_size": 2, "n_robots": n_robots,
+              "device": device,
+              "task": {"goal_tolerance": 0.1, "termination_config": {"max_steps": 25, "max_collisions": 30}}}
+    runs = []
+    for compiled in (True, False):
+        with mock.patch.object(contacts_jit, "available", lambda floors, on=compiled: on):
+            env = VectorPointNavEnv(worlds, **kwargs)
+            to_np = env.arrays.numpy
+            out = [[to_np(env.reset(options={"episodes": episodes})[0])]]
+            for act in actions:
+                obs, reward, terminated, truncated, info = env.step(act)
+                out.append([to_np(v) for v in (obs, reward, terminated, truncated, info["in_contact"],
+                                               env._state["x"], env._state["y"], env._state["yaw"])])
+        runs.append(out)
+    for t, (got, want) in enumerate(zip(*runs)):
+        for g, w in zip(got, want):
+            if g.dtype == np.bool_:
+                np.testing.assert_array_equal(g, w, err_msg=f"step {t}")
+            else:
+                np.testing.assert_allclose(g, w, rtol=0.0, atol=1e-9, err_msg=f"step {t}")

@@ -5,7 +5,7 @@ of 2 to 4 robots and random action sequences, ``VectorPointNavEnv(W, n_robots=R)
 matches ``W`` separate ``parallel_env(n_robots=R, backend="kinematic")`` step for step
 (observations within 1e-4, rewards within 1e-5, the same terminated, truncated and active
 flags, success, SPL and SoftSPL) over whole episodes and their autoresets, with parked or
-removed finished robots, with or without a range scan and a local map (both see the other
+removed finished robots, differential or holonomic, with or without a range scan and a local map (both see the other
 robots of its world; the map's codes are equal, except at a cell centre on a cell edge or
 a disc's rim, ``local_map_reference``), on numpy and on torch on the CPU; and the same with
 discrete actions (``action_space="discrete"``, random ``forward_step``, ``turn_angle`` and
@@ -22,6 +22,7 @@ import pytest
 from fleet_reference import compare_fleet, fleet_episodes
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
+from vector_reference import random_actions
 
 from pointnav_core.maps import FREE, OBSTACLE, VOID
 from pointnav_core.scenes import Scene
@@ -65,22 +66,22 @@ def crowded_scenes(draw: st.DrawFn) -> Scene:
     local_map=st.one_of(st.none(), st.fixed_dictionaries({
         "size": st.floats(0.2, 4.0), "cells": st.integers(1, 12), "dtype": st.sampled_from(["uint8", "float32"]),
     })),
+    drive=st.sampled_from(["differential", "holonomic"]),
 )
 def test_fleet_matches_parallel_envs(
     device: str, scene: Scene, seed: int, n_worlds: int, n_robots: int, steps: int, reward_type: str,
-    max_steps: int, max_cycles: int, finished: str, scan: dict | None, local_map: dict | None,
+    max_steps: int, max_cycles: int, finished: str, scan: dict | None, local_map: dict | None, drive: str,
 ) -> None:
     rng = np.random.default_rng(seed)
     # goal_tolerance 0.2 m: the multi-robot env keeps goals max(0.4, 0.36, 0.1) m apart.
     episodes = fleet_episodes(scene, n_worlds, n_robots, rng, goal_gap=0.4)
-    # Overshoot [-1, 1] (clipping), and drive straight ahead often, into walls and robots.
-    actions = rng.uniform(-1.2, 1.2, (steps, n_worlds, n_robots, 2)).astype(np.float32)
-    actions[rng.random((steps, n_worlds, n_robots)) < 0.4, 0] = 1.0
+    # Overshoot [-1, 1] (clipping), and drive straight ahead (and diagonally) often, into walls and robots.
+    actions = random_actions(rng, (steps, n_worlds, n_robots), drive)
     task = {"reward_type": reward_type, "goal_tolerance": 0.2,
             "termination_config": {"max_steps": max_steps, "max_collisions": 15}}
     sensors = {k: v for k, v in (("scan", scan), ("local_map", local_map)) if v is not None}
     compare_fleet(scene, episodes, actions, task=task, device=device, finished=finished, max_cycles=max_cycles,
-                  sensors=sensors or None)
+                  sensors=sensors or None, robot={"drive": drive})
 
 
 @st.composite
@@ -91,7 +92,7 @@ def robot_tasks(draw: st.DrawFn) -> dict:
         "goal_tolerance": draw(st.floats(0.05, 0.2)),
         "goal_in_polar": draw(st.booleans()),
         "termination_config": {"max_steps": draw(st.integers(5, 60)), "max_collisions": draw(st.integers(0, 20)),
-                               "fall_height": draw(st.sampled_from([0.01, 0.03, 0.1]))},
+                               "fall_height": draw(st.sampled_from([0.01, 0.03, 0.1, 0.2, 0.7, 2.0]))},
         "reward_config": {"r_potential": draw(st.floats(0.0, 2.0)), "r_collision": draw(st.floats(0.0, 1.0)),
                           "r_pointgoal": draw(st.floats(0.0, 20.0))},
     }
@@ -120,20 +121,23 @@ robot_specs = st.fixed_dictionaries({"radius": st.sampled_from([0.18, 0.05, 0.1,
     finished=st.sampled_from(["park", "remove"]),
     scan=st.booleans(),
     local_map=st.booleans(),
+    drive=st.sampled_from(["differential", "holonomic"]),
 )
 def test_fleet_with_per_robot_lists_matches_parallel_envs(
     device: str, scene: Scene, seed: int, n_worlds: int, lists: tuple, steps: int, max_cycles: int,
-    finished: str, scan: bool, local_map: bool,
+    finished: str, scan: bool, local_map: bool, drive: str,
 ) -> None:
     """Per-robot ``task`` and ``robot`` lists (or one shared value) give each robot its own
     rewards, tolerance, limits, goal frame, speed limits and radius (its contacts, and its
-    disc in the others' scans and local maps), as in the multi-robot env."""
+    disc in the others' scans and local maps), as in the multi-robot env (every robot of
+    one drive)."""
     task, robot, n_robots = lists
+    if drive == "holonomic":
+        robot = [{**r, "drive": drive} for r in robot] if isinstance(robot, list) else {**(robot or {}), "drive": drive}
     rng = np.random.default_rng(seed)
     # The multi-robot env keeps goals max(tol_i + tol_j, r_i + r_j, cell) apart: 0.4 m at most here.
     episodes = fleet_episodes(scene, n_worlds, n_robots, rng, radius=0.2, goal_gap=0.4)
-    actions = rng.uniform(-1.2, 1.2, (steps, n_worlds, n_robots, 2)).astype(np.float32)
-    actions[rng.random((steps, n_worlds, n_robots)) < 0.4, 0] = 1.0
+    actions = random_actions(rng, (steps, n_worlds, n_robots), drive)
     sensors = {"scan": {"n_rays": 8, "max_range": 2.0}} if scan else {}
     if local_map:
         sensors["local_map"] = {"size": 1.6, "cells": 8}
@@ -197,11 +201,12 @@ def test_one_slow_robot_resolves_as_in_the_multi_robot_resolver(
     stop=st.booleans(),
     scan=st.one_of(st.none(), st.fixed_dictionaries({"n_rays": st.integers(1, 16), "max_range": st.floats(0.3, 3.0)})),
     local_map=st.one_of(st.none(), st.fixed_dictionaries({"size": st.floats(0.2, 4.0), "cells": st.integers(1, 12)})),
+    drive=st.sampled_from(["differential", "holonomic"]),
 )
 def test_fleet_discrete_matches_parallel_envs(
     device: str, scene: Scene, seed: int, n_worlds: int, n_robots: int, steps: int, reward_type: str,
     max_steps: int, max_cycles: int, finished: str, forward_step: float, turn_angle: float, stop: bool,
-    scan: dict | None, local_map: dict | None,
+    scan: dict | None, local_map: dict | None, drive: str,
 ) -> None:
     """Discrete actions (each robot's for its control steps, all robots of a world together,
     cut short by contacts; STOP) as the multi-robot env runs them."""
@@ -216,4 +221,42 @@ def test_fleet_discrete_matches_parallel_envs(
     discrete = {"forward_step": forward_step, "turn_angle": turn_angle, "stop": stop}
     sensors = {k: v for k, v in (("scan", scan), ("local_map", local_map)) if v is not None}
     compare_fleet(scene, episodes, actions, task=task, device=device, finished=finished, max_cycles=max_cycles,
-                  sensors=sensors or None, action_space="discrete", discrete_actions=discrete)
+                  sensors=sensors or None, action_space="discrete", discrete_actions=discrete, robot={"drive": drive})
+
+
+@pytest.mark.parametrize("device", DEVICES)
+@settings(max_examples=10, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(
+    scene=crowded_scenes(),
+    seed=st.integers(0, 2**31 - 1),
+    n_worlds=st.integers(1, 3),
+    lists=st.integers(2, 4).flatmap(lambda r: st.tuples(
+        st.one_of(robot_tasks(), st.lists(robot_tasks(), min_size=r, max_size=r)),
+        st.lists(robot_specs, min_size=r, max_size=r),
+        st.just(r),
+    )),
+    steps=st.integers(1, 60),
+    max_cycles=st.integers(3, 50),
+    finished=st.sampled_from(["park", "remove"]),
+    forward_step=st.floats(0.02, 0.4),
+    turn_angle=st.floats(0.05, 1.5),
+    stop=st.booleans(),
+)
+def test_fleet_discrete_with_per_robot_speeds_matches_parallel_envs(
+    device: str, scene: Scene, seed: int, n_worlds: int, lists: tuple, steps: int, max_cycles: int,
+    finished: str, forward_step: float, turn_angle: float, stop: bool,
+) -> None:
+    """Discrete actions of robots whose speed limits differ: each robot holds its action for
+    its own number of control steps, and a world runs as many as its longest action, as in
+    the multi-robot env."""
+    task, robot, n_robots = lists
+    rng = np.random.default_rng(seed)
+    # No goal at a start: after a straight MOVE_FORWARD from it the goal lies exactly behind,
+    # where a polar goal's angle is +pi or -pi by the last bit of a cosine (torch's or math's).
+    episodes = fleet_episodes(scene, n_worlds, n_robots, rng, goal_gap=0.4)
+    n_actions = 4 if stop else 3
+    weights = np.array([0.5, 0.2, 0.2, 0.1][:n_actions])
+    actions = rng.choice(n_actions, size=(steps, n_worlds, n_robots), p=weights / weights.sum())
+    discrete = {"forward_step": forward_step, "turn_angle": turn_angle, "stop": stop}
+    compare_fleet(scene, episodes, actions, task=task, robot=robot, device=device, finished=finished,
+                  max_cycles=max_cycles, action_space="discrete", discrete_actions=discrete)

@@ -4,7 +4,7 @@ For random grid scenes (clutter, walls, a hole to fall into), fixed random episo
 random action sequences, ``VectorPointNavEnv`` matches separate ``PointNavEnv``s on the
 kinematic backend step for step (observations within 1e-4, rewards within 1e-5, the same
 flags, success, SPL and SoftSPL) over whole episodes and their autoresets, on numpy and
-on torch on the CPU; with a local map, its codes equal the single env's except at a cell
+on torch on the CPU, with differential and holonomic robots; with a local map, its codes equal the single env's except at a cell
 centre on a cell edge (``local_map_reference``).
 """
 
@@ -16,7 +16,7 @@ import numpy as np
 import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
-from vector_reference import compare, random_episodes
+from vector_reference import compare, random_actions, random_episodes
 
 from pointnav_core.maps import FREE, OBSTACLE, VOID
 from pointnav_core.scenes import Scene
@@ -50,15 +50,17 @@ def cluttered_scenes(draw: st.DrawFn) -> Scene:
     steps=st.integers(1, 160),
     reward_type=st.sampled_from(["l2", "geodesic"]),
     max_steps=st.integers(5, 80),
+    drive=st.sampled_from(["differential", "holonomic"]),
 )
-def test_vector_matches_single_envs(device: str, scene: Scene, seed: int, n: int, steps: int, reward_type: str, max_steps: int) -> None:
+def test_vector_matches_single_envs(
+    device: str, scene: Scene, seed: int, n: int, steps: int, reward_type: str, max_steps: int, drive: str
+) -> None:
     rng = np.random.default_rng(seed)
     episodes = random_episodes(scene, n, rng)
-    # Overshoot [-1, 1] (clipping), and drive straight ahead often, into walls.
-    actions = rng.uniform(-1.2, 1.2, (steps, n, 2)).astype(np.float32)
-    actions[rng.random((steps, n)) < 0.4, 0] = 1.0
+    # Overshoot [-1, 1] (clipping), and drive straight ahead (and diagonally) often, into walls.
+    actions = random_actions(rng, (steps, n), drive)
     task = {"reward_type": reward_type, "termination_config": {"max_steps": max_steps, "max_collisions": 20}}
-    compare(scene, episodes, actions, task=task, device=device)
+    compare(scene, episodes, actions, task=task, device=device, robot={"drive": drive})
 
 
 @pytest.mark.parametrize("device", DEVICES)
@@ -152,10 +154,11 @@ def test_wall_table_holds_every_wall_within_reach(scene: Scene, seed: int, reach
     forward_step=st.floats(0.02, 0.6),
     turn_angle=st.floats(0.05, 1.5),
     stop=st.booleans(),
+    drive=st.sampled_from(["differential", "holonomic"]),
 )
 def test_vector_discrete_matches_single_envs(
     device: str, scene: Scene, seed: int, n: int, steps: int, reward_type: str, max_steps: int,
-    forward_step: float, turn_angle: float, stop: bool,
+    forward_step: float, turn_angle: float, stop: bool, drive: str,
 ) -> None:
     """Discrete actions (several control steps each, cut short by contacts; STOP) as the single env runs them."""
     rng = np.random.default_rng(seed)
@@ -167,4 +170,5 @@ def test_vector_discrete_matches_single_envs(
     actions = rng.choice(n_actions, size=(steps, n), p=weights / weights.sum())
     task = {"reward_type": reward_type, "termination_config": {"max_steps": max_steps, "max_collisions": 20}}
     discrete = {"forward_step": forward_step, "turn_angle": turn_angle, "stop": stop}
-    compare(scene, episodes, actions, task=task, device=device, action_space="discrete", discrete_actions=discrete)
+    compare(scene, episodes, actions, task=task, device=device, action_space="discrete", discrete_actions=discrete,
+            robot={"drive": drive})

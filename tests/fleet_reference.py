@@ -76,7 +76,7 @@ def compare_fleet(
         sobs[i] = [obs[a] for a in agents]
         ties[i] = [obs_ties(env, k, sensors, dim) for k in range(r)]
     stats = {"ends": 0, "successes": 0, "contacts": 0, "autoresets": 0, "robot_contacts": 0, "parked_steps": 0,
-             "falls": 0, "stops": 0, "map_ties": 0}
+             "falls": 0, "stops": 0, "map_ties": 0, "falling_steps": 0}
     assert to_np(vinfo["active"]).all()
     for t, act in enumerate(actions):
         stats["map_ties"] += assert_obs(to_np(vobs), sobs, ties, OBS_TOL, f"observations before step {t}")
@@ -120,6 +120,10 @@ def compare_fleet(
                 stats["contacts"] += bool(vinfo["in_contact"][i, k])
                 stats["robot_contacts"] += bool(vinfo["in_contact"][i, k]) and _touches_robot(env, k)
                 stats["falls"] += bool(term[a]) and env.backend.get_pose(k)[0][2] < env.tasks[k].floor_height
+                stats["falling_steps"] += not term[a] and env.backend.get_pose(k)[0][2] < env.tasks[k].floor_height
+            # Every robot's height, falls over several steps included (parked falling robots too).
+            z = np.array([env.backend.get_pose(k)[0][2] for k in range(r)])
+            np.testing.assert_allclose(to_np(venv._state["z"])[i], z, rtol=0, atol=1e-9, err_msg=f"z {where}")
     return stats
 
 

@@ -103,16 +103,45 @@ def test_make_vec_builds_the_batched_engine() -> None:
     assert reward.dtype == np.float64 and terminated.dtype == truncated.dtype == np.bool_ and env.observation_space.contains(obs)
 
 
-@pytest.mark.parametrize("n_robots", [1, 3])
-@pytest.mark.parametrize(("frequency", "fall_height"), [(10.0, 0.15), (10.0, 0.2), (30.0, 0.05)])
-def test_a_fall_height_a_fall_would_not_pass_in_one_step_is_refused(n_robots: int, frequency: float, fall_height: float) -> None:
-    # A fall's first drop (the backend's): max(1 m/s x dt + 9.81 m/s^2 x dt^2 / 2, 0.05 m),
-    # 0.14905 m at 10 Hz and 0.05 m at 30 Hz; the batched engines end a fall in that step.
-    task = {"termination_config": {"fall_height": fall_height}}
-    with pytest.raises(ValueError, match=r"task: fall_height must be below a fall's first drop"):
-        VectorPointNavEnv(2, n_robots=n_robots, scene=room(), task=task, action_frequency=frequency, pool_size=1)
-    ok = {"termination_config": {"fall_height": 0.149 if frequency == 10.0 else 0.0499}}
-    VectorPointNavEnv(2, n_robots=n_robots, scene=room(), task=ok, action_frequency=frequency, pool_size=1)
+@pytest.mark.parametrize("device", DEVICES)
+@pytest.mark.parametrize("n_robots", [1, 2])
+def test_a_fall_goes_on_over_three_steps_by_hand(device: str, n_robots: int) -> None:
+    # VOID from x = 1.1 m (y 0.5 to 2.5 m); robot 0 at x = 0.92 m drives +x at 0.05 m a step,
+    # so its centre is over VOID after step 4 (x = 1.12 m). The backend's fall at 10 Hz:
+    # step 4 drops 1 m/s x 0.1 s + 9.81 x 0.1^2 / 2 = 0.14905 m (speed then 1.981 m/s),
+    # step 5 0.1981 + 0.04905 = 0.24715 m (2.962 m/s), step 6 0.2962 + 0.04905 = 0.34525 m:
+    # z = -0.14905, -0.39620, -0.74145 m. With fall_height 0.5 m the episode ends at step 6.
+    grid = np.zeros((30, 40), np.uint8)
+    grid[0, :] = grid[-1, :] = grid[:, 0] = grid[:, -1] = OBSTACLE
+    grid[5:25, 11:15] = VOID
+    task = {"reward_type": "l2", "termination_config": {"fall_height": 0.5}}
+    first = ((0.92, 1.5), 0.0, (3.0, 1.5))
+    if n_robots == 1:
+        env = VectorPointNavEnv(1, scene=Scene.from_array(grid, 0.1), task=task, device=device)
+        episodes: list = [first]
+    else:  # a second robot that stands still far away
+        env = VectorPointNavEnv(1, n_robots=2, scene=Scene.from_array(grid, 0.1), task=task, device=device)
+        episodes = [[first, ((3.0, 2.5), 0.0, (3.5, 0.5))]]
+    to_np = env.arrays.numpy
+    obs, _ = env.reset(options={"episodes": episodes})
+    want_z = {4: -0.14905, 5: -0.39620, 6: -0.74145}
+    assert float(env.single_observation_space.low[4]) > -1.4905  # so the clip below is seen
+    for step in range(1, 7):
+        obs, reward, terminated, _, info = env.step(np.array([[[1.0, 0.0]] * n_robots] if n_robots > 1 else [[1.0, 0.0]]))
+        z = float(to_np(env._state["z"]).reshape(-1)[0])
+        o, r = to_np(obs).reshape(n_robots, -1)[0], float(to_np(reward).reshape(-1)[0])
+        assert z == pytest.approx(want_z.get(step, 0.0), abs=1e-12), f"step {step}"
+        assert bool(to_np(terminated).reshape(-1)[0]) == (step == 6), f"step {step}"
+        x = float(to_np(env._state["x"]).reshape(-1)[0])
+        assert x == pytest.approx(min(0.92 + 0.05 * step, 1.12), abs=1e-12)
+        # Driving at 0.5 m/s until the fall's first step; then no planar motion, no reward.
+        assert o[2] == pytest.approx(0.5 if step <= 4 else 0.0, abs=1e-6)
+        # vz: the step's drop over 0.1 s, clipped to the observation's bound.
+        vz = {4: -1.4905, 5: -2.4715, 6: -3.4525}.get(step, 0.0)
+        assert o[4] == pytest.approx(max(vz, float(env.single_observation_space.low[4])), abs=1e-6)
+        assert r == pytest.approx(0.05 if step <= 4 else 0.0, abs=1e-9)
+    if n_robots == 2:  # the fallen robot leaves; the other goes on
+        assert to_np(info["active"]).tolist() == [[False, True]]
 
 
 @pytest.mark.parametrize("device", ["gpu", "cuda:x", 0, "numpy "])
@@ -144,7 +173,7 @@ def test_bad_actions_are_refused(device: str, actions: np.ndarray) -> None:
 
 @pytest.mark.parametrize(("kwargs", "name"), [({"n_robots": 0}, "n_robots"), ({"sensors": {"lidar": {}}}, "sensors"),
                                              ({"num_envs": 0}, "num_envs"), ({"pool_size": 0}, "pool_size"),
-                                             ({"robot": {"drive": "holonomic"}}, "robot")])
+                                             ({"robot": {"drive": "tank"}}, "drive")])
 def test_unsupported_arguments_are_named(kwargs: dict, name: str) -> None:
     args = {"num_envs": 1, "scene": room(), **kwargs}
     with pytest.raises(ValueError, match=name):

@@ -200,7 +200,7 @@ def test_bad_actions_are_refused(device: str, actions: np.ndarray) -> None:
     ({"n_robots": 2, "finished": "vanish"}, "finished"), ({"n_robots": 2, "max_cycles": 0}, "max_cycles"),
     ({"max_cycles": 10}, "max_cycles"), ({"finished": "park"}, "finished"),
     ({"n_robots": 2, "sensors": {"lidar": {}}}, "sensors"), ({"n_robots": 2, "pool_size": 0}, "pool_size"),
-    ({"n_robots": 2, "robot": {"drive": "holonomic"}}, "robot"), ({"n_robots": 2, "device": "tpu"}, "device"),
+    ({"n_robots": 2, "robot": [{}, {"drive": "holonomic"}]}, "robot"), ({"n_robots": 2, "device": "tpu"}, "device"),
 ])
 def test_unsupported_arguments_are_named(kwargs: dict, name: str) -> None:
     with pytest.raises(ValueError, match=name):

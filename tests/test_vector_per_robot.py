@@ -106,7 +106,7 @@ def two_floors() -> Scene:
     ({"task": [{"floor": 0}, {"floor": 1}], "scene": two_floors()}, r"^task: .*same floor"),
     ({"robot": [{}]}, r"^robot must be one value for all robots or a list .*got a list of 1"),
     ({"robot": [{}, "fast"]}, r"^robot\[1\] must be a RobotSpec"),
-    ({"robot": [{}, {"drive": "holonomic"}]}, r"^robot\[1\] must have a differential drive"),
+    ({"robot": [{}, {"drive": "holonomic"}]}, r"^robot: every robot must have the same drive .*\['differential', 'holonomic'\]"),
     ({"robot": [{}, {"max_linear_velocity": 0.8}]}, r"^action_frequency"),
 ])
 def test_bad_lists_are_named(kwargs: dict, words: str) -> None:
@@ -134,12 +134,6 @@ def test_discrete_actions_take_task_lists(device: str) -> None:
     stats = compare_fleet(room(20, 16), episodes, actions, task=tasks, robot=[{"radius": 0.18}] * 2, device=device,
                           action_space="discrete", discrete_actions={"forward_step": 0.1, "stop": True})
     assert stats["ends"] > 3 and stats["successes"] > 0
-
-
-def test_discrete_actions_refuse_robots_of_different_speeds() -> None:
-    with pytest.raises(ValueError, match=r"^robot: .*speed limits differ.*discrete"):
-        VectorPointNavEnv(1, n_robots=2, scene=room(), pool_size=1, action_space="discrete",
-                          robot=[{}, {"max_linear_velocity": 0.25}])
 
 
 # Two robots of radii 0.1 and 0.3 m face each other on y = 1 m, centres 0.72 m apart.
@@ -203,3 +197,43 @@ def test_discrete_actions_take_robots_of_different_radii() -> None:
                             robot=[{"radius": 0.1}, {"radius": 0.3}])
     env.reset(options={"episodes": [RADII_EPISODE]})
     env.step(np.zeros((1, 2), np.int64))
+
+
+@pytest.mark.parametrize("device", DEVICES)
+def test_discrete_actions_of_robots_of_different_speeds_by_hand(device: str) -> None:
+    # 10 Hz, MOVE_FORWARD 0.25 m, turns 10 deg. Robot 0 (0.5 m/s, 1.5 rad/s): forward in
+    # 0.25 / 0.05 = 5 control steps, a turn in ceil(0.1745 / 0.15) = 2. Robot 1 (0.25 m/s,
+    # 0.5 rad/s): forward in 0.25 / 0.025 = 10, a turn in ceil(0.1745 / 0.05) = 4.
+    robots = [{}, {"max_linear_velocity": 0.25, "max_angular_velocity": 0.5}]
+    env = VectorPointNavEnv(1, n_robots=2, scene=room(), robot=robots, device=device, action_space="discrete")
+    to_np = env.arrays.numpy
+    env.reset(options={"episodes": [[((0.5, 0.5), 0.0, (3.5, 0.5)), ((0.5, 1.5), 0.0, (3.5, 1.5))]]})
+    assert to_np(env._discrete.steps).tolist() == [[5, 2, 2, 1], [10, 4, 4, 1]]
+    # Both forward: the world runs 10 control steps; robot 0 drives in the first 5 and then
+    # stands (zero velocity at the end), robot 1 drives in all 10. Both end 0.25 m ahead.
+    obs, _, _, _, info = env.step(np.array([[0, 0]]))
+    np.testing.assert_allclose(to_np(env._state["x"])[0], [0.75, 0.75], atol=1e-12)
+    np.testing.assert_allclose(to_np(obs)[0, :, 2], [0.0, 0.25], atol=1e-6)  # forward speed (m/s)
+    assert to_np(info["episode_length"]).tolist() == [[1, 1]]
+    np.testing.assert_allclose(to_np(info["path_length"])[0], [0.25, 0.25], atol=1e-12)
+    # Robot 0 forward (5 steps) while robot 1 turns left (4 steps): robot 0 drives to the end of
+    # the world's 5 steps, robot 1 turns 10 deg at 0.436 rad/s and stands in the 5th.
+    obs, _, _, _, _ = env.step(np.array([[0, 1]]))
+    np.testing.assert_allclose(to_np(env._state["x"])[0], [1.0, 0.75], atol=1e-12)
+    np.testing.assert_allclose(to_np(env._state["yaw"])[0], [0.0, math.radians(10.0)], atol=1e-12)
+    np.testing.assert_allclose(to_np(obs)[0, :, 2], [0.5, 0.0], atol=1e-6)
+    np.testing.assert_allclose(to_np(obs)[0, :, 7], [0.0, 0.0], atol=1e-6)  # yaw rate (rad/s)
+
+
+@pytest.mark.parametrize("device", DEVICES)
+def test_discrete_actions_of_robots_of_different_speeds_match_parallel_envs(device: str) -> None:
+    # Each robot holds its action for its own number of control steps; the world runs its
+    # longest. Crowded, so that robots of different speeds meet and the slow one is cut short.
+    rng = np.random.default_rng(9)
+    robots = [{"max_linear_velocity": 0.5}, {"max_linear_velocity": 0.2, "max_angular_velocity": 0.6},
+              {"max_linear_velocity": 0.35, "max_angular_velocity": 2.0}]
+    episodes = fleet_episodes(room(20, 16), 3, 3, rng, goal_gap=0.45, at_start=0.3)
+    actions = rng.choice(4, size=(60, 3, 3), p=[0.55, 0.2, 0.15, 0.1])
+    stats = compare_fleet(room(20, 16), episodes, actions, robot=robots, device=device, task={"goal_tolerance": 0.2},
+                          action_space="discrete", discrete_actions={"forward_step": 0.3, "stop": True})
+    assert stats["ends"] > 3 and stats["contacts"] > 0 and stats["robot_contacts"] > 0

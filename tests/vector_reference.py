@@ -64,7 +64,7 @@ def compare(
     ties = np.array([obs_ties(env, 0, sensors, dim) for env in singles])
     ended = [False] * n
     stats = {"ends": 0, "successes": 0, "contacts": 0, "autoresets": 0, "obs_diff": 0.0, "reward_diff": 0.0,
-             "map_ties": 0}
+             "map_ties": 0, "falling_steps": 0}
     for t, act in enumerate(actions):
         stats["map_ties"] += assert_obs(to_np(vobs), sobs, ties, OBS_TOL, f"observations before step {t}")
         stats["obs_diff"] = max(stats["obs_diff"], float(np.where(ties, 0.0, np.abs(to_np(vobs) - sobs)).max()))
@@ -81,6 +81,10 @@ def compare(
                 obs, reward, term, trunc, info = env.step(act[i])
             ended[i] = term or trunc
             sobs[i] = obs
+            # The robot's height, falls over several steps included (the engine's state).
+            z = float(env.backend.get_pose(0)[0][2])
+            assert abs(z - float(to_np(venv._state["z"])[i])) <= 1e-9, f"z world {i}, step {t}"
+            stats["falling_steps"] += info is not None and z < env.task.floor_height and not term
             ties[i] = obs_ties(env, 0, sensors, dim)
             where = f"world {i}, step {t}"
             assert abs(reward - vrew[i]) <= REWARD_TOL, f"reward {where}: {reward} vs {vrew[i]}"
@@ -105,3 +109,17 @@ def random_episodes(scene: Any, n: int, rng: np.random.Generator, radius: float 
         _, goal = scene.get_random_point(0, robot=radius, rng=rng)
         out.append((start[:2], float(rng.uniform(-math.pi, math.pi)), goal[:2]))
     return out
+
+
+def random_actions(rng: np.random.Generator, shape: tuple[int, ...], drive: str = "differential") -> np.ndarray:
+    """Float32 actions of ``shape + (action_dim,)`` for ``drive``: uniform in [-1.2, 1.2]
+    (clipping), full speed ahead 40 % of the time (into walls and robots), and for a
+    holonomic robot full speed diagonally 30 % of the time (a step of sqrt(2) times the top
+    speed: the backend's two sub-steps)."""
+    dim = 3 if drive == "holonomic" else 2
+    actions = rng.uniform(-1.2, 1.2, (*shape, dim)).astype(np.float32)
+    actions[rng.random(shape) < 0.4, 0] = 1.0
+    if dim == 3:
+        diagonal = rng.random(shape) < 0.3
+        actions[diagonal, :2] = rng.choice([-1.0, 1.0], size=(int(diagonal.sum()), 2))
+    return actions

@@ -58,8 +58,11 @@ def _divmod(xp: Any, a: Any, b: Any) -> tuple[Any, Any]:
 
 def _nearest(xp: Any, dist: Any, k: int) -> Any:
     """Indices of the ``k`` smallest distances of each row, in their original order."""
-    order = xp.argsort(dist, -1)[..., :k]
-    return xp.sort(order, -1)[0] if hasattr(xp, "Tensor") else xp.sort(order, -1)
+    # A stable sort: of walls at equal distances (common on a grid) the first ones are kept
+    # on numpy, torch and in the compiled kernel alike (torch's default sort is not stable).
+    if hasattr(xp, "Tensor"):
+        return xp.sort(xp.argsort(dist, dim=-1, stable=True)[..., :k], -1)[0]
+    return xp.sort(xp.argsort(dist, -1, kind="stable")[..., :k], -1)
 
 
 def _take(xp: Any, a: Any, idx: Any) -> Any:

@@ -41,10 +41,9 @@ from pointnav_core.vector.xp import Arrays
 
 __all__ = ["DiscretePlan"]
 
-_GRAVITY = 9.81  # m/s^2, the kinematic backend's
-_FALL_SPEED = 1.0  # m/s at the start of a fall, the kinematic backend's default fall_speed
-# The state a control step changes: pose, height and the backend's velocities.
-MOVED = ("x", "y", "yaw", "z", "vx", "vy", "w", "vz")
+# The state a control step changes: pose, height, the backend's velocities and the fall
+# speed (m/s, 0 while standing; vector.falls).
+MOVED = ("x", "y", "yaw", "z", "vx", "vy", "w", "vz", "fs")
 
 
 class DiscretePlan:
@@ -54,8 +53,10 @@ class DiscretePlan:
     ----------
     actions : DiscreteActions
         The action set (as the single env's ``discrete_actions`` makes it).
-    robot : RobotSpec
-        The robot (top speeds, differential drive).
+    robot : RobotSpec or sequence of RobotSpec
+        The robot (top speeds and drive; a holonomic command is ``(vx, 0, w)``), or one
+        per robot of a world: then every robot has its own commands and control steps per
+        action (a slower robot holds MOVE_FORWARD for more steps), as in the multi-robot env.
     action_frequency : float
         Control steps per second (Hz).
     arrays : Arrays
@@ -63,26 +64,40 @@ class DiscretePlan:
 
     Attributes
     ----------
-    commands : array, shape (n, 2)
-        Each action's command in ``[-1, 1]`` units (forward, yaw rate).
-    steps : array of int, shape (n,)
+    commands : array, shape (n, action_dim), or (R, n, action_dim) with one robot spec per robot
+        Each action's command in ``[-1, 1]`` units (forward, yaw rate; a holonomic robot's
+        has a zero sideways speed between them).
+    steps : array of int, shape (n,), or (R, n) with one robot spec per robot
         Each action's control steps.
     n : int
         Number of actions.
     max_steps : int
-        The most control steps any action takes.
+        The most control steps any action takes (of any robot).
     stop : int or None
         The index of STOP, or None when STOP is not an action.
+
+    Examples
+    --------
+    >>> from pointnav_core.backend import RobotSpec
+    >>> from pointnav_core.vector.xp import make_arrays
+    >>> slow = RobotSpec(max_linear_velocity=0.25)
+    >>> DiscretePlan(DiscreteActions(), [RobotSpec(), slow], 10.0, make_arrays("numpy")).steps.tolist()
+    [[5, 2, 2, 1], [10, 2, 2, 1]]
     """
 
     def __init__(self, actions: DiscreteActions, robot: Any, action_frequency: float, arrays: Arrays) -> None:
-        plan = actions.commands(robot, action_frequency)
+        per_robot = isinstance(robot, (list, tuple))
+        plans = [actions.commands(spec, action_frequency) for spec in (robot if per_robot else [robot])]
         self.arrays = arrays
         self.actions = actions
-        self.commands = arrays.asarray(np.stack([command for command, _ in plan]))
-        self.steps = arrays.asarray([steps for _, steps in plan], arrays.i64)
-        self.n = len(plan)
-        self.max_steps = max(steps for _, steps in plan)
+        commands = np.stack([np.stack([command for command, _ in plan]) for plan in plans])
+        steps = np.array([[n_steps for _, n_steps in plan] for plan in plans], np.int64)
+        self.commands = arrays.asarray(commands if per_robot else commands[0])
+        self.steps = arrays.asarray(steps if per_robot else steps[0], arrays.i64)
+        # Gathers (robot, action) with several robots: robot ids (1, R) beside the actions (W, R).
+        self._robots = arrays.asarray(np.arange(len(plans)).reshape(1, -1), arrays.i64) if per_robot else None
+        self.n = len(plans[0])
+        self.max_steps = int(steps.max())
         self.stop = STOP if actions.stop else None
 
     def check(self, actions: Any, num_envs: int, n_robots: int | None = None) -> Any:
@@ -142,12 +157,12 @@ class DiscretePlan:
             The worlds (robots) that called STOP, or None without STOP.
         """
         a, xp = self.arrays, self.arrays.xp
-        command, steps = self.commands[index], self.steps[index]
+        if self._robots is None:
+            command, steps = self.commands[index], self.steps[index]
+        else:  # one plan per robot: (robot, action) pairs
+            command, steps = self.commands[self._robots, index], self.steps[self._robots, index]
         state = {key: env._state[key] for key in MOVED}
         contact = xp.zeros_like(index) > 0
-        z_start, dt = state["z"], env.dt
-        fall_speed = xp.zeros_like(z_start)  # m/s, of the worlds that fell in an earlier sub-step
-        zero = xp.zeros_like(z_start)
         for k in range(self.max_steps):
             lasts = steps > k
             if acting is None:
@@ -160,18 +175,10 @@ class DiscretePlan:
                 active = lasts.any(-1)[:, None]
             if not a.any(active):
                 break
-            falling = state["z"] < z_start
+            # A falling robot ignores its command and drops, faster each step (env._drive, vector.falls).
             moved, touched = env._drive(xp.where(running[..., None], command, 0.0 * command), state)
-            # A falling robot no longer drives: it only drops, faster each step (the backend's _fall).
-            drop = fall_speed * dt + 0.5 * _GRAVITY * dt * dt
-            fell = {"x": state["x"], "y": state["y"], "yaw": state["yaw"], "z": state["z"] - drop,
-                    "vx": zero, "vy": zero, "w": zero, "vz": -drop / dt}
-            moved = {key: xp.where(falling, fell[key], moved[key]) for key in MOVED}
             state = {key: xp.where(active, moved[key], state[key]) for key in MOVED}
-            began = active & ~falling & (state["z"] < z_start)
-            fall_speed = xp.where(began, _FALL_SPEED + _GRAVITY * dt,
-                                  xp.where(active & falling, fall_speed + _GRAVITY * dt, fall_speed))
-            contact = contact | (active & touched & ~falling)
+            contact = contact | (active & touched)
         stopped = None if self.stop is None else index == self.stop
         return state, contact, stopped
 

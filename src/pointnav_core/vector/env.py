@@ -22,19 +22,18 @@ from pointnav_core import _envcommon, scenes, validation
 from pointnav_core.vector import contacts_jit
 from pointnav_core.vector.contacts import advance
 from pointnav_core.vector.discrete import MOVED, DiscretePlan
+from pointnav_core.vector.drive import arc, body_command, sub_steps, substep_drive, travel
 from pointnav_core.vector.episodes import EpisodePool
+from pointnav_core.vector.falls import apply_falls, first_drop
 from pointnav_core.vector.floors import FloorTables
 from pointnav_core.vector.local_map import VectorLocalMap, local_map_term
 from pointnav_core.vector.refresh import PoolRefreshing
 from pointnav_core.vector.scan import ScanTables, VectorScan
 from pointnav_core.vector.xp import make_arrays
 
-__all__ = ["VectorPointNavEnv"]
+__all__ = ["VectorPointNavEnv", "first_drop"]
 
-_GRAVITY = 9.81
-_MIN_FIRST_DROP = 0.05
-_FALL_SPEED = 1.0  # the kinematic backend's default fall_speed (m/s)
-_MAX_TURN = 0.25  # rad per control step the backend resolves without sub-steps
+_MAX_TURN = 0.25  # rad per control step the rate check allows: the backend's sub-step turn
 
 
 def _scan_term(sensors: Mapping[str, Any] | None) -> Any:
@@ -65,42 +64,12 @@ def _task_arguments(task: Mapping[str, Any] | None) -> dict[str, Any]:
     return dict(task or {})
 
 
-def first_drop(dt: float) -> float:
-    """How far (m) a robot drops in the control step of ``dt`` (s) in which it begins to
-    fall: the kinematic backend's ``max(fall_speed dt + g dt^2 / 2, 0.05 m)``."""
-    return max(_FALL_SPEED * dt + 0.5 * _GRAVITY * dt * dt, _MIN_FIRST_DROP)
-
-
-def check_fall_height(fall_height: float, dt: float, name: str = "task") -> None:
-    """ValueError naming ``name`` unless a fall ends the episode in the step it begins.
-
-    The batched engines drop a robot that starts to fall by the backend's first drop
-    (``max(fall_speed dt + g dt^2 / 2, 0.05 m)``) and end its episode there; they do not
-    carry a fall over later steps, so a ``fall_height`` (m) it does not pass is refused
-    rather than stepped differently from the single envs.
-    """
-    drop = first_drop(dt)
-    if not fall_height < drop:
-        raise ValueError(
-            f"{name}: fall_height must be below a fall's first drop, {drop:.6g} m at {1.0 / dt:g} Hz, in the "
-            f"batched engine (it ends a fall in the step it begins), got {fall_height!r}"
-        )
-
-
 def _scene_list(scene: scenes.Scene | Sequence[scenes.Scene] | None) -> list[scenes.Scene]:
     """The worlds' scenes (default: the default house as a grid); ValueError if not Scenes."""
     scene_list = [scene] if isinstance(scene, scenes.Scene) else list(scene) if scene is not None else [_default_scene()]
     if not scene_list or not all(isinstance(s, scenes.Scene) for s in scene_list):
         raise ValueError(f"scene must be a Scene or a non-empty sequence of Scenes, got {scene!r}")
     return scene_list
-
-
-def _differential_robot(robot: Any) -> Any:
-    """The robot spec; ValueError unless it has a differential drive."""
-    spec = _envcommon.make_robot(robot)
-    if spec.drive != "differential":
-        raise ValueError(f"robot must have a differential drive in the batched engine, got {spec.drive!r}")
-    return spec
 
 
 class VectorPointNavEnv(PoolRefreshing, VectorEnv):
@@ -124,15 +93,18 @@ class VectorPointNavEnv(PoolRefreshing, VectorEnv):
         World ``i`` runs on ``scene[i % len(scene)]``. Floors must be grid cells only (no
         obstacle polygons). Default: the single env's default house as a grid.
     robot : RobotSpec or dict, optional
-        Differential drive only. With several robots per world, also a list with one entry
-        per robot, as for :func:`~pointnav_core.parallel.parallel_env`: their speed limits
-        and radii may differ.
+        As for the single env: a differential drive (actions ``(v, w)``) or a holonomic one
+        (actions ``(vx, vy, w)`` in the robot frame, +x ahead, +y to the left), scaled and
+        integrated as the kinematic backend does (:mod:`pointnav_core.vector.drive`). With
+        several robots per world, also a list with one entry per robot, as for
+        :func:`~pointnav_core.parallel.parallel_env`: their speed limits and radii may
+        differ, their drive may not (the actions are one array).
     task : dict, optional
         ``PointNavigationTask`` keyword arguments, as for the single env (its default
-        ``path_range`` too). Custom terms are not supported. A fall ends in the step it
-        begins, so ``fall_height`` must be below a fall's first drop (0.149 m at 10 Hz;
-        :func:`check_fall_height`). With several robots per world, also a list of one dict
-        per robot (see "Several robots per world").
+        ``path_range`` too). Custom terms are not supported. Any ``fall_height`` (m):
+        a fall goes on over as many control steps as it takes to pass it, as in the
+        single env (:mod:`pointnav_core.vector.falls`). With several robots per world,
+        also a list of one dict per robot (see "Several robots per world").
     sensors : dict, optional
         ``{"scan": {...}}`` (:class:`~pointnav_core.sensors.RangeScan` arguments, as for the
         single env): the flat observation is the 8 ``low_dim`` values, then the scan's
@@ -169,7 +141,8 @@ class VectorPointNavEnv(PoolRefreshing, VectorEnv):
     Notes
     -----
     ``step`` takes actions of shape ``(num_envs, 2)`` (or ``(num_envs, 1, 2)``) in
-    ``[-1, 1]`` (clipped), or with discrete actions integers of shape ``(num_envs,)``, and
+    ``[-1, 1]`` (clipped), ``(num_envs, 3)`` (or ``(num_envs, 1, 3)``) for a holonomic
+    robot, or with discrete actions integers of shape ``(num_envs,)``, and
     returns observations ``(num_envs, 8)`` float32 (``(num_envs, 8 + n_rays)`` with the
     scan, plus ``cells * cells`` with the local map), rewards float64, terminated and truncated bool, and ``info``, a dict of arrays of shape
     ``(num_envs,)``: ``success``, ``spl``, ``soft_spl``, ``path_length``,
@@ -188,7 +161,8 @@ class VectorPointNavEnv(PoolRefreshing, VectorEnv):
     robot-robot contact counts as a collision for both, every robot has its own task
     (rewards, terminations, SPL), and all robots still active are truncated after
     ``max_cycles`` steps. Every return carries the robot axis: ``step`` takes actions
-    ``(num_envs, R, 2)`` (all finite; those of inactive robots are ignored), or with
+    ``(num_envs, R, 2)`` (``(num_envs, R, 3)`` for holonomic robots; all finite, those of
+    inactive robots are ignored), or with
     ``action_space="discrete"`` integers ``(num_envs, R)`` (all in range), and returns
     observations ``(num_envs, R, 8)`` float32 (``(num_envs, R, 8 + n_rays)`` with the scan,
     which sees the other robots present in its world as the multi-robot env's scan does;
@@ -215,7 +189,8 @@ class VectorPointNavEnv(PoolRefreshing, VectorEnv):
     every world entry ``i``: its task's ``goal_tolerance``, ``reward_type``,
     ``goal_in_polar``, ``termination_config`` (``max_steps``, ``max_collisions``,
     ``fall_height``), ``reward_config`` and ``path_range`` and its robot's speed limits
-    (m/s, rad/s) and radius (m: walls at its radius, another robot at the sum of the two
+    (m/s, rad/s; with discrete actions, each robot's actions then last its own number of
+    control steps) and radius (m: walls at its radius, another robot at the sum of the two
     radii, its disc in the others' scans and maps) may differ; a list whose tasks'
     ``floor`` differ raises ``ValueError`` naming ``task``, as does a list of the wrong
     length or an entry of the wrong type (naming ``task[i]`` or ``robot[i]``).
@@ -279,7 +254,7 @@ class VectorPointNavEnv(PoolRefreshing, VectorEnv):
         self.arrays = make_arrays(device)
         self.device = device
         self.scenes = scene_list = _scene_list(scene)
-        self.robot = _differential_robot(robot)
+        self.robot = _envcommon.make_robot(robot)  # either drive (vector.drive)
         self._samplers = [
             PointNavEnv(scene=s, robot=self.robot, task=dict(task), sensors=sensors, flatten_obs=True,
                         action_frequency=action_frequency, action_space=action_space, discrete_actions=discrete_actions)
@@ -308,7 +283,8 @@ class VectorPointNavEnv(PoolRefreshing, VectorEnv):
         self._fixed: Any = None
         self.pool: EpisodePool | None = None  # sampled at the first reset that needs it
         n = self.num_envs
-        self._state = {k: a.zeros(n) for k in ("x", "y", "yaw", "z", "vx", "vy", "vz", "w", "gx", "gy", "d0", "pot", "path", "dist")}
+        # "fs": the fall speed (m/s), 0 while the robot stands (vector.falls).
+        self._state = {k: a.zeros(n) for k in ("x", "y", "yaw", "z", "vx", "vy", "vz", "w", "fs", "gx", "gy", "d0", "pot", "path", "dist")}
         self._field = a.zeros(n, a.i64)
         self._geo_metric = a.zeros(n, a.boolean)
         self._steps = a.zeros(n, a.i64)
@@ -330,11 +306,12 @@ class VectorPointNavEnv(PoolRefreshing, VectorEnv):
         cfg, rcfg = t.termination_config, t.reward_config
         self.max_steps, self.max_collisions = int(cfg["max_steps"]), int(cfg["max_collisions"])
         self.fall_height, self.goal_tolerance = float(cfg["fall_height"]), t.goal_tolerance
-        check_fall_height(self.fall_height, self.dt)
         self.r_potential, self.r_collision, self.r_pointgoal = (float(rcfg[k]) for k in ("r_potential", "r_collision", "r_pointgoal"))
         self.geodesic_reward = t.reward_type == "geodesic"
         self.goal_in_polar = bool(t.goal_in_polar)
         spec = self.robot
+        # Top speed on one axis: a holonomic robot's diagonal step may travel sqrt(2) times
+        # that, which the backend splits into sub-steps near walls, and so does vector.drive.
         if spec.max_angular_velocity * self.dt > _MAX_TURN or spec.max_linear_velocity * self.dt > 0.5 * min(
             float(s.floors[t.floor].resolution) for s in self.scenes
         ):
@@ -342,8 +319,11 @@ class VectorPointNavEnv(PoolRefreshing, VectorEnv):
                 f"action_frequency {self.action_frequency} Hz is too low for the batched engine: one control "
                 "step may turn at most 0.25 rad and drive at most half a cell (the kinematic backend's sub-step)"
             )
-        # A chord is never longer than its arc; the margin covers rounding.
-        self._max_travel = spec.max_linear_velocity * self.dt * (1.0 + 1e-9) + 1e-12
+        self.holonomic = spec.drive == "holonomic"
+        # A chord is never longer than its arc (a holonomic one: the diagonal of its two
+        # top speeds); the margin covers rounding.
+        top = spec.max_linear_velocity * (math.sqrt(2.0) if self.holonomic else 1.0)
+        self._max_travel = top * self.dt * (1.0 + 1e-9) + 1e-12
 
     # ------------------------------------------------------------------ pools
     def _build_pool(self, fixed: Sequence[tuple[Any, float, Any, int]]) -> None:
@@ -412,7 +392,7 @@ class VectorPointNavEnv(PoolRefreshing, VectorEnv):
         for key, src in (("x", p.sx), ("y", p.sy), ("yaw", p.syaw), ("gx", p.gx), ("gy", p.gy), ("d0", p.d0)):
             st[key][idx] = src[e]
         st["z"][idx] = self.floors.height[self._world_scene[idx]]
-        for key in ("vx", "vy", "vz", "w", "path"):
+        for key in ("vx", "vy", "vz", "w", "fs", "path"):
             st[key][idx] = 0.0
         self._field[idx] = p.field[e]
         self._steps[idx] = 0
@@ -428,16 +408,19 @@ class VectorPointNavEnv(PoolRefreshing, VectorEnv):
         self._needs_reset[idx] = False
 
     def check_actions(self, actions: Any) -> Any:
-        """``actions`` as a float64 array ``(num_envs, 2)``, or with discrete actions an int64
-        array ``(num_envs,)``; ValueError naming ``actions`` if bad."""
+        """``actions`` as a float64 array ``(num_envs, action_dim)`` (2 for a differential
+        drive, 3 for a holonomic one), or with discrete actions an int64 array
+        ``(num_envs,)``; ValueError naming ``actions`` if bad."""
         a = self.arrays
         if self._discrete is not None:
             return self._discrete.check(actions, self.num_envs)
         shape = tuple(getattr(actions, "shape", np.shape(actions)))
-        n = self.num_envs
-        if shape not in ((n, 2), (n, 1, 2)):
-            raise ValueError(f"actions must have shape ({n}, 2) or ({n}, 1, 2), got {shape}")
-        arr = a.asarray(actions).reshape(n, 2)
+        n, dim = self.num_envs, self.robot.action_dim
+        if shape not in ((n, dim), (n, 1, dim)):
+            raise ValueError(
+                f"actions must have shape ({n}, {dim}) or ({n}, 1, {dim}) for a {self.robot.drive} drive, got {shape}"
+            )
+        arr = a.asarray(actions).reshape(n, dim)
         if not bool(a.xp.isfinite(arr).all()):
             raise ValueError("actions must be finite (no NaN or infinity)")
         return arr
@@ -462,50 +445,53 @@ class VectorPointNavEnv(PoolRefreshing, VectorEnv):
         return self._account(moved, contact, stopped)
 
     def _drive(self, act: Any, state: Mapping[str, Any]) -> tuple[dict[str, Any], Any]:
-        """One control step of every world from ``state`` under commands ``act`` ``(num_envs, 2)``,
-        not committed: the new pose, height and velocities (keys ``MOVED``) and the contacts."""
+        """One control step of every world from ``state`` under commands ``act``
+        ``(num_envs, action_dim)``, not committed: the new pose, height, velocities and fall
+        speed (keys ``MOVED``) and the contacts. A falling robot ignores its command and drops
+        (:func:`~pointnav_core.vector.falls.apply_falls`)."""
         a, xp = self.arrays, self.arrays.xp
-        spec = self.robot
-        one = 1.0
-        v0, v1 = act[:, 0], act[:, 1]
-        vmax, wmax = spec.max_linear_velocity, spec.max_angular_velocity
-        vx = xp.where(v0 >= one, vmax, xp.where(v0 <= -one, -vmax, v0 * vmax))
-        w = xp.where(v1 >= one, wmax, xp.where(v1 <= -one, -wmax, v1 * wmax))
-        dt = self.dt
+        spec, dt = self.robot, self.dt
+        vx, vy, w = body_command(xp, act, spec.max_linear_velocity, spec.max_angular_velocity, self.holonomic)
         x0, y0, yaw0 = state["x"], state["y"], state["yaw"]
-        # The exact arc over the step (state.drive_arc with vy = 0).
-        half = 0.5 * w * dt
-        safe = xp.where(half != 0.0, half, 1.0)
-        s = dt * xp.where(half != 0.0, xp.sin(safe) / safe, 1.0)
-        mid = yaw0 + half
-        dx = s * (vx * xp.cos(mid) - 0.0 * xp.sin(mid))
-        dy = s * (vx * xp.sin(mid) + 0.0 * xp.cos(mid))
-        travel = xp.abs(vx) * dt
+        dx, dy = arc(xp, yaw0, vx, vy, w, dt)  # the exact arc over the step (drive_arc)
+        length = travel(xp, vx, vy, dt)
         scene = self._world_scene
         row, col, inside = self.floors.cells(scene, x0, y0)
         budget = self.floors.fast[self.floors.flat_index(scene, row, col, inside)]
-        fast = inside & (budget > travel)
+        standing = ~(state["fs"] > 0.0)
+        fast = inside & (budget > length)
         x, y, yaw = x0 + dx, y0 + dy, yaw0 + w * dt
         vel_x, vel_y, vel_w = dx / dt, dy / dt, w
-        vz = xp.zeros_like(x)
         contact = xp.zeros_like(x) > 1.0
-        z = state["z"]
-        slow = a.nonzero(~fast)
+        began = contact
+        slow = a.nonzero(~fast & standing)
         if slow.shape[0]:
+            sc = scene[slow]
             resolver = contacts_jit.advance_one if contacts_jit.available(self.floors) else advance
-            sx, sy, c = resolver(self.floors, scene[slow], x0[slow], y0[slow], dx[slow], dy[slow], spec.radius, self._max_travel)
-            syaw = yaw0[slow] + w[slow] * dt
-            fall = self.floors.is_void(scene[slow], sx, sy)
-            drop = first_drop(dt)
+
+            def move(px: Any, py: Any, mx: Any, my: Any, part: Any) -> tuple[Any, Any, Any]:
+                # The worlds of ``part`` by their chords; a later sub-step has fewer of them.
+                if bool(part.all()):
+                    return resolver(self.floors, sc, px, py, mx, my, spec.radius, self._max_travel)
+                idx = a.nonzero(part)
+                ix, iy, ic = resolver(self.floors, sc[idx], px[idx], py[idx], mx[idx], my[idx], spec.radius, self._max_travel)
+                nx, ny, c = px + 0.0, py + 0.0, xp.zeros_like(part)
+                nx[idx], ny[idx], c[idx] = ix, iy, ic
+                return nx, ny, c
+
+            n_sub = sub_steps(xp, length[slow], w[slow], dt, self.floors.res[sc])
+            sx, sy, syaw, fall, c = substep_drive(
+                xp, (x0[slow], y0[slow], yaw0[slow]), (vx[slow], vy[slow], w[slow]), n_sub, dt, move,
+                lambda px, py: self.floors.is_void(sc, px, py),
+            )
             x[slow], y[slow], yaw[slow] = sx, sy, syaw
             vel_x[slow] = (sx - x0[slow]) / dt
             vel_y[slow] = (sy - y0[slow]) / dt
             vel_w = xp.where(fast, vel_w, (yaw - yaw0) / dt)
-            vz[slow] = xp.where(fall, -drop / dt, xp.zeros_like(sx))
-            z = z.clone() if a.is_torch else z.copy()
-            z[slow] = xp.where(fall, z[slow] - drop, z[slow])
+            began = began.clone() if a.is_torch else began.copy()
+            began[slow] = fall
             contact[slow] = c
-        moved = {"x": x, "y": y, "yaw": yaw, "z": z, "vx": vel_x, "vy": vel_y, "w": vel_w, "vz": vz}
+        moved = apply_falls(xp, state, {"x": x, "y": y, "yaw": yaw, "vx": vel_x, "vy": vel_y, "w": vel_w}, began, dt)
         return moved, contact
 
     def _account(self, moved: Mapping[str, Any], contact: Any, stopped: Any) -> tuple[Any, Any, Any, Any, dict[str, Any]]:
@@ -513,7 +499,7 @@ class VectorPointNavEnv(PoolRefreshing, VectorEnv):
         then the commit and the next-step autoresets. ``stopped``: the worlds that called STOP."""
         a, xp, st = self.arrays, self.arrays.xp, self._state
         x0, y0, scene = st["x"], st["y"], self._world_scene
-        x, y, yaw, z, vel_x, vel_y, vel_w, vz = (moved[k] for k in MOVED)
+        x, y, z = moved["x"], moved["y"], moved["z"]
         # --- the task's accounting (PointNavigationTask.step)
         path = st["path"] + xp.sqrt((x - x0) ** 2 + (y - y0) ** 2)
         steps = self._steps + 1
@@ -536,7 +522,7 @@ class VectorPointNavEnv(PoolRefreshing, VectorEnv):
         r_goal = xp.where(success, self.r_pointgoal, zero)
         reward = ((0.0 + r_pot) + r_col) + r_goal
         # Commit, then reset the worlds that ended on the previous step (next-step autoreset).
-        st.update(x=x, y=y, yaw=yaw, z=z, vx=vel_x, vy=vel_y, vz=vz, w=vel_w, path=path, dist=dist, pot=pot)
+        st.update({key: moved[key] for key in MOVED}, path=path, dist=dist, pot=pot)
         self._steps, self._collisions = steps, collisions
         resetting = self._needs_reset.clone() if a.is_torch else self._needs_reset.copy()
         if a.any(resetting):

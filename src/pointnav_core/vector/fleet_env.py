@@ -30,12 +30,13 @@ from pointnav_core.vector import contacts_jit
 from pointnav_core.vector.contacts import advance
 from pointnav_core.vector.contacts_jit import advance_compiled
 from pointnav_core.vector.discrete import MOVED, DiscretePlan
+from pointnav_core.vector.drive import arc, body_command, sub_steps, substep_drive, travel
 from pointnav_core.vector.env import (
     VectorPointNavEnv,
     _scan_term,
     _scene_list,
-    first_drop,
 )
+from pointnav_core.vector.falls import apply_falls
 from pointnav_core.vector.fleet_pool import FleetPool, check_fixed_episode
 from pointnav_core.vector.floors import FloorTables
 from pointnav_core.vector.local_map import VectorLocalMap, local_map_term
@@ -75,7 +76,9 @@ class VectorFleetEnv(VectorPointNavEnv):
         together, for as many control steps as its longest action
         (:mod:`pointnav_core.vector.discrete`).
     discrete_actions : dict, optional
-        ``forward_step``, ``turn_angle``, ``stop``, as the multi-robot env.
+        ``forward_step``, ``turn_angle``, ``stop``, as the multi-robot env; each robot's
+        actions are planned with its own speed limits (a slower robot holds an action for
+        more control steps).
     starts_per_goal : int
         Sets of starts per pool episode, >= 1: the extra sets share its goals and their
         settled fields (:class:`~pointnav_core.vector.fleet_pool.FleetPool`).
@@ -133,10 +136,8 @@ class VectorFleetEnv(VectorPointNavEnv):
         read_tasks(self, first.tasks, self.robots, a)  # then the per-robot settings, (1, R)
         t = self.task
         acts = first.discrete_actions
-        speeds = {(s.max_linear_velocity, s.max_angular_velocity) for s in self.robots}
-        if acts is not None and len(speeds) > 1:  # one plan of control steps for all robots
-            raise ValueError("robot: a list of robots whose speed limits differ is not supported with discrete actions")
-        self._discrete = None if acts is None else DiscretePlan(acts, spec, self.action_frequency, a)
+        # Each robot's own commands and control steps (its speed limits), as the multi-robot env plans them.
+        self._discrete = None if acts is None else DiscretePlan(acts, list(self.robots), self.action_frequency, a)
         self.floors = FloorTables(scene_list, t.floor, spec.radius, a)
         # Each robot's clearance table, of its own radius: (R, all cells).
         self._fast = a.xp.stack([self.floors.fast_for(s.radius) for s in self.robots])
@@ -160,7 +161,8 @@ class VectorFleetEnv(VectorPointNavEnv):
         self._robot_ids = a.asarray(np.arange(r), a.i64).reshape(1, r)
         self._fixed: Any = None
         self.pool: FleetPool | None = None  # type: ignore[assignment]
-        keys = ("x", "y", "yaw", "z", "vx", "vy", "vz", "w", "gx", "gy", "d0", "pot", "path", "dist")
+        # "fs": the fall speed (m/s), 0 while the robot stands (vector.falls).
+        keys = ("x", "y", "yaw", "z", "vx", "vy", "vz", "w", "fs", "gx", "gy", "d0", "pot", "path", "dist")
         self._state = {k: a.zeros((n, r)) for k in keys}
         self._field = a.zeros((n, r), a.i64)
         self._geo_metric = a.zeros((n, r), a.boolean)
@@ -214,7 +216,7 @@ class VectorFleetEnv(VectorPointNavEnv):
         for key, src in (("x", p.sx), ("y", p.sy), ("yaw", p.syaw), ("gx", p.gx), ("gy", p.gy), ("d0", p.d0)):
             st[key][idx] = src[e]
         st["z"][idx] = self.floors.height[self._world_scene[idx]][:, None] + 0.0 * st["x"][idx]
-        for key in ("vx", "vy", "vz", "w", "path"):
+        for key in ("vx", "vy", "vz", "w", "fs", "path"):
             st[key][idx] = 0.0
         field = p.field[e]
         self._field[idx] = field
@@ -234,8 +236,9 @@ class VectorFleetEnv(VectorPointNavEnv):
         self._needs_reset[idx] = False
 
     def check_actions(self, actions: Any) -> Any:
-        """``actions`` as a float64 array ``(num_envs, n_robots, 2)``, or with discrete actions
-        an int64 array ``(num_envs, n_robots)``; ValueError naming ``actions`` if bad.
+        """``actions`` as a float64 array ``(num_envs, n_robots, action_dim)`` (2 for a
+        differential drive, 3 for a holonomic one), or with discrete actions an int64 array
+        ``(num_envs, n_robots)``; ValueError naming ``actions`` if bad.
 
         Every entry must be valid (finite; with discrete actions an integer in range), also
         those of inactive robots (which are ignored).
@@ -243,9 +246,9 @@ class VectorFleetEnv(VectorPointNavEnv):
         if self._discrete is not None:
             return self._discrete.check(actions, self.num_envs, self.n_robots)
         shape = tuple(getattr(actions, "shape", np.shape(actions)))
-        want = (self.num_envs, self.n_robots, 2)
+        want = (self.num_envs, self.n_robots, self.robot.action_dim)
         if shape != want:
-            raise ValueError(f"actions must have shape {want}, got {shape}")
+            raise ValueError(f"actions must have shape {want} for a {self.robot.drive} drive, got {shape}")
         arr = self.arrays.asarray(actions)
         if not bool(self.arrays.xp.isfinite(arr).all()):
             raise ValueError("actions must be finite (no NaN or infinity)")
@@ -263,56 +266,56 @@ class VectorFleetEnv(VectorPointNavEnv):
 
     def _drive(self, act: Any, state: Mapping[str, Any]) -> tuple[dict[str, Any], Any]:
         """One control step of every world from ``state`` under commands ``act``
-        ``(num_envs, n_robots, 2)`` in ``[-1, 1]`` units, not committed: the new pose, height
-        and velocities (keys ``MOVED``) and the contacts. Robots that began to fall since the
-        committed state (inside a discrete action) neither move nor block."""
+        ``(num_envs, n_robots, action_dim)`` in ``[-1, 1]`` units, not committed: the new pose,
+        height, velocities and fall speed (keys ``MOVED``) and the contacts. A falling robot
+        present in the world drops (:func:`~pointnav_core.vector.falls.apply_falls`); it
+        neither drives nor blocks. A robot out of the world stays as it is."""
         a, xp = self.arrays, self.arrays.xp
         dt, radius = self.dt, self._radius  # (1, R): each robot's radius
-        present = self._present & ~(state["z"] < self._state["z"])
-        v0, v1 = act[..., 0], act[..., 1]
+        falling = state["fs"] > 0.0
+        present = self._present & ~falling
         vmax, wmax = self._vmax, self._wmax  # (1, R): each robot's speed limits
-        zero = xp.zeros_like(v0)
-        vx = xp.where(v0 >= 1.0, vmax, xp.where(v0 <= -1.0, -vmax, v0 * vmax))
-        w = xp.where(v1 >= 1.0, wmax, xp.where(v1 <= -1.0, -wmax, v1 * wmax))
+        vx, vy, w = body_command(xp, act, vmax, wmax, self.holonomic)
+        zero = xp.zeros_like(vx)
         x0, y0, yaw0 = state["x"], state["y"], state["yaw"]
-        half = 0.5 * w * dt
-        safe = xp.where(half != 0.0, half, 1.0)
-        s = dt * xp.where(half != 0.0, xp.sin(safe) / safe, 1.0)
-        mid = yaw0 + half
-        dx = s * (vx * xp.cos(mid) - 0.0 * xp.sin(mid))
-        dy = s * (vx * xp.sin(mid) + 0.0 * xp.cos(mid))
-        travel = xp.abs(vx) * dt
+        dx, dy = arc(xp, yaw0, vx, vy, w, dt)
+        length = travel(xp, vx, vy, dt)
         # The backend's fast path: clearance beyond the step and no other free robot within reach.
         scene = self._robot_scene
         row, col, inside = self.floors.cells(scene, x0, y0)
         budget = self._fast[self._robot_ids, self.floors.flat_index(scene, row, col, inside)]
-        reach = radius + travel
+        reach = radius + length
         # The backend's sum, in its order: robot i's reach, then robot j's radius and travel.
-        gap = reach[:, :, None] + radius[:, None, :] + travel[:, None, :]
+        gap = reach[:, :, None] + radius[:, None, :] + length[:, None, :]
         gap2 = (x0[:, :, None] - x0[:, None, :]) ** 2 + (y0[:, :, None] - y0[:, None, :]) ** 2
         ids = self._robot_ids
         others = (ids.reshape(1, -1, 1) != ids.reshape(1, 1, -1)) & present[:, None, :] & (gap2 <= gap * gap)
-        fast = present & inside & (budget > travel) & ~others.any(-1)
+        fast = present & inside & (budget > length) & ~others.any(-1)
         slow = present & ~fast
         x, y, yaw = x0 + xp.where(fast, dx, zero), y0 + xp.where(fast, dy, zero), yaw0 + w * dt
         contact = zero > 1.0
-        z, vz = state["z"], zero + 0.0
-        if contacts_jit.available(self.floors):  # every world in one compiled loop
-            sx, sy, c = advance_compiled(self.floors, scene, x0, y0, dx, dy, slow, radius, self._max_travel)
-            x, y = xp.where(slow, a.asarray(sx), x), xp.where(slow, a.asarray(sy), y)
-            contact = a.asarray(c, a.boolean)
-        else:
-            self._advance_slow(x0, y0, dx, dy, slow, x, y, contact)
-        fall = slow & self.floors.is_void(scene, x, y)
-        drop = first_drop(dt)
-        z = xp.where(fall, z - drop, z)
-        vz = xp.where(fall, -drop / dt, vz)
+        began = contact
+        if a.any(slow):
+            # Every slow robot of a world takes the world's sub-steps (the backend's _slow_step).
+            n_sub = sub_steps(xp, length, w, dt, self.floors.res[scene])
+            n_sub = xp.where(slow, n_sub, zero).amax(-1) if a.is_torch else xp.where(slow, n_sub, zero).max(-1)
+            n_sub = xp.where(slow, n_sub[:, None], zero)
+            sx, sy, syaw, fall, contact = substep_drive(
+                xp, (x0, y0, yaw0), (vx, vy, w), n_sub, dt, self._move_slow,
+                lambda px, py: self.floors.is_void(scene, px, py),
+            )
+            x, y, yaw = xp.where(slow, sx, x), xp.where(slow, sy, y), xp.where(slow, syaw, yaw)
+            began = slow & fall
         vel_x = xp.where(fast, dx / dt, (x - x0) / dt)
         vel_y = xp.where(fast, dy / dt, (y - y0) / dt)
         vel_w = xp.where(fast, w, (yaw - yaw0) / dt)
         vel_x, vel_y, vel_w = (xp.where(present, v, zero) for v in (vel_x, vel_y, vel_w))
-        moved = {"x": x, "y": y, "yaw": yaw, "z": z, "vx": vel_x, "vy": vel_y, "w": vel_w, "vz": vz}
-        return moved, contact
+        moved = apply_falls(xp, state, {"x": x, "y": y, "yaw": yaw, "vx": vel_x, "vy": vel_y, "w": vel_w}, began, dt)
+        # A robot out of the world (removed, or fallen and gone) is not moved by the backend.
+        out = ~self._present
+        moved = {key: xp.where(out, state[key], value) if key in ("z", "fs") else value for key, value in moved.items()}
+        moved["vz"] = xp.where(out, zero, moved["vz"])
+        return moved, contact & ~falling
 
     def _account(self, moved: Mapping[str, Any], contact: Any, stopped: Any) -> tuple[Any, Any, Any, Any, dict[str, Any]]:
         """Each active robot's task step (``PointNavigationTask.step``, masked by the robots
@@ -321,7 +324,7 @@ class VectorFleetEnv(VectorPointNavEnv):
         a, xp, st = self.arrays, self.arrays.xp, self._state
         acting, present = self._active, self._present
         x0, y0 = st["x"], st["y"]
-        x, y, yaw, z, vel_x, vel_y, vel_w, vz = (moved[k] for k in MOVED)
+        x, y, z = moved["x"], moved["y"], moved["z"]
         zero = xp.zeros_like(x)
         path = st["path"] + xp.where(acting, xp.sqrt((x - x0) ** 2 + (y - y0) ** 2), zero)
         steps = self._steps + a.to_int(acting)
@@ -347,8 +350,7 @@ class VectorFleetEnv(VectorPointNavEnv):
         active = acting & ~ended
         # A robot that fell leaves its floor; with "remove" every finished robot leaves.
         gone = (ended & fell) if self.finished == "park" else ended
-        st.update(x=x, y=y, yaw=yaw, z=z, vx=vel_x, vy=vel_y, vz=vz, w=vel_w, path=path, dist=dist,
-                  pot=xp.where(acting, pot, st["pot"]))
+        st.update({key: moved[key] for key in MOVED}, path=path, dist=dist, pot=xp.where(acting, pot, st["pot"]))
         self._steps, self._collisions, self._cycles = steps, collisions, cycles
         self._active, self._present = active, present & ~gone
         # The multi-robot env observes every robot before its finished robots leave the world.
@@ -370,6 +372,18 @@ class VectorFleetEnv(VectorPointNavEnv):
         info = self._info(success, r_pot, r_col, r_goal, contact, shown, resetting[:, None] & shown)
         return self._observe(shown), reward, terminated, truncated, info
 
+
+    def _move_slow(self, x0: Any, y0: Any, dx: Any, dy: Any, slow: Any) -> tuple[Any, Any, Any]:
+        """The ``slow`` robots moved together by their chords ``(dx, dy)`` (m) with contacts,
+        the others where they are: ``x``, ``y`` and the contact flags, ``(num_envs, n_robots)``."""
+        a = self.arrays
+        if contacts_jit.available(self.floors):  # every world in one compiled loop
+            sx, sy, c = advance_compiled(self.floors, self._robot_scene, x0, y0, dx, dy, slow, self._radius,
+                                         self._max_travel)
+            return a.asarray(sx), a.asarray(sy), a.asarray(c, a.boolean)
+        x, y, contact = x0 + 0.0, y0 + 0.0, a.xp.zeros_like(slow)
+        self._advance_slow(x0, y0, dx, dy, slow, x, y, contact)
+        return x, y, contact
 
     def _advance_slow(self, x0: Any, y0: Any, dx: Any, dy: Any, slow: Any, x: Any, y: Any, contact: Any) -> None:
         """The array path of the slow robots' contacts: writes their ends into ``x``, ``y``

@@ -11,12 +11,14 @@ robot axis ``(1, R)`` that the step broadcasts over its ``(num_envs, R)`` state:
   ``r_pointgoal``); ``path_range``, ``initial_pos``, ``initial_quat`` and ``goal_pos``
   only shape the episodes, which each scene's multi-robot env draws;
 - from each robot: ``max_linear_velocity`` and ``max_angular_velocity`` (the drive's
-  scaling and the observations' bounds) and ``radius`` (the fast path's clearance table
-  of that radius, the contacts, with walls at the radius and with another robot at the
-  sum of the two radii, and the disc the others' scans and local maps see).
+  scaling, the observations' bounds and, with discrete actions, each action's control
+  steps) and ``radius`` (the fast path's clearance table of that radius, the contacts,
+  with walls at the radius and with another robot at the sum of the two radii, and the
+  disc the others' scans and local maps see).
 
 What the engine cannot vary per robot is refused with a ``ValueError`` naming it: the
-task's ``floor`` (the floor tables are built for one floor; see ``docs/decisions.md``).
+task's ``floor`` (the floor tables are built for one floor; see ``docs/decisions.md``) and
+the robots' drives (the actions are one array, of one ``action_dim``).
 """
 
 from __future__ import annotations
@@ -29,6 +31,7 @@ import numpy as np
 
 from pointnav_core.fleet import make_robots, per_robot
 from pointnav_core.robot_spec import RobotSpec
+from pointnav_core.vector.drive import drive_of
 from pointnav_core.vector.xp import Arrays
 
 __all__ = ["envelope", "read_tasks", "robot_specs", "task_arguments"]
@@ -66,19 +69,16 @@ def task_arguments(task: Any, n_robots: int, max_episode_steps: int | None) -> d
 
 
 def robot_specs(robot: Any, n_robots: int) -> tuple[RobotSpec, ...]:
-    """One differential-drive :class:`RobotSpec` per robot.
+    """One :class:`RobotSpec` per robot, all of one drive.
 
     Raises
     ------
     ValueError
-        Naming ``robot`` (a list of the wrong length, a drive that is not differential) or
-        ``robot[i]`` (an entry that is not a spec, dict or None).
+        Naming ``robot`` (a list of the wrong length, drives that differ) or ``robot[i]``
+        (an entry that is not a spec, dict or None).
     """
     specs = make_robots(robot, n_robots)
-    for i, spec in enumerate(specs):
-        if spec.drive != "differential":
-            name = "robot" if per_robot(robot, n_robots, "robot") is None else f"robot[{i}]"
-            raise ValueError(f"{name} must have a differential drive in the batched engine, got {spec.drive!r}")
+    drive_of(specs)  # one action array, of one action_dim, for every robot
     return specs
 
 
@@ -111,10 +111,6 @@ def read_tasks(env: Any, tasks: Sequence[Any], specs: Sequence[RobotSpec], array
     rcfg = [t.reward_config for t in tasks]
     env.max_steps = row([int(c["max_steps"]) for c in cfg], arrays.i64)
     env.max_collisions = row([int(c["max_collisions"]) for c in cfg], arrays.i64)
-    from pointnav_core.vector.env import check_fall_height
-
-    for c in cfg:
-        check_fall_height(float(c["fall_height"]), env.dt)
     env.fall_height = row([float(c["fall_height"]) for c in cfg])
     env.goal_tolerance = row([float(t.goal_tolerance) for t in tasks])
     env.r_potential, env.r_collision, env.r_pointgoal = (row([float(c[k]) for c in rcfg]) for k in ("r_potential", "r_collision", "r_pointgoal"))

@@ -1,0 +1,90 @@
+"""Falls in the batched engine: the kinematic backend's fall, carried over control steps.
+
+A robot whose centre ends a control step over VOID (or off the map) begins to fall: in
+that step it drops by the backend's first drop, ``max(fall_speed dt + g dt^2 / 2,
+0.05 m)`` with ``fall_speed`` 1 m/s, and keeps the step's planar velocities beside the
+drop's ``vz``. From then on it no longer drives or blocks: every control step it drops by
+``v dt + g dt^2 / 2`` at its current fall speed ``v`` (which then grows by ``g dt``), with
+zero planar velocities (``RobotStateBackend._fall``). Nothing stops a fall; the task ends
+the episode once ``z < floor height - fall_height``, however many steps that takes.
+
+The engines keep each robot's fall speed in their state (key ``"fs"``, m/s; 0 while it
+stands). :func:`apply_falls` turns one control step of the standing robots into the step
+of all of them, as arrays of any shape (numpy or torch).
+
+Examples
+--------
+>>> import numpy as np
+>>> start = {"x": np.zeros(3), "y": np.zeros(3), "yaw": np.zeros(3), "z": np.zeros(3), "fs": np.array([0.0, 0.0, 1.0])}
+>>> standing = {"x": np.array([0.1, 0.1, 0.5]), "y": np.zeros(3), "yaw": np.zeros(3),
+...             "vx": np.ones(3), "vy": np.zeros(3), "w": np.zeros(3)}
+>>> began = np.array([False, True, False])  # robot 1 went over VOID, robot 2 was falling
+>>> out = apply_falls(np, start, standing, began, 0.1)
+>>> out["z"].round(5).tolist(), out["x"].tolist(), out["fs"].round(3).tolist()
+([0.0, -0.14905, -0.14905], [0.1, 0.1, 0.0], [0.0, 1.981, 1.981])
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from typing import Any
+
+__all__ = ["FALL_SPEED", "GRAVITY", "MIN_FIRST_DROP", "apply_falls", "first_drop"]
+
+#: m/s^2, the kinematic backend's gravity.
+GRAVITY = 9.81
+#: m/s, the kinematic backend's default ``fall_speed`` (a fall's speed as it begins).
+FALL_SPEED = 1.0
+#: m, the least a robot drops in the step it begins to fall (so that a fall shows at any rate).
+MIN_FIRST_DROP = 0.05
+
+
+def first_drop(dt: float) -> float:
+    """How far (m) a robot drops in the control step of ``dt`` (s) in which it begins to
+    fall: the kinematic backend's ``max(fall_speed dt + g dt^2 / 2, 0.05 m)``.
+
+    Examples
+    --------
+    >>> round(first_drop(0.1), 5), first_drop(1 / 30)
+    (0.14905, 0.05)
+    """
+    return max(FALL_SPEED * dt + 0.5 * GRAVITY * dt * dt, MIN_FIRST_DROP)
+
+
+def apply_falls(xp: Any, start: Mapping[str, Any], standing: Mapping[str, Any], began: Any, dt: float) -> dict[str, Any]:
+    """One control step of every robot, falls included, from the standing robots' step.
+
+    Parameters
+    ----------
+    xp : module
+        ``numpy`` or ``torch``.
+    start : dict of arrays
+        The state before the step: ``x``, ``y`` (m), ``yaw`` (rad), ``z`` (m) and ``fs``,
+        the fall speed (m/s, > 0 for a robot already falling, 0 otherwise).
+    standing : dict of arrays
+        The step as the drive and contacts give it: ``x``, ``y``, ``yaw``, ``vx``, ``vy``
+        (m/s) and ``w`` (rad/s); entries of falling robots are ignored.
+    began : array of bool
+        The robots that were standing and whose centre ended this step over VOID.
+    dt : float
+        The control step (s).
+
+    Returns
+    -------
+    dict of arrays
+        ``x``, ``y``, ``yaw``, ``vx``, ``vy``, ``w``: the standing step, except that a robot
+        already falling keeps its pose and has zero planar velocities; ``z`` (m), ``vz``
+        (m/s, the drop over ``dt``, negative) and ``fs`` (m/s) after the step.
+    """
+    fs0, z0 = start["fs"], start["z"]
+    falling = fs0 > 0.0
+    zero = xp.zeros_like(z0)
+    # The backend's _fall, in its own expression order: drop = v dt + g dt^2 / 2.
+    drop = fs0 * dt + 0.5 * GRAVITY * dt * dt
+    first = first_drop(dt)
+    out = {key: xp.where(falling, start[key], standing[key]) for key in ("x", "y", "yaw")}
+    out.update({key: xp.where(falling, zero, standing[key]) for key in ("vx", "vy", "w")})
+    out["z"] = xp.where(falling, z0 - drop, xp.where(began, z0 - first, z0))
+    out["vz"] = xp.where(falling, -drop / dt, xp.where(began, zero - first / dt, zero))
+    out["fs"] = xp.where(falling, fs0 + GRAVITY * dt, xp.where(began, zero + (FALL_SPEED + GRAVITY * dt), zero))
+    return out
