@@ -97,8 +97,8 @@ class VectorPointNavEnv(PoolRefreshing, VectorEnv):
         (actions ``(vx, vy, w)`` in the robot frame, +x ahead, +y to the left), scaled and
         integrated as the kinematic backend does (:mod:`pointnav_core.vector.drive`). With
         several robots per world, also a list with one entry per robot, as for
-        :func:`~pointnav_core.parallel.parallel_env`: their speed limits may differ, their
-        radius and drive may not (the actions are one array).
+        :func:`~pointnav_core.parallel.parallel_env`: their speed limits and radii may
+        differ, their drive may not (the actions are one array).
     task : dict, optional
         ``PointNavigationTask`` keyword arguments, as for the single env (its default
         ``path_range`` too). Custom terms are not supported. Any ``fall_height`` (m):
@@ -190,9 +190,10 @@ class VectorPointNavEnv(PoolRefreshing, VectorEnv):
     ``goal_in_polar``, ``termination_config`` (``max_steps``, ``max_collisions``,
     ``fall_height``), ``reward_config`` and ``path_range`` and its robot's speed limits
     (m/s, rad/s; with discrete actions, each robot's actions then last its own number of
-    control steps) may differ; a list whose tasks' ``floor`` or robots' ``radius`` differ
-    raises ``ValueError`` naming ``task`` or ``robot``, as does a list of the wrong length
-    or an entry of the wrong type (naming ``task[i]`` or ``robot[i]``).
+    control steps) and radius (m: walls at its radius, another robot at the sum of the two
+    radii, its disc in the others' scans and maps) may differ; a list whose tasks'
+    ``floor`` differ raises ``ValueError`` naming ``task``, as does a list of the wrong
+    length or an entry of the wrong type (naming ``task[i]`` or ``robot[i]``).
 
     Examples
     --------

@@ -84,7 +84,8 @@ class FieldTables:
     Parameters
     ----------
     fields : sequence of GoalField
-        All from planners of one robot radius.
+        Each keeps its planner's robot radius (``radius``, per field), so fields of robots
+        of different radii share the tables.
     arrays : Arrays
     starts : sequence of array_like (n_i, 2), optional
         Per field, the starts (m) of the episodes that use it. With ``reach``, each field

@@ -33,8 +33,8 @@ FleetEpisode = tuple[Any, float, Any]
 def check_fixed_episode(sampler: Any, episode: Sequence[FleetEpisode], where: str) -> list[tuple[Any, float, Any]]:
     """One world's fixed robots, checked by the multi-robot env's rules; ValueError naming ``where``.
 
-    Each start and goal must be usable by the robot, starts at least two radii apart and
-    goals :func:`~pointnav_core.fleet.goal_separation` apart.
+    Each start and goal must be usable by its robot, starts at least the sum of the two
+    robots' radii apart and goals :func:`~pointnav_core.fleet.goal_separation` apart.
     """
     n = len(sampler.tasks)
     try:
@@ -43,18 +43,18 @@ def check_fixed_episode(sampler: Any, episode: Sequence[FleetEpisode], where: st
         raise ValueError(f"{where} must hold {n} (start_xy, yaw, goal_xy) tuples, got {episode!r}") from None
     if len(robots) != n:
         raise ValueError(f"{where} must hold one (start_xy, yaw, goal_xy) per robot ({n}), got {len(robots)}")
-    scene, floor, spec = sampler.scene, sampler.tasks[0].floor, sampler.robots[0]
+    scene, floor, specs = sampler.scene, sampler.tasks[0].floor, sampler.robots
     for r, (start, yaw, goal) in enumerate(robots):
         if not math.isfinite(yaw):
             raise ValueError(f"{where}[{r}]: yaw must be finite, got {yaw}")
         for name, xy in (("start", start), ("goal", goal)):
-            if not scene.is_usable(floor, xy, spec):
+            if not scene.is_usable(floor, xy, specs[r]):
                 raise ValueError(f"{where}[{r}]: {name} {list(xy)} is not usable by the robot")
     sep = sampler._separation
     for i in range(n):
         for j in range(i + 1, n):
             (si, _, gi), (sj, _, gj) = robots[i], robots[j]
-            if math.dist(si[:2], sj[:2]) < 2.0 * spec.radius:
+            if math.dist(si[:2], sj[:2]) < specs[i].radius + specs[j].radius:
                 raise ValueError(f"{where}: robots {i} and {j} start overlapping ({math.dist(si[:2], sj[:2]):.3g} m apart)")
             if math.dist(gi[:2], gj[:2]) < sep[i][j]:
                 raise ValueError(
@@ -124,8 +124,9 @@ class FleetPool:
             env = samplers[s]
             episode = []
             field_of.append([len(fields) + i for i in range(len(robots))])
-            for start, yaw, goal in robots:
-                field = env.scene.goal_field(env.tasks[0].floor, goal, robot=env.robots[0])
+            for i, (start, yaw, goal) in enumerate(robots):
+                # The field of the robot's own radius, as its task reads it.
+                field = env.scene.goal_field(env.tasks[0].floor, goal, robot=env.robots[i])
                 episode.append((float(start[0]), float(start[1]), yaw, float(goal[0]), float(goal[1]), field.exact_distance(start)))
                 fields.append(field.field)
             rows.append(episode)
