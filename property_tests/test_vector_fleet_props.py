@@ -253,7 +253,7 @@ def test_fleet_discrete_with_per_robot_speeds_matches_parallel_envs(
     rng = np.random.default_rng(seed)
     # No goal at a start: after a straight MOVE_FORWARD from it the goal lies exactly behind,
     # where a polar goal's angle is +pi or -pi by the last bit of a cosine (torch's or math's).
-    episodes = fleet_episodes(scene, n_worlds, n_robots, rng, goal_gap=0.4)
+    episodes = fleet_episodes(scene, n_worlds, n_robots, rng, radius=0.2, goal_gap=0.4)  # the largest radius drawn
     n_actions = 4 if stop else 3
     weights = np.array([0.5, 0.2, 0.2, 0.1][:n_actions])
     actions = rng.choice(n_actions, size=(steps, n_worlds, n_robots), p=weights / weights.sum())
