@@ -4,7 +4,8 @@ For random grid scenes (clutter, walls), robots crowded around a point and rando
 driven for several rounds from where the last round left them (so that they rest against
 walls and each other), :func:`~pointnav_core.vector.contacts_jit.advance_compiled` gives
 the same end positions (bit for bit on numpy, within 1e-12 m on torch) and contact
-flags as the array path: with several robots per world
+flags as the array path, with one radius for all robots or each robot its own: with
+several robots per world
 :func:`~pointnav_core.vector.robots.advance_robots` (which the kinematic backend's resolver
 checks in ``tests/test_vector_robots.py``), with one :func:`~pointnav_core.vector.contacts.advance`.
 """
@@ -94,9 +95,10 @@ def _chords(rng: np.random.Generator, shape: tuple[int, ...], travel: float) -> 
 @pytest.mark.parametrize("device", DEVICES)
 @settings(max_examples=25, deadline=None)
 @given(scene=cluttered_scenes(), seed=st.integers(0, 2**31 - 1), n_robots=st.integers(2, 5),
-       radius=st.sampled_from([0.0, 0.05, 0.12, 0.18]), travel=st.sampled_from([0.02, 0.05, 0.1, 0.3]))
+       radius=st.sampled_from([0.0, 0.05, 0.12, 0.18]), travel=st.sampled_from([0.02, 0.05, 0.1, 0.3]),
+       own_radii=st.booleans())
 def test_compiled_contacts_equal_the_multi_robot_array_path(
-    device: str, scene: Scene, seed: int, n_robots: int, radius: float, travel: float
+    device: str, scene: Scene, seed: int, n_robots: int, radius: float, travel: float, own_radii: bool
 ) -> None:
     from pointnav_core.vector.contacts_jit import advance_compiled
     from pointnav_core.vector.floors import FloorTables
@@ -108,13 +110,15 @@ def test_compiled_contacts_equal_the_multi_robot_array_path(
     floors = FloorTables([scene], 0, radius, a)
     x, y = _crowd(scene, worlds, n_robots, radius, rng)
     scene_ids = a.zeros((worlds, n_robots), a.i64)
+    # Placed for the drawn radius, so smaller robots fit too: radii from 0 to it, per robot.
+    rad = a.asarray(rng.choice([0.0, 0.5, 1.0], (worlds, n_robots)) * radius) if own_radii else radius
     for _ in range(6):
         mx, my = _chords(rng, (worlds, n_robots), travel)
         slow = rng.random((worlds, n_robots)) < 0.85
         args = [a.asarray(v) for v in (x, y, mx, my)]
-        walls = robot_walls(floors, scene_ids, *args, radius, travel)
-        want = [a.numpy(v) for v in advance_robots(a, *args, radius, present=a.asarray(slow, a.boolean), walls=walls)]
-        got = advance_compiled(floors, scene_ids, *args, a.asarray(slow, a.boolean), radius, travel)
+        walls = robot_walls(floors, scene_ids, *args, rad, travel)
+        want = [a.numpy(v) for v in advance_robots(a, *args, rad, present=a.asarray(slow, a.boolean), walls=walls)]
+        got = advance_compiled(floors, scene_ids, *args, a.asarray(slow, a.boolean), rad, travel)
         _assert_same(device, got[0][slow], want[0][slow])
         _assert_same(device, got[1][slow], want[1][slow])
         np.testing.assert_array_equal(got[2][slow], want[2][slow])
@@ -127,9 +131,10 @@ def test_compiled_contacts_equal_the_multi_robot_array_path(
 @pytest.mark.parametrize("device", DEVICES)
 @settings(max_examples=25, deadline=None)
 @given(scene=cluttered_scenes(), seed=st.integers(0, 2**31 - 1),
-       radius=st.sampled_from([0.0, 0.05, 0.12, 0.18]), travel=st.sampled_from([0.02, 0.05, 0.1, 0.3]))
+       radius=st.sampled_from([0.0, 0.05, 0.12, 0.18]), travel=st.sampled_from([0.02, 0.05, 0.1, 0.3]),
+       own_radii=st.booleans())
 def test_compiled_contacts_equal_the_one_robot_array_path(
-    device: str, scene: Scene, seed: int, radius: float, travel: float
+    device: str, scene: Scene, seed: int, radius: float, travel: float, own_radii: bool
 ) -> None:
     from pointnav_core.vector.contacts import advance
     from pointnav_core.vector.contacts_jit import advance_compiled
@@ -143,12 +148,14 @@ def test_compiled_contacts_equal_the_one_robot_array_path(
     x, y = _crowd(scene, worlds, 1, radius, rng)
     x, y = x[:, 0], y[:, 0]
     scene_ids = a.zeros(worlds, a.i64)
+    rad = a.asarray(rng.choice([0.0, 0.5, 1.0], worlds) * radius) if own_radii else radius
     for _ in range(6):
         mx, my = _chords(rng, (worlds,), travel)
         args = [a.asarray(v) for v in (x, y, mx, my)]
-        want = [a.numpy(v) for v in advance(floors, scene_ids, *args, radius, limit)]
+        want = [a.numpy(v) for v in advance(floors, scene_ids, *args, rad, limit)]
         got = advance_compiled(floors, scene_ids[:, None], *(v[:, None] for v in args),
-                               a.asarray(np.ones((worlds, 1), bool), a.boolean), radius, limit)
+                               a.asarray(np.ones((worlds, 1), bool), a.boolean),
+                               rad[:, None] if own_radii else rad, limit)
         _assert_same(device, got[0][:, 0], want[0])
         _assert_same(device, got[1][:, 0], want[1])
         np.testing.assert_array_equal(got[2][:, 0], want[2])

@@ -10,7 +10,7 @@ robots of its world; the map's codes are equal, except at a cell centre on a cel
 a disc's rim, ``local_map_reference``), on numpy and on torch on the CPU; and the same with
 discrete actions (``action_space="discrete"``, random ``forward_step``, ``turn_angle`` and
 STOP, with or without a scan and a local map); and with per-robot
-``task`` and ``robot`` lists.
+``task`` and ``robot`` lists, robots of different radii among them.
 """
 
 from __future__ import annotations
@@ -98,8 +98,10 @@ def robot_tasks(draw: st.DrawFn) -> dict:
     }
 
 
-# Speed limits the batched engine takes at 10 Hz: at most half a 0.1 m cell and 0.25 rad a step.
-robot_specs = st.fixed_dictionaries({"radius": st.just(0.18), "max_linear_velocity": st.floats(0.05, 0.5),
+# Speed limits the batched engine takes at 10 Hz: at most half a 0.1 m cell and 0.25 rad a
+# step; radii up to 0.2 m (the episodes are placed for the largest, 0.2 m).
+robot_specs = st.fixed_dictionaries({"radius": st.sampled_from([0.18, 0.05, 0.1, 0.2]),
+                                     "max_linear_velocity": st.floats(0.05, 0.5),
                                      "max_angular_velocity": st.floats(0.2, 2.5)})
 
 
@@ -118,33 +120,40 @@ robot_specs = st.fixed_dictionaries({"radius": st.just(0.18), "max_linear_veloci
     max_cycles=st.integers(3, 70),
     finished=st.sampled_from(["park", "remove"]),
     scan=st.booleans(),
+    local_map=st.booleans(),
     drive=st.sampled_from(["differential", "holonomic"]),
 )
 def test_fleet_with_per_robot_lists_matches_parallel_envs(
     device: str, scene: Scene, seed: int, n_worlds: int, lists: tuple, steps: int, max_cycles: int,
-    finished: str, scan: bool, drive: str,
+    finished: str, scan: bool, local_map: bool, drive: str,
 ) -> None:
     """Per-robot ``task`` and ``robot`` lists (or one shared value) give each robot its own
-    rewards, tolerance, limits, goal frame and speed limits, as in the multi-robot env
-    (every robot of one drive)."""
+    rewards, tolerance, limits, goal frame, speed limits and radius (its contacts, and its
+    disc in the others' scans and local maps), as in the multi-robot env (every robot of
+    one drive)."""
     task, robot, n_robots = lists
     if drive == "holonomic":
         robot = [{**r, "drive": drive} for r in robot] if isinstance(robot, list) else {**(robot or {}), "drive": drive}
     rng = np.random.default_rng(seed)
     # The multi-robot env keeps goals max(tol_i + tol_j, r_i + r_j, cell) apart: 0.4 m at most here.
-    episodes = fleet_episodes(scene, n_worlds, n_robots, rng, goal_gap=0.4)
+    episodes = fleet_episodes(scene, n_worlds, n_robots, rng, radius=0.2, goal_gap=0.4)
     actions = random_actions(rng, (steps, n_worlds, n_robots), drive)
-    sensors = {"scan": {"n_rays": 8, "max_range": 2.0}} if scan else None
+    sensors = {"scan": {"n_rays": 8, "max_range": 2.0}} if scan else {}
+    if local_map:
+        sensors["local_map"] = {"size": 1.6, "cells": 8}
     compare_fleet(scene, episodes, actions, task=task, robot=robot, device=device, finished=finished,
-                  max_cycles=max_cycles, sensors=sensors)
+                  max_cycles=max_cycles, sensors=sensors or None)
 
 
 @pytest.mark.parametrize("device", DEVICES)
 @settings(max_examples=30, deadline=None)
-@given(scene=crowded_scenes(), seed=st.integers(0, 2**31 - 1), n_robots=st.integers(1, 4))
-def test_one_slow_robot_resolves_as_in_the_multi_robot_resolver(device: str, scene: Scene, seed: int, n_robots: int) -> None:
+@given(scene=crowded_scenes(), seed=st.integers(0, 2**31 - 1), n_robots=st.integers(1, 4), own_radii=st.booleans())
+def test_one_slow_robot_resolves_as_in_the_multi_robot_resolver(
+    device: str, scene: Scene, seed: int, n_robots: int, own_radii: bool
+) -> None:
     """The env's shortcut for a world with one slow robot (the one-robot resolver) equals
-    the multi-robot resolver with that robot the only one present."""
+    the multi-robot resolver with that robot the only one present (one radius for all, or
+    each robot its own)."""
     from pointnav_core.vector.contacts import advance
     from pointnav_core.vector.floors import FloorTables
     from pointnav_core.vector.robots import advance_robots, robot_walls
@@ -162,11 +171,14 @@ def test_one_slow_robot_resolves_as_in_the_multi_robot_resolver(device: str, sce
     present = np.arange(n_robots)[None, :] == mover[:, None]
     args = [a.asarray(v) for v in (x, y, mx, my)]
     scene_ids = a.zeros((worlds, n_robots), a.i64)
-    walls = robot_walls(floors, scene_ids, *args, radius, travel)
-    got = [a.numpy(v) for v in advance_robots(a, *args, radius, present=a.asarray(present, a.boolean), walls=walls)]
     rows = np.arange(worlds)
+    # Placed for 0.18 m, so that smaller robots fit too.
+    radii = rng.choice([0.05, 0.1, 0.18], (worlds, n_robots)) if own_radii else np.full((worlds, n_robots), radius)
+    rad, one_rad = (a.asarray(radii), a.asarray(radii[rows, mover])) if own_radii else (radius, radius)
+    walls = robot_walls(floors, scene_ids, *args, rad, travel)
+    got = [a.numpy(v) for v in advance_robots(a, *args, rad, present=a.asarray(present, a.boolean), walls=walls)]
     one = [a.asarray(v[rows, mover]) for v in (x, y, mx, my)]
-    want = [a.numpy(v) for v in advance(floors, a.zeros(worlds, a.i64), *one, radius, travel)]
+    want = [a.numpy(v) for v in advance(floors, a.zeros(worlds, a.i64), *one, one_rad, travel)]
     np.testing.assert_allclose(got[0][rows, mover], want[0], rtol=0, atol=1e-12)
     np.testing.assert_allclose(got[1][rows, mover], want[1], rtol=0, atol=1e-12)
     np.testing.assert_array_equal(got[2][rows, mover], want[2])
@@ -241,7 +253,7 @@ def test_fleet_discrete_with_per_robot_speeds_matches_parallel_envs(
     rng = np.random.default_rng(seed)
     # No goal at a start: after a straight MOVE_FORWARD from it the goal lies exactly behind,
     # where a polar goal's angle is +pi or -pi by the last bit of a cosine (torch's or math's).
-    episodes = fleet_episodes(scene, n_worlds, n_robots, rng, goal_gap=0.4)
+    episodes = fleet_episodes(scene, n_worlds, n_robots, rng, radius=0.2, goal_gap=0.4)  # the largest radius drawn
     n_actions = 4 if stop else 3
     weights = np.array([0.5, 0.2, 0.2, 0.1][:n_actions])
     actions = rng.choice(n_actions, size=(steps, n_worlds, n_robots), p=weights / weights.sum())

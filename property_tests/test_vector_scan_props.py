@@ -1,7 +1,8 @@
 """The batched range scan: its two paths equal, both against shapely, and the env against PointNavEnv.
 
 For random grid scenes (obstacle cells, VOID, the map's edge) and random poses of up to
-four robots per world, some absent, at robot radius / cell size ratios from 0.3 to 5:
+four robots per world, some absent, at robot radius / cell size ratios from 0.3 to 5
+(one radius for all robots, or each robot its own):
 
 - the compiled path (numba) and the array path (numpy, and torch on the CPU) give the
   same ranges;
@@ -51,7 +52,8 @@ def _paths(scenes, tables_np, scene, x, y, yaw, present, radius, angles, max_ran
         import torch
 
         tables_t = ScanTables(scenes, 0, make_arrays("cpu"))
-        args = (torch.as_tensor(scene), *(torch.as_tensor(v) for v in (x, y, yaw, present)), radius, angles, max_range)
+        rad = radius if isinstance(radius, float) else torch.as_tensor(radius)
+        args = (torch.as_tensor(scene), *(torch.as_tensor(v) for v in (x, y, yaw, present)), rad, angles, max_range)
         out["torch"] = cast_batch(tables_t, *args, "array").numpy()
         if compiled_available():  # torch on the CPU goes through the kernel, on views
             out["torch numba"] = cast_batch(tables_t, *args, "numba").numpy()
@@ -77,7 +79,8 @@ def _check_scenes(scenes, x, y, yaw, present, scene, radius, angles, max_range):
             if not present[w, i]:
                 assert (ref[w, i] == max_range).all()
                 continue
-            discs = [(x[w, m], y[w, m], radius) for m in range(r_n) if m != i and present[w, m]]
+            rad = np.broadcast_to(radius, x.shape)  # one radius, or each robot's own
+            discs = [(x[w, m], y[w, m], rad[w, m]) for m in range(r_n) if m != i and present[w, m]]
             loose, strict = reference_ranges(shapes[k], (x[w, i], y[w, i]), yaw[w, i] + angles, max_range, discs)
             for got in results.values():
                 assert_within(got[w, i], loose, strict, ATOL)
@@ -92,8 +95,9 @@ def _check_scenes(scenes, x, y, yaw, present, scene, radius, angles, max_range):
     res=st.sampled_from([0.05, 0.1, 0.25]),
     n_rays=st.integers(1, 24),
     max_range=st.floats(0.3, 4.0),
+    own_radii=st.booleans(),
 )
-def test_paths_agree_with_each_other_and_shapely(seed, n_worlds, n_robots, ratio, res, n_rays, max_range) -> None:
+def test_paths_agree_with_each_other_and_shapely(seed, n_worlds, n_robots, ratio, res, n_rays, max_range, own_radii) -> None:
     rng = np.random.default_rng(seed)
     scenes = []
     for cell in (res, float(rng.choice([0.05, 0.1, 0.25]))):  # worlds on floors of different cell sizes
@@ -114,7 +118,10 @@ def test_paths_agree_with_each_other_and_shapely(seed, n_worlds, n_robots, ratio
     yaw = rng.uniform(-2 * np.pi, 2 * np.pi, (n_worlds, n_robots))
     present = rng.random((n_worlds, n_robots)) < 0.8
     angles = scan_angles(n_rays, rng.uniform(0.5, 2 * np.pi))
-    _check_scenes(scenes, x, y, yaw, present, scene, ratio * float(scenes[0].floors[0].resolution), angles, max_range)
+    radius = ratio * float(scenes[0].floors[0].resolution)
+    if own_radii:  # each robot its own radius, down to a fifth of the drawn one
+        radius = radius * rng.uniform(0.2, 1.0, (n_worlds, n_robots))
+    _check_scenes(scenes, x, y, yaw, present, scene, radius, angles, max_range)
 
 
 @settings(max_examples=3, deadline=None, suppress_health_check=[HealthCheck.too_slow])

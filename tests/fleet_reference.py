@@ -132,7 +132,8 @@ def _touches_robot(env: Any, k: int) -> bool:
     backend = env.backend
     pk = backend.get_pose(k)[0]
     return any(
-        j != k and backend.is_present(j) and math.dist(pk[:2], backend.get_pose(j)[0][:2]) <= 2 * env.robots[k].radius + 1e-6
+        j != k and backend.is_present(j)
+        and math.dist(pk[:2], backend.get_pose(j)[0][:2]) <= env.robots[k].radius + env.robots[j].radius + 1e-6
         for j in range(len(env.robots))
     )
 

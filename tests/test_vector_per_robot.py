@@ -107,7 +107,6 @@ def two_floors() -> Scene:
     ({"robot": [{}]}, r"^robot must be one value for all robots or a list .*got a list of 1"),
     ({"robot": [{}, "fast"]}, r"^robot\[1\] must be a RobotSpec"),
     ({"robot": [{}, {"drive": "holonomic"}]}, r"^robot: every robot must have the same drive .*\['differential', 'holonomic'\]"),
-    ({"robot": [{"radius": 0.18}, {"radius": 0.2}]}, r"^robot: .*same radius.*\[0\.18, 0\.2\]"),
     ({"robot": [{}, {"max_linear_velocity": 0.8}]}, r"^action_frequency"),
 ])
 def test_bad_lists_are_named(kwargs: dict, words: str) -> None:
@@ -135,6 +134,69 @@ def test_discrete_actions_take_task_lists(device: str) -> None:
     stats = compare_fleet(room(20, 16), episodes, actions, task=tasks, robot=[{"radius": 0.18}] * 2, device=device,
                           action_space="discrete", discrete_actions={"forward_step": 0.1, "stop": True})
     assert stats["ends"] > 3 and stats["successes"] > 0
+
+
+# Two robots of radii 0.1 and 0.3 m face each other on y = 1 m, centres 0.72 m apart.
+# Robot 0 drives +x at 0.05 m a step; robot 1 stands. They touch at 0.1 + 0.3 = 0.4 m:
+# after 6 steps the gap is 0.42 m, and step 7 stops robot 0 at 0.4 m (less the backend's
+# 1e-9 m placing margin), both robots flagged. Each scan ray ahead reads the other robot's
+# centre distance less the other's radius: 0.72 - 0.3 = 0.42 and 0.72 - 0.1 = 0.62 m.
+RADII_EPISODE = [((0.5, 1.0), 0.0, (3.0, 2.5)), ((1.22, 1.0), math.pi, (3.0, 0.5))]
+RADII_ROBOTS = [{"radius": 0.1, "max_linear_velocity": 0.5}, {"radius": 0.3, "max_linear_velocity": 0.5}]
+ONE_RAY = {"scan": {"n_rays": 1, "max_range": 2.0}}
+
+
+def _array_paths(monkeypatch: pytest.MonkeyPatch) -> None:
+    """Make the engine take its array paths (contacts and scan) instead of the compiled ones."""
+    from pointnav_core.vector import contacts_jit, scan
+
+    monkeypatch.setattr(contacts_jit, "available", lambda floors: False)
+    monkeypatch.setattr(scan, "compiled_available", lambda: False)
+
+
+@pytest.mark.parametrize("path", ["compiled", "array"])
+@pytest.mark.parametrize("device", DEVICES)
+def test_robots_of_radii_01_and_03_touch_at_04_m(device: str, path: str, monkeypatch: pytest.MonkeyPatch) -> None:
+    if path == "array":
+        _array_paths(monkeypatch)
+    elif importlib.util.find_spec("numba") is None:
+        pytest.skip("the compiled path needs numba")
+    env = VectorPointNavEnv(1, n_robots=2, scene=room(), robot=RADII_ROBOTS, task={"goal_tolerance": 0.1},
+                            sensors=ONE_RAY, device=device, pool_size=1)
+    obs, _ = env.reset(options={"episodes": [RADII_EPISODE]})
+    np_ = env.arrays.numpy
+    np.testing.assert_allclose(np_(obs)[0, :, -1], [0.42, 0.62], atol=1e-9)
+    drive = np.array([[[1.0, 0.0], [0.0, 0.0]]])
+    for step in range(1, 8):
+        obs, _, _, _, info = env.step(drive)
+        x = np_(env._state["x"])[0]
+        contact = np_(info["in_contact"])[0].tolist()
+        if step < 7:
+            np.testing.assert_allclose(x, [0.5 + 0.05 * step, 1.22], atol=1e-12)
+            assert contact == [False, False], step
+    np.testing.assert_allclose(x, [1.22 - 0.4 - 1e-9, 1.22], atol=1e-12)
+    assert contact == [True, True]
+    np.testing.assert_array_equal(np_(info["collisions"])[0], [1, 1])
+    np.testing.assert_allclose(np_(obs)[0, :, -1], [0.1, 0.3], atol=1e-8)
+
+
+@pytest.mark.parametrize("device", DEVICES)
+def test_robots_of_radii_01_and_03_match_parallel_envs(device: str) -> None:
+    # The same meeting, and the robots driving on into each other, step for step as the
+    # multi-robot env (scan and local map on).
+    actions = np.tile([[1.0, 0.0], [0.3, 0.1]], (25, 1, 1, 1))
+    sensors = {**ONE_RAY, "local_map": {"size": 1.2, "cells": 12}}
+    stats = compare_fleet(room(), [RADII_EPISODE], actions, robot=RADII_ROBOTS, task={"goal_tolerance": 0.1},
+                          sensors=sensors, device=device)
+    assert stats["robot_contacts"] > 0
+
+
+def test_discrete_actions_take_robots_of_different_radii() -> None:
+    # One plan of control steps needs one speed, not one radius.
+    env = VectorPointNavEnv(1, n_robots=2, scene=room(), pool_size=1, action_space="discrete",
+                            robot=[{"radius": 0.1}, {"radius": 0.3}])
+    env.reset(options={"episodes": [RADII_EPISODE]})
+    env.step(np.zeros((1, 2), np.int64))
 
 
 @pytest.mark.parametrize("device", DEVICES)

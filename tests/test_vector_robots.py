@@ -157,3 +157,85 @@ def test_absent_robots_neither_move_nor_block(device: str) -> None:
     # Present, robot 1 stops robot 0 head-on where the discs touch, 0.1 m on.
     np.testing.assert_allclose(ex[1], [10.1, 10.3], atol=1e-8)
     assert c[1].tolist() == [True, True]
+
+
+@pytest.mark.parametrize("device", DEVICES)
+def test_radii_01_and_03_touch_at_their_sum(device: str) -> None:
+    # Robot 0 (0.1 m) drives 0.8 m at robot 1 (0.3 m) standing 1.0 m away: it stops where
+    # the centres are 0.1 + 0.3 = 0.4 m apart, at 10.6 m (less the 1e-9 m placing margin);
+    # robot 2 (0.3 m) drives 0.5 m at robot 3 (0.3 m) 1.0 m away: they touch at 0.6 m, at 10.4 m.
+    a = make_arrays(device)
+    x = a.asarray(np.array([[10.0, 11.0], [10.0, 11.0]]))
+    y = a.asarray(np.full((2, 2), 10.0))
+    mx = a.asarray(np.array([[0.8, 0.0], [0.5, 0.0]]))
+    radius = a.asarray(np.array([[0.1, 0.3], [0.3, 0.3]]))
+    ex, ey, c = (a.numpy(v) for v in advance_robots(a, x, y, mx, 0.0 * mx, radius))
+    np.testing.assert_allclose(ex, [[10.6 - 1e-9, 11.0], [10.4 - 1e-9, 11.0]], rtol=0, atol=1e-12)
+    assert (ey == 10.0).all() and c.tolist() == [[True, True], [True, True]]
+
+
+def _mixed_crowds(rng: np.random.Generator, scene: Scene, n_worlds: int, n_robots: int) -> tuple[np.ndarray, ...]:
+    """Robots of radii 0.05 to 0.2 m packed near each other and the clutter, starts clear
+    of walls and of each other (by the sum of the radii)."""
+    radius = rng.choice([0.05, 0.1, 0.12, 0.2], (n_worlds, n_robots))
+    x, y = np.empty((n_worlds, n_robots)), np.empty((n_worlds, n_robots))
+    for w in range(n_worlds):
+        pts: list[tuple[float, float]] = []
+        while len(pts) < n_robots:  # a new centre until the world's robots fit around one
+            centre, pts = rng.uniform(0.6, 2.4, 2), []
+            for _ in range(300):
+                p = tuple(centre + rng.uniform(-0.5, 0.5, 2))
+                r = radius[w, len(pts)]
+                if scene.is_usable(0, p, float(r)) and all(math.dist(p, q) >= r + radius[w, k] for k, q in enumerate(pts)):
+                    pts.append(p)
+                    if len(pts) == n_robots:
+                        break
+        x[w], y[w] = np.array(pts).T
+    return x, y, radius
+
+
+@pytest.mark.parametrize("device", DEVICES)
+@pytest.mark.parametrize("path", ["array", "compiled"])
+@pytest.mark.parametrize("n_robots", [2, 4])
+def test_crowds_of_different_radii_among_walls_match_the_backend(device: str, path: str, n_robots: int) -> None:
+    # As above, each robot with its own radius: walls at its radius, robots at the sum.
+    from pointnav_core.vector.contacts_jit import advance_compiled, available
+    from pointnav_core.vector.floors import FloorTables
+
+    rng = np.random.default_rng(20 + n_robots)
+    grid = (rng.random((30, 30)) < 0.12).astype(np.uint8)
+    grid[[0, -1], :] = grid[:, [0, -1]] = OBSTACLE
+    scene = Scene.from_array(grid, 0.1)
+    geom = FloorGeometry(scene.floors[0], 0.0)
+    a = make_arrays(device)
+    n_worlds, travel = 120, 0.05
+    x, y, radius = _mixed_crowds(rng, scene, n_worlds, n_robots)
+    speed = rng.uniform(0.0, travel, (n_worlds, n_robots)) * (rng.random((n_worlds, n_robots)) > 0.2)
+    heading = rng.uniform(-math.pi, math.pi, (n_worlds, n_robots))
+    mx, my = speed * np.cos(heading), speed * np.sin(heading)
+    want_x, want_y, want_c = np.empty_like(x), np.empty_like(y), np.zeros(x.shape, bool)
+    for w in range(n_worlds):
+        discs = [_Disc(*map(float, v)) for v in zip(x[w], y[w], mx[w], my[w], radius[w])]
+        for d in discs:
+            d.geom = geom
+        advance(discs, stop=False)
+        want_x[w], want_y[w], want_c[w] = [d.x for d in discs], [d.y for d in discs], [d.contact for d in discs]
+    floors = FloorTables([scene], 0, 0.2, a)
+    args = [a.asarray(v) for v in (x, y, mx, my)]
+    scene_ids = a.zeros(x.shape, a.i64)
+    limit = travel * (1 + 1e-9)
+    if path == "array":
+        walls = robot_walls(floors, scene_ids, *args, a.asarray(radius), limit)
+        got = [a.numpy(v) for v in advance_robots(a, *args, a.asarray(radius), walls=walls)]
+    else:
+        if not available(floors):
+            pytest.skip("the compiled path needs numba")
+        got = advance_compiled(floors, scene_ids, *args, a.full(x.shape, True, a.boolean), a.asarray(radius), limit)
+    np.testing.assert_allclose(got[0], want_x, atol=1e-9)
+    np.testing.assert_allclose(got[1], want_y, atol=1e-9)
+    np.testing.assert_array_equal(got[2], want_c)
+    assert want_c.any() and not want_c.all()
+    # Independently: no two robots end overlapping by more than the hit tolerance.
+    gap = np.hypot(got[0][:, :, None] - got[0][:, None, :], got[1][:, :, None] - got[1][:, None, :])
+    gap[:, np.arange(n_robots), np.arange(n_robots)] = np.inf
+    assert (gap - (radius[:, :, None] + radius[:, None, :])).min() >= -1e-8

@@ -103,7 +103,13 @@ def square_distance(px, py, x0, y0, x1, y1):  # pragma: no cover
 
 
 @_jit
-def _blocks(k, c, tx, ty, left, px, py, cnx, cny, ckind, cforced, wall, hit_w, hit_r):  # pragma: no cover
+def _hit(radius):  # pragma: no cover
+    # A point robot is a disc of _HIT (the backend's _hit_radius).
+    return max(radius - _HIT, _HIT)
+
+
+@_jit
+def _blocks(k, c, tx, ty, left, px, py, rad, cnx, cny, ckind, cforced, wall):  # pragma: no cover
     # Whether motion (tx, ty) of robot k, for ``left`` of the step, goes into its contact c
     # (the backend's _blocks): towards it, and forced or deeper than _HIT before ``left``.
     if tx * cnx[c] + ty * cny[c] >= 0.0:
@@ -112,15 +118,16 @@ def _blocks(k, c, tx, ty, left, px, py, cnx, cny, ckind, cforced, wall, hit_w, h
         return True
     j = ckind[c]
     if j >= 0:
-        t = enter_rounded_square(px[k], py[k], tx, ty, wall[k, j, 0], wall[k, j, 1], wall[k, j, 2], wall[k, j, 3], hit_w)
+        t = enter_rounded_square(px[k], py[k], tx, ty, wall[k, j, 0], wall[k, j, 1], wall[k, j, 2], wall[k, j, 3],
+                                 _hit(rad[k]))
     else:
         m = -j - 1
-        t = enter_disc(px[k], py[k], tx, ty, px[m], py[m], hit_r)
+        t = enter_disc(px[k], py[k], tx, ty, px[m], py[m], _hit(rad[k] + rad[m]))
     return t <= left
 
 
 @_jit
-def _resolve(n, px, py, mx, my, left, nwall, wall, pair, ev_k, ev_j, ev_m, radius, hit_w, hit_r, flag,
+def _resolve(n, px, py, mx, my, left, nwall, wall, pair, ev_k, ev_j, ev_m, rad, flag,
              cnx, cny, ckind, cforced):  # pragma: no cover
     # Every moving robot whose motion goes into a contact it touches (within _ACTIVE)
     # slides along the longest contact tangent that goes into no contact, else stops
@@ -133,7 +140,7 @@ def _resolve(n, px, py, mx, my, left, nwall, wall, pair, ev_k, ev_j, ev_m, radiu
         nc = 0
         for j in range(nwall[k]):
             d, nx, ny = square_distance(px[k], py[k], wall[k, j, 0], wall[k, j, 1], wall[k, j, 2], wall[k, j, 3])
-            if d <= radius + _ACTIVE:
+            if d <= rad[k] + _ACTIVE:
                 cnx[nc] = nx
                 cny[nc] = ny
                 ckind[nc] = j
@@ -145,7 +152,7 @@ def _resolve(n, px, py, mx, my, left, nwall, wall, pair, ev_k, ev_j, ev_m, radiu
             ex = px[k] - px[m]
             ey = py[k] - py[m]
             dist = math.sqrt(ex * ex + ey * ey)
-            if dist <= 2.0 * radius + _ACTIVE:
+            if dist <= rad[k] + rad[m] + _ACTIVE:
                 cnx[nc] = ex / dist if dist > 0.0 else 1.0
                 cny[nc] = ey / dist if dist > 0.0 else 0.0
                 ckind[nc] = -m - 1
@@ -155,7 +162,7 @@ def _resolve(n, px, py, mx, my, left, nwall, wall, pair, ev_k, ev_j, ev_m, radiu
         ty0 = my[k]
         blocked = False
         for c in range(nc):
-            if _blocks(k, c, tx0, ty0, left, px, py, cnx, cny, ckind, cforced, wall, hit_w, hit_r):
+            if _blocks(k, c, tx0, ty0, left, px, py, rad, cnx, cny, ckind, cforced, wall):
                 blocked = True
                 if ckind[c] < 0:
                     flag[-ckind[c] - 1] = True  # the robot it ran into
@@ -174,7 +181,7 @@ def _resolve(n, px, py, mx, my, left, nwall, wall, pair, ev_k, ev_j, ev_m, radiu
                 continue
             clear = True
             for c in range(nc):
-                if c != along and _blocks(k, c, tx, ty, left, px, py, cnx, cny, ckind, cforced, wall, hit_w, hit_r):
+                if c != along and _blocks(k, c, tx, ty, left, px, py, rad, cnx, cny, ckind, cforced, wall):
                     clear = False
                     break
             if clear:
@@ -191,6 +198,7 @@ def advance_worlds(x, y, mx, my, slow, scene, radius, meta, table, x_out, y_out,
 
     ``x, y, mx, my`` (W, R) float64 start positions and chords (m); ``slow`` (W, R) the
     robots resolved here (the others neither move nor block: they are out of reach);
+    ``radius`` (W, R) float64 each robot's radius (m; two robots touch at the sum);
     ``scene`` (W, R) int64; ``meta`` (S, 7) per scene: flat offset, rows, width, ox, oy,
     cell size, 1 / cell size; ``table`` the floors' wall table (cells, K) for the longest
     chord. Writes the slow robots' end positions to ``x_out, y_out`` and their contact flags
@@ -198,9 +206,8 @@ def advance_worlds(x, y, mx, my, slow, scene, radius, meta, table, x_out, y_out,
     """
     n_worlds, n_robots = x.shape
     n_table = table.shape[1]
-    hit_w = max(radius - _HIT, _HIT)
-    hit_r = max(2.0 * radius - _HIT, _HIT)
     ids = np.empty(n_robots, np.int64)
+    rad = np.empty(n_robots)
     px = np.empty(n_robots)
     py = np.empty(n_robots)
     sx = np.empty(n_robots)
@@ -232,6 +239,7 @@ def advance_worlds(x, y, mx, my, slow, scene, radius, meta, table, x_out, y_out,
             py[k] = sy[k] = y[w, i]
             vx[k] = mx[w, i]
             vy[k] = my[w, i]
+            rad[k] = radius[w, i]
             span[k] = math.sqrt(vx[k] * vx[k] + vy[k] * vy[k])
             flag[k] = False
             nwall[k] = 0
@@ -250,7 +258,7 @@ def advance_worlds(x, y, mx, my, slow, scene, radius, meta, table, x_out, y_out,
             row = math.floor((py[k] - oy) * inv)
             if not (0 <= col < width and 0 <= row < rows):
                 continue
-            reach = radius + span[k] + 4.0 * _ACTIVE
+            reach = rad[k] + span[k] + 4.0 * _ACTIVE
             cell = off + int(row) * width + int(col)
             for j in range(n_table):
                 wid = table[cell, j]
@@ -279,13 +287,12 @@ def advance_worlds(x, y, mx, my, slow, scene, radius, meta, table, x_out, y_out,
             for m in range(k + 1, n):
                 near = False
                 if span[k] > 0.0 or span[m] > 0.0:
-                    reach = 2.0 * radius + span[k] + span[m] + 4.0 * _ACTIVE
+                    reach = rad[k] + rad[m] + span[k] + span[m] + 4.0 * _ACTIVE
                     near = (px[k] - px[m]) ** 2 + (py[k] - py[m]) ** 2 < reach * reach
                 pair[k, m] = near
                 pair[m, k] = near
         left = 1.0
-        _resolve(n, px, py, vx, vy, left, nwall, wall, pair, -1, -1, -1, radius, hit_w, hit_r, flag,
-                 cnx, cny, ckind, cforced)
+        _resolve(n, px, py, vx, vy, left, nwall, wall, pair, -1, -1, -1, rad, flag, cnx, cny, ckind, cforced)
         for _ in range(_EVENTS_PER_ROBOT * n_moving):
             # The first hit: walls robot by robot, then pairs; the first wins a tie.
             t_first = left
@@ -296,6 +303,7 @@ def advance_worlds(x, y, mx, my, slow, scene, radius, meta, table, x_out, y_out,
                 if vx[k] == 0.0 and vy[k] == 0.0:
                     continue
                 speed = math.sqrt(vx[k] * vx[k] + vy[k] * vy[k])
+                hit_w = _hit(rad[k])
                 for j in range(nwall[k]):
                     d, nx, ny = square_distance(px[k], py[k], wall[k, j, 0], wall[k, j, 1], wall[k, j, 2], wall[k, j, 3])
                     if vx[k] * nx + vy[k] * ny >= 0.0 or d - hit_w > speed * left:
@@ -315,7 +323,7 @@ def advance_worlds(x, y, mx, my, slow, scene, radius, meta, table, x_out, y_out,
                     rvy = vy[k] - vy[m]
                     if rvx == 0.0 and rvy == 0.0:
                         continue
-                    t = enter_disc(px[k], py[k], rvx, rvy, px[m], py[m], hit_r)
+                    t = enter_disc(px[k], py[k], rvx, rvy, px[m], py[m], _hit(rad[k] + rad[m]))
                     if t < t_first:
                         if t == 0.0 and (px[k] - px[m]) * rvx + (py[k] - py[m]) * rvy >= 0.0:
                             continue
@@ -333,17 +341,16 @@ def advance_worlds(x, y, mx, my, slow, scene, radius, meta, table, x_out, y_out,
             if ev_m < 0:
                 j = ev_j
                 place = enter_rounded_square(px[k], py[k], vx[k], vy[k], wall[k, j, 0], wall[k, j, 1],
-                                             wall[k, j, 2], wall[k, j, 3], radius + _PLACE)
+                                             wall[k, j, 2], wall[k, j, 3], rad[k] + _PLACE)
             else:
                 m = ev_m
-                place = enter_disc(px[k], py[k], vx[k] - vx[m], vy[k] - vy[m], px[m], py[m], 2.0 * radius + _PLACE)
+                place = enter_disc(px[k], py[k], vx[k] - vx[m], vy[k] - vy[m], px[m], py[m], rad[k] + rad[m] + _PLACE)
             step = min(max(place, 0.0), t_first)
             for q in range(n):
                 px[q] = px[q] + vx[q] * step
                 py[q] = py[q] + vy[q] * step
             left = left - step
-            _resolve(n, px, py, vx, vy, left, nwall, wall, pair, ev_k, ev_j, ev_m, radius, hit_w, hit_r, flag,
-                     cnx, cny, ckind, cforced)
+            _resolve(n, px, py, vx, vy, left, nwall, wall, pair, ev_k, ev_j, ev_m, rad, flag, cnx, cny, ckind, cforced)
         # Safety net against rounding: never end deeper in a wall than at the start.
         for k in range(n):
             i = ids[k]
@@ -352,8 +359,8 @@ def advance_worlds(x, y, mx, my, slow, scene, radius, meta, table, x_out, y_out,
                 depth_start = -_INF
                 for j in range(nwall[k]):
                     w0, w1, w2, w3 = wall[k, j, 0], wall[k, j, 1], wall[k, j, 2], wall[k, j, 3]
-                    depth_end = max(depth_end, radius - square_distance(px[k], py[k], w0, w1, w2, w3)[0])
-                    depth_start = max(depth_start, radius - square_distance(sx[k], sy[k], w0, w1, w2, w3)[0])
+                    depth_end = max(depth_end, rad[k] - square_distance(px[k], py[k], w0, w1, w2, w3)[0])
+                    depth_start = max(depth_start, rad[k] - square_distance(sx[k], sy[k], w0, w1, w2, w3)[0])
                 if depth_end > _HIT and depth_end > depth_start:
                     px[k] = sx[k]
                     py[k] = sy[k]

@@ -25,12 +25,10 @@ _jit = numba.njit(cache=True, nogil=True, error_model="numpy")
 def cast_worlds(scene, x, y, cyaw, syaw, ca, sa, present, radius, max_range, meta, lookup, clear, out):  # pragma: no cover
     n_worlds, n_robots = x.shape
     n_rays = ca.shape[0]
-    r2 = radius * radius
+    # radius (W, R): each robot's disc (m).
     c = np.empty(n_rays)
     s = np.empty(n_rays)
     near = np.empty(n_robots, np.int64)
-    # Farther than this (m^2, with a margin for rounding) a disc is out of every ray's reach.
-    reach2 = ((max_range + radius) * (1.0 + 1e-9) + 1e-12) ** 2
     for w in range(n_worlds):
         k = scene[w]
         loff = int(meta[k, 0])
@@ -74,6 +72,8 @@ def cast_worlds(scene, x, y, cyaw, syaw, ca, sa, present, radius, max_range, met
                 if m != i and present[w, m]:
                     fx = px - x[w, m]
                     fy = py - y[w, m]
+                    # Farther than this (m^2, with a margin for rounding) the disc is out of every ray's reach.
+                    reach2 = ((max_range + radius[w, m]) * (1.0 + 1e-9) + 1e-12) ** 2
                     if fx * fx + fy * fy <= reach2:
                         near[n_near] = m
                         n_near += 1
@@ -83,5 +83,5 @@ def cast_worlds(scene, x, y, cyaw, syaw, ca, sa, present, radius, max_range, met
                 best = min(grid_range(gx, gy, dx, dy, fhp, fwp, plane, look, clr, e, n_cross, reach) * res, max_range)
                 for j in range(n_near):
                     m = near[j]
-                    best = min(best, disc_range(px - x[w, m], py - y[w, m], dx, dy, r2))
+                    best = min(best, disc_range(px - x[w, m], py - y[w, m], dx, dy, radius[w, m] * radius[w, m]))
                 out[w, i, r] = best

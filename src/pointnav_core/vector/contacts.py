@@ -70,7 +70,7 @@ def _take(xp: Any, a: Any, idx: Any) -> Any:
 
 
 def advance(
-    floors: FloorTables, scene: Any, x: Any, y: Any, mx: Any, my: Any, radius: float, max_travel: float
+    floors: FloorTables, scene: Any, x: Any, y: Any, mx: Any, my: Any, radius: Any, max_travel: float
 ) -> tuple[Any, Any, Any]:
     """Move robots by their chords ``(mx, my)`` (m) with contacts; new ``x``, ``y`` and contact flags.
 
@@ -81,8 +81,8 @@ def advance(
         Each robot's scene index.
     x, y, mx, my : float arrays (M,)
         Start positions and chords, in metres.
-    radius : float
-        Robot radius (m).
+    radius : float or float array (M,)
+        Robot radius (m): one for all, or each robot's own.
     max_travel : float
         The longest chord any step may have (m): the wall table is built for it.
     """
@@ -91,10 +91,13 @@ def advance(
     inf = math.inf
     span = xp.sqrt(mx * mx + my * my)
     max_span = float(span.max()) if span.shape[0] else 0.0
-    reach = radius + max_span + 4.0 * _ACTIVE
+    # Each robot's radius as a column (M, 1), against its (M, K) walls.
+    rcol = (xp.zeros_like(x) + radius)[:, None]
+    largest = float(rcol.max()) if rcol.shape[0] else 0.0
+    reach = rcol + max_span + 4.0 * _ACTIVE
     if max_span > max_travel:
         raise ValueError(f"a chord of {max_span} m is longer than max_travel {max_travel} m")
-    wx0, wy0, wx1, wy1, valid = window(floors, scene, x, y, radius + max_travel + 4.0 * _ACTIVE)
+    wx0, wy0, wx1, wy1, valid = window(floors, scene, x, y, largest + max_travel + 4.0 * _ACTIVE)
     d0 = square_distance(xp, x[:, None], y[:, None], wx0, wy0, wx1, wy1)[0]
     # Only walls within reach of the start can be met (sliding only shortens the motion):
     # keep the most any robot has, nearest first, so that every later test is on few walls.
@@ -103,7 +106,7 @@ def advance(
     order = _nearest(xp, xp.where(in_reach, d0, inf), k)
     wx0, wy0, wx1, wy1, valid, d0 = (_take(xp, v, order) for v in (wx0, wy0, wx1, wy1, in_reach, d0))
     n_contacts = min(CONTACTS, valid.shape[1])
-    hit_r = max(radius - _HIT, _HIT)
+    hit_r = (rcol - _HIT).clip(_HIT, None)
     start_x, start_y = x, y
     contact = xp.zeros_like(x) > 1.0
     left = xp.ones_like(x)
@@ -113,11 +116,11 @@ def advance(
     def resolve(x: Any, y: Any, mx: Any, my: Any, left: Any, forced_all: Any) -> tuple[Any, Any, Any]:
         # Only a moving robot within _ACTIVE of some wall can be blocked: the others keep going.
         dist_all = square_distance(xp, x[:, None], y[:, None], wx0, wy0, wx1, wy1)[0]
-        need = a.nonzero((valid & (dist_all <= radius + _ACTIVE)).any(-1) & ((mx != 0.0) | (my != 0.0)))
+        need = a.nonzero((valid & (dist_all <= rcol + _ACTIVE)).any(-1) & ((mx != 0.0) | (my != 0.0)))
         hit = xp.zeros_like(x) > 1.0
         if not need.shape[0]:
             return mx, my, hit
-        sub = (v[need] for v in (x, y, mx, my, left, forced_all, dist_all, wx0, wy0, wx1, wy1, valid))
+        sub = (v[need] for v in (x, y, mx, my, left, forced_all, dist_all, wx0, wy0, wx1, wy1, valid, rcol, hit_r))
         smx, smy, shit = _slide(*sub)
         mx, my = mx.clone() if a.is_torch else mx.copy(), my.clone() if a.is_torch else my.copy()
         mx[need], my[need], hit[need] = smx, smy, shit
@@ -125,7 +128,7 @@ def advance(
 
     def _slide(
         x: Any, y: Any, mx: Any, my: Any, left: Any, forced_all: Any, dist_all: Any,
-        wx0: Any, wy0: Any, wx1: Any, wy1: Any, valid: Any,
+        wx0: Any, wy0: Any, wx1: Any, wy1: Any, valid: Any, rcol: Any, hit_r: Any,
     ) -> tuple[Any, Any, Any]:
         # The walls within _ACTIVE of touching are among the nearest few: slide against those.
         near = _nearest(xp, xp.where(valid, dist_all, inf), n_contacts)
@@ -133,13 +136,13 @@ def advance(
             _take(xp, v, near) for v in (wx0, wy0, wx1, wy1, valid, forced_all)
         )
         dist, nx, ny = square_distance(xp, x[:, None], y[:, None], cx0, cy0, cx1, cy1)
-        touching = cvalid & (dist <= radius + _ACTIVE)
+        touching = cvalid & (dist <= rcol + _ACTIVE)
 
         def blocks(tx: Any, ty: Any) -> Any:  # (M, K) motions against (M, C) contacts
             into = tx[..., None] * nx[:, None, :] + ty[..., None] * ny[:, None, :] < 0.0
             t = enter_rounded_square(
                 xp, x[:, None, None], y[:, None, None], tx[..., None], ty[..., None],
-                cx0[:, None, :], cy0[:, None, :], cx1[:, None, :], cy1[:, None, :], hit_r,
+                cx0[:, None, :], cy0[:, None, :], cx1[:, None, :], cy1[:, None, :], hit_r[:, None],
             )
             return touching[:, None, :] & into & (forced[:, None, :] | (t <= left[:, None, None]))
 
@@ -184,7 +187,7 @@ def advance(
         if not a.any(event):
             break
         ex0, ey0, ex1, ey1 = (_take(xp, v, first[:, None])[:, 0] for v in (wx0, wy0, wx1, wy1))
-        place = enter_rounded_square(xp, x, y, mx, my, ex0, ey0, ex1, ey1, radius + _PLACE)
+        place = enter_rounded_square(xp, x, y, mx, my, ex0, ey0, ex1, ey1, rcol[:, 0] + _PLACE)
         step = xp.minimum(xp.maximum(place, xp.zeros_like(place)), t_first)
         step = xp.where(event, step, 0.0)
         x, y = x + mx * step, y + my * step
@@ -194,8 +197,8 @@ def advance(
         mx, my = xp.where(event, nmx, mx), xp.where(event, nmy, my)
         contact = contact | (hit & event)
     # Safety net against rounding: never end deeper in a wall than at the start.
-    depth_end = xp.amax(xp.where(valid, radius - square_distance(xp, x[:, None], y[:, None], wx0, wy0, wx1, wy1)[0], -inf), -1)
-    depth_start = xp.amax(xp.where(valid, radius - d0, -inf), -1)
+    depth_end = xp.amax(xp.where(valid, rcol - square_distance(xp, x[:, None], y[:, None], wx0, wy0, wx1, wy1)[0], -inf), -1)
+    depth_start = xp.amax(xp.where(valid, rcol - d0, -inf), -1)
     moved = (x != start_x) | (y != start_y)
     undo = contact & moved & (depth_end > _HIT) & (depth_end > depth_start)
     return xp.where(undo, start_x, x), xp.where(undo, start_y, y), contact

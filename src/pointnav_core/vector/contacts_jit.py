@@ -42,7 +42,7 @@ def _kernel() -> Any:
 
 
 def advance_compiled(
-    floors: FloorTables, scene: Any, x: Any, y: Any, mx: Any, my: Any, slow: Any, radius: float, max_travel: float
+    floors: FloorTables, scene: Any, x: Any, y: Any, mx: Any, my: Any, slow: Any, radius: Any, max_travel: float
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Move the ``slow`` robots by their chords with contacts; the others stay.
 
@@ -56,8 +56,9 @@ def advance_compiled(
     slow : bool array (W, R)
         The robots to resolve: within a world they move together and block each other;
         the others neither move nor block (the caller moves them: they are out of reach).
-    radius : float
-        Every robot's radius (m).
+    radius : float or float array broadcasting to (W, R)
+        Every robot's radius (m), one for all or each robot's own (two robots touch at the
+        sum of their radii).
     max_travel : float
         The longest chord any step may have (m): the wall table is built for it.
 
@@ -71,24 +72,28 @@ def advance_compiled(
     advance_worlds = _kernel()
     a = floors.arrays
     view = (lambda v: v.numpy()) if a.is_torch else (lambda v: v)
-    table = floors.wall_table(radius + max_travel + _WALL_MARGIN)
     x, y = np.ascontiguousarray(view(x), np.float64), np.ascontiguousarray(view(y), np.float64)
+    radius = view(radius) if a.is_torch and not isinstance(radius, (int, float)) else radius
+    rad = np.ascontiguousarray(np.broadcast_to(np.asarray(radius, np.float64), x.shape))
+    # One wall table for the largest robot: each robot keeps the walls within its own reach.
+    table = floors.wall_table((float(rad.max()) if rad.size else 0.0) + max_travel + _WALL_MARGIN)
     x_out, y_out = x.copy(), y.copy()
     contact = np.zeros(x.shape, np.bool_)
     advance_worlds(
         x, y, np.ascontiguousarray(view(mx), np.float64), np.ascontiguousarray(view(my), np.float64),
-        np.ascontiguousarray(view(slow), np.bool_), np.ascontiguousarray(view(scene), np.int64), float(radius),
+        np.ascontiguousarray(view(slow), np.bool_), np.ascontiguousarray(view(scene), np.int64), rad,
         floors.host_meta, np.ascontiguousarray(view(table), np.int64), x_out, y_out, contact,
     )
     return x_out, y_out, contact
 
 
 def advance_one(
-    floors: FloorTables, scene: Any, x: Any, y: Any, mx: Any, my: Any, radius: float, max_travel: float
+    floors: FloorTables, scene: Any, x: Any, y: Any, mx: Any, my: Any, radius: Any, max_travel: float
 ) -> tuple[Any, Any, Any]:
     """:func:`advance_compiled` for one robot per world, with the arguments and results of
     :func:`~pointnav_core.vector.contacts.advance`: ``(M,)`` arrays in the floors' namespace."""
     a = floors.arrays
+    rad = radius if isinstance(radius, (int, float)) else radius[:, None]
     out = advance_compiled(floors, scene[:, None], x[:, None], y[:, None], mx[:, None], my[:, None],
-                           a.xp.ones_like(x[:, None]) > 0.0, radius, max_travel)
+                           a.xp.ones_like(x[:, None]) > 0.0, rad, max_travel)
     return tuple(a.asarray(v[:, 0], a.boolean if v.dtype == np.bool_ else None) for v in out)  # type: ignore[return-value]

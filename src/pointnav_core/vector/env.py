@@ -97,8 +97,8 @@ class VectorPointNavEnv(PoolRefreshing, VectorEnv):
         (actions ``(vx, vy, w)`` in the robot frame, +x ahead, +y to the left), scaled and
         integrated as the kinematic backend does (:mod:`pointnav_core.vector.drive`). With
         several robots per world, also a list with one entry per robot, as for
-        :func:`~pointnav_core.parallel.parallel_env`: their speed limits may differ, their
-        radius and drive may not (the actions are one array).
+        :func:`~pointnav_core.parallel.parallel_env`: their speed limits and radii may
+        differ, their drive may not (the actions are one array).
     task : dict, optional
         ``PointNavigationTask`` keyword arguments, as for the single env (its default
         ``path_range`` too). Custom terms are not supported. Any ``fall_height`` (m):
@@ -190,9 +190,10 @@ class VectorPointNavEnv(PoolRefreshing, VectorEnv):
     ``goal_in_polar``, ``termination_config`` (``max_steps``, ``max_collisions``,
     ``fall_height``), ``reward_config`` and ``path_range`` and its robot's speed limits
     (m/s, rad/s; with discrete actions, each robot's actions then last its own number of
-    control steps) may differ; a list whose tasks' ``floor`` or robots' ``radius`` differ
-    raises ``ValueError`` naming ``task`` or ``robot``, as does a list of the wrong length
-    or an entry of the wrong type (naming ``task[i]`` or ``robot[i]``).
+    control steps) and radius (m: walls at its radius, another robot at the sum of the two
+    radii, its disc in the others' scans and maps) may differ; a list whose tasks'
+    ``floor`` differ raises ``ValueError`` naming ``task``, as does a list of the wrong
+    length or an entry of the wrong type (naming ``task[i]`` or ``robot[i]``).
 
     Examples
     --------
@@ -325,10 +326,21 @@ class VectorPointNavEnv(PoolRefreshing, VectorEnv):
         self._max_travel = top * self.dt * (1.0 + 1e-9) + 1e-12
 
     # ------------------------------------------------------------------ pools
+    @property
+    def _reach(self) -> float:
+        """How far (m) a robot's centre can get from its start in one episode: its steps (the
+        most of any robot's ``max_steps``, and at most ``max_cycles`` with several robots)
+        times the longest chord of a step (of each of a discrete action's control steps).
+        Goal fields keep only the cells within it of their starts (``FieldTables``)."""
+        steps = self.max_steps if isinstance(self.max_steps, int) else int(self.arrays.numpy(self.max_steps).max())
+        steps = min(steps, getattr(self, "max_cycles", steps))
+        per_step = self._max_travel * (1 if self._discrete is None else self._discrete.max_steps)
+        return steps * per_step
+
     def _build_pool(self, fixed: Sequence[tuple[Any, float, Any, int]]) -> None:
         size = 0 if fixed else self.pool_size
         seeds = self._rng.integers(2**31, size=size * len(self.scenes))
-        self.pool = EpisodePool(self._samplers, size, seeds, self.arrays, fixed, self.starts_per_goal)
+        self.pool = EpisodePool(self._samplers, size, seeds, self.arrays, fixed, self.starts_per_goal, self._reach)
 
     # ------------------------------------------------------------------ Gymnasium API
     def reset(self, *, seed: int | None = None, options: dict[str, Any] | None = None) -> tuple[Any, dict[str, Any]]:

@@ -13,6 +13,7 @@ within reach, a random heading, the geodesic in ``path_range``), all sharing its
 
 from __future__ import annotations
 
+import math
 from collections.abc import Sequence
 from typing import Any
 
@@ -42,6 +43,9 @@ class EpisodePool:
     arrays : Arrays
     starts : int
         Episodes per sampled goal (>= 1), sharing its goal field.
+    reach : float
+        How far (m) a robot gets from its start in one episode: each field keeps the cells
+        within it of its episodes' starts (:class:`~pointnav_core.vector.fields.FieldTables`).
 
     Attributes
     ----------
@@ -59,6 +63,7 @@ class EpisodePool:
         arrays: Arrays,
         fixed: Sequence[tuple[Any, float, Any, int]] = (),
         starts: int = 1,
+        reach: float = math.inf,
     ) -> None:
         from pointnav_core.sampling import sample_episode
 
@@ -97,7 +102,9 @@ class EpisodePool:
         self.sx, self.sy, self.syaw, self.gx, self.gy, self.d0 = (a.asarray(table[:, i]) for i in range(6))
         self.scene = a.asarray(table[:, 6], a.i64)
         self.field = a.asarray(field_of, a.i64)
-        self.fields = FieldTables(fields, arrays)
+        field_index = np.asarray(field_of, dtype=np.int64)
+        per_field = [table[field_index == f, :2] for f in range(len(fields))]
+        self.fields = FieldTables(fields, arrays, per_field, reach)
         self.pool_size = pool_size * starts
         self.n_sampled = self.pool_size * len(samplers)
 

@@ -8,6 +8,12 @@ the goal, 2 by a label of the Dijkstra search) and label, and per label the arc 
 and cost. :meth:`FieldTables.distance` then evaluates ``GoalField.distance``'s formula
 for every robot at once. Because the single env reads the same (now settled) table of
 the same cached field, both give the same numbers.
+
+A robot cannot leave the disc of an episode's reach around its start (its steps times its
+longest chord per step), so with the episodes' ``starts`` and that ``reach`` a field keeps
+only its window of cells (:func:`reach_window`), and only the blocks those cells look up
+are checked: on a large map the settling and the memory scale with the episodes' reach,
+not with the map.
 """
 
 from __future__ import annotations
@@ -17,30 +23,58 @@ from collections.abc import Sequence
 from typing import Any
 
 import numpy as np
+from numpy.typing import ArrayLike, NDArray
 
 from pointnav_core.tangent_field import _BLOCK, _UNCHECKED, GoalField
 from pointnav_core.tangent_graph import _ANG_TOL, _TWO_PI
 from pointnav_core.vector.xp import Arrays
 
-__all__ = ["FieldTables", "settle"]
+__all__ = ["FieldTables", "reach_window", "settle"]
 
 # Per Dijkstra label, in the order of the label table's columns.
 _PER_LABEL = ("cost", "cx", "cy", "side", "phi0", "span", "pos", "qx", "qy")
 _PER_FIELD_FLOAT = ("gx", "gy", "ox", "oy", "res", "radius")
-_INDICES = ("kind", "label", "offset", "rows", "width")
+_INDICES = ("kind", "label", "offset", "rows", "width", "row0", "col0")
 
 
-def settle(field: GoalField) -> dict[str, Any]:
-    """Check every block of ``field``'s root table and settle every cell; the table."""
+def settle(field: GoalField, cells: NDArray[np.int64] | None = None) -> dict[str, Any]:
+    """Check the blocks of ``field``'s root table and settle the cells; the table.
+
+    ``cells`` (flat table indices) limits this to the blocks holding them, in the same
+    (row-major) order, and to settling those cells; default: every block and cell.
+    """
     t = field._table if field._table is not None else field._build_table()
     h, w = field.planner.geo.shape
-    for r0 in range(0, h, _BLOCK):
-        for c0 in range(0, w, _BLOCK):
-            if not t["done"][(r0 // _BLOCK) * t["blocks_w"] + c0 // _BLOCK]:
-                field._check_block(r0 * w + c0)
-    field._settle_cells(np.flatnonzero(t["kind"] == 3))
-    assert not (t["kind"] == _UNCHECKED).any()
+    bw = t["blocks_w"]
+    if cells is None:
+        blocks: Any = range(len(t["done"]))
+    else:
+        cells = np.unique(np.asarray(cells, dtype=np.int64))
+        blocks = np.unique((cells // w) // _BLOCK * bw + (cells % w) // _BLOCK).tolist()
+    for b in blocks:
+        if not t["done"][b]:
+            field._check_block((b // bw) * _BLOCK * w + (b % bw) * _BLOCK)
+    left = np.flatnonzero(t["kind"] == 3) if cells is None else cells[t["kind"][cells] == 3]
+    field._settle_cells(left)
+    assert not (t["kind"][slice(None) if cells is None else cells] == _UNCHECKED).any()
     return t
+
+
+def reach_window(field: GoalField, starts: ArrayLike, reach: float) -> tuple[int, int, int, int]:
+    """The cells ``(row0, row1, col0, col1)`` (half-open) of ``field``'s grid that a robot
+    centre within ``reach`` (m) of one of ``starts`` ``(n, 2)`` (m) can lie in, with a cell
+    to spare each side; the whole grid when ``reach`` is infinite."""
+    geo = field.planner.geo
+    h, w = geo.shape
+    xy = np.asarray(starts, dtype=np.float64).reshape(-1, 2)
+    if not math.isfinite(reach) or not len(xy):
+        return 0, h, 0, w
+    res, (ox, oy) = geo.resolution, geo.origin[:2]
+    lo = np.floor((xy.min(0) - reach - (ox, oy)) / res) - 1
+    hi = np.floor((xy.max(0) + reach - (ox, oy)) / res) + 2
+    c0, r0 = (int(min(max(v, 0), n)) for v, n in zip(lo, (w, h)))
+    c1, r1 = (int(min(max(v, 0), n)) for v, n in zip(hi, (w, h)))
+    return r0, max(r1, r0), c0, max(c1, c0)
 
 
 class FieldTables:
@@ -49,8 +83,16 @@ class FieldTables:
     Parameters
     ----------
     fields : sequence of GoalField
-        All from planners of one robot radius.
+        Each keeps its planner's robot radius (``radius``, per field), so fields of robots
+        of different radii share the tables.
     arrays : Arrays
+    starts : sequence of array_like (n_i, 2), optional
+        Per field, the starts (m) of the episodes that use it. With ``reach``, each field
+        keeps only the window of cells a robot from those starts can reach; a lookup
+        outside it reads ``inf``. Default: every field keeps its whole grid.
+    reach : float
+        How far (m) a robot's centre can get from its start in one episode (``inf``: any
+        distance, the whole grid).
     """
 
     # Per label (one spare row at the end of each field's labels): see _PER_LABEL.
@@ -64,14 +106,20 @@ class FieldTables:
     qx: Any
     qy: Any
 
-    def __init__(self, fields: Sequence[GoalField], arrays: Arrays) -> None:
+    def __init__(
+        self, fields: Sequence[GoalField], arrays: Arrays, starts: Sequence[ArrayLike] | None = None,
+        reach: float = math.inf,
+    ) -> None:
         kinds, labels, goal, geo, lab_arrays = [], [], [], [], []
         cell_off = lab_off = 0
-        for field in fields:
-            t = settle(field)
+        for f, field in enumerate(fields):
             p = field.planner
             h, w = p.geo.shape
-            near = np.asarray(p.near_usable, dtype=np.int64).ravel()
+            r0, r1, c0, c1 = (0, h, 0, w) if starts is None else reach_window(field, starts[f], reach)
+            near = np.asarray(p.near_usable, dtype=np.int64).reshape(h, w)[r0:r1, c0:c1].ravel()
+            whole = (r0, r1, c0, c1) == (0, h, 0, w)
+            # Only the cells the window's cells look up are settled (every one for the whole grid).
+            t = settle(field, None if whole else near[near >= 0])
             kind = np.where(near >= 0, t["kind"][np.maximum(near, 0)], 0).astype(np.int64)
             label = np.where(kind == 2, t["label"][np.maximum(near, 0)], 0).astype(np.int64)
             s = field._search
@@ -88,11 +136,11 @@ class FieldTables:
             kinds.append(kind)
             labels.append(label + lab_off)
             goal.append((float(field.goal[0]), float(field.goal[1])))
-            geo.append((cell_off, h, w, p.geo.origin[0], p.geo.origin[1], p.geo.resolution, p.radius))
-            cell_off += h * w
+            geo.append((cell_off, r1 - r0, c1 - c0, p.geo.origin[0], p.geo.origin[1], p.geo.resolution, p.radius, r0, c0))
+            cell_off += (r1 - r0) * (c1 - c0)
             lab_off += n_lab
         a = arrays
-        g = np.array(geo, dtype=np.float64).reshape(-1, 7)
+        g = np.array(geo, dtype=np.float64).reshape(-1, 9)
         self.kind = a.asarray(np.concatenate(kinds), a.i64)
         self.label = a.asarray(np.concatenate(labels), a.i64)
         # One spare row: cells with no label point at the end of their field's labels.
@@ -102,7 +150,9 @@ class FieldTables:
         gxy = np.array(goal, dtype=np.float64).reshape(-1, 2)
         self.gx, self.gy = a.asarray(gxy[:, 0]), a.asarray(gxy[:, 1])
         self.offset = a.asarray(g[:, 0], a.i64)
+        # Each field's window of its grid: rows x width cells from (row0, col0).
         self.rows, self.width = a.asarray(g[:, 1], a.i64), a.asarray(g[:, 2], a.i64)
+        self.row0, self.col0 = a.asarray(g[:, 7], a.i64), a.asarray(g[:, 8], a.i64)
         self.ox, self.oy, self.res, self.radius = (a.asarray(g[:, i]) for i in (3, 4, 5, 6))
         self.arrays = a
 
@@ -129,7 +179,7 @@ class FieldTables:
         joined.arrays = a
         joined.kind = cat([first.kind, second.kind])
         joined.label = cat([first.label, second.label + first.cost.shape[0]])
-        for name in _PER_LABEL + _PER_FIELD_FLOAT + ("rows", "width"):
+        for name in _PER_LABEL + _PER_FIELD_FLOAT + ("rows", "width", "row0", "col0"):
             setattr(joined, name, cat([getattr(first, name), getattr(second, name)]))
         joined.offset = cat([first.offset, second.offset + first.kind.shape[0]])
         return joined
@@ -143,8 +193,9 @@ class FieldTables:
         a = self.arrays
         xp = a.xp
         res = self.res[field]
-        col = a.to_int(xp.floor((x - self.ox[field]) / res))
-        row = a.to_int(xp.floor((y - self.oy[field]) / res))
+        # The grid's cell, as the single env finds it, then its place in the field's window.
+        col = a.to_int(xp.floor((x - self.ox[field]) / res)) - self.col0[field]
+        row = a.to_int(xp.floor((y - self.oy[field]) / res)) - self.row0[field]
         inside = (row >= 0) & (row < self.rows[field]) & (col >= 0) & (col < self.width[field])
         cell = xp.where(inside, self.offset[field] + row * self.width[field] + col, 0)
         kind = xp.where(inside, self.kind[cell], 0)

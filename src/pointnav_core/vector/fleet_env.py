@@ -11,7 +11,9 @@ the one-robot engine's, masked by the robots still active (PettingZoo's ``agents
 robots of its world that the multi-robot env's scan sees when it observes the step: those
 present before the step's finished robots leave (parked, removed or fallen alike), all of
 them after a reset; with ``sensors={"local_map": {...}}`` every robot's map draws the discs
-of the same robots as code 3.
+of the same robots as code 3. Robots may differ in radius (a ``robot`` list): each takes
+the fast path by the clearance table of its radius, meets walls at its radius and another
+robot at the sum of their radii, and is a disc of its radius in the scans and maps.
 """
 
 from __future__ import annotations
@@ -118,7 +120,7 @@ class VectorFleetEnv(VectorPointNavEnv):
         self.arrays = a = make_arrays(device)
         self.device = device
         self.scenes = scene_list = _scene_list(scene)
-        #: One spec per robot; ``robot`` is their envelope (shared radius, highest speeds).
+        #: One spec per robot; ``robot`` is their envelope (largest radius, highest speeds).
         self.robots = robot_specs(robot, self.n_robots)
         self.robot = spec = envelope(self.robots)
         # The multi-robot env of each scene samples its episodes and is the semantics.
@@ -137,6 +139,8 @@ class VectorFleetEnv(VectorPointNavEnv):
         # Each robot's own commands and control steps (its speed limits), as the multi-robot env plans them.
         self._discrete = None if acts is None else DiscretePlan(acts, list(self.robots), self.action_frequency, a)
         self.floors = FloorTables(scene_list, t.floor, spec.radius, a)
+        # Each robot's clearance table, of its own radius: (R, all cells).
+        self._fast = a.xp.stack([self.floors.fast_for(s.radius) for s in self.robots])
         bounds = [[t.observation_bounds for t in env.tasks] for env in self._samplers]  # (scene, robot)
         lows, highs = (np.array([[b[k] for b in row] for row in bounds], np.float64) for k in (0, 1))
         self._low, self._high = a.asarray(lows), a.asarray(highs)
@@ -180,7 +184,7 @@ class VectorFleetEnv(VectorPointNavEnv):
     def _build_pool(self, fixed: Sequence[Any]) -> None:
         size = 0 if fixed else self.pool_size
         seeds = self._rng.integers(2**31, size=size * len(self.scenes))
-        self.pool = FleetPool(self._samplers, size, seeds, self.arrays, fixed, self.starts_per_goal)
+        self.pool = FleetPool(self._samplers, size, seeds, self.arrays, fixed, self.starts_per_goal, self._reach)
 
     def reset(self, *, seed: int | None = None, options: dict[str, Any] | None = None) -> tuple[Any, dict[str, Any]]:
         """Reset every world. ``options={"episodes": [[(start_xy, yaw, goal_xy), ...], ...]}``
@@ -267,7 +271,7 @@ class VectorFleetEnv(VectorPointNavEnv):
         present in the world drops (:func:`~pointnav_core.vector.falls.apply_falls`); it
         neither drives nor blocks. A robot out of the world stays as it is."""
         a, xp = self.arrays, self.arrays.xp
-        dt, radius = self.dt, self.robot.radius
+        dt, radius = self.dt, self._radius  # (1, R): each robot's radius
         falling = state["fs"] > 0.0
         present = self._present & ~falling
         vmax, wmax = self._vmax, self._wmax  # (1, R): each robot's speed limits
@@ -279,9 +283,10 @@ class VectorFleetEnv(VectorPointNavEnv):
         # The backend's fast path: clearance beyond the step and no other free robot within reach.
         scene = self._robot_scene
         row, col, inside = self.floors.cells(scene, x0, y0)
-        budget = self.floors.fast[self.floors.flat_index(scene, row, col, inside)]
+        budget = self._fast[self._robot_ids, self.floors.flat_index(scene, row, col, inside)]
         reach = radius + length
-        gap = reach[:, :, None] + reach[:, None, :]
+        # The backend's sum, in its order: robot i's reach, then robot j's radius and travel.
+        gap = reach[:, :, None] + radius[:, None, :] + length[:, None, :]
         gap2 = (x0[:, :, None] - x0[:, None, :]) ** 2 + (y0[:, :, None] - y0[:, None, :]) ** 2
         ids = self._robot_ids
         others = (ids.reshape(1, -1, 1) != ids.reshape(1, 1, -1)) & present[:, None, :] & (gap2 <= gap * gap)
@@ -373,7 +378,7 @@ class VectorFleetEnv(VectorPointNavEnv):
         the others where they are: ``x``, ``y`` and the contact flags, ``(num_envs, n_robots)``."""
         a = self.arrays
         if contacts_jit.available(self.floors):  # every world in one compiled loop
-            sx, sy, c = advance_compiled(self.floors, self._robot_scene, x0, y0, dx, dy, slow, self.robot.radius,
+            sx, sy, c = advance_compiled(self.floors, self._robot_scene, x0, y0, dx, dy, slow, self._radius,
                                          self._max_travel)
             return a.asarray(sx), a.asarray(sy), a.asarray(c, a.boolean)
         x, y, contact = x0 + 0.0, y0 + 0.0, a.xp.zeros_like(slow)
@@ -383,20 +388,22 @@ class VectorFleetEnv(VectorPointNavEnv):
     def _advance_slow(self, x0: Any, y0: Any, dx: Any, dy: Any, slow: Any, x: Any, y: Any, contact: Any) -> None:
         """The array path of the slow robots' contacts: writes their ends into ``x``, ``y``
         and their flags into ``contact`` (in place)."""
-        a, xp, radius, scene = self.arrays, self.arrays.xp, self.robot.radius, self._robot_scene
+        a, xp, scene = self.arrays, self.arrays.xp, self._robot_scene
+        radius = xp.zeros_like(x0) + self._radius  # (W, R)
         n_slow = slow.sum(-1)
         # A world with one slow robot is the one-robot resolver's case (the backend's
         # advance with a single robot): cheaper, and most busy worlds are such.
         alone = a.nonzero((slow & (n_slow == 1)[:, None]).reshape(-1))
         if alone.shape[0]:
-            flat = [v.reshape(-1)[alone] for v in (scene, x0, y0, dx, dy)]
-            nx, ny, c = advance(self.floors, *flat, radius, self._max_travel)
+            flat = [v.reshape(-1)[alone] for v in (scene, x0, y0, dx, dy, radius)]
+            nx, ny, c = advance(self.floors, *flat, self._max_travel)
             x.reshape(-1)[alone], y.reshape(-1)[alone], contact.reshape(-1)[alone] = nx, ny, c
         busy = a.nonzero(n_slow > 1)
         if busy.shape[0]:
             bx, by, bdx, bdy = x0[busy], y0[busy], dx[busy], dy[busy]
-            walls = robot_walls(self.floors, scene[busy], bx, by, bdx, bdy, radius, self._max_travel)
-            nx, ny, c = advance_robots(a, bx, by, bdx, bdy, radius, present=slow[busy], walls=walls)
+            brad = radius[busy]
+            walls = robot_walls(self.floors, scene[busy], bx, by, bdx, bdy, brad, self._max_travel)
+            nx, ny, c = advance_robots(a, bx, by, bdx, bdy, brad, present=slow[busy], walls=walls)
             bslow = slow[busy]
             x[busy] = xp.where(bslow, nx, x[busy])
             y[busy] = xp.where(bslow, ny, y[busy])
@@ -408,13 +415,13 @@ class VectorFleetEnv(VectorPointNavEnv):
         ``_seen`` neither see nor are seen (their rows are hidden by ``_observe``)."""
         xp, st = self.arrays.xp, self._state
         yaw = xp.arctan2(s, c)  # the heading as the multi-robot env's frame gives it
-        return self.scan.readings(self._world_scene, st["x"], st["y"], yaw, self._seen, self.robot.radius)
+        return self.scan.readings(self._world_scene, st["x"], st["y"], yaw, self._seen, self._radius)
 
     def _map_values(self) -> Any:
         """Every robot's local map, ``(num_envs, n_robots, cells * cells)``, with the discs of
         the robots in ``_seen`` (the scan's rule); rows outside it are hidden by ``_observe``."""
         st = self._state
-        return self.local_map.values(self._world_scene, st["x"], st["y"], st["yaw"], self._seen, self.robot.radius)
+        return self.local_map.values(self._world_scene, st["x"], st["y"], st["yaw"], self._seen, self._radius)
 
     def _observe(self, shown: Any) -> Any:
         """The robots' ``low_dim`` observations, zero where ``shown`` is False."""

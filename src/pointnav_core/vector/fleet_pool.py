@@ -33,8 +33,8 @@ FleetEpisode = tuple[Any, float, Any]
 def check_fixed_episode(sampler: Any, episode: Sequence[FleetEpisode], where: str) -> list[tuple[Any, float, Any]]:
     """One world's fixed robots, checked by the multi-robot env's rules; ValueError naming ``where``.
 
-    Each start and goal must be usable by the robot, starts at least two radii apart and
-    goals :func:`~pointnav_core.fleet.goal_separation` apart.
+    Each start and goal must be usable by its robot, starts at least the sum of the two
+    robots' radii apart and goals :func:`~pointnav_core.fleet.goal_separation` apart.
     """
     n = len(sampler.tasks)
     try:
@@ -43,18 +43,18 @@ def check_fixed_episode(sampler: Any, episode: Sequence[FleetEpisode], where: st
         raise ValueError(f"{where} must hold {n} (start_xy, yaw, goal_xy) tuples, got {episode!r}") from None
     if len(robots) != n:
         raise ValueError(f"{where} must hold one (start_xy, yaw, goal_xy) per robot ({n}), got {len(robots)}")
-    scene, floor, spec = sampler.scene, sampler.tasks[0].floor, sampler.robots[0]
+    scene, floor, specs = sampler.scene, sampler.tasks[0].floor, sampler.robots
     for r, (start, yaw, goal) in enumerate(robots):
         if not math.isfinite(yaw):
             raise ValueError(f"{where}[{r}]: yaw must be finite, got {yaw}")
         for name, xy in (("start", start), ("goal", goal)):
-            if not scene.is_usable(floor, xy, spec):
+            if not scene.is_usable(floor, xy, specs[r]):
                 raise ValueError(f"{where}[{r}]: {name} {list(xy)} is not usable by the robot")
     sep = sampler._separation
     for i in range(n):
         for j in range(i + 1, n):
             (si, _, gi), (sj, _, gj) = robots[i], robots[j]
-            if math.dist(si[:2], sj[:2]) < 2.0 * spec.radius:
+            if math.dist(si[:2], sj[:2]) < specs[i].radius + specs[j].radius:
                 raise ValueError(f"{where}: robots {i} and {j} start overlapping ({math.dist(si[:2], sj[:2]):.3g} m apart)")
             if math.dist(gi[:2], gj[:2]) < sep[i][j]:
                 raise ValueError(
@@ -87,6 +87,9 @@ class FleetPool:
         Given episodes (``robots`` as :func:`check_fixed_episode` returns them).
     starts : int
         Sets of starts per sampled set of goals (>= 1), sharing its goal fields.
+    reach : float
+        How far (m) a robot gets from its start in one episode: each field keeps the cells
+        within it of its robots' starts (:class:`~pointnav_core.vector.fields.FieldTables`).
     """
 
     def __init__(
@@ -97,6 +100,7 @@ class FleetPool:
         arrays: Arrays,
         fixed: Sequence[tuple[Sequence[tuple[Any, float, Any]], int]] = (),
         starts: int = 1,
+        reach: float = math.inf,
     ) -> None:
         rows: list[list[tuple[float, ...]]] = []
         fields = []
@@ -120,8 +124,9 @@ class FleetPool:
             env = samplers[s]
             episode = []
             field_of.append([len(fields) + i for i in range(len(robots))])
-            for start, yaw, goal in robots:
-                field = env.scene.goal_field(env.tasks[0].floor, goal, robot=env.robots[0])
+            for i, (start, yaw, goal) in enumerate(robots):
+                # The field of the robot's own radius, as its task reads it.
+                field = env.scene.goal_field(env.tasks[0].floor, goal, robot=env.robots[i])
                 episode.append((float(start[0]), float(start[1]), yaw, float(goal[0]), float(goal[1]), field.exact_distance(start)))
                 fields.append(field.field)
             rows.append(episode)
@@ -129,8 +134,10 @@ class FleetPool:
         table = np.array(rows, dtype=np.float64).reshape(-1, n_robots, 6)
         a = arrays
         self.sx, self.sy, self.syaw, self.gx, self.gy, self.d0 = (a.asarray(table[..., i]) for i in range(6))
-        self.fields = FieldTables(fields, arrays)
-        self.field = a.asarray(np.array(field_of, dtype=np.int64).reshape(-1, n_robots), a.i64)
+        field_index = np.array(field_of, dtype=np.int64).reshape(-1, n_robots)
+        per_field = [table[field_index == f][:, :2] for f in range(len(fields))]
+        self.fields = FieldTables(fields, arrays, per_field, reach)
+        self.field = a.asarray(field_index, a.i64)
         self.pool_size = pool_size * starts
         self.n_sampled = self.pool_size * len(samplers)
         self.n_robots = n_robots

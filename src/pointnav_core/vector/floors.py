@@ -22,7 +22,10 @@ __all__ = ["FloorTables"]
 
 
 class FloorTables:
-    """One floor per scene, for robots of one radius, as flat arrays on ``arrays.device``.
+    """One floor per scene as flat arrays on ``arrays.device``.
+
+    ``fast`` is the clearance table for ``radius``; :meth:`fast_for` gives the table of
+    any other radius (robots of several radii in one world), the backend's own per radius.
 
     Parameters
     ----------
@@ -31,7 +34,7 @@ class FloorTables:
     floor : int
         The task's floor.
     radius : float
-        Robot radius (m), for the clearance table.
+        Robot radius (m), for the clearance table ``fast``.
     arrays : Arrays
         Namespace and device.
 
@@ -44,7 +47,7 @@ class FloorTables:
     def __init__(self, scenes: Sequence[Any], floor: int, radius: float, arrays: Arrays) -> None:
         from pointnav_kinematic.geometry import FloorGeometry
 
-        codes, edge, fast, meta = [], [], [], []
+        codes, edge, meta = [], [], []
         offset = 0
         self.geometries = []
         self._edges: list[np.ndarray] = []
@@ -61,7 +64,6 @@ class FloorTables:
             grid = np.asarray(tmap.codes, dtype=np.uint8)
             codes.append(grid.ravel())
             edge.append(np.frombuffer(geom.edge, dtype=np.uint8).astype(bool))
-            fast.append(np.asarray(geom.fast_clearance(radius), dtype=np.float64))
             meta.append((offset, geom.rows, geom.width, geom.ox, geom.oy, geom.res, geom.height))
             self._edges.append(np.frombuffer(geom.edge, dtype=np.uint8).astype(bool).reshape(grid.shape))
             offset += grid.size
@@ -69,7 +71,6 @@ class FloorTables:
         a = arrays
         self.codes = a.asarray(np.concatenate(codes), a.i64)
         self.edge = a.asarray(np.concatenate(edge), a.boolean)
-        self.fast = a.asarray(np.concatenate(fast))
         self.offset = a.asarray(m[:, 0], a.i64)
         self.rows = a.asarray(m[:, 1], a.i64)
         self.width = a.asarray(m[:, 2], a.i64)
@@ -80,6 +81,20 @@ class FloorTables:
         #: 1 / cell size as ``inv_res`` holds it (float64, ``(scenes, 7)``), for compiled code.
         self.host_meta = np.ascontiguousarray(np.column_stack([m[:, :6], 1.0 / m[:, 5]]))
         self.arrays = a
+        self._fast: dict[float, Any] = {}
+        self.fast = self.fast_for(radius)
+
+    def fast_for(self, radius: float) -> Any:
+        """The clearance table for robots of ``radius`` (m): per cell of every floor, the
+        travel budget (m) within which such a disc meets nothing (the backend's
+        ``FloorGeometry.fast_clearance``), a float array ``(all cells,)``. Cached per radius."""
+        radius = float(radius)
+        table = self._fast.get(radius)
+        if table is None:
+            table = self.arrays.asarray(np.concatenate(
+                [np.asarray(g.fast_clearance(radius), dtype=np.float64) for g in self.geometries]))
+            self._fast[radius] = table
+        return table
 
     def wall_table(self, reach: float) -> Any:
         """Per cell, the flat indices of the edge obstacle cells whose squares come within

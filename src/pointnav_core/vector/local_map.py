@@ -15,7 +15,7 @@ The same code runs on numpy and on torch on any device (:class:`~pointnav_core.v
 on a CPU in blocks of worlds of about :data:`CPU_BLOCK` cells, on a GPU in one call;
 its temporaries are ``(W, R, cells * cells)`` arrays, and ``(W, R, R, k * k)`` for the
 discs when there are several robots per world (``k`` cells around each other robot, about
-``2 radius / cell size + 3``).
+``2 radius / cell size + 3`` for the largest radius; each disc has its robot's radius).
 
 Examples
 --------
@@ -131,7 +131,7 @@ class VectorLocalMap:
         """Values per robot in the flat observation, ``cells * cells``."""
         return self.term.size
 
-    def values(self, scene: Any, x: Any, y: Any, yaw: Any, present: Any, radius: float) -> Any:
+    def values(self, scene: Any, x: Any, y: Any, yaw: Any, present: Any, radius: Any) -> Any:
         """Every robot's local map, row by row, as float32 codes on the arrays' device.
 
         Parameters
@@ -143,8 +143,8 @@ class VectorLocalMap:
         present : bool array, shape (W, R)
             Robots drawn on the others' maps (an absent robot's own map is still computed;
             the env hides it).
-        radius : float
-            Robot radius (m): the discs drawn as code 3.
+        radius : float or float array broadcasting to (W, R)
+            Robot radius (m), one for all or each robot's own: the discs drawn as code 3.
 
         Returns
         -------
@@ -153,16 +153,17 @@ class VectorLocalMap:
         """
         a, xp = self.arrays, self.arrays.xp
         w, n = x.shape
+        radius = xp.zeros_like(x) + radius  # (W, R)
         block = max(1, CPU_BLOCK // (n * self.size))
         if w <= block or (a.is_torch and a.device != "cpu"):
             return self._values(scene, x, y, yaw, present, radius)
         # On a CPU, blocks of worlds whose temporaries stay in cache (about twice as fast
         # at 1,024 x 4 robots with 32 x 32 maps as one call); a GPU takes the whole batch.
         parts = [self._values(scene[i : i + block], x[i : i + block], y[i : i + block], yaw[i : i + block],
-                              present[i : i + block], radius) for i in range(0, w, block)]
+                              present[i : i + block], radius[i : i + block]) for i in range(0, w, block)]
         return (xp.cat if a.is_torch else xp.concatenate)(parts)
 
-    def _values(self, scene: Any, x: Any, y: Any, yaw: Any, present: Any, radius: float) -> Any:
+    def _values(self, scene: Any, x: Any, y: Any, yaw: Any, present: Any, radius: Any) -> Any:
         """:meth:`values` of one block of worlds."""
         a, xp, fl = self.arrays, self.arrays.xp, self.floors
         c0, s0 = frame_heading(xp, yaw)
@@ -184,8 +185,9 @@ class VectorLocalMap:
             out = self._draw_discs(out, x, y, c0, s0, present, radius)
         return out.to(xp.float32) if a.is_torch else out.astype(np.float32)
 
-    def _draw_discs(self, out: Any, x: Any, y: Any, c: Any, s: Any, present: Any, radius: float) -> Any:
-        """``out`` with code 3 where another present robot's disc covers a cell centre.
+    def _draw_discs(self, out: Any, x: Any, y: Any, c: Any, s: Any, present: Any, radius: Any) -> Any:
+        """``out`` with code 3 where another present robot's disc (of its own ``radius``,
+        (W, R), m) covers a cell centre.
 
         Only a window of ``k x k`` cells around each other robot (where its disc can reach)
         is tested, with the full map's expressions for the centres, so the test is the
@@ -195,15 +197,17 @@ class VectorLocalMap:
         w, n = x.shape
         cells, cs = term.cells, term.cell_size
         # The disc spans at most floor(2 r / cs) + 1 rows; one more each side for rounding.
-        k = min(math.ceil(2.0 * radius / cs) + 3, cells)
+        # One window size for all, from the largest disc.
+        k = min(math.ceil(2.0 * float(radius.max()) / cs) + 3, cells)
+        rm = radius[:, None, :]  # (W, 1, M): robot m's radius
         dx = x[:, None, :] - x[:, :, None]  # (W, R, M): robot m relative to robot i
         dy = y[:, None, :] - y[:, :, None]
         c, s = c[..., None], s[..., None]
         fwd, left = c * dx + s * dy, c * dy - s * dx
         # Fractional row and column of robot m in robot i's map (row i's centre: u_i).
         half = cells / 2.0 - 0.5
-        r0 = (xp.floor(half - fwd / cs - radius / cs) - 1.0).clip(0.0, float(cells - k))
-        c0 = (xp.floor(half - left / cs - radius / cs) - 1.0).clip(0.0, float(cells - k))
+        r0 = (xp.floor(half - fwd / cs - rm / cs) - 1.0).clip(0.0, float(cells - k))
+        c0 = (xp.floor(half - left / cs - rm / cs) - 1.0).clip(0.0, float(cells - k))
         ks = a.asarray(np.arange(k, dtype=np.float64))
         cell = a.to_int((r0[..., None, None] + ks[:, None]) * cells + (c0[..., None, None] + ks[None, :]))
         cell = cell.reshape(w, n, n, k * k)
@@ -215,7 +219,7 @@ class VectorLocalMap:
         ey = wy - y[:, None, :, None]
         other = a.asarray(~np.eye(n, dtype=bool), a.boolean)
         seen = (other[None] & present[:, None, :])[..., None]
-        hit = (ex * ex + ey * ey <= radius * radius) & seen
+        hit = (ex * ex + ey * ey <= (rm * rm)[..., None]) & seen
         base = a.asarray(np.arange(w * n, dtype=np.int64).reshape(w, n, 1, 1) * (cells * cells), a.i64)
         flat = out.reshape(-1)
         # Every write is 3, so windows overlapping on a cell need no reduction.

@@ -12,12 +12,13 @@ robot axis ``(1, R)`` that the step broadcasts over its ``(num_envs, R)`` state:
   only shape the episodes, which each scene's multi-robot env draws;
 - from each robot: ``max_linear_velocity`` and ``max_angular_velocity`` (the drive's
   scaling, the observations' bounds and, with discrete actions, each action's control
-  steps).
+  steps) and ``radius`` (the fast path's clearance table of that radius, the contacts,
+  with walls at the radius and with another robot at the sum of the two radii, and the
+  disc the others' scans and local maps see).
 
 What the engine cannot vary per robot is refused with a ``ValueError`` naming it: the
-task's ``floor`` (the floor tables are built for one floor), the robots' radii (the
-contact step's tables and resolvers take one radius; see ``docs/decisions.md``) and their
-drives (the actions are one array, of one ``action_dim``).
+task's ``floor`` (the floor tables are built for one floor; see ``docs/decisions.md``) and
+the robots' drives (the actions are one array, of one ``action_dim``).
 """
 
 from __future__ import annotations
@@ -68,29 +69,24 @@ def task_arguments(task: Any, n_robots: int, max_episode_steps: int | None) -> d
 
 
 def robot_specs(robot: Any, n_robots: int) -> tuple[RobotSpec, ...]:
-    """One :class:`RobotSpec` per robot, all of one radius and one drive.
+    """One :class:`RobotSpec` per robot, all of one drive.
 
     Raises
     ------
     ValueError
-        Naming ``robot`` (a list of the wrong length, radii or drives that differ) or
-        ``robot[i]`` (an entry that is not a spec, dict or None).
+        Naming ``robot`` (a list of the wrong length, drives that differ) or ``robot[i]``
+        (an entry that is not a spec, dict or None).
     """
     specs = make_robots(robot, n_robots)
     drive_of(specs)  # one action array, of one action_dim, for every robot
-    radii = sorted({spec.radius for spec in specs})
-    if len(radii) > 1:
-        raise ValueError(
-            f"robot: every robot of a world must have the same radius in the batched engine, got radii {radii} m "
-            "(speed limits may differ)"
-        )
     return specs
 
 
 def envelope(specs: Sequence[RobotSpec]) -> RobotSpec:
-    """The spec that bounds every robot's step: their radius and their highest speed limits."""
+    """The spec that bounds every robot's step: their largest radius and highest speed limits."""
     return dataclasses.replace(
         specs[0],
+        radius=max(s.radius for s in specs),
         max_linear_velocity=max(s.max_linear_velocity for s in specs),
         max_angular_velocity=max(s.max_angular_velocity for s in specs),
     )
@@ -99,8 +95,8 @@ def envelope(specs: Sequence[RobotSpec]) -> RobotSpec:
 def read_tasks(env: Any, tasks: Sequence[Any], specs: Sequence[RobotSpec], arrays: Arrays) -> None:
     """Set the engine's per-robot settings from the robots' built ``tasks`` and ``specs``.
 
-    The reward weights, tolerances, step and collision limits, fall height and speed limits
-    become ``(1, R)`` arrays on the engine's device; ``goal_in_polar`` stays a bool when all
+    The reward weights, tolerances, step and collision limits, fall height, speed limits
+    and radii become ``(1, R)`` arrays on the engine's device; ``goal_in_polar`` stays a bool when all
     robots agree, else it is a ``(1, R)`` mask. ValueError naming ``task`` if the robots'
     floors differ.
     """
@@ -123,3 +119,4 @@ def read_tasks(env: Any, tasks: Sequence[Any], specs: Sequence[RobotSpec], array
     env.goal_in_polar = polar[0] if len(set(polar)) == 1 else row(polar, arrays.boolean)
     env._vmax = row([s.max_linear_velocity for s in specs])
     env._wmax = row([s.max_angular_velocity for s in specs])
+    env._radius = row([s.radius for s in specs])

@@ -161,7 +161,7 @@ class PoolRefreshing:
         # The pool class with this env's starts per goal (a partial pickles for the worker);
         # the multi-robot engine, which inherits refresh_pool, has one start per goal.
         starts = getattr(self, "starts_per_goal", 1)
-        return type(self.pool) if starts == 1 else functools.partial(type(self.pool), starts=starts)
+        return functools.partial(type(self.pool), starts=starts, reach=self._reach)
 
     @property
     def refresh_pending(self) -> bool:

@@ -35,12 +35,13 @@ _EVENTS_PER_ROBOT = 8
 _CONTACTS = 6  # nearest walls that may be contacts while sliding, as in vector.contacts
 
 
-def _hit_radius(radius: float) -> float:
-    return max(radius - _HIT, _HIT)
+def _hit_radius(radius: Any) -> Any:
+    # A point robot is a disc of _HIT (the backend's _hit_radius), elementwise.
+    return (radius - _HIT).clip(_HIT, None)
 
 
 def advance_robots(
-    arrays: Arrays, x: Any, y: Any, mx: Any, my: Any, radius: float, present: Any = None, walls: Any = None
+    arrays: Arrays, x: Any, y: Any, mx: Any, my: Any, radius: Any, present: Any = None, walls: Any = None
 ) -> tuple[Any, Any, Any]:
     """Move every world's robots by their chords ``(mx, my)`` (m), resolving their contacts.
 
@@ -50,8 +51,9 @@ def advance_robots(
         The array namespace (numpy or torch) the inputs live in.
     x, y, mx, my : float arrays (W, R)
         Start positions and chords over the step, in metres.
-    radius : float
-        Every robot's radius (m), >= 0.
+    radius : float or float array broadcasting to (W, R)
+        Every robot's radius (m), >= 0: one for all, or each robot's own (two robots touch
+        at the sum of their radii, as in the backend).
     present : bool array (W, R), optional
         Robots that take part; absent ones neither move nor block. Default: all.
     walls : tuple of arrays (W, R, K), optional
@@ -69,6 +71,9 @@ def advance_robots(
     xp = a.xp
     inf = math.inf
     n_robots = x.shape[1]
+    rad = xp.zeros_like(x) + radius  # (W, R)
+    # The distance at which robots i and j touch: r_i + r_j, (W, R, R).
+    rsum = rad[:, :, None] + rad[:, None, :]
     if present is None:
         present = xp.ones_like(x) > 0.0
     if walls is None:
@@ -86,15 +91,15 @@ def advance_robots(
     eye = a.arange(n_robots)
     upper = eye.reshape(1, -1, 1) < eye.reshape(1, 1, -1)
     # The backend's pair list: robots on the floor, not both still, within reach of each other.
-    reach = 2.0 * radius + span[:, :, None] + span[:, None, :] + 4.0 * _ACTIVE
+    reach = rsum + span[:, :, None] + span[:, None, :] + 4.0 * _ACTIVE
     gap2 = (x[:, :, None] - x[:, None, :]) ** 2 + (y[:, :, None] - y[:, None, :]) ** 2
     pair = (
         upper & present[:, :, None] & present[:, None, :]
         & (moving[:, :, None] | moving[:, None, :]) & (gap2 < reach * reach)
     )
     pair = pair | (pair.transpose(1, 2) if a.is_torch else xp.swapaxes(pair, 1, 2))
-    hit_w = _hit_radius(radius)
-    hit_r = _hit_radius(2.0 * radius)
+    hit_w = _hit_radius(rad)
+    hit_r = _hit_radius(rsum)
     left = xp.ones_like(x[:, 0])
     contact = xp.zeros_like(x) > 1.0
     no_pair = xp.zeros_like(gap2) > 1.0
@@ -111,15 +116,15 @@ def advance_robots(
         # if its motion goes into it; contacts are its walls, then the other robots.
         # The walls within _ACTIVE of touching are among the nearest few (a disc touches at
         # most four squares): only those take part, in their original order.
-        wx0, wy0, wx1, wy1, wvalid, pair = geo
+        wx0, wy0, wx1, wy1, wvalid, pair, rad, rsum, hit_w, hit_r = geo
         wd = square_distance(xp, x[..., None], y[..., None], wx0, wy0, wx1, wy1)[0]
         near = nearest(xp, xp.where(wvalid, wd, inf), n_near)
         cx0, cy0, cx1, cy1, cvalid, forced_w = (take_along(xp, v, near) for v in (wx0, wy0, wx1, wy1, wvalid, forced_w))
         wd, wnx, wny = square_distance(xp, x[..., None], y[..., None], cx0, cy0, cx1, cy1)
-        wtouch = cvalid & (wd <= radius + _ACTIVE)
+        wtouch = cvalid & (wd <= rad[..., None] + _ACTIVE)
         ex, ey = x[:, :, None] - x[:, None, :], y[:, :, None] - y[:, None, :]
         dist = xp.sqrt(ex * ex + ey * ey)
-        ptouch = pair & (dist <= 2.0 * radius + _ACTIVE)
+        ptouch = pair & (dist <= rsum + _ACTIVE)
         safe = xp.where(dist > 0.0, dist, 1.0)
         nx = xp.cat([wnx, xp.where(dist > 0.0, ex / safe, 1.0)], -1) if a.is_torch else xp.concatenate([wnx, xp.where(dist > 0.0, ex / safe, 1.0)], -1)
         ny = xp.cat([wny, xp.where(dist > 0.0, ey / safe, 0.0)], -1) if a.is_torch else xp.concatenate([wny, xp.where(dist > 0.0, ey / safe, 0.0)], -1)
@@ -133,9 +138,10 @@ def advance_robots(
             into = tx[..., None] * nx[:, :, None, :] + ty[..., None] * ny[:, :, None, :] < 0.0
             tw = enter_rounded_square(
                 xp, px, py, tx[..., None], ty[..., None], cx0[:, :, None, :], cy0[:, :, None, :],
-                cx1[:, :, None, :], cy1[:, :, None, :], hit_w,
+                cx1[:, :, None, :], cy1[:, :, None, :], hit_w[:, :, None, None],
             )
-            tr = enter_disc(xp, px, py, tx[..., None], ty[..., None], x[:, None, None, :], y[:, None, None, :], hit_r)
+            tr = enter_disc(xp, px, py, tx[..., None], ty[..., None], x[:, None, None, :], y[:, None, None, :],
+                            hit_r[:, :, None, :])
             t = cat([tw, tr], -1)
             return touching[:, :, None, :] & into & (forced[:, :, None, :] | (t <= left[:, None, None, None]))
 
@@ -158,7 +164,8 @@ def advance_robots(
 
     active = moving.any(-1)
     x, y = x + 0.0, y + 0.0
-    mx, my, hit = resolve(x, y, mx, my, no_pair, no_wall, left, active, (wx0, wy0, wx1, wy1, wvalid, pair))
+    mx, my, hit = resolve(x, y, mx, my, no_pair, no_wall, left, active,
+                          (wx0, wy0, wx1, wy1, wvalid, pair, rad, rsum, hit_w, hit_r))
     contact = contact | hit
     done = ~active
     mx, my = mx + 0.0, my + 0.0
@@ -171,19 +178,20 @@ def advance_robots(
         sel = a.nonzero(live)
         n = sel.shape[0]
         rows = a.arange(n)
-        geo = tuple(v[sel] for v in (wx0, wy0, wx1, wy1, wvalid, pair))
-        gx0, gy0, gx1, gy1, gvalid, gpair = geo
+        geo = tuple(v[sel] for v in (wx0, wy0, wx1, wy1, wvalid, pair, rad, rsum, hit_w, hit_r))
+        gx0, gy0, gx1, gy1, gvalid, gpair, grad, grsum, ghit_w, ghit_r = geo
         sx, sy, smx, smy, sleft = x[sel], y[sel], mx[sel], my[sel], left[sel]
         # Wall events, robot by robot and wall by wall, then pair events: the first wins a tie.
         wd, wnx, wny = square_distance(xp, sx[..., None], sy[..., None], gx0, gy0, gx1, gy1)
         speed = xp.sqrt(smx * smx + smy * smy)
         towards = gvalid & (smx[..., None] * wnx + smy[..., None] * wny < 0.0)
-        towards = towards & ~(wd - hit_w > (speed * sleft[:, None])[..., None])
-        tw = enter_rounded_square(xp, sx[..., None], sy[..., None], smx[..., None], smy[..., None], gx0, gy0, gx1, gy1, hit_w)
+        towards = towards & ~(wd - ghit_w[..., None] > (speed * sleft[:, None])[..., None])
+        tw = enter_rounded_square(xp, sx[..., None], sy[..., None], smx[..., None], smy[..., None], gx0, gy0, gx1, gy1,
+                                  ghit_w[..., None])
         tw = xp.where(towards, tw, inf)
         vx = smx[:, :, None] - smx[:, None, :]
         vy = smy[:, :, None] - smy[:, None, :]
-        tp = enter_disc(xp, sx[:, :, None], sy[:, :, None], vx, vy, sx[:, None, :], sy[:, None, :], hit_r)
+        tp = enter_disc(xp, sx[:, :, None], sy[:, :, None], vx, vy, sx[:, None, :], sy[:, None, :], ghit_r)
         apart = (sx[:, :, None] - sx[:, None, :]) * vx + (sy[:, :, None] - sy[:, None, :]) * vy >= 0.0
         tp = xp.where(gpair & upper & ((vx != 0.0) | (vy != 0.0)) & ~((tp == 0.0) & apart), tp, inf)
         cat = xp.cat if a.is_torch else xp.concatenate
@@ -204,11 +212,11 @@ def advance_robots(
             i, j = xp.where(is_wall, wi, fp // n_robots), fp % n_robots
             ex0, ey0, ex1, ey1 = (v[rows, wi, wkk] for v in (gx0, gy0, gx1, gy1))
             place_w = enter_rounded_square(
-                xp, sx[rows, wi], sy[rows, wi], smx[rows, wi], smy[rows, wi], ex0, ey0, ex1, ey1, radius + _PLACE
+                xp, sx[rows, wi], sy[rows, wi], smx[rows, wi], smy[rows, wi], ex0, ey0, ex1, ey1, grad[rows, wi] + _PLACE
             )
             place_p = enter_disc(
                 xp, sx[rows, i], sy[rows, i], smx[rows, i] - smx[rows, j], smy[rows, i] - smy[rows, j],
-                sx[rows, j], sy[rows, j], 2.0 * radius + _PLACE,
+                sx[rows, j], sy[rows, j], grsum[rows, i, j] + _PLACE,
             )
             place = xp.where(is_wall, place_w, place_p)
             step = xp.minimum(xp.maximum(place, xp.zeros_like(place)), t_first)
@@ -232,14 +240,14 @@ def advance_robots(
     # Safety net against rounding: never end deeper in a wall than at the start.
     d_end = square_distance(xp, x[..., None], y[..., None], wx0, wy0, wx1, wy1)[0]
     d_start = square_distance(xp, start_x[..., None], start_y[..., None], wx0, wy0, wx1, wy1)[0]
-    depth_end = xp.amax(xp.where(wvalid, radius - d_end, -inf), -1)
-    depth_start = xp.amax(xp.where(wvalid, radius - d_start, -inf), -1)
+    depth_end = xp.amax(xp.where(wvalid, rad[..., None] - d_end, -inf), -1)
+    depth_start = xp.amax(xp.where(wvalid, rad[..., None] - d_start, -inf), -1)
     moved = (x != start_x) | (y != start_y)
     undo = contact & moved & (depth_end > _HIT) & (depth_end > depth_start)
     return xp.where(undo, start_x, x), xp.where(undo, start_y, y), contact
 
 
-def robot_walls(floors: FloorTables, scene: Any, x: Any, y: Any, mx: Any, my: Any, radius: float, max_travel: float) -> tuple[Any, ...]:
+def robot_walls(floors: FloorTables, scene: Any, x: Any, y: Any, mx: Any, my: Any, radius: Any, max_travel: float) -> tuple[Any, ...]:
     """Each robot's walls within reach of its chord, the few that can matter: ``(W, R, K)`` arrays.
 
     Parameters
@@ -249,8 +257,10 @@ def robot_walls(floors: FloorTables, scene: Any, x: Any, y: Any, mx: Any, my: An
         Each robot's scene index.
     x, y, mx, my : float arrays (W, R)
         Start positions and chords (m).
-    radius, max_travel : float
-        Robot radius and the longest chord of any step (m).
+    radius : float or float array broadcasting to (W, R)
+        Robot radius (m), one for all or each robot's own.
+    max_travel : float
+        The longest chord of any step (m).
 
     Returns
     -------
@@ -260,11 +270,14 @@ def robot_walls(floors: FloorTables, scene: Any, x: Any, y: Any, mx: Any, my: An
     """
     xp = floors.arrays.xp
     n_worlds, n_robots = x.shape
-    flat = [v.reshape(-1) for v in (scene, x, y, mx, my)]
-    sc, fx, fy, fmx, fmy = flat
-    wx0, wy0, wx1, wy1, valid = window(floors, sc, fx, fy, radius + max_travel + 4.0 * _ACTIVE)
+    rad = xp.zeros_like(x) + radius
+    flat = [v.reshape(-1) for v in (scene, x, y, mx, my, rad)]
+    sc, fx, fy, fmx, fmy, frad = flat
+    # One window for the largest robot; each robot then keeps the walls within its own reach.
+    largest = float(frad.max()) if frad.shape[0] else 0.0
+    wx0, wy0, wx1, wy1, valid = window(floors, sc, fx, fy, largest + max_travel + 4.0 * _ACTIVE)
     d0 = square_distance(xp, fx[:, None], fy[:, None], wx0, wy0, wx1, wy1)[0]
-    reach = radius + xp.sqrt(fmx * fmx + fmy * fmy) + 4.0 * _ACTIVE
+    reach = frad + xp.sqrt(fmx * fmx + fmy * fmy) + 4.0 * _ACTIVE
     in_reach = valid & (d0 <= reach[:, None])
     k = max(int(in_reach.sum(-1).max()) if in_reach.shape[0] else 0, 1)
     order = nearest(xp, xp.where(in_reach, d0, math.inf), k)

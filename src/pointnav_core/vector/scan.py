@@ -116,7 +116,7 @@ def cast_batch(
     y: Any,
     yaw: Any,
     present: Any,
-    radius: float,
+    radius: Any,
     angles: Any,
     max_range: float,
     method: str = "auto",
@@ -133,8 +133,8 @@ def cast_batch(
         Robot centres (m) and headings (rad).
     present : bool array, shape (W, R)
         Robots that see and are seen.
-    radius : float
-        Robot radius (m): the discs the other robots see.
+    radius : float or float array broadcasting to (W, R)
+        Robot radius (m), one for all or each robot's own: the discs the other robots see.
     angles : float64 array, shape (n,)
         Ray bearings in the robot frame (rad).
     max_range : float
@@ -171,6 +171,7 @@ def cast_batch(
     if method == "numba" and not (on_cpu and compiled_available()):
         raise ValueError('method="numba" needs arrays on the CPU and numba: pip install "pointnav-core[fast]"')
     angles = a.asarray(angles)
+    radius = a.xp.zeros_like(x) + radius  # (W, R)
     if method != "array" and on_cpu and compiled_available():
         from pointnav_core.vector._scan_kernel import cast_worlds
 
@@ -182,13 +183,14 @@ def cast_batch(
         cast_worlds(
             np.ascontiguousarray(view(scene), dtype=np.int64), np.ascontiguousarray(x, dtype=np.float64),
             np.ascontiguousarray(y, dtype=np.float64), np.cos(yaw), np.sin(yaw), np.cos(angles), np.sin(angles),
-            np.ascontiguousarray(view(present), dtype=np.bool_), float(radius), float(max_range),
+            np.ascontiguousarray(view(present), dtype=np.bool_), np.ascontiguousarray(view(radius), dtype=np.float64),
+            float(max_range),
             tables.meta, tables.lookup, tables.clearance, out,
         )
         return a.asarray(out) if a.is_torch else out
     c, s = directions(a, yaw, angles)
     best = _grid_ranges(tables, scene, x, y, c, s, float(max_range))
-    best = a.xp.minimum(best, _disc_ranges(a, x, y, c, s, present, float(radius)))
+    best = a.xp.minimum(best, _disc_ranges(a, x, y, c, s, present, radius))
     return a.xp.where(present[..., None], best, a.xp.full_like(best, float(max_range)))
 
 
@@ -260,8 +262,9 @@ def _grid_ranges(tables: ScanTables, scene: Any, x: Any, y: Any, c: Any, s: Any,
     return xp.where(touching[..., None], xp.zeros_like(best), best)
 
 
-def _disc_ranges(a: Arrays, x: Any, y: Any, c: Any, s: Any, present: Any, radius: float) -> Any:
-    """Range (m) to the first other present robot's disc of the same world (inf: none)."""
+def _disc_ranges(a: Arrays, x: Any, y: Any, c: Any, s: Any, present: Any, radius: Any) -> Any:
+    """Range (m) to the first other present robot's disc of the same world (inf: none);
+    ``radius`` (W, R) each robot's disc (m)."""
     xp = a.xp
     r = x.shape[1]
     if r == 1:
@@ -270,7 +273,7 @@ def _disc_ranges(a: Arrays, x: Any, y: Any, c: Any, s: Any, present: Any, radius
     fx = (x[:, :, None] - x[:, None, :])[:, :, None, :]
     fy = (y[:, :, None] - y[:, None, :])[:, :, None, :]
     b = fx * c[..., None] + fy * s[..., None]
-    cc = fx * fx + fy * fy - radius * radius
+    cc = fx * fx + fy * fy - (radius * radius)[:, None, None, :]
     disc = b * b - cc
     # The nearer root, written without cancellation (raycast._disc_hits).
     denom = xp.sqrt(disc.clip(0.0, None)) - b
@@ -328,8 +331,9 @@ class VectorScan:
         else:
             self.rng = np.random.default_rng(rng.integers(2**63))
 
-    def readings(self, scene: Any, x: Any, y: Any, yaw: Any, present: Any, radius: float) -> Any:
-        """The scan's readings (m), ``(W, R, n_rays)`` float64 on the arrays' device."""
+    def readings(self, scene: Any, x: Any, y: Any, yaw: Any, present: Any, radius: Any) -> Any:
+        """The scan's readings (m), ``(W, R, n_rays)`` float64 on the arrays' device;
+        ``radius`` as for :func:`cast_batch`."""
         t, a = self.term, self.tables.arrays
         xp = a.xp
         d = cast_batch(self.tables, scene, x, y, yaw, present, radius, self.angles, t.max_range, self.method)

@@ -54,19 +54,27 @@ def enter_disc(xp: Any, px: Any, py: Any, dx: Any, dy: Any, cx: Any, cy: Any, ra
 
 
 def enter_rounded_square(
-    xp: Any, px: Any, py: Any, dx: Any, dy: Any, x0: Any, y0: Any, x1: Any, y1: Any, radius: float
+    xp: Any, px: Any, py: Any, dx: Any, dy: Any, x0: Any, y0: Any, x1: Any, y1: Any, radius: Any
 ) -> Any:
-    """First ``t >= 0`` at which a disc of ``radius`` at ``p + t*d`` overlaps the square; inf if never."""
+    """First ``t >= 0`` at which a disc of ``radius`` at ``p + t*d`` overlaps the square; inf if never.
+
+    ``radius`` (m) is a float or an array that broadcasts with the others (one per robot).
+    """
     t = xp.minimum(
         enter_box(xp, px, py, dx, dy, x0 - radius, y0, x1 + radius, y1),
         enter_box(xp, px, py, dx, dy, x0, y0 - radius, x1, y1 + radius),
     )
-    if radius > 0.0:
-        corners = t
-        for cx, cy in ((x0, y0), (x1, y0), (x0, y1), (x1, y1)):
-            corners = xp.minimum(corners, enter_disc(xp, px, py, dx, dy, cx, cy, radius))
-        t = xp.where(t > 0.0, corners, t)
-    return t
+    if isinstance(radius, (int, float)):
+        if radius > 0.0:
+            corners = t
+            for cx, cy in ((x0, y0), (x1, y0), (x0, y1), (x1, y1)):
+                corners = xp.minimum(corners, enter_disc(xp, px, py, dx, dy, cx, cy, radius))
+            t = xp.where(t > 0.0, corners, t)
+        return t
+    corners = t
+    for cx, cy in ((x0, y0), (x1, y0), (x0, y1), (x1, y1)):
+        corners = xp.minimum(corners, enter_disc(xp, px, py, dx, dy, cx, cy, radius))
+    return xp.where((t > 0.0) & (radius > 0.0), corners, t)
 
 
 def square_distance(xp: Any, px: Any, py: Any, x0: Any, y0: Any, x1: Any, y1: Any) -> tuple[Any, Any, Any]:
