@@ -8,7 +8,8 @@ on the first lookup a seeded multi-source Dijkstra on the grid proposes every ce
 label (cheap); the exact checks are made one block of cells at a time, when a lookup first
 lands in the block: each proposal is checked, cells whose proposal fails and cells on the
 border of two roots try their neighbours' roots, and a cell left without one takes its
-centre's exact root on its own first lookup. Everything is in world metres.
+centre's exact root on its own first lookup (or, settling the whole table, all such cells at
+once, :meth:`GoalField._settle_cells`). Everything is in world metres.
 """
 
 from __future__ import annotations
@@ -21,6 +22,7 @@ from numpy.typing import ArrayLike, NDArray
 from scipy import ndimage, sparse
 from scipy.sparse import csgraph
 
+from pointnav_core.field_roots import cell_roots
 from pointnav_core.frozen import ThawOnUnpickle
 from pointnav_core.tangent_graph import (
     _ANG_TOL,
@@ -190,6 +192,31 @@ class GoalField(ThawOnUnpickle):
         kind = 0 if lab == -2 else 1 if lab == -1 else 2
         t["kind"][i] = kind
         t["label"][i] = max(lab, -1)
+        return kind
+
+    def _settle_cells(self, cells: ArrayLike) -> NDArray[np.int8]:
+        """Give table cells ``cells`` their exact roots at once; their new kinds.
+
+        Each cell gets exactly the kind and label :meth:`_settle_cell` would give it (the
+        same decision, made on arrays: :func:`pointnav_core.field_roots.cell_roots`).
+
+        Parameters
+        ----------
+        cells : array_like of int, shape (N,)
+            Flat table indices (``row * width + col``), each in ``[0, height * width)``.
+        """
+        t = self._table
+        assert t is not None
+        idx = np.asarray(cells)
+        n_cells = len(t["kind"])
+        if idx.ndim != 1 or (idx.size and not np.issubdtype(idx.dtype, np.integer)):
+            raise ValueError(f"cells must be a 1D array of integer cell indices, got shape {idx.shape} of {idx.dtype}")
+        idx = idx.astype(np.int64)
+        if idx.size and (idx.min() < 0 or idx.max() >= n_cells):
+            raise ValueError(f"cells must lie in [0, {n_cells}), got {idx.min()} to {idx.max()}")
+        kind, label = cell_roots(self, idx)
+        t["kind"][idx] = kind
+        t["label"][idx] = label
         return kind
 
     def _root_values(

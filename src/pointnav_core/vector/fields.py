@@ -55,8 +55,7 @@ def settle(field: GoalField, cells: NDArray[np.int64] | None = None) -> dict[str
         if not t["done"][b]:
             field._check_block((b // bw) * _BLOCK * w + (b % bw) * _BLOCK)
     left = np.flatnonzero(t["kind"] == 3) if cells is None else cells[t["kind"][cells] == 3]
-    for i in left:
-        field._settle_cell(int(i))
+    field._settle_cells(left)
     assert not (t["kind"][slice(None) if cells is None else cells] == _UNCHECKED).any()
     return t
 
