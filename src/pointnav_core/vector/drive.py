@@ -133,6 +133,7 @@ def substep_drive(
     dt: float,
     move: Callable[[Any, Any, Any, Any, Any], tuple[Any, Any, Any]],
     is_void: Callable[[Any, Any], Any],
+    whole: tuple[Any, Any] | None = None,
 ) -> tuple[Any, Any, Any, Any, Any]:
     """Advance slow robots in their sub-steps, as the backend's ``_slow_step``.
 
@@ -155,6 +156,10 @@ def substep_drive(
         neither move nor block.
     is_void : callable
         ``is_void(x, y)``: whether each position is over VOID or off the map.
+    whole : tuple of float arrays, optional
+        The chord ``arc(yaw, vx, vy, w, dt)`` of the whole step, if the caller has it: when
+        no robot takes more than one sub-step it is the first sub-step's (the same
+        expressions on the same numbers), so it is not computed again.
 
     Returns
     -------
@@ -176,7 +181,8 @@ def substep_drive(
         part = (n_sub > k) & ~fell
         if not bool(part.any()):
             break
-        mx, my = arc(xp, yaw, vx, vy, w, h)
+        one = k == 0 and whole is not None and bool((n_sub <= 1.0).all())
+        mx, my = whole if one else arc(xp, yaw, vx, vy, w, h)
         zero = xp.zeros_like(mx)
         mx, my = xp.where(part & ~still, mx, zero), xp.where(part & ~still, my, zero)
         nx, ny, c = move(x, y, mx, my, part)

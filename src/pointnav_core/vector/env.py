@@ -493,7 +493,7 @@ class VectorPointNavEnv(PoolRefreshing, VectorEnv):
             n_sub = sub_steps(xp, length[slow], w[slow], dt, self.floors.res[sc])
             sx, sy, syaw, fall, c = substep_drive(
                 xp, (x0[slow], y0[slow], yaw0[slow]), (vx[slow], vy[slow], w[slow]), n_sub, dt, move,
-                lambda px, py: self.floors.is_void(sc, px, py),
+                lambda px, py: self.floors.is_void(sc, px, py), (dx[slow], dy[slow]),
             )
             x[slow], y[slow], yaw[slow] = sx, sy, syaw
             vel_x[slow] = (sx - x0[slow]) / dt

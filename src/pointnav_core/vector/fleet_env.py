@@ -302,7 +302,7 @@ class VectorFleetEnv(VectorPointNavEnv):
             n_sub = xp.where(slow, n_sub[:, None], zero)
             sx, sy, syaw, fall, contact = substep_drive(
                 xp, (x0, y0, yaw0), (vx, vy, w), n_sub, dt, self._move_slow,
-                lambda px, py: self.floors.is_void(scene, px, py),
+                lambda px, py: self.floors.is_void(scene, px, py), (dx, dy),
             )
             x, y, yaw = xp.where(slow, sx, x), xp.where(slow, sy, y), xp.where(slow, syaw, yaw)
             began = slow & fall
