@@ -18,27 +18,15 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 from vector_reference import compare, random_actions, random_episodes
 
-from pointnav_core.maps import FREE, OBSTACLE, VOID
 from pointnav_core.scenes import Scene
+from pointnav_core.testing.strategies import cluttered_rooms
 
 DEVICES = ["numpy"] + (["cpu"] if importlib.util.find_spec("torch") else [])
 
 
-@st.composite
-def cluttered_scenes(draw: st.DrawFn) -> Scene:
-    """A walled room, 12 to 30 cells a side, with random obstacle cells, maybe a hole, and a free patch."""
-    rows, cols = draw(st.integers(12, 30)), draw(st.integers(12, 30))
-    rng = np.random.default_rng(draw(st.integers(0, 2**31 - 1)))
-    grid = np.zeros((rows, cols), np.uint8)
-    grid[rng.random((rows, cols)) < draw(st.floats(0.0, 0.12))] = OBSTACLE
-    grid[0, :] = grid[-1, :] = grid[:, 0] = grid[:, -1] = OBSTACLE
-    if draw(st.booleans()):
-        r, c = draw(st.integers(1, rows - 4)), draw(st.integers(1, cols - 4))
-        grid[r : r + 3, c : c + 3] = VOID
-    # A free 6 x 6 patch somewhere inside, so that the robot always fits.
-    r, c = draw(st.integers(1, rows - 7)), draw(st.integers(1, cols - 7))
-    grid[r : r + 6, c : c + 6] = FREE
-    return Scene.from_array(grid, 0.1)
+def cluttered_scenes() -> st.SearchStrategy[Scene]:
+    """Walled rooms with up to 12 % obstacle cells, maybe a hole, and a free patch."""
+    return cluttered_rooms(max_clutter=0.12)
 
 
 @pytest.mark.parametrize("device", DEVICES)
