@@ -61,7 +61,7 @@ class _ArcTables:
 
     ``labels[start[g]:start[g + 1]]`` are ``search.on_arc(node, side)`` for the arc group
     ``g = 2 * node + (side < 0)``, in its order (graph vertices, then the field's own
-    arrivals); ``blocked[n]`` holds node ``n``'s blocked arc samples (NaN padded).
+    arrivals); ``cheapest[g]`` is the cheapest reached label's cost of group ``g``.
     """
 
     def __init__(self, planner: Planner, search: FieldLabels) -> None:
@@ -75,34 +75,6 @@ class _ArcTables:
         some = np.flatnonzero(self.start[1:] > self.start[:-1])
         if len(some):
             self.cheapest[some] = np.minimum.reduceat(search.cost[self.labels], self.start[some])
-        lists = planner._blocked_ccw
-        widest = max((len(b) for b in lists), default=0)
-        self.blocked = np.full((planner.n_nodes, max(widest, 1)), np.nan)
-        for n, b in enumerate(lists):
-            if b:
-                self.blocked[n, : len(b)] = b
-        self.has_blocked = np.fromiter((bool(b) for b in lists), dtype=bool, count=planner.n_nodes)
-
-    def arcs_free(
-        self,
-        planner: Planner,
-        node: NDArray[np.int64],
-        s: NDArray[np.int64],
-        p1: NDArray[np.float64],
-        p2: NDArray[np.float64],
-    ) -> NDArray[np.bool_]:
-        """:meth:`Planner._arc_free` of each ``(node, s, p1, p2)``, with its expressions."""
-        out = np.ones(len(node), dtype=bool)
-        k = np.flatnonzero(self.has_blocked[node])
-        if len(k):
-            sp = planner.span[node[k]]
-            ccw_side = s[k] > 0
-            lo = np.where(ccw_side, p1[k], sp - p2[k])
-            hi = np.where(ccw_side, p2[k], sp - p1[k])
-            b = self.blocked[node[k]]
-            with np.errstate(invalid="ignore"):
-                out[k] = ~((lo[:, None] + _ANG_TOL < b) & (b < hi[:, None] - _ANG_TOL)).any(axis=1)
-        return out
 
 
 def cell_roots(field: GoalField, cells: NDArray[np.int64]) -> tuple[NDArray[np.int8], NDArray[np.int32]]:
@@ -315,7 +287,7 @@ def _link_values(
     d = dep[link]
     ok = lp <= d + _ANG_TOL
     k = np.flatnonzero(ok)
-    ok[k] = tables.arcs_free(p, node[link[k]], -s[link[k]], lp[k], d[k])
+    ok[k] = p.arcs_free(node[link[k]], -s[link[k]], lp[k], d[k])
     pair = np.where(ok, search.cost[labs] + p.radius * np.maximum(d - lp, 0.0) + length[link], math.inf)
     some = np.flatnonzero(count)
     value[some] = np.minimum.reduceat(pair, begin[some])

@@ -221,11 +221,26 @@ class Planner(ThawOnUnpickle):
     def arcs_free(
         self, nodes: NDArray[np.int64], sides: NDArray[np.int64], p1: NDArray[np.float64], p2: NDArray[np.float64]
     ) -> NDArray[np.bool_]:
-        """Vectorised :meth:`_arc_free` (only nodes with a blocked arc sample are looked at)."""
+        """Vectorised :meth:`_arc_free`, with its expressions (only nodes with a blocked arc
+        sample are looked at)."""
+        if getattr(self, "_blocked", None) is None:
+            # Each node's blocked samples as a row, NaN padded (NaN compares false).
+            widest = max((len(b) for b in self._blocked_ccw), default=0)
+            self._blocked = np.full((self.n_nodes, max(widest, 1)), np.nan)
+            for n, b in enumerate(self._blocked_ccw):
+                self._blocked[n, : len(b)] = b
+            self._has_blocked = np.fromiter((bool(b) for b in self._blocked_ccw), dtype=bool, count=self.n_nodes)
         out = np.ones(len(nodes), dtype=bool)
-        some = np.flatnonzero(~self.arc_clear[nodes].all(axis=1))
-        for i in some.tolist():
-            out[i] = self._arc_free(int(nodes[i]), int(sides[i]), float(p1[i]), float(p2[i]))
+        k = np.flatnonzero(self._has_blocked[nodes])
+        if len(k):
+            node = nodes[k]
+            sp = self.span[node]
+            ccw = sides[k] > 0
+            lo = np.where(ccw, p1[k], sp - p2[k])
+            hi = np.where(ccw, p2[k], sp - p1[k])
+            b = self._blocked[node]
+            with np.errstate(invalid="ignore"):
+                out[k] = ~((lo[:, None] + _ANG_TOL < b) & (b < hi[:, None] - _ANG_TOL)).any(axis=1)
         return out
 
     # ------------------------------------------------------------------ sight
