@@ -32,9 +32,10 @@ from typing import Any
 
 from pointnav_core.robot_spec import RobotSpec
 
-__all__ = ["action_dim", "arc", "body_command", "drive_of", "sub_steps", "substep_drive", "travel"]
+__all__ = ["MAX_TURN", "arc", "body_command", "drive_of", "sub_steps", "substep_drive", "travel"]
 
-_MAX_TURN = 0.25  # rad per sub-step, the kinematic backend's
+#: rad per sub-step, the kinematic backend's: a control step may turn this much without sub-steps.
+MAX_TURN = 0.25
 _MAX_SUBSTEPS = 1024  # the kinematic backend's cap
 
 
@@ -58,11 +59,6 @@ def drive_of(specs: Sequence[RobotSpec], name: str = "robot") -> str:
             f"{name}: every robot must have the same drive in the batched engine (one action array), got {drives}"
         )
     return drives[0]
-
-
-def action_dim(drive: str) -> int:
-    """Length of an action of ``drive``: 2 for ``"differential"``, 3 for ``"holonomic"``."""
-    return 3 if drive == "holonomic" else 2
 
 
 def body_command(xp: Any, act: Any, vmax: Any, wmax: Any, holonomic: bool) -> tuple[Any, Any, Any]:
@@ -121,7 +117,7 @@ def sub_steps(xp: Any, length: Any, w: Any, dt: float, res: Any) -> Any:
     ``res`` the cell size (m) of the robot's floor; a world of several slow robots takes
     the most of theirs.
     """
-    need = xp.maximum(length / (0.5 * res), xp.abs(w) * dt / _MAX_TURN)
+    need = xp.maximum(length / (0.5 * res), xp.abs(w) * dt / MAX_TURN)
     return xp.minimum(xp.maximum(xp.ceil(need), xp.ones_like(need)), xp.zeros_like(need) + _MAX_SUBSTEPS)
 
 

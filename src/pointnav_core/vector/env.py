@@ -22,19 +22,16 @@ from pointnav_core import _envcommon, scenes, validation
 from pointnav_core.vector import contacts_jit
 from pointnav_core.vector.contacts import advance
 from pointnav_core.vector.discrete import MOVED, DiscretePlan
-from pointnav_core.vector.drive import arc, body_command, sub_steps, substep_drive, travel
+from pointnav_core.vector.drive import MAX_TURN, arc, body_command, sub_steps, substep_drive, travel
 from pointnav_core.vector.episodes import EpisodePool
-from pointnav_core.vector.falls import apply_falls, first_drop
+from pointnav_core.vector.falls import apply_falls
 from pointnav_core.vector.floors import FloorTables
 from pointnav_core.vector.local_map import VectorLocalMap, local_map_term
 from pointnav_core.vector.refresh import PoolRefreshing
 from pointnav_core.vector.scan import ScanTables, VectorScan
 from pointnav_core.vector.xp import make_arrays
 
-__all__ = ["VectorPointNavEnv", "first_drop"]
-
-_MAX_TURN = 0.25  # rad per control step the rate check allows: the backend's sub-step turn
-
+__all__ = ["VectorPointNavEnv"]
 
 def _scan_term(sensors: Mapping[str, Any] | None) -> Any:
     """The range scan ``sensors`` asks for, or None; ValueError naming an unsupported sensor."""
@@ -312,7 +309,7 @@ class VectorPointNavEnv(PoolRefreshing, VectorEnv):
         spec = self.robot
         # Top speed on one axis: a holonomic robot's diagonal step may travel sqrt(2) times
         # that, which the backend splits into sub-steps near walls, and so does vector.drive.
-        if spec.max_angular_velocity * self.dt > _MAX_TURN or spec.max_linear_velocity * self.dt > 0.5 * min(
+        if spec.max_angular_velocity * self.dt > MAX_TURN or spec.max_linear_velocity * self.dt > 0.5 * min(
             float(s.floors[t.floor].resolution) for s in self.scenes
         ):
             raise ValueError(

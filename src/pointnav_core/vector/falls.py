@@ -29,14 +29,16 @@ from __future__ import annotations
 from collections.abc import Mapping
 from typing import Any
 
+from pointnav_core.backend_kit.base import _GRAVITY, _MIN_FIRST_DROP
+
 __all__ = ["FALL_SPEED", "GRAVITY", "MIN_FIRST_DROP", "apply_falls", "first_drop"]
 
 #: m/s^2, the kinematic backend's gravity.
-GRAVITY = 9.81
+GRAVITY = _GRAVITY
 #: m/s, the kinematic backend's default ``fall_speed`` (a fall's speed as it begins).
 FALL_SPEED = 1.0
 #: m, the least a robot drops in the step it begins to fall (so that a fall shows at any rate).
-MIN_FIRST_DROP = 0.05
+MIN_FIRST_DROP = _MIN_FIRST_DROP
 
 
 def first_drop(dt: float) -> float:

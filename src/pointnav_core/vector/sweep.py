@@ -64,13 +64,8 @@ def enter_rounded_square(
         enter_box(xp, px, py, dx, dy, x0 - radius, y0, x1 + radius, y1),
         enter_box(xp, px, py, dx, dy, x0, y0 - radius, x1, y1 + radius),
     )
-    if isinstance(radius, (int, float)):
-        if radius > 0.0:
-            corners = t
-            for cx, cy in ((x0, y0), (x1, y0), (x0, y1), (x1, y1)):
-                corners = xp.minimum(corners, enter_disc(xp, px, py, dx, dy, cx, cy, radius))
-            t = xp.where(t > 0.0, corners, t)
-        return t
+    if isinstance(radius, (int, float)) and radius <= 0.0:
+        return t  # a point robot: the square itself, no rounded corners
     corners = t
     for cx, cy in ((x0, y0), (x1, y0), (x0, y1), (x1, y1)):
         corners = xp.minimum(corners, enter_disc(xp, px, py, dx, dy, cx, cy, radius))
