@@ -414,6 +414,8 @@ class VectorPointNavEnv(PoolRefreshing, VectorEnv):
         l2 = xp.sqrt((st["gx"][idx] - x) ** 2 + (st["gy"][idx] - y) ** 2)
         st["pot"][idx] = xp.where(geo, xp.where(dist < math.inf, dist, d0), l2)
         self._needs_reset[idx] = False
+        if self.scan is not None:  # the worlds' episode counts key the scan's noise
+            self.scan.begin(mask, n)
 
     def check_actions(self, actions: Any) -> Any:
         """``actions`` as a float64 array ``(num_envs, action_dim)`` (2 for a differential
@@ -571,7 +573,7 @@ class VectorPointNavEnv(PoolRefreshing, VectorEnv):
         """The scan's readings (m), ``(num_envs, n_rays)``, at the headings' cosines ``c`` and sines ``s``."""
         xp, st = self.arrays.xp, self._state
         yaw, one = xp.arctan2(s, c)[:, None], xp.ones_like(c)[:, None] > 0.0  # the single env's frame heading
-        return self.scan.readings(self._world_scene, st["x"][:, None], st["y"][:, None], yaw, one, self.robot.radius)[:, 0]
+        return self.scan.readings(self._world_scene, st["x"][:, None], st["y"][:, None], yaw, one, self.robot.radius, self._steps[:, None])[:, 0]
 
     def _map_values(self) -> Any:
         """The local map's codes, ``(num_envs, cells * cells)`` float32 (one robot: no discs)."""
