@@ -56,6 +56,8 @@ def test_draws_are_uniform_and_normal() -> None:
     # scan_noise: noise_std times the normals of the noise channel; dropout at its rate.
     noise, lost = scan_noise(ep, np.arange(5)[None, :, None], np.full((1, 1, 1), 7), 100, 0.3, 0.25)
     np.testing.assert_allclose(noise.ravel(), 0.3 * z, rtol=0, atol=1e-15)
+    u = uniforms(ep, np.arange(5)[None, :, None], 7, np.arange(100)[None, None, :], DROPOUT)
+    np.testing.assert_array_equal(lost, u < 0.25)
     assert abs(lost.mean() - 0.25) < 0.02
 
 

@@ -168,12 +168,14 @@ def scan_noise(
         channel :data:`DROPOUT`, each of the keys' shape with ``n_rays`` last.
     """
     ray = np.arange(n_rays, dtype=np.uint64)
-    base = mix(mix(mix(episode, robot), step), ray)
-    noise = lost = None
-    if noise_std > 0.0:
-        k = mix(base, NOISE) >> _S11
-        noise = noise_std * ndtri((k.astype(np.float64) + 0.5) * (1.0 / 9007199254740992.0))
-    if dropout > 0.0:
-        k = mix(base, DROPOUT) >> _S11
-        lost = (k.astype(np.float64) + 0.5) * (1.0 / 9007199254740992.0) < dropout
+    with np.errstate(over="ignore"):
+        # mix(key, channel) = f(f(key + G) ^ channel): the inner word is the channels' common part.
+        inner = _finalise(mix(mix(mix(episode, robot), step), ray) + _GOLDEN)
+        noise = lost = None
+        if noise_std > 0.0:
+            k = _finalise(inner ^ np.uint64(NOISE)) >> _S11
+            noise = noise_std * ndtri((k.astype(np.float64) + 0.5) * (1.0 / 9007199254740992.0))
+        if dropout > 0.0:
+            k = _finalise(inner ^ np.uint64(DROPOUT)) >> _S11
+            lost = (k.astype(np.float64) + 0.5) * (1.0 / 9007199254740992.0) < dropout
     return noise, lost

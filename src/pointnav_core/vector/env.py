@@ -107,7 +107,7 @@ class VectorPointNavEnv(PoolRefreshing, VectorEnv):
         single env): the flat observation is the 8 ``low_dim`` values, then the scan's
         ``n_rays`` ranges (m, in ``[0, max_range]``), in the single env's order and bounds,
         cast by :mod:`pointnav_core.vector.scan` (compiled with numba on numpy, arrays on
-        torch). Noise and dropout draw from a stream of their own, not the single env's.
+        torch). Noise and dropout are the single env's draws: world ``w`` of seed ``s`` as ``reset(seed=s + w)``.
         ``{"local_map": {...}}`` (:class:`~pointnav_core.sensors.LocalMap` arguments) adds
         its ``cells * cells`` codes (0 free, 1 blocked, 2 void or off the map, 3 another
         robot; after the scan when both are given), equal to the single env's
