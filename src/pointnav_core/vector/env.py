@@ -38,9 +38,8 @@ def _scan_term(sensors: Mapping[str, Any] | None) -> Any:
     from pointnav_core.sensors import make_sensors
 
     terms = make_sensors(sensors)  # the single envs' checks: unknown sensors and keys
-    for term in terms:
-        if term.name not in ("scan", "local_map"):
-            raise ValueError(f"sensors: {term.name!r} is not supported by the batched engine (only 'scan', 'local_map')")
+    for term in (t for t in terms if t.name not in ("scan", "local_map")):
+        raise ValueError(f"sensors: {term.name!r} is not supported by the batched engine (only 'scan', 'local_map')")
     return next((term for term in terms if term.name == "scan"), None)
 
 
@@ -403,8 +402,7 @@ class VectorPointNavEnv(PoolRefreshing, VectorEnv):
         for key in ("vx", "vy", "vz", "w", "fs", "path"):
             st[key][idx] = 0.0
         self._field[idx] = p.field[e]
-        self._steps[idx] = 0
-        self._collisions[idx] = 0
+        self._steps[idx] = self._collisions[idx] = 0
         d0 = st["d0"][idx]
         geo = self.geodesic_reward & (d0 < math.inf)
         self._geo_metric[idx] = geo
