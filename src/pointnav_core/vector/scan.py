@@ -349,7 +349,7 @@ class VectorScan:
         mask = np.asarray(a.numpy(worlds) if a.is_torch else worlds, dtype=bool)
         self._episodes[mask] += 1
         w = np.nonzero(mask)[0]
-        self._keys[w] = episode_key(mix_base(self._base, w), self._episodes[w])
+        self._keys[w] = episode_key(_world_base(self._base, w), self._episodes[w])
 
     def readings(self, scene: Any, x: Any, y: Any, yaw: Any, present: Any, radius: Any, steps: Any = None) -> Any:
         """The scan's readings (m), ``(W, R, n_rays)`` float64 on the arrays' device;
@@ -377,7 +377,7 @@ class VectorScan:
         return d
 
 
-def mix_base(base: int, worlds: Any) -> np.ndarray:
+def _world_base(base: int, worlds: Any) -> np.ndarray:
     """World ``worlds``' base entropy: ``base + w`` modulo 2**64 (gymnasium's sub-env seeds)."""
     with np.errstate(over="ignore"):
         return np.uint64(base) + np.asarray(worlds, dtype=np.uint64)
