@@ -62,6 +62,8 @@ def crowded_scenes(draw: st.DrawFn) -> Scene:
     scan=st.one_of(st.none(), st.fixed_dictionaries({
         "n_rays": st.integers(1, 32), "fov": st.floats(0.5, 2 * np.pi), "max_range": st.floats(0.3, 5.6),
         "min_range": st.sampled_from([0.0, 0.05, 0.2]),
+        # Counter-based noise and dropout: the same draws as the parallel env reset with seed w.
+        "noise_std": st.sampled_from([0.0, 0.05]), "dropout": st.sampled_from([0.0, 0.3]),
     })),
     local_map=st.one_of(st.none(), st.fixed_dictionaries({
         "size": st.floats(0.2, 4.0), "cells": st.integers(1, 12), "dtype": st.sampled_from(["uint8", "float32"]),
@@ -138,7 +140,7 @@ def test_fleet_with_per_robot_lists_matches_parallel_envs(
     # The multi-robot env keeps goals max(tol_i + tol_j, r_i + r_j, cell) apart: 0.4 m at most here.
     episodes = fleet_episodes(scene, n_worlds, n_robots, rng, radius=0.2, goal_gap=0.4)
     actions = random_actions(rng, (steps, n_worlds, n_robots), drive)
-    sensors = {"scan": {"n_rays": 8, "max_range": 2.0}} if scan else {}
+    sensors = {"scan": {"n_rays": 8, "max_range": 2.0, "noise_std": 0.05, "dropout": 0.2}} if scan else {}
     if local_map:
         sensors["local_map"] = {"size": 1.6, "cells": 8}
     compare_fleet(scene, episodes, actions, task=task, robot=robot, device=device, finished=finished,

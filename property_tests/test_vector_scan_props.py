@@ -151,8 +151,12 @@ def test_large_floor(seed, ratio) -> None:
     n_rays=st.integers(1, 32),
     max_range=st.floats(0.5, 5.6),
     min_range=st.floats(0.0, 0.3),
+    noise_std=st.sampled_from([0.0, 0.01, 0.2]),
+    dropout=st.sampled_from([0.0, 0.1, 0.5]),
 )
-def test_env_scan_matches_single_env(device, seed, n, steps, n_rays, max_range, min_range) -> None:
+def test_env_scan_matches_single_env(device, seed, n, steps, n_rays, max_range, min_range, noise_std, dropout) -> None:
+    """Step for step against single envs, autoresets included; with noise and dropout the
+    engine seeded with 0 reads in world w the counter-based draws of the env reset with seed w."""
     rng = np.random.default_rng(seed)
     rows, cols = rng.integers(12, 30, 2)
     grid = _grid(rng, rows, cols, rng.uniform(0.0, 0.12))
@@ -164,7 +168,7 @@ def test_env_scan_matches_single_env(device, seed, n, steps, n_rays, max_range, 
     actions = rng.uniform(-1.2, 1.2, (steps, n, 2)).astype(np.float32)
     actions[rng.random((steps, n)) < 0.4, 0] = 1.0
     sensors = {"scan": {"n_rays": n_rays, "max_range": max_range, "min_range": min(min_range, max_range / 2),
-                        "fov": float(rng.uniform(0.5, 2 * math.pi))}}
+                        "fov": float(rng.uniform(0.5, 2 * math.pi)), "noise_std": noise_std, "dropout": dropout}}
     task = {"reward_type": "geodesic", "termination_config": {"max_steps": 40, "max_collisions": 20}}
     compare(scene, episodes, actions, task=task, device=device, sensors=sensors)
 

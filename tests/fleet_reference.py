@@ -72,7 +72,7 @@ def compare_fleet(
     # Local map cells whose centre is on a cell edge or a disc's rim may round either way.
     ties = np.zeros((n, r, dim), bool)
     for i, env in enumerate(refs):
-        obs, _ = env.reset(seed=0)
+        obs, _ = env.reset(seed=i)  # world i of an engine seeded with 0: the scan noise's seed i
         sobs[i] = [obs[a] for a in agents]
         ties[i] = [obs_ties(env, k, sensors, dim) for k in range(r)]
     stats = {"ends": 0, "successes": 0, "contacts": 0, "autoresets": 0, "robot_contacts": 0, "parked_steps": 0,

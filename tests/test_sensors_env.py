@@ -178,7 +178,7 @@ def test_noise_off_is_deterministic_and_noise_on_reproduces_under_the_same_seed(
     assert same(noisy, run(1, noise_std=0.05, dropout=0.2))
     assert not same(noisy, run(2, noise_std=0.05, dropout=0.2))
     assert not same(noisy, run(1))
-    # Noise draws from its own stream: the episodes (goals) are those of the noiseless env.
+    # Noise draws from no generator: the episodes (goals) are those of the noiseless env.
     np.testing.assert_array_equal(noisy[1], run(1)[1])
     scans = np.array(noisy[:1] + noisy[2:])
     assert ((scans >= 0.0) & (scans <= 5.6)).all()

@@ -47,10 +47,14 @@ def test_min_range_reads_max_range() -> None:
 def test_noise_and_dropout_follow_the_rules_and_the_seed() -> None:
     scan, pose = _scan(n_rays=32, min_range=0.0, max_range=1.0, noise_std=0.01, dropout=0.25)
     exact = cast_batch(scan.tables, *pose, scan.angles, 1.0)
+    steps = np.zeros((len(pose[0]), 1), np.int64)
+    every = np.ones(len(pose[0]), bool)
     scan.seed(np.random.default_rng(7))
-    a = scan.readings(*pose)
+    scan.begin(every, len(every))
+    a = scan.readings(*pose, steps)
     scan.seed(np.random.default_rng(7))
-    b = scan.readings(*pose)
+    scan.begin(every, len(every))
+    b = scan.readings(*pose, steps)
     np.testing.assert_array_equal(a, b)  # the same seed, the same scans
     assert ((a >= 0.0) & (a <= 1.0)).all()
     lost = a == 1.0
@@ -62,7 +66,10 @@ def test_noise_and_dropout_follow_the_rules_and_the_seed() -> None:
     diff = a[kept] - exact[kept]
     assert 0.005 < diff.std() < 0.015 and np.abs(diff).max() < 0.06
     scan.seed(np.random.default_rng(8))
-    assert not np.array_equal(scan.readings(*pose), a)
+    scan.begin(every, len(every))
+    assert not np.array_equal(scan.readings(*pose, steps), a)
+    with pytest.raises(ValueError, match="steps"):
+        scan.readings(*pose)
 
 
 def test_observation_layout_and_bounds_match_the_single_env() -> None:

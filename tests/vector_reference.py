@@ -58,7 +58,8 @@ def compare(
     ]
     to_np = venv.arrays.numpy
     vobs, _ = venv.reset(options={"episodes": episodes})
-    sobs = np.array([env.reset(seed=0)[0] for env in singles])
+    # World i of an engine seeded with 0 keys its scan noise as a single env reset with seed i.
+    sobs = np.array([env.reset(seed=i)[0] for i, env in enumerate(singles)])
     dim = sobs.shape[1]
     # Local map cells whose centre is on a cell edge or a disc's rim may round either way.
     ties = np.array([obs_ties(env, 0, sensors, dim) for env in singles])

@@ -20,9 +20,12 @@ In order, for each ray:
    readings below ``max_range``, and the result is clipped to ``[0, max_range]``;
 4. with ``dropout > 0``, each reading is lost (reads ``max_range``) with that probability.
 
-Noise and dropout draw from a generator the sensor spawns at every reset from the env's
-``np_random`` seed sequence, without drawing from the env's stream: the same seed gives the
-same noisy scans, and turning noise on changes no episode.
+Noise and dropout are counter-based draws (:mod:`pointnav_core.sensors.noise`): a hash of
+the env's seed (the entropy of ``np_random``'s seed sequence), the number of resets since
+that seeding, the robot's index, the step within the episode, the ray and the channel. No
+generator is drawn from, so the same seed gives the same noisy scans, turning noise on
+changes no episode, and the batched engine's world ``w`` seeded with ``s`` reads the same
+numbers as a single env reset with seed ``s + w`` (:class:`~pointnav_core.vector.scan.VectorScan`).
 
 Examples
 --------
@@ -49,6 +52,7 @@ from numpy.typing import NDArray
 from pointnav_core.backend import float_twin
 from pointnav_core.observations import Frame, ObservationTerm
 from pointnav_core.sensors._checks import check_int, check_number
+from pointnav_core.sensors.noise import episode_key, scan_noise, seed_entropy
 from pointnav_core.sensors.raycast import ScanGeometry, cast_pose_compiled, cast_rays
 
 __all__ = ["RangeScan", "ScanShare", "other_robot_discs", "scan_angles"]
@@ -152,7 +156,11 @@ class RangeScan(ObservationTerm):
         self.angles = angles
         self._geometry: ScanGeometry | None = None
         self._share: ScanShare | None = None
-        self._rng: np.random.Generator | None = None
+        # The noise keys: the seeding (its seed sequence), its base, the resets since, the episode's key.
+        self._seeding: Any = None
+        self._base = 0
+        self._episode = -1
+        self._key: Any = None
         # The pose goes in through small buffers (origin, yaw, the yaw's cosine and sine):
         # cheaper than converting tuples each step; the bearings' cosines and sines are fixed.
         self._pose = (np.zeros((1, 2)), np.zeros(1), np.zeros(2))
@@ -191,7 +199,11 @@ class RangeScan(ObservationTerm):
         if self._geometry is None or self._geometry.tmap is not tmap:
             self._geometry = ScanGeometry(tmap)
         if self.noise_std > 0.0 or self.dropout > 0.0:
-            self._rng = _spawn(env.np_random)
+            seeding, base = seed_entropy(env.np_random)
+            if seeding is not self._seeding:  # a new seeding: episodes count from 0 again
+                self._seeding, self._base, self._episode = seeding, base, -1
+            self._episode += 1
+            self._key = episode_key(self._base, self._episode)
         self.last_scan = None
 
     def ranges(self, frame: Frame) -> NDArray[np.float64]:
@@ -228,14 +240,15 @@ class RangeScan(ObservationTerm):
         d = self.ranges(frame)
         if self.min_range > 0.0:
             d[d < self.min_range] = self.max_range
-        if self._rng is not None:
-            rng = self._rng
-            if self.noise_std > 0.0:
-                seen = d < self.max_range
-                d = np.where(seen, d + rng.normal(0.0, self.noise_std, d.shape), d)
+        if self._key is not None:
+            task = frame.task
+            noise, lost = scan_noise(self._key, task.robot_idn, task.episode_length, self.n_rays,
+                                     self.noise_std, self.dropout)
+            if noise is not None:
+                d = np.where(d < self.max_range, d + noise, d)
                 np.clip(d, 0.0, self.max_range, out=d)
-            if self.dropout > 0.0:
-                d[rng.random(d.shape) < self.dropout] = self.max_range
+            if lost is not None:
+                d[lost] = self.max_range
         return d
 
     def __repr__(self) -> str:
@@ -323,10 +336,3 @@ class ScanShare:
         row = self._rows.get(idn)
         return None if row is None else row.copy()
 
-
-def _spawn(rng: np.random.Generator) -> np.random.Generator:
-    """A child generator of ``rng``'s seed sequence; ``rng``'s own stream is not drawn from."""
-    seed_seq = getattr(rng.bit_generator, "seed_seq", None)
-    if isinstance(seed_seq, np.random.SeedSequence):
-        return np.random.default_rng(seed_seq.spawn(1)[0])
-    return np.random.default_rng(rng.integers(2**63))

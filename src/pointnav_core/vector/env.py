@@ -38,9 +38,8 @@ def _scan_term(sensors: Mapping[str, Any] | None) -> Any:
     from pointnav_core.sensors import make_sensors
 
     terms = make_sensors(sensors)  # the single envs' checks: unknown sensors and keys
-    for term in terms:
-        if term.name not in ("scan", "local_map"):
-            raise ValueError(f"sensors: {term.name!r} is not supported by the batched engine (only 'scan', 'local_map')")
+    for term in (t for t in terms if t.name not in ("scan", "local_map")):
+        raise ValueError(f"sensors: {term.name!r} is not supported by the batched engine (only 'scan', 'local_map')")
     return next((term for term in terms if term.name == "scan"), None)
 
 
@@ -107,7 +106,7 @@ class VectorPointNavEnv(PoolRefreshing, VectorEnv):
         single env): the flat observation is the 8 ``low_dim`` values, then the scan's
         ``n_rays`` ranges (m, in ``[0, max_range]``), in the single env's order and bounds,
         cast by :mod:`pointnav_core.vector.scan` (compiled with numba on numpy, arrays on
-        torch). Noise and dropout draw from a stream of their own, not the single env's.
+        torch). Noise and dropout are the single env's draws: world ``w`` of seed ``s`` as ``reset(seed=s + w)``.
         ``{"local_map": {...}}`` (:class:`~pointnav_core.sensors.LocalMap` arguments) adds
         its ``cells * cells`` codes (0 free, 1 blocked, 2 void or off the map, 3 another
         robot; after the scan when both are given), equal to the single env's
@@ -403,8 +402,7 @@ class VectorPointNavEnv(PoolRefreshing, VectorEnv):
         for key in ("vx", "vy", "vz", "w", "fs", "path"):
             st[key][idx] = 0.0
         self._field[idx] = p.field[e]
-        self._steps[idx] = 0
-        self._collisions[idx] = 0
+        self._steps[idx] = self._collisions[idx] = 0
         d0 = st["d0"][idx]
         geo = self.geodesic_reward & (d0 < math.inf)
         self._geo_metric[idx] = geo
@@ -414,6 +412,8 @@ class VectorPointNavEnv(PoolRefreshing, VectorEnv):
         l2 = xp.sqrt((st["gx"][idx] - x) ** 2 + (st["gy"][idx] - y) ** 2)
         st["pot"][idx] = xp.where(geo, xp.where(dist < math.inf, dist, d0), l2)
         self._needs_reset[idx] = False
+        if self.scan is not None:  # the worlds' episode counts key the scan's noise
+            self.scan.begin(mask, n)
 
     def check_actions(self, actions: Any) -> Any:
         """``actions`` as a float64 array ``(num_envs, action_dim)`` (2 for a differential
@@ -571,7 +571,7 @@ class VectorPointNavEnv(PoolRefreshing, VectorEnv):
         """The scan's readings (m), ``(num_envs, n_rays)``, at the headings' cosines ``c`` and sines ``s``."""
         xp, st = self.arrays.xp, self._state
         yaw, one = xp.arctan2(s, c)[:, None], xp.ones_like(c)[:, None] > 0.0  # the single env's frame heading
-        return self.scan.readings(self._world_scene, st["x"][:, None], st["y"][:, None], yaw, one, self.robot.radius)[:, 0]
+        return self.scan.readings(self._world_scene, st["x"][:, None], st["y"][:, None], yaw, one, self.robot.radius, self._steps[:, None])[:, 0]
 
     def _map_values(self) -> Any:
         """The local map's codes, ``(num_envs, cells * cells)`` float32 (one robot: no discs)."""

@@ -234,6 +234,8 @@ class VectorFleetEnv(VectorPointNavEnv):
         l2 = xp.sqrt((st["gx"][idx] - x) ** 2 + (st["gy"][idx] - y) ** 2)
         st["pot"][idx] = xp.where(geo, xp.where(dist < math.inf, dist, d0), l2)
         self._needs_reset[idx] = False
+        if self.scan is not None:  # the worlds' episode counts key the scan's noise
+            self.scan.begin(mask, self.num_envs)
 
     def check_actions(self, actions: Any) -> Any:
         """``actions`` as a float64 array ``(num_envs, n_robots, action_dim)`` (2 for a
@@ -415,7 +417,7 @@ class VectorFleetEnv(VectorPointNavEnv):
         ``_seen`` neither see nor are seen (their rows are hidden by ``_observe``)."""
         xp, st = self.arrays.xp, self._state
         yaw = xp.arctan2(s, c)  # the heading as the multi-robot env's frame gives it
-        return self.scan.readings(self._world_scene, st["x"], st["y"], yaw, self._seen, self._radius)
+        return self.scan.readings(self._world_scene, st["x"], st["y"], yaw, self._seen, self._radius, self._steps)
 
     def _map_values(self) -> Any:
         """Every robot's local map, ``(num_envs, n_robots, cells * cells)``, with the discs of

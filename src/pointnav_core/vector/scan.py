@@ -33,6 +33,7 @@ from typing import Any
 
 import numpy as np
 
+from pointnav_core.sensors.noise import episode_key, scan_noise, seed_entropy
 from pointnav_core.sensors.raycast import TOUCH_EPS, ScanGeometry
 from pointnav_core.sensors.scan import RangeScan
 from pointnav_core.vector.xp import Arrays
@@ -298,9 +299,13 @@ class VectorScan:
     Applies the single scan's reading rules (its module docstring) to :func:`cast_batch`'s
     ranges: a return nearer than ``min_range`` reads ``max_range``; then, if configured,
     Gaussian noise on the readings below ``max_range`` (clipped to ``[0, max_range]``)
-    and dropout. Noise and dropout come from :attr:`rng`, which :meth:`seed` spawns from
-    the env's generator: the same seed gives the same scans, but not the stream of the
-    single env's scan (``docs/decisions.md``).
+    and dropout. Noise and dropout are the single scan's counter-based draws
+    (:mod:`pointnav_core.sensors.noise`), computed with numpy on the host and moved to the
+    arrays' device: world ``w`` of an engine seeded with ``s`` (:meth:`seed`) keys its
+    episodes with base ``s + w`` and counts them from 0 (:meth:`begin`), and robot ``r``'s
+    ray ``i`` at step ``k`` of the episode reads what a single env reset with seed
+    ``s + w`` (and reset again after each episode) reads for robot ``r``, ray ``i``, step
+    ``k``. Nothing is drawn from a generator.
 
     Parameters
     ----------
@@ -320,31 +325,59 @@ class VectorScan:
         self.method = method
         a = tables.arrays
         self.angles = a.asarray(np.array(term.angles))
-        self.rng = np.random.default_rng()
+        self.noisy = term.noise_std > 0.0 or term.dropout > 0.0
+        self._base = 0  # the seeding's entropy (mod 2**64); world w's base is this + w
+        self._episodes: np.ndarray = np.zeros(0, np.int64)  # per world: episodes begun since
+        self._keys: np.ndarray = np.zeros(0, np.uint64)  # per world: its episode's key
 
     def seed(self, rng: np.random.Generator) -> None:
-        """Take a child of ``rng``'s seed sequence for noise and dropout (``rng``'s stream is
-        not drawn from)."""
-        seq = getattr(rng.bit_generator, "seed_seq", None)
-        if isinstance(seq, np.random.SeedSequence):
-            self.rng = np.random.default_rng(seq.spawn(1)[0])
-        else:
-            self.rng = np.random.default_rng(rng.integers(2**63))
+        """Key the noise by the entropy of ``rng``'s seed sequence (``reset(seed=s)`` gives
+        ``s``); the worlds' episodes count from 0 again. ``rng``'s stream is not drawn from
+        (a generator without a seed sequence gives one draw)."""
+        self._base = seed_entropy(rng)[1]
+        self._episodes = np.zeros(0, np.int64)
 
-    def readings(self, scene: Any, x: Any, y: Any, yaw: Any, present: Any, radius: Any) -> Any:
+    def begin(self, worlds: Any, num_envs: int) -> None:
+        """Worlds ``worlds`` (a bool mask ``(num_envs,)``, numpy or on the device) begin an
+        episode: the next in their count since :meth:`seed`."""
+        if not self.noisy:
+            return
+        if self._episodes.shape[0] != num_envs:
+            self._episodes = np.full(num_envs, -1, np.int64)
+            self._keys = np.zeros(num_envs, np.uint64)
+        a = self.tables.arrays
+        mask = np.asarray(a.numpy(worlds) if a.is_torch else worlds, dtype=bool)
+        self._episodes[mask] += 1
+        w = np.nonzero(mask)[0]
+        self._keys[w] = episode_key(_world_base(self._base, w), self._episodes[w])
+
+    def readings(self, scene: Any, x: Any, y: Any, yaw: Any, present: Any, radius: Any, steps: Any = None) -> Any:
         """The scan's readings (m), ``(W, R, n_rays)`` float64 on the arrays' device;
-        ``radius`` as for :func:`cast_batch`."""
+        ``radius`` as for :func:`cast_batch`; ``steps`` ``(W, R)`` each robot's step within
+        its world's episode (0 at reset), needed with noise or dropout (after :meth:`begin`)."""
         t, a = self.term, self.tables.arrays
         xp = a.xp
         d = cast_batch(self.tables, scene, x, y, yaw, present, radius, self.angles, t.max_range, self.method)
         top = t.max_range
         if t.min_range > 0.0:
             d = xp.where(d < t.min_range, top, d)
-        if t.noise_std > 0.0:
-            noise = a.asarray(self.rng.normal(0.0, t.noise_std, tuple(d.shape)))
-            d = xp.where(d < top, d + noise, d)
+        if not self.noisy:
+            return d
+        w, r = d.shape[0], d.shape[1]
+        if steps is None or self._keys.shape[0] != w:
+            raise ValueError(f"steps: noise needs each robot's step (W, R) after begin() for all {w} worlds")
+        k = np.asarray(a.numpy(steps) if a.is_torch else steps, dtype=np.int64).reshape(w, r, 1)
+        noise, lost = scan_noise(self._keys[:, None, None], np.arange(r)[None, :, None], k, d.shape[2],
+                                 t.noise_std, t.dropout)
+        if noise is not None:
+            d = xp.where(d < top, d + a.asarray(noise), d)
             d = d.clip(0.0, top)
-        if t.dropout > 0.0:
-            lost = a.asarray(self.rng.random(tuple(d.shape))) < t.dropout
-            d = xp.where(lost, top, d)
+        if lost is not None:
+            d = xp.where(a.asarray(lost, a.boolean), top, d)
         return d
+
+
+def _world_base(base: int, worlds: Any) -> np.ndarray:
+    """World ``worlds``' base entropy: ``base + w`` modulo 2**64 (gymnasium's sub-env seeds)."""
+    with np.errstate(over="ignore"):
+        return np.uint64(base) + np.asarray(worlds, dtype=np.uint64)
