@@ -187,6 +187,8 @@ from pointnav_core._parallel_state import STATE_FIELDS, global_state, state_spac
 from pointnav_core.actions import make_discrete_actions
 from pointnav_core.backend import Backend, RobotSpec, make_backend
 from pointnav_core.fleet import (
+    FINISHED_MODES,
+    check_finished,
     check_fixed_positions,
     derived_path_ranges,
     goal_separation,
@@ -206,9 +208,6 @@ __all__ = [
     "parallel_env",
     "raw_env",
 ]
-
-#: What happens to a robot whose episode ended: stays as an obstacle, or leaves the world.
-FINISHED_MODES = ("park", "remove")
 
 
 def _check_int(name: str, value: Any, minimum: int) -> int:
@@ -282,8 +281,7 @@ class MultiPointNavEnv(ParallelEnv[str, Any, np.ndarray]):
             )
         n = _check_int("n_robots", n_robots, 1)
         self.max_cycles = _check_int("max_cycles", max_cycles, 1)
-        if not isinstance(finished, str) or finished not in FINISHED_MODES:
-            raise ValueError(f"finished must be one of {list(FINISHED_MODES)}, got {finished!r}")
+        check_finished(finished)
         scene, frequency = _envcommon.check_world_args(
             scene, flatten_obs, action_frequency, backend_kwargs
         )
