@@ -1,9 +1,10 @@
 """The batched contacts' compiled path equals their array path.
 
 For random grid scenes (clutter, walls), robots crowded around a point and random chords
-up to half a cell long (the longest the batched engines make: ``TRAVEL_CELLS``), driven for
-several rounds from where the last round left them (so that they rest against walls and
-each other), :func:`~pointnav_core.vector.contacts_jit.advance_compiled` gives the same end
+up to half a cell long (the longest the batched engines make: ``TRAVEL_CELLS``), the robots
+within reach of each other always resolved together (as the engines' slow robots), driven
+for several rounds from where the last round left them (so that they rest against walls
+and each other), :func:`~pointnav_core.vector.contacts_jit.advance_compiled` gives the same end
 positions (bit for bit on numpy, within 1e-12 m on torch) and contact flags as the array
 path, with one radius for all robots or each robot its own: with several robots per world
 :func:`~pointnav_core.vector.robots.advance_robots` (which the kinematic backend's resolver
