@@ -1,11 +1,12 @@
 """The batched contacts' compiled path equals their array path.
 
-For random grid scenes (clutter, walls), robots crowded around a point and random chords,
-driven for several rounds from where the last round left them (so that they rest against
-walls and each other), :func:`~pointnav_core.vector.contacts_jit.advance_compiled` gives
-the same end positions (bit for bit on numpy, within 1e-12 m on torch) and contact
-flags as the array path, with one radius for all robots or each robot its own: with
-several robots per world
+For random grid scenes (clutter, walls), robots crowded around a point and random chords
+up to half a cell long (the longest the batched engines make: ``TRAVEL_CELLS``), the robots
+within reach of each other always resolved together (as the engines' slow robots), driven
+for several rounds from where the last round left them (so that they rest against walls
+and each other), :func:`~pointnav_core.vector.contacts_jit.advance_compiled` gives the same end
+positions (bit for bit on numpy, within 1e-12 m on torch) and contact flags as the array
+path, with one radius for all robots or each robot its own: with several robots per world
 :func:`~pointnav_core.vector.robots.advance_robots` (which the kinematic backend's resolver
 checks in ``tests/test_vector_robots.py``), with one :func:`~pointnav_core.vector.contacts.advance`.
 """
@@ -25,6 +26,18 @@ from pointnav_core.scenes import Scene
 pytest.importorskip("numba")
 
 DEVICES = ["numpy"] + (["cpu"] if importlib.util.find_spec("torch") else [])
+
+# The chords the batched engines hand their contacts: their control-rate check lets a robot
+# drive at most half a cell in one step (top speed * dt <= 0.5 * resolution), and a faster
+# step (a holonomic robot's diagonal) is split into sub-steps of at most half a cell each
+# (vector.drive.sub_steps). The two paths are meant to agree on chords up to that bound, so
+# a round's longest chord is drawn as one of these fractions of the scene's cell size.
+TRAVEL_CELLS = (0.05, 0.2, 0.35, 0.5)
+
+
+def _travel(scene: Scene, cells: float) -> float:
+    """The longest chord (m) of a round: ``cells`` (<= 0.5) of the floor's cell size."""
+    return cells * float(scene.floors[0].resolution)
 
 
 def _assert_same(device: str, got: np.ndarray, want: np.ndarray) -> None:
@@ -53,9 +66,15 @@ def cluttered_scenes(draw: st.DrawFn, patch: int = 8) -> Scene:
     return Scene.from_array(grid, 0.1)
 
 
-def _crowd(scene: Scene, worlds: int, n_robots: int, radius: float, rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray]:
+def _crowd(
+    scene: Scene, worlds: int, n_robots: int, radius: float, rng: np.random.Generator
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Robot positions as an episode can have them: each world's robots within about 0.6 m
-    of a usable point, clear of every obstacle cell and of each other (brute force)."""
+    of a usable point, clear of every obstacle cell and of each other (brute force).
+
+    Robots that find no room there are put off the map, apart, and marked in the returned
+    ``(worlds, n_robots)`` mask as not on the map: the engines never resolve a robot that
+    is off its floor (one that fell has left the world), so they must not take part."""
     tmap = scene.floors[0]
     rows, cols = np.nonzero(np.asarray(tmap.codes) == OBSTACLE)
     res, (ox, oy) = tmap.resolution, tmap.origin[:2]
@@ -69,6 +88,7 @@ def _crowd(scene: Scene, worlds: int, n_robots: int, radius: float, rng: np.rand
         return walls_ok and all((px - qx) ** 2 + (py - qy) ** 2 >= (2 * radius) ** 2 for qx, qy in others)
 
     x, y = np.empty((worlds, n_robots)), np.empty((worlds, n_robots))
+    on_map = np.ones((worlds, n_robots), bool)
     for w in range(worlds):
         cx, cy = scene.get_random_point(0, robot=radius, rng=rng)[1][:2]
         placed = [(cx, cy)]
@@ -78,10 +98,11 @@ def _crowd(scene: Scene, worlds: int, n_robots: int, radius: float, rng: np.rand
             px, py = cx + rng.uniform(-0.6, 0.6), cy + rng.uniform(-0.6, 0.6)
             if 0.0 < px - ox < width and 0.0 < py - oy < height and clear(px, py, placed):
                 placed.append((px, py))
+        on_map[w, len(placed) :] = False
         while len(placed) < n_robots:  # no room near it: off the map, apart
             placed.append((ox - 10.0 * len(placed), oy - 10.0))
         x[w], y[w] = [p[0] for p in placed], [p[1] for p in placed]
-    return x, y
+    return x, y, on_map
 
 
 def _chords(rng: np.random.Generator, shape: tuple[int, ...], travel: float) -> tuple[np.ndarray, np.ndarray]:
@@ -92,13 +113,30 @@ def _chords(rng: np.random.Generator, shape: tuple[int, ...], travel: float) -> 
     return length * np.cos(heading), length * np.sin(heading)
 
 
+def _resolved(
+    rng: np.random.Generator, x: np.ndarray, y: np.ndarray, mx: np.ndarray, my: np.ndarray,
+    radii: np.ndarray, on_map: np.ndarray,
+) -> np.ndarray:
+    """The robots a round resolves, chosen as the engines choose their slow robots: every
+    robot with another one within reach (the sum of both radii and both chords, m) takes
+    part, the others at random (85 %), robots off the map never. A robot that is not
+    resolved is then out of every resolved robot's reach, so none drives into it: robots
+    that do not block (``present`` False) never overlap the others, as in the engines."""
+    n_robots = x.shape[1]
+    reach = radii + np.hypot(mx, my)  # (W, R)
+    gap = reach[:, :, None] + reach[:, None, :]
+    dist2 = (x[:, :, None] - x[:, None, :]) ** 2 + (y[:, :, None] - y[:, None, :]) ** 2
+    near = ~np.eye(n_robots, dtype=bool) & on_map[:, None, :] & (dist2 <= gap * gap)
+    return ((rng.random(x.shape) < 0.85) | near.any(-1)) & on_map
+
+
 @pytest.mark.parametrize("device", DEVICES)
 @settings(max_examples=25, deadline=None)
 @given(scene=cluttered_scenes(), seed=st.integers(0, 2**31 - 1), n_robots=st.integers(2, 5),
-       radius=st.sampled_from([0.0, 0.05, 0.12, 0.18]), travel=st.sampled_from([0.02, 0.05, 0.1, 0.3]),
+       radius=st.sampled_from([0.0, 0.05, 0.12, 0.18]), cells=st.sampled_from(TRAVEL_CELLS),
        own_radii=st.booleans())
 def test_compiled_contacts_equal_the_multi_robot_array_path(
-    device: str, scene: Scene, seed: int, n_robots: int, radius: float, travel: float, own_radii: bool
+    device: str, scene: Scene, seed: int, n_robots: int, radius: float, cells: float, own_radii: bool
 ) -> None:
     from pointnav_core.vector.contacts_jit import advance_compiled
     from pointnav_core.vector.floors import FloorTables
@@ -107,14 +145,16 @@ def test_compiled_contacts_equal_the_multi_robot_array_path(
 
     rng = np.random.default_rng(seed)
     a, worlds = make_arrays(device), 12
+    travel = _travel(scene, cells)
     floors = FloorTables([scene], 0, radius, a)
-    x, y = _crowd(scene, worlds, n_robots, radius, rng)
+    x, y, on_map = _crowd(scene, worlds, n_robots, radius, rng)
     scene_ids = a.zeros((worlds, n_robots), a.i64)
     # Placed for the drawn radius, so smaller robots fit too: radii from 0 to it, per robot.
-    rad = a.asarray(rng.choice([0.0, 0.5, 1.0], (worlds, n_robots)) * radius) if own_radii else radius
+    radii = rng.choice([0.0, 0.5, 1.0], (worlds, n_robots)) * radius if own_radii else np.full((worlds, n_robots), radius)
+    rad = a.asarray(radii) if own_radii else radius
     for _ in range(6):
         mx, my = _chords(rng, (worlds, n_robots), travel)
-        slow = rng.random((worlds, n_robots)) < 0.85
+        slow = _resolved(rng, x, y, mx, my, radii, on_map)
         args = [a.asarray(v) for v in (x, y, mx, my)]
         walls = robot_walls(floors, scene_ids, *args, rad, travel)
         want = [a.numpy(v) for v in advance_robots(a, *args, rad, present=a.asarray(slow, a.boolean), walls=walls)]
@@ -131,10 +171,10 @@ def test_compiled_contacts_equal_the_multi_robot_array_path(
 @pytest.mark.parametrize("device", DEVICES)
 @settings(max_examples=25, deadline=None)
 @given(scene=cluttered_scenes(), seed=st.integers(0, 2**31 - 1),
-       radius=st.sampled_from([0.0, 0.05, 0.12, 0.18]), travel=st.sampled_from([0.02, 0.05, 0.1, 0.3]),
+       radius=st.sampled_from([0.0, 0.05, 0.12, 0.18]), cells=st.sampled_from(TRAVEL_CELLS),
        own_radii=st.booleans())
 def test_compiled_contacts_equal_the_one_robot_array_path(
-    device: str, scene: Scene, seed: int, radius: float, travel: float, own_radii: bool
+    device: str, scene: Scene, seed: int, radius: float, cells: float, own_radii: bool
 ) -> None:
     from pointnav_core.vector.contacts import advance
     from pointnav_core.vector.contacts_jit import advance_compiled
@@ -143,9 +183,10 @@ def test_compiled_contacts_equal_the_one_robot_array_path(
 
     rng = np.random.default_rng(seed)
     a, worlds = make_arrays(device), 48
+    travel = _travel(scene, cells)
     limit = travel * (1.0 + 1e-9) + 1e-12  # the env's max_travel: a chord's rounding fits
     floors = FloorTables([scene], 0, radius, a)
-    x, y = _crowd(scene, worlds, 1, radius, rng)
+    x, y, _ = _crowd(scene, worlds, 1, radius, rng)
     x, y = x[:, 0], y[:, 0]
     scene_ids = a.zeros(worlds, a.i64)
     rad = a.asarray(rng.choice([0.0, 0.5, 1.0], worlds) * radius) if own_radii else radius

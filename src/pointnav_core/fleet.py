@@ -21,6 +21,8 @@ from pointnav_core.sampling import GoalConstraint
 from pointnav_core.task import PointNavigationTask
 
 __all__ = [
+    "FINISHED_MODES",
+    "check_finished",
     "check_fixed_positions",
     "derived_path_ranges",
     "goal_separation",
@@ -30,6 +32,17 @@ __all__ = [
     "per_robot",
     "prefixed",
 ]
+
+
+#: What happens to a robot whose episode ended: stays as an obstacle, or leaves the world.
+FINISHED_MODES = ("park", "remove")
+
+
+def check_finished(finished: Any) -> str:
+    """``finished`` if it is one of :data:`FINISHED_MODES`; else ValueError naming it."""
+    if not isinstance(finished, str) or finished not in FINISHED_MODES:
+        raise ValueError(f"finished must be one of {list(FINISHED_MODES)}, got {finished!r}")
+    return finished
 
 
 def prefixed(name: str, err: ValueError) -> ValueError:

@@ -170,9 +170,8 @@ Version History
 
 from __future__ import annotations
 
-import math
 from collections.abc import Mapping, Sequence
-from typing import Any, NoReturn
+from typing import Any
 
 import gymnasium
 import numpy as np
@@ -183,9 +182,13 @@ from pettingzoo import AECEnv, ParallelEnv
 from pettingzoo.utils.conversions import parallel_to_aec, parallel_to_aec_wrapper
 
 from pointnav_core import _envcommon, scenes, validation
-from pointnav_core.actions import check_discrete_action, make_discrete_actions
+from pointnav_core._parallel_actions import check_actions, named_action_error, no_agents_error
+from pointnav_core._parallel_state import STATE_FIELDS, global_state, state_space
+from pointnav_core.actions import make_discrete_actions
 from pointnav_core.backend import Backend, RobotSpec, make_backend
 from pointnav_core.fleet import (
+    FINISHED_MODES,
+    check_finished,
     check_fixed_positions,
     derived_path_ranges,
     goal_separation,
@@ -205,26 +208,6 @@ __all__ = [
     "parallel_env",
     "raw_env",
 ]
-
-#: What happens to a robot whose episode ended: stays as an obstacle, or leaves the world.
-FINISHED_MODES = ("park", "remove")
-#: The values ``state()`` holds for each robot, in order.
-STATE_FIELDS = ("x", "y", "z", "yaw", "goal_x", "goal_y", "goal_z", "active")
-
-# State bounds: margin (m) around the floors' extents (a robot falling off an edge), and
-# how far below the lowest floor a falling robot's z is still shown (it is clipped there).
-_XY_MARGIN = 1.0
-_Z_BELOW = 10.0
-_Z_ABOVE = 1.0
-
-
-def _named_action_error(err: ValueError, todo: list[Any]) -> ValueError:
-    """The backend's refusal of a step, prefixed with the first agent whose action is not
-    finite (the backend refuses the first bad action it meets, in the agents' order)."""
-    for agent, _, action, *_ in todo:
-        if not np.isfinite(action).all():
-            return ValueError(f"{agent}: {err}")
-    return err
 
 
 def _check_int(name: str, value: Any, minimum: int) -> int:
@@ -298,8 +281,7 @@ class MultiPointNavEnv(ParallelEnv[str, Any, np.ndarray]):
             )
         n = _check_int("n_robots", n_robots, 1)
         self.max_cycles = _check_int("max_cycles", max_cycles, 1)
-        if not isinstance(finished, str) or finished not in FINISHED_MODES:
-            raise ValueError(f"finished must be one of {list(FINISHED_MODES)}, got {finished!r}")
+        check_finished(finished)
         scene, frequency = _envcommon.check_world_args(
             scene, flatten_obs, action_frequency, backend_kwargs
         )
@@ -350,7 +332,7 @@ class MultiPointNavEnv(ParallelEnv[str, Any, np.ndarray]):
             agent: _envcommon.observation_space(t, self.flatten_obs)
             for agent, t in zip(self.possible_agents, tasks)
         }
-        self.state_space = self._build_state_space()
+        self.state_space = state_space(scene, n)
         self._state_low = self.state_space.low.astype(np.float64)
         self._state_high = self.state_space.high.astype(np.float64)
 
@@ -368,25 +350,6 @@ class MultiPointNavEnv(ParallelEnv[str, Any, np.ndarray]):
         # True until a reset completes, and after a step or reset that failed half-way.
         self._void = True
         self._started = False  # whether reset() was ever called
-
-    # ------------------------------------------------------------------ construction
-    def _build_state_space(self) -> spaces.Box:
-        scene = self.scene
-        extents = [scene.floors[f].extent for f in range(scene.n_floors)]
-        heights = [float(scene.get_floor_height(f)) for f in range(scene.n_floors)]
-        xmin = min(e[0] for e in extents) - _XY_MARGIN
-        xmax = max(e[1] for e in extents) + _XY_MARGIN
-        ymin = min(e[2] for e in extents) - _XY_MARGIN
-        ymax = max(e[3] for e in extents) + _XY_MARGIN
-        zmin, zmax = min(heights) - _Z_BELOW, max(heights) + _Z_ABOVE
-        low = [xmin, ymin, zmin, -math.pi, xmin, ymin, zmin, 0.0]
-        high = [xmax, ymax, zmax, math.pi, xmax, ymax, zmax, 1.0]
-        n = len(self.robots)
-        return spaces.Box(
-            np.array(low * n, dtype=np.float32),
-            np.array(high * n, dtype=np.float32),
-            dtype=np.float32,
-        )
 
     # ------------------------------------------------------------------ PettingZoo API
     def observation_space(self, agent: str) -> spaces.Space[Any]:
@@ -483,39 +446,11 @@ class MultiPointNavEnv(ParallelEnv[str, Any, np.ndarray]):
         """
         agents = self.agents
         if not agents:
-            self._no_agents()
-        if type(actions) is not dict and not isinstance(actions, Mapping):
-            raise ValueError(
-                f"actions must be a dict of agent -> action for the agents in env.agents "
-                f"{agents}, got {type(actions).__name__}"
-            )
-        if len(actions) != len(agents):
-            self._bad_keys(actions)
+            raise no_agents_error(self._started, self._void)
         # Check every action before anything moves (finiteness: the backend, which moves
         # nothing when it refuses a step): a rejected step changes nothing.
-        slots, check, plans = self._slots, _envcommon.check_action, self._plans
-        commands: dict[int, np.ndarray] = {}
-        todo = []
-        for agent in agents:
-            i, shape, drive, task_step, observe = slots[agent]
-            try:
-                action = actions[agent]
-            except KeyError:  # as many keys as agents, so one is missing and one is extra
-                self._bad_keys(actions)
-            if action is None:
-                raise ValueError(
-                    f"missing action for {agent}: got None, but {agent} is alive; every agent "
-                    f"in env.agents must act"
-                )
-            try:
-                if plans is None:  # finiteness: the backend's step checks it, below
-                    action = check(action, shape, drive, finite=False)
-                else:
-                    action = check_discrete_action(action, len(plans[i]))
-            except ValueError as err:
-                raise ValueError(f"{agent}: {err}") from None
-            commands[i] = action
-            todo.append((agent, i, action, task_step, observe))
+        plans = self._plans
+        commands, todo = check_actions(agents, actions, self._slots, plans, self._index)
 
         observations: dict[str, Any] = {}
         rewards: dict[str, float] = {}
@@ -526,7 +461,7 @@ class MultiPointNavEnv(ParallelEnv[str, Any, np.ndarray]):
             try:
                 self.backend.step(commands)
             except ValueError as err:  # a rejected step moved nothing: name the agent
-                raise _named_action_error(err, todo) from None
+                raise named_action_error(err, todo) from None
             except BaseException:
                 self.agents = []
                 self._void = True
@@ -584,43 +519,6 @@ class MultiPointNavEnv(ParallelEnv[str, Any, np.ndarray]):
         if self.finished == "remove" or gone:
             self.backend.set_present(i, False)
 
-    def _no_agents(self) -> NoReturn:
-        if not self._started:
-            reason = "no episode has started: call reset() first"
-        elif self._void:
-            reason = (
-                "the last reset or step failed half-way, so there is no valid episode: "
-                "call reset()"
-            )
-        else:
-            reason = "every agent's episode has ended: call reset() to start new ones"
-        raise TaskStateError(f"step() needs alive agents, but env.agents is empty: {reason}")
-
-    def _bad_keys(self, actions: Mapping[str, Any]) -> NoReturn:
-        alive = set(self.agents)
-        for agent in self.agents:
-            if agent not in actions:
-                raise ValueError(
-                    f"missing action for {agent}: every agent in env.agents {self.agents} must "
-                    f"act (agents whose episode ended must not)"
-                )
-        for key in actions:
-            if key in alive:
-                continue
-            if key in self._index:
-                raise ValueError(
-                    f"got an action for {key}, which is not alive: its episode has ended; step() "
-                    f"takes actions only for the agents in env.agents {self.agents}"
-                )
-            raise ValueError(
-                f"got an action for unknown agent {key!r}; step() takes actions only for the "
-                f"agents in env.agents {self.agents}"
-            )
-        raise ValueError(  # only a Mapping whose len() disagrees with its keys gets here
-            f"actions must hold exactly one action per agent in env.agents {self.agents}, "
-            f"got {len(actions)} for keys {list(actions)}"
-        )
-
     def state(self) -> NDArray[np.float32]:
         """Return the global state: ``x, y, z, yaw, goal_x, goal_y, goal_z, active`` per robot.
 
@@ -633,17 +531,9 @@ class MultiPointNavEnv(ParallelEnv[str, Any, np.ndarray]):
         """
         if self._void:
             raise TaskStateError("state() needs an episode: call reset() first")
-        values: list[float] = []
-        backend = self.backend
-        for i, task in enumerate(self.tasks):
-            pos, quat = backend.get_pose(i)
-            x, y, z = pos.tolist()
-            qx, qy, qz, qw = quat.tolist()
-            yaw = math.atan2(2.0 * (qw * qz + qx * qy), 1.0 - 2.0 * (qy * qy + qz * qz))
-            gx, gy = task.goal_xy  # type: ignore[misc]
-            values += (x, y, z, yaw, gx, gy, task.floor_height, 1.0 if self._active[i] else 0.0)
-        state = np.clip(np.array(values), self._state_low, self._state_high)
-        return state.astype(np.float32)
+        return global_state(
+            self.backend, self.tasks, self._active, self._state_low, self._state_high
+        )
 
     def render(self, mode: str | None = None) -> NDArray[np.uint8] | None:
         """Return a top-down RGB image (H, W, 3) uint8 when ``render_mode="rgb_array"``.

@@ -26,6 +26,7 @@ import gymnasium as gym
 import numpy as np
 
 from pointnav_core import scenes, validation
+from pointnav_core.fleet import FINISHED_MODES, check_finished
 from pointnav_core.vector import contacts_jit
 from pointnav_core.vector.contacts import advance
 from pointnav_core.vector.contacts_jit import advance_compiled
@@ -51,9 +52,6 @@ from pointnav_core.vector.scan import ScanTables, VectorScan
 from pointnav_core.vector.xp import make_arrays
 
 __all__ = ["FINISHED_MODES", "VectorFleetEnv"]
-
-#: What happens to a robot whose episode ended, as in :mod:`pointnav_core.parallel`.
-FINISHED_MODES = ("park", "remove")
 
 
 class VectorFleetEnv(VectorPointNavEnv):
@@ -108,9 +106,7 @@ class VectorFleetEnv(VectorPointNavEnv):
         self.num_envs = validation.integer("num_envs", num_envs, minimum=1)
         self.n_robots = validation.integer("n_robots", n_robots, minimum=2)
         self.max_cycles = validation.integer("max_cycles", max_cycles, minimum=1)
-        if not isinstance(finished, str) or finished not in FINISHED_MODES:
-            raise ValueError(f"finished must be one of {list(FINISHED_MODES)}, got {finished!r}")
-        self.finished = finished
+        self.finished = check_finished(finished)
         scan_term = _scan_term(sensors)
         if max_episode_steps is not None:
             max_episode_steps = validation.integer("max_episode_steps", max_episode_steps, minimum=1)
