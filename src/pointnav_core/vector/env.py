@@ -28,19 +28,10 @@ from pointnav_core.vector.falls import apply_falls
 from pointnav_core.vector.floors import FloorTables
 from pointnav_core.vector.local_map import VectorLocalMap, local_map_term
 from pointnav_core.vector.refresh import PoolRefreshing
-from pointnav_core.vector.scan import ScanTables, VectorScan
+from pointnav_core.vector.scan import ScanTables, VectorScan, requested_scan
 from pointnav_core.vector.xp import make_arrays
 
 __all__ = ["VectorPointNavEnv"]
-
-def _scan_term(sensors: Mapping[str, Any] | None) -> Any:
-    """The range scan ``sensors`` asks for, or None; ValueError naming an unsupported sensor."""
-    from pointnav_core.sensors import make_sensors
-
-    terms = make_sensors(sensors)  # the single envs' checks: unknown sensors and keys
-    for term in (t for t in terms if t.name not in ("scan", "local_map")):
-        raise ValueError(f"sensors: {term.name!r} is not supported by the batched engine (only 'scan', 'local_map')")
-    return next((term for term in terms if term.name == "scan"), None)
 
 
 def _default_scene() -> scenes.Scene:
@@ -243,7 +234,7 @@ class VectorPointNavEnv(PoolRefreshing, VectorEnv):
         self.num_envs = validation.integer("num_envs", num_envs, minimum=1)
         if validation.integer("n_robots", n_robots, minimum=1) != 1:  # several: built by __new__
             raise ValueError(f"n_robots must be 1 here, got {n_robots}: VectorPointNavEnv builds the multi-robot engine")
-        scan_term = _scan_term(sensors)
+        scan_term = requested_scan(sensors)
         task = _task_arguments(task)
         self.pool_size = validation.integer("pool_size", pool_size, minimum=1)
         self.starts_per_goal = validation.integer("starts_per_goal", starts_per_goal, minimum=1)

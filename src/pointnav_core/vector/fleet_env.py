@@ -32,11 +32,7 @@ from pointnav_core.vector.contacts import advance
 from pointnav_core.vector.contacts_jit import advance_compiled
 from pointnav_core.vector.discrete import MOVED, DiscretePlan
 from pointnav_core.vector.drive import arc, body_command, sub_steps, substep_drive, travel
-from pointnav_core.vector.env import (
-    VectorPointNavEnv,
-    _scan_term,
-    _scene_list,
-)
+from pointnav_core.vector.env import VectorPointNavEnv, _scene_list
 from pointnav_core.vector.falls import apply_falls
 from pointnav_core.vector.fleet_pool import FleetPool, check_fixed_episode
 from pointnav_core.vector.floors import FloorTables
@@ -48,7 +44,7 @@ from pointnav_core.vector.per_robot import (
     task_arguments,
 )
 from pointnav_core.vector.robots import advance_robots, robot_walls
-from pointnav_core.vector.scan import ScanTables, VectorScan
+from pointnav_core.vector.scan import ScanTables, VectorScan, requested_scan
 from pointnav_core.vector.xp import make_arrays
 
 __all__ = ["FINISHED_MODES", "VectorFleetEnv"]
@@ -107,7 +103,7 @@ class VectorFleetEnv(VectorPointNavEnv):
         self.n_robots = validation.integer("n_robots", n_robots, minimum=2)
         self.max_cycles = validation.integer("max_cycles", max_cycles, minimum=1)
         self.finished = check_finished(finished)
-        scan_term = _scan_term(sensors)
+        scan_term = requested_scan(sensors)
         if max_episode_steps is not None:
             max_episode_steps = validation.integer("max_episode_steps", max_episode_steps, minimum=1)
         task = task_arguments(task, self.n_robots, max_episode_steps)  # one dict, or one per robot

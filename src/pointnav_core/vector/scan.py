@@ -38,7 +38,7 @@ from pointnav_core.sensors.raycast import TOUCH_EPS, ScanGeometry
 from pointnav_core.sensors.scan import RangeScan
 from pointnav_core.vector.xp import Arrays
 
-__all__ = ["BLOCK", "ScanTables", "VectorScan", "cast_batch", "compiled_available", "directions"]
+__all__ = ["BLOCK", "ScanTables", "VectorScan", "cast_batch", "compiled_available", "directions", "requested_scan"]
 
 #: Crossings per family taken together by one iteration of the array path.
 BLOCK = 8
@@ -92,6 +92,21 @@ class ScanTables:
         m = self.meta
         self.m_off = a.asarray(m[:, 0], a.i64)
         self.m_hp, self.m_wp, self.m_res, self.m_ox, self.m_oy = (a.asarray(m[:, i]) for i in (2, 3, 4, 5, 6))
+
+
+def requested_scan(sensors: Any) -> RangeScan | None:
+    """The range scan a batched engine's ``sensors`` asks for, or None.
+
+    The single envs' checks apply (unknown sensors and keys); the batched engines take a
+    ``"scan"`` and a ``"local_map"`` only: any other sensor raises a ValueError naming it.
+    """
+    from pointnav_core.sensors import make_sensors
+
+    terms = make_sensors(sensors)
+    unsupported = [term.name for term in terms if term.name not in ("scan", "local_map")]
+    if unsupported:
+        raise ValueError(f"sensors: {unsupported[0]!r} is not supported by the batched engine (only 'scan', 'local_map')")
+    return next((term for term in terms if isinstance(term, RangeScan)), None)
 
 
 def compiled_available() -> bool:
