@@ -111,3 +111,16 @@ def test_bad_method_raises() -> None:
     scan, pose = _scan()
     with pytest.raises(ValueError, match="method must be one of"):
         cast_batch(scan.tables, *pose, scan.angles, 1.0, method="gpu")
+
+
+def test_a_sensor_the_batched_engines_do_not_cast_is_refused_by_name(monkeypatch) -> None:
+    # Every sensor the single envs know today is cast by the batched engines; one added to
+    # the single envs only must be refused, not silently left out of the observation.
+    import pointnav_core.sensors as sensors_module
+
+    class Depth:
+        name = "depth"
+
+    monkeypatch.setattr(sensors_module, "make_sensors", lambda sensors: [Depth()])
+    with pytest.raises(ValueError, match="'depth' is not supported by the batched engine"):
+        VectorPointNavEnv(2, scene=_room(), sensors={"depth": {}})
