@@ -21,6 +21,7 @@ from gymnasium.vector import AutoresetMode, VectorEnv
 from pointnav_core import _envcommon, scenes, validation
 from pointnav_core.vector import contacts_jit
 from pointnav_core.vector.contacts import advance
+from pointnav_core.vector.accounting import task_step
 from pointnav_core.vector.discrete import MOVED, DiscretePlan
 from pointnav_core.vector.drive import MAX_TURN, arc, body_command, sub_steps, substep_drive, travel
 from pointnav_core.vector.episodes import EpisodePool
@@ -497,32 +498,12 @@ class VectorPointNavEnv(PoolRefreshing, VectorEnv):
         """The task's step over the worlds' moves from the committed state: rewards, ends, info,
         then the commit and the next-step autoresets. ``stopped``: the worlds that called STOP."""
         a, xp, st = self.arrays, self.arrays.xp, self._state
-        x0, y0, scene = st["x"], st["y"], self._world_scene
-        x, y, z = moved["x"], moved["y"], moved["z"]
-        # --- the task's accounting (PointNavigationTask.step)
-        path = st["path"] + xp.sqrt((x - x0) ** 2 + (y - y0) ** 2)
-        steps = self._steps + 1
-        collisions = self._collisions + a.to_int(contact)
-        dist = self.pool.fields.distance(self._field, x, y)
-        gx, gy = st["gx"], st["gy"]
-        l2 = xp.sqrt((gx - x) ** 2 + (gy - y) ** 2)
-        pot = xp.where(self._geo_metric, xp.where(dist < math.inf, dist, st["pot"]), l2)
-        success = l2 < self.goal_tolerance
-        if stopped is not None:  # with STOP, success needs STOP within the tolerance (StopAtGoal)
-            success = success & stopped
-        fell = z < self.floors.height[scene] - self.fall_height
-        terminated = (collisions > self.max_collisions) | fell | success
-        if stopped is not None:
-            terminated = terminated | stopped
-        truncated = steps >= self.max_steps
-        r_pot = self.r_potential * (st["pot"] - pot)
-        zero = xp.zeros_like(x)  # torch.where of two numbers would give float32
-        r_col = xp.where(contact, -self.r_collision, zero)
-        r_goal = xp.where(success, self.r_pointgoal, zero)
-        reward = ((0.0 + r_pot) + r_col) + r_goal
+        t = task_step(self, moved, contact, stopped)  # PointNavigationTask.step's accounting
+        reward, terminated, truncated, success = t.reward, t.terminated, t.truncated, t.success
+        r_pot, r_col, r_goal = t.r_pot, t.r_col, t.r_goal
         # Commit, then reset the worlds that ended on the previous step (next-step autoreset).
-        st.update({key: moved[key] for key in MOVED}, path=path, dist=dist, pot=pot)
-        self._steps, self._collisions = steps, collisions
+        st.update({key: moved[key] for key in MOVED}, path=t.path, dist=t.dist, pot=t.pot)
+        self._steps, self._collisions = t.steps, t.collisions
         resetting = self._needs_reset.clone() if a.is_torch else self._needs_reset.copy()
         if a.any(resetting):
             self._reset_worlds(resetting)

@@ -29,6 +29,7 @@ from pointnav_core import scenes, validation
 from pointnav_core.fleet import FINISHED_MODES, check_finished
 from pointnav_core.vector import contacts_jit
 from pointnav_core.vector.contacts import advance
+from pointnav_core.vector.accounting import task_step
 from pointnav_core.vector.contacts_jit import advance_compiled
 from pointnav_core.vector.discrete import MOVED, DiscretePlan
 from pointnav_core.vector.drive import arc, body_command, sub_steps, substep_drive, travel
@@ -317,35 +318,18 @@ class VectorFleetEnv(VectorPointNavEnv):
         next-step autoresets. ``stopped``: the robots that called STOP (None without STOP)."""
         a, xp, st = self.arrays, self.arrays.xp, self._state
         acting, present = self._active, self._present
-        x0, y0 = st["x"], st["y"]
-        x, y, z = moved["x"], moved["y"], moved["z"]
-        zero = xp.zeros_like(x)
-        path = st["path"] + xp.where(acting, xp.sqrt((x - x0) ** 2 + (y - y0) ** 2), zero)
-        steps = self._steps + a.to_int(acting)
-        collisions = self._collisions + a.to_int(contact & acting)
+        zero = xp.zeros_like(st["x"])
+        t = task_step(self, moved, contact, stopped, acting)  # each acting robot's task step
         cycles = self._cycles + 1
-        dist = self.pool.fields.distance(self._field, x, y)
-        gx, gy = st["gx"], st["gy"]
-        l2 = xp.sqrt((gx - x) ** 2 + (gy - y) ** 2)
-        pot = xp.where(self._geo_metric, xp.where(dist < math.inf, dist, st["pot"]), l2)
-        success = acting & (l2 < self.goal_tolerance)
-        if stopped is not None:  # with STOP, success needs STOP within the tolerance (StopAtGoal)
-            success = success & stopped
-        fell = acting & (z < self.floors.height[self._world_scene][:, None] - self.fall_height)
-        terminated = acting & ((collisions > self.max_collisions) | fell | success)
-        if stopped is not None:
-            terminated = terminated | (acting & stopped)
-        truncated = acting & ((steps >= self.max_steps) | (cycles >= self.max_cycles)[:, None])
-        r_pot = xp.where(acting, self.r_potential * (st["pot"] - pot), zero)
-        r_col = xp.where(acting & contact, -self.r_collision, zero)
-        r_goal = xp.where(success, self.r_pointgoal, zero)
-        reward = ((0.0 + r_pot) + r_col) + r_goal
+        reward, terminated, success, fell = t.reward, t.terminated, t.success, t.fell
+        truncated = t.truncated | (acting & (cycles >= self.max_cycles)[:, None])
+        r_pot, r_col, r_goal = t.r_pot, t.r_col, t.r_goal
         ended = terminated | truncated
         active = acting & ~ended
         # A robot that fell leaves its floor; with "remove" every finished robot leaves.
         gone = (ended & fell) if self.finished == "park" else ended
-        st.update({key: moved[key] for key in MOVED}, path=path, dist=dist, pot=xp.where(acting, pot, st["pot"]))
-        self._steps, self._collisions, self._cycles = steps, collisions, cycles
+        st.update({key: moved[key] for key in MOVED}, path=t.path, dist=t.dist, pot=xp.where(acting, t.pot, st["pot"]))
+        self._steps, self._collisions, self._cycles = t.steps, t.collisions, cycles
         self._active, self._present = active, present & ~gone
         # The multi-robot env observes every robot before its finished robots leave the world.
         self._seen = present

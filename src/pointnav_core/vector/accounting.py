@@ -1,0 +1,95 @@
+"""The task's step on a batch of robots: ``PointNavigationTask.step``'s accounting as arrays.
+
+One function for both batched engines: the one-robot engine's ``(num_envs,)`` robots and
+the fleet's ``(num_envs, n_robots)`` robots, masked there by the robots still acting (an
+ended robot's path, steps, collisions and rewards stay as they were). The expressions and
+their order are the single task's (``rewards``, ``terminations``, ``metrics``), so the
+rewards are the same floats.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping
+from typing import Any, NamedTuple
+
+__all__ = ["TaskStep", "task_step"]
+
+
+class TaskStep(NamedTuple):
+    """What one step does to the task of every robot (arrays of the robots' shape)."""
+
+    path: Any  #: path length so far (m)
+    steps: Any  #: steps taken in the episode
+    collisions: Any  #: steps with a contact
+    dist: Any  #: geodesic distance to the goal (m; inf where the field has none)
+    pot: Any  #: the potential the next step's reward starts from (m)
+    success: Any  #: within the goal tolerance (and STOP called, with STOP)
+    fell: Any  #: fell below the floor by more than ``fall_height``
+    terminated: Any
+    truncated: Any  #: ``max_steps`` reached (the fleet adds ``max_cycles``)
+    r_pot: Any  #: the potential reward
+    r_col: Any  #: the collision penalty
+    r_goal: Any  #: the goal reward
+    reward: Any  #: their sum, as the task adds them
+
+
+def task_step(engine: Any, moved: Mapping[str, Any], contact: Any, stopped: Any, acting: Any = None) -> TaskStep:
+    """The task's step over the robots' moves from the engine's committed state.
+
+    Parameters
+    ----------
+    engine : VectorPointNavEnv
+        Its committed state (``_state``, ``_steps``, ``_collisions``), goal fields and task
+        constants (floats, or ``(1, n_robots)`` arrays when the robots' tasks differ).
+    moved : mapping
+        The moved state (``x``, ``y``, ``z``: m).
+    contact : bool array
+        Robots that touched a wall or another robot this step.
+    stopped : bool array or None
+        Robots that called STOP (None without the STOP action).
+    acting : bool array, optional
+        The robots still acting (the fleet); None: every robot acts (the one-robot engine).
+
+    Returns
+    -------
+    TaskStep
+    """
+    a, xp, st = engine.arrays, engine.arrays.xp, engine._state
+    x0, y0 = st["x"], st["y"]
+    x, y, z = moved["x"], moved["y"], moved["z"]
+    zero = xp.zeros_like(x)  # torch.where of two numbers would give float32
+    moved_by = xp.sqrt((x - x0) ** 2 + (y - y0) ** 2)
+    height = engine.floors.height[engine._world_scene]
+    if acting is None:
+        path = st["path"] + moved_by
+        steps = engine._steps + 1
+        touched = contact
+    else:
+        path = st["path"] + xp.where(acting, moved_by, zero)
+        steps = engine._steps + a.to_int(acting)
+        touched = contact & acting
+        height = height[:, None]
+    collisions = engine._collisions + a.to_int(touched)
+    dist = engine.pool.fields.distance(engine._field, x, y)
+    gx, gy = st["gx"], st["gy"]
+    l2 = xp.sqrt((gx - x) ** 2 + (gy - y) ** 2)
+    pot = xp.where(engine._geo_metric, xp.where(dist < math.inf, dist, st["pot"]), l2)
+    success = l2 < engine.goal_tolerance
+    fell = z < height - engine.fall_height
+    truncated = steps >= engine.max_steps
+    if acting is not None:
+        success, fell, truncated = acting & success, acting & fell, acting & truncated
+    if stopped is not None:  # with STOP, success needs STOP within the tolerance (StopAtGoal)
+        success = success & stopped
+    terminated = (collisions > engine.max_collisions) | fell | success
+    if stopped is not None:
+        terminated = terminated | stopped
+    r_pot = engine.r_potential * (st["pot"] - pot)
+    if acting is not None:
+        terminated = acting & terminated
+        r_pot = xp.where(acting, r_pot, zero)
+    r_col = xp.where(touched, -engine.r_collision, zero)
+    r_goal = xp.where(success, engine.r_pointgoal, zero)
+    reward = ((0.0 + r_pot) + r_col) + r_goal
+    return TaskStep(path, steps, collisions, dist, pot, success, fell, terminated, truncated, r_pot, r_col, r_goal, reward)
