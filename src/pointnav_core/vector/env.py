@@ -390,7 +390,8 @@ class VectorPointNavEnv(PoolRefreshing, VectorEnv):
         e = ep[idx]
         for key, src in (("x", p.sx), ("y", p.sy), ("yaw", p.syaw), ("gx", p.gx), ("gy", p.gy), ("d0", p.d0)):
             st[key][idx] = src[e]
-        st["z"][idx] = self.floors.height[self._world_scene[idx]]
+        height = self.floors.height[self._world_scene[idx]]  # (k,); each robot of a fleet's world
+        st["z"][idx] = height if st["z"].ndim == 1 else height[:, None] + 0.0 * st["x"][idx]
         for key in ("vx", "vy", "vz", "w", "fs", "path"):
             st[key][idx] = 0.0
         self._field[idx] = p.field[e]

@@ -18,7 +18,6 @@ robot at the sum of their radii, and is a disc of its radius in the scans and ma
 
 from __future__ import annotations
 
-import math
 from collections.abc import Mapping, Sequence
 from typing import Any
 
@@ -198,37 +197,11 @@ class VectorFleetEnv(VectorPointNavEnv):
         return check_fixed_episode(self._samplers[s], episode, f"options['episodes'][{i}]"), s
 
     def _reset_worlds(self, mask: Any) -> None:
-        a, xp, st, p = self.arrays, self.arrays.xp, self._state, self.pool
-        if self._fixed is not None:
-            ep = self._fixed
-        else:
-            k = a.asarray(self._rng.integers(p.pool_size, size=self.num_envs), a.i64)
-            ep = self._world_scene * p.pool_size + k
-        idx = a.nonzero(mask)
-        e = ep[idx]
-        for key, src in (("x", p.sx), ("y", p.sy), ("yaw", p.syaw), ("gx", p.gx), ("gy", p.gy), ("d0", p.d0)):
-            st[key][idx] = src[e]
-        st["z"][idx] = self.floors.height[self._world_scene[idx]][:, None] + 0.0 * st["x"][idx]
-        for key in ("vx", "vy", "vz", "w", "fs", "path"):
-            st[key][idx] = 0.0
-        field = p.field[e]
-        self._field[idx] = field
-        self._steps[idx] = 0
-        self._collisions[idx] = 0
+        super()._reset_worlds(mask)  # the one-robot engine's, on (num_envs, n_robots) state
+        idx = self.arrays.nonzero(mask)
         self._cycles[idx] = 0
         self._active[idx] = True
         self._present[idx] = True
-        d0 = st["d0"][idx]
-        geo = self.geodesic_reward & (d0 < math.inf)
-        self._geo_metric[idx] = geo
-        x, y = st["x"][idx], st["y"][idx]
-        dist = p.fields.distance(field, x, y)
-        st["dist"][idx] = dist
-        l2 = xp.sqrt((st["gx"][idx] - x) ** 2 + (st["gy"][idx] - y) ** 2)
-        st["pot"][idx] = xp.where(geo, xp.where(dist < math.inf, dist, d0), l2)
-        self._needs_reset[idx] = False
-        if self.scan is not None:  # the worlds' episode counts key the scan's noise
-            self.scan.begin(mask, self.num_envs)
 
     def check_actions(self, actions: Any) -> Any:
         """``actions`` as a float64 array ``(num_envs, n_robots, action_dim)`` (2 for a
