@@ -199,6 +199,7 @@ class VectorPointNavEnv(PoolRefreshing, VectorEnv):
     """
 
     metadata = {"autoreset_mode": AutoresetMode.NEXT_STEP, "render_modes": []}
+    _pool_class: Any = EpisodePool  # the episodes prepared ahead (the fleet's have a robot axis)
 
     def __new__(cls, *args: Any, **kwargs: Any) -> Self:
         # Several robots per world are their own engine (vector.fleet_env), built from here.
@@ -328,7 +329,7 @@ class VectorPointNavEnv(PoolRefreshing, VectorEnv):
     def _build_pool(self, fixed: Sequence[tuple[Any, float, Any, int]]) -> None:
         size = 0 if fixed else self.pool_size
         seeds = self._rng.integers(2**31, size=size * len(self.scenes))
-        self.pool = EpisodePool(self._samplers, size, seeds, self.arrays, fixed, self.starts_per_goal, self._reach)
+        self.pool = self._pool_class(self._samplers, size, seeds, self.arrays, fixed, self.starts_per_goal, self._reach)
 
     # ------------------------------------------------------------------ Gymnasium API
     def reset(self, *, seed: int | None = None, options: dict[str, Any] | None = None) -> tuple[Any, dict[str, Any]]:

@@ -78,6 +78,8 @@ class VectorFleetEnv(VectorPointNavEnv):
         settled fields (:class:`~pointnav_core.vector.fleet_pool.FleetPool`).
     """
 
+    _pool_class = FleetPool
+
     def __init__(
         self,
         num_envs: int = 1,
@@ -173,11 +175,6 @@ class VectorFleetEnv(VectorPointNavEnv):
         self.local_map = None if map_term is None else VectorLocalMap(map_term, self.floors)
 
     # ------------------------------------------------------------------ pools
-    def _build_pool(self, fixed: Sequence[Any]) -> None:
-        size = 0 if fixed else self.pool_size
-        seeds = self._rng.integers(2**31, size=size * len(self.scenes))
-        self.pool = FleetPool(self._samplers, size, seeds, self.arrays, fixed, self.starts_per_goal, self._reach)
-
     def reset(self, *, seed: int | None = None, options: dict[str, Any] | None = None) -> tuple[Any, dict[str, Any]]:
         """Reset every world. ``options={"episodes": [[(start_xy, yaw, goal_xy), ...], ...]}``
         (per world, one tuple per robot) fixes each world's episode, at this reset and every
