@@ -269,18 +269,25 @@ class VectorPointNavEnv(PoolRefreshing, VectorEnv):
         self.action_space = gym.vector.utils.batch_space(self.single_action_space, self.num_envs)
         self._rng = np.random.default_rng(seed)
         self._world_scene = a.asarray(np.arange(self.num_envs) % len(scene_list), a.i64)
-        self._fixed: Any = None
         self.pool: EpisodePool | None = None  # sampled at the first reset that needs it
-        n = self.num_envs
+        self._allocate((self.num_envs,), scan_term, sensors)
+
+    def _allocate(self, shape: tuple[int, ...], scan_term: Any, sensors: Mapping[str, Any] | None) -> None:
+        """The state arrays of ``shape`` (one entry per world, or per robot), the per-world
+        flags and the sensors (both engines)."""
+        a = self.arrays
+        self._fixed: Any = None
         # "fs": the fall speed (m/s), 0 while the robot stands (vector.falls).
-        self._state = {k: a.zeros(n) for k in ("x", "y", "yaw", "z", "vx", "vy", "vz", "w", "fs", "gx", "gy", "d0", "pot", "path", "dist")}
-        self._field = a.zeros(n, a.i64)
-        self._geo_metric = a.zeros(n, a.boolean)
-        self._steps = a.zeros(n, a.i64)
-        self._collisions = a.zeros(n, a.i64)
-        self._needs_reset = a.zeros(n, a.boolean)
+        keys = ("x", "y", "yaw", "z", "vx", "vy", "vz", "w", "fs", "gx", "gy", "d0", "pot", "path", "dist")
+        self._state = {k: a.zeros(shape) for k in keys}
+        self._field = a.zeros(shape, a.i64)
+        self._geo_metric = a.zeros(shape, a.boolean)
+        self._steps = a.zeros(shape, a.i64)
+        self._collisions = a.zeros(shape, a.i64)
+        self._needs_reset = a.zeros(self.num_envs, a.boolean)
         self._started = False
-        self.scan = None if scan_term is None else VectorScan(scan_term, ScanTables(scene_list, t.floor, a))
+        tables = None if scan_term is None else ScanTables(self.scenes, self.task.floor, a)
+        self.scan = None if scan_term is None else VectorScan(scan_term, tables)
         if self.scan is not None:
             self.scan.seed(self._rng)
         map_term = local_map_term(sensors)

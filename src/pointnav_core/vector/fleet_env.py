@@ -36,7 +36,6 @@ from pointnav_core.vector.env import VectorPointNavEnv, _scene_list
 from pointnav_core.vector.falls import apply_falls
 from pointnav_core.vector.fleet_pool import FleetPool, check_fixed_episode
 from pointnav_core.vector.floors import FloorTables
-from pointnav_core.vector.local_map import VectorLocalMap, local_map_term
 from pointnav_core.vector.per_robot import (
     envelope,
     read_tasks,
@@ -44,7 +43,7 @@ from pointnav_core.vector.per_robot import (
     task_arguments,
 )
 from pointnav_core.vector.robots import advance_robots, robot_walls
-from pointnav_core.vector.scan import ScanTables, VectorScan, requested_scan
+from pointnav_core.vector.scan import requested_scan
 from pointnav_core.vector.xp import make_arrays
 
 __all__ = ["FINISHED_MODES", "VectorFleetEnv"]
@@ -153,26 +152,12 @@ class VectorFleetEnv(VectorPointNavEnv):
         self._world_scene = a.asarray(np.arange(n) % len(scene_list), a.i64)
         self._robot_scene = a.asarray(np.repeat(np.arange(n) % len(scene_list), r).reshape(n, r), a.i64)
         self._robot_ids = a.asarray(np.arange(r), a.i64).reshape(1, r)
-        self._fixed: Any = None
         self.pool: FleetPool | None = None  # type: ignore[assignment]
-        # "fs": the fall speed (m/s), 0 while the robot stands (vector.falls).
-        keys = ("x", "y", "yaw", "z", "vx", "vy", "vz", "w", "fs", "gx", "gy", "d0", "pot", "path", "dist")
-        self._state = {k: a.zeros((n, r)) for k in keys}
-        self._field = a.zeros((n, r), a.i64)
-        self._geo_metric = a.zeros((n, r), a.boolean)
-        self._steps = a.zeros((n, r), a.i64)
-        self._collisions = a.zeros((n, r), a.i64)
+        self._allocate((n, r), scan_term, sensors)
         self._active = a.zeros((n, r), a.boolean)
         self._present = a.zeros((n, r), a.boolean)
         self._seen = self._present  # the robots the scans see at the next observation
         self._cycles = a.zeros(n, a.i64)
-        self._needs_reset = a.zeros(n, a.boolean)
-        self._started = False
-        self.scan = None if scan_term is None else VectorScan(scan_term, ScanTables(scene_list, t.floor, a))
-        if self.scan is not None:
-            self.scan.seed(self._rng)
-        map_term = local_map_term(sensors)
-        self.local_map = None if map_term is None else VectorLocalMap(map_term, self.floors)
 
     # ------------------------------------------------------------------ pools
     def reset(self, *, seed: int | None = None, options: dict[str, Any] | None = None) -> tuple[Any, dict[str, Any]]:
