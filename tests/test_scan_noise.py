@@ -161,3 +161,8 @@ def test_noise_changes_no_episode(n_robots: int) -> None:
         return out
 
     assert single(NOISY) == single({"scan": {"n_rays": 24, "max_range": 2.0}})
+
+
+def test_scan_noise_refuses_an_unknown_method() -> None:
+    with pytest.raises(ValueError, match="method must be 'auto', 'numpy' or 'numba', got 'gpu'"):
+        scan_noise(episode_key(1, 0), 0, 0, 4, 0.1, 0.0, method="gpu")

@@ -146,7 +146,7 @@ def normals(episode: Any, robot: Any, step: Any, ray: Any, channel: int = NOISE)
 
 
 def scan_noise(
-    episode: Any, robot: Any, step: Any, n_rays: int, noise_std: float, dropout: float
+    episode: Any, robot: Any, step: Any, n_rays: int, noise_std: float, dropout: float, method: str = "auto"
 ) -> tuple[NDArray[np.float64] | None, NDArray[np.bool_] | None]:
     """The noise (m) and the lost readings of ``n_rays`` rays (keys broadcast over a last ray axis).
 
@@ -160,6 +160,9 @@ def scan_noise(
         Standard deviation (m); 0 gives None.
     dropout : float
         Probability of a lost reading; 0 gives None.
+    method : {"auto", "numpy", "numba"}
+        The hashing of the rays' words: numpy's whole-array passes, or one compiled loop
+        (the ``fast`` extra; ``"auto"`` takes it when numba is installed). The same bits.
 
     Returns
     -------
@@ -167,15 +170,44 @@ def scan_noise(
         ``noise_std * ndtri(u)`` on channel :data:`NOISE`, and ``u < dropout`` on
         channel :data:`DROPOUT`, each of the keys' shape with ``n_rays`` last.
     """
+    if method not in ("auto", "numpy", "numba"):
+        raise ValueError(f"method must be 'auto', 'numpy' or 'numba', got {method!r}")
+    channels = [c for c, on in ((NOISE, noise_std > 0.0), (DROPOUT, dropout > 0.0)) if on]
+    if not channels:
+        return None, None
+    with np.errstate(over="ignore"):
+        h = mix(mix(episode, robot), step)  # the keys' part common to the rays
+    u = _ray_uniforms(h, n_rays, channels, method)
+    noise = noise_std * ndtri(u[0]) if noise_std > 0.0 else None
+    lost = u[-1] < dropout if dropout > 0.0 else None
+    return noise, lost
+
+
+def _ray_uniforms(h: NDArray[np.uint64], n_rays: int, channels: list[int], method: str) -> NDArray[np.float64]:
+    """:func:`uniforms` of keys ``mix(h, ray)`` for every ray and channel: shape
+    ``(len(channels),) + h.shape[:-1] + (n_rays,)`` (``h`` has a trailing axis of 1)."""
+    kernel = _kernel() if method != "numpy" else None
+    if method == "numba" and kernel is None:
+        raise ValueError('method="numba" needs numba: pip install "pointnav-core[fast]"')
+    if kernel is not None:
+        flat = np.ascontiguousarray(h, dtype=np.uint64).reshape(-1)
+        out = np.empty((len(channels), flat.shape[0], n_rays))
+        kernel(flat, n_rays, np.asarray(channels, dtype=np.uint64), out)
+        return out.reshape((len(channels),) + h.shape[:-1] + (n_rays,))
     ray = np.arange(n_rays, dtype=np.uint64)
     with np.errstate(over="ignore"):
         # mix(key, channel) = f(f(key + G) ^ channel): the inner word is the channels' common part.
-        inner = _finalise(mix(mix(mix(episode, robot), step), ray) + _GOLDEN)
-        noise = lost = None
-        if noise_std > 0.0:
-            k = _finalise(inner ^ np.uint64(NOISE)) >> _S11
-            noise = noise_std * ndtri((k.astype(np.float64) + 0.5) * (1.0 / 9007199254740992.0))
-        if dropout > 0.0:
-            k = _finalise(inner ^ np.uint64(DROPOUT)) >> _S11
-            lost = (k.astype(np.float64) + 0.5) * (1.0 / 9007199254740992.0) < dropout
-    return noise, lost
+        inner = _finalise(mix(h, ray) + _GOLDEN)
+        words = [_finalise(inner ^ np.uint64(c)) >> _S11 for c in channels]
+    return (np.stack(words).astype(np.float64) + 0.5) * (1.0 / 9007199254740992.0)
+
+
+def _kernel() -> Any:
+    """The compiled loop of :func:`_ray_uniforms`, or None without numba."""
+    try:
+        from pointnav_core.sensors._noise_kernel import ray_uniforms
+    except ModuleNotFoundError as error:
+        if error.name not in ("numba", "llvmlite"):
+            raise
+        return None
+    return ray_uniforms
