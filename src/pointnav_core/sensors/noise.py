@@ -202,12 +202,18 @@ def _ray_uniforms(h: NDArray[np.uint64], n_rays: int, channels: list[int], metho
     return (np.stack(words).astype(np.float64) + 0.5) * (1.0 / 9007199254740992.0)
 
 
+_KERNEL: list[Any] = []  # the compiled loop, or None without numba, once looked up
+
+
 def _kernel() -> Any:
-    """The compiled loop of :func:`_ray_uniforms`, or None without numba."""
-    try:
-        from pointnav_core.sensors._noise_kernel import ray_uniforms
-    except ModuleNotFoundError as error:
-        if error.name not in ("numba", "llvmlite"):
-            raise
-        return None
-    return ray_uniforms
+    """The compiled loop of :func:`_ray_uniforms`, or None without numba (looked up once)."""
+    if not _KERNEL:
+        try:
+            from pointnav_core.sensors._noise_kernel import ray_uniforms
+        except ModuleNotFoundError as error:
+            if error.name not in ("numba", "llvmlite"):
+                raise
+            _KERNEL.append(None)
+        else:
+            _KERNEL.append(ray_uniforms)
+    return _KERNEL[0]
