@@ -166,3 +166,17 @@ def test_noise_changes_no_episode(n_robots: int) -> None:
 def test_scan_noise_refuses_an_unknown_method() -> None:
     with pytest.raises(ValueError, match="method must be 'auto', 'numpy' or 'numba', got 'gpu'"):
         scan_noise(episode_key(1, 0), 0, 0, 4, 0.1, 0.0, method="gpu")
+
+
+@pytest.mark.parametrize("method", ["numpy", "auto"])
+def test_scan_noise_is_the_hash_by_hand(method: str) -> None:
+    # Two worlds, two robots, three rays: every element against splitmix64 with Python ints.
+    episode = np.array([[[5]], [[2**64 - 3]]], dtype=np.uint64)
+    robot, step = np.arange(2)[None, :, None], np.array([[[0], [7]], [[41], [3]]])
+    noise, lost = scan_noise(episode, robot, step, 3, 0.2, 0.4, method=method)
+    for i, j, r in np.ndindex(2, 2, 3):
+        keys = (int(episode[i, 0, 0]), j, int(step[i, j, 0]), r)
+        u_noise, u_lost = (((_mix(_mix(_mix(_mix(*keys[:2]), keys[2]), r), c) >> 11) + 0.5) / 2.0**53
+                           for c in (NOISE, DROPOUT))
+        assert noise[i, j, r] == 0.2 * stats.norm.ppf(u_noise)
+        assert bool(lost[i, j, r]) == (u_lost < 0.4)
