@@ -262,7 +262,7 @@ class GoalField(ThawOnUnpickle):
             val[lab] = self._root_values(cells[lab], keys[lab], px[lab], py[lab])
         return val
 
-    def _check_block(self, i: int) -> None:
+    def _check_block(self, i: int, memo: NDArray[np.int8] | None = None) -> None:
         """Check the proposed roots of the block holding cell ``i``, then let its cells adopt.
 
         Each proposal (the goal directly, or a label's tangent) is checked exactly at the cell
@@ -277,6 +277,11 @@ class GoalField(ThawOnUnpickle):
         better root found next door can still flow in; only the block's cells are written.
         Margin cells start from their table root where their block is checked, else from their
         own proposal, checked here first: nothing unchecked is ever adopted.
+
+        An unchecked cell's proposal never changes, so neither does its check: ``memo`` (per
+        table cell, 0 not yet checked, 1 passed, 2 failed; updated here) lets a caller that
+        checks many blocks (:func:`pointnav_core.vector.fields.settle`) check each proposal
+        once, not again in the margin of every neighbouring block. The table comes out the same.
         """
         t = self._table
         assert t is not None
@@ -297,7 +302,14 @@ class GoalField(ThawOnUnpickle):
         prop = label[ids[fresh]].astype(np.int64)
         has = prop > -2
         ok = np.zeros(len(fresh), dtype=bool)
-        ok[has] = np.isfinite(self._key_values(ids[fresh[has]], prop[has]))
+        if memo is None:
+            ok[has] = np.isfinite(self._key_values(ids[fresh[has]], prop[has]))
+        else:
+            seen = memo[ids[fresh]]
+            todo = has & (seen == 0)
+            ok[todo] = np.isfinite(self._key_values(ids[fresh[todo]], prop[todo]))
+            ok |= has & (seen == 1)
+            memo[ids[fresh[todo]]] = np.where(ok[todo], 1, 2)
         key[fresh[ok]] = prop[ok]
         # The block's own cells take their checked proposals now; margin cells stay unchecked.
         sel = mine[fresh]
@@ -326,7 +338,7 @@ class GoalField(ThawOnUnpickle):
             for dr, dc in shifts:
                 cells.append(loc)
                 roots.append(pad[1 + lr + dr, 1 + lc + dc])
-            pair = np.unique(np.stack([np.concatenate(cells), np.concatenate(roots)], axis=1), axis=0)
+            pair = _unique_pairs(np.concatenate(cells), np.concatenate(roots))
             pair = pair[pair[:, 1] > -2]
             if not len(pair):
                 break
@@ -443,6 +455,30 @@ class GoalField(ThawOnUnpickle):
         # The table made this field bigger: keep the planner's cache within its budget.
         self.planner._trim_fields()
         return table
+
+
+def _unique_pairs(cells: NDArray[np.int64], roots: NDArray[np.int64]) -> NDArray[np.int64]:
+    """The distinct ``(cell, root)`` pairs, sorted by cell then root: an ``(N, 2)`` int array.
+
+    The rows of ``np.unique(np.stack([cells, roots], 1), axis=0)``, found by sorting one
+    int64 key per pair (``cell * span + root + 2``) instead of the pairs as structured rows,
+    which sorts several times slower. Same order, so ties later keep their order.
+
+    Parameters
+    ----------
+    cells : ndarray of int, shape (N,)
+        Cell indices, >= 0.
+    roots : ndarray of int, shape (N,)
+        Roots, >= -2 (-2: none, -1: the goal directly, else a label).
+    """
+    cells = np.asarray(cells, dtype=np.int64)
+    roots = np.asarray(roots, dtype=np.int64)
+    if not len(cells):
+        return np.zeros((0, 2), dtype=np.int64)
+    span = int(roots.max()) + 3
+    key = np.unique(cells * span + (roots + 2))
+    cell, root = np.divmod(key, span)
+    return np.stack([cell, root - 2], axis=1)
 
 
 def _cell_graph(usable: NDArray[np.bool_], res: float) -> sparse.csr_matrix:
