@@ -54,3 +54,53 @@ def test_compiled_sight_radii_equal_the_numpy_loop(
     # Every bound covers at least the two cells added to the longest ray.
     assert (got >= 2.0 * resolution - 1e-12).all() or not n_points
     assert math.isfinite(float(got.sum()))
+
+
+@settings(max_examples=60, deadline=None)
+@given(
+    seed=st.integers(0, 2**31 - 1),
+    rows=st.integers(2, 40),
+    cols=st.integers(2, 40),
+    density=st.floats(0.0, 0.5),
+    radius=st.floats(0.0, 0.3),
+    resolution=st.sampled_from([0.05, 0.1, 0.25]),
+    outside=st.booleans(),
+    n_segments=st.integers(0, 60),
+    step=st.sampled_from([2.0, 0.5, 0.3, 1.0]),
+)
+def test_compiled_fully_blocked_samples_equal_the_numpy_ones(
+    seed: int, rows: int, cols: int, density: float, radius: float, resolution: float, outside: bool,
+    n_segments: int, step: float,
+) -> None:
+    """``_misses_full`` (the cheap rejection of candidate tangent segments) gives the same
+    answer, segment by segment, with its numba kernel and with its numpy samples, for
+    segments on and off the map, of zero length, along cell edges and across the map."""
+    from pointnav_core.collision import FloorCollision
+    from pointnav_core.tangent_graph import Planner
+
+    rng = np.random.default_rng(seed)
+    blocked = rng.random((rows, cols)) < density
+    origin = (float(rng.uniform(-3, 3)), float(rng.uniform(-3, 3)))
+    geo = FloorCollision(blocked, resolution, origin, outside_blocked=outside)
+    planner = Planner(geo, radius)
+    lo = np.array(origin) - 0.2 * np.array([cols, rows]) * resolution
+    hi = np.array(origin) + 1.2 * np.array([cols, rows]) * resolution
+    a = rng.uniform(lo, hi, (n_segments, 2))
+    b = rng.uniform(lo, hi, (n_segments, 2))
+    b[: n_segments // 5] = a[: n_segments // 5]  # zero length
+    # Along a row of cell edges.
+    k = slice(n_segments // 5, 2 * n_segments // 5)
+    a[k, 1] = b[k, 1] = origin[1] + resolution * rng.integers(0, rows + 1, len(a[k]))
+    assert kernel("pointnav_core._sight_kernel", "misses_full") is not None
+    got = tangent_edges._misses_full(planner, a, b, step)
+    with numpy_paths():
+        want = tangent_edges._misses_full(planner, a, b, step)
+    np.testing.assert_array_equal(got, want)
+    assert got.dtype == np.bool_ and got.shape == (n_segments,)
+    # A segment with an end in a fully blocked cell (or off a closed map) is rejected.
+    full = planner.fully_blocked_mask()
+    col = np.floor((a[:, 0] - origin[0]) / resolution).astype(np.int64) + 1
+    row = np.floor((a[:, 1] - origin[1]) / resolution).astype(np.int64) + 1
+    on = (col >= 0) & (col < full.shape[1]) & (row >= 0) & (row < full.shape[0])
+    end_bad = np.where(on, full[np.clip(row, 0, full.shape[0] - 1), np.clip(col, 0, full.shape[1] - 1)], outside)
+    assert not (got & end_bad).any()

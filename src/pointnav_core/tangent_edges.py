@@ -208,12 +208,21 @@ def _misses_full(p: Planner, a: NDArray[np.float64], b: NDArray[np.float64], ste
 
     Every point of a clear segment is clear, so its cell is not fully blocked; samples
     every ``step`` cells therefore never reject a clear segment (they may miss a blocked one,
-    which the exact test then rejects).
+    which the exact test then rejects). With numba (the ``fast`` extra) the samples are
+    taken in compiled code (:mod:`pointnav_core._sight_kernel`), with the same expressions,
+    and a segment stops at its first bad sample.
     """
     geo = p.geo
     full = p.fully_blocked_mask()  # padded by one ring
     h, w = full.shape
     res = geo.resolution
+    kernel = _compiled.kernel("pointnav_core._sight_kernel", "misses_full")
+    if kernel is not None:  # the same samples, each segment stopping at its first bad one
+        out = np.empty(len(a), dtype=np.bool_)
+        kernel(np.ascontiguousarray(a[:, 0]), np.ascontiguousarray(a[:, 1]), np.ascontiguousarray(b[:, 0]),
+               np.ascontiguousarray(b[:, 1]), np.ascontiguousarray(full).ravel(), h, w, float(geo.origin[0]),
+               float(geo.origin[1]), float(res), float(step), bool(geo.outside_blocked), out)
+        return out
     n = np.maximum(np.ceil(np.hypot(*(b - a).T) / (step * res)).astype(np.int64), 1) + 1
     seg = np.repeat(np.arange(len(a)), n)
     start = np.repeat(np.cumsum(n) - n, n)

@@ -51,9 +51,11 @@ def settle(field: GoalField, cells: NDArray[np.int64] | None = None) -> dict[str
     else:
         cells = np.unique(np.asarray(cells, dtype=np.int64))
         blocks = np.unique((cells // w) // _BLOCK * bw + (cells % w) // _BLOCK).tolist()
+    # Each unchecked cell's proposal is checked once, however many blocks' margins hold it.
+    memo = np.zeros(len(t["kind"]), dtype=np.int8)
     for b in blocks:
         if not t["done"][b]:
-            field._check_block((b // bw) * _BLOCK * w + (b % bw) * _BLOCK)
+            field._check_block((b // bw) * _BLOCK * w + (b % bw) * _BLOCK, memo)
     left = np.flatnonzero(t["kind"] == 3) if cells is None else cells[t["kind"][cells] == 3]
     field._settle_cells(left)
     assert not (t["kind"][slice(None) if cells is None else cells] == _UNCHECKED).any()
