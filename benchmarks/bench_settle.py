@@ -18,19 +18,15 @@ import time
 
 import numpy as np
 
+from bench_build import grid  # the same random-box map (this folder is on the path when run)
+
 from pointnav_core import scenes
 from pointnav_core.tangent_field import _BLOCK
 
 
 def build(side: int, boxes: int) -> tuple[object, float]:
     """The goal field with every block checked, and the seconds that took."""
-    rng = np.random.default_rng(0)
-    grid = np.zeros((side, side), np.uint8)
-    for _ in range(boxes):
-        r, c = rng.integers(0, side - 10, 2)
-        h, w = rng.integers(2, 10, 2)
-        grid[r : r + h, c : c + w] = 1
-    scene = scenes.Scene.from_array(grid, 0.1)
+    scene = scenes.Scene.from_array(grid(side, boxes), 0.1)  # bench_build's map
     start = time.perf_counter()
     planner = scene.planner(0, 0.18)
     goal = scene.get_random_point(0, robot=0.18, rng=np.random.default_rng(1))[1][:2]
