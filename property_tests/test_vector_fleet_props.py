@@ -16,6 +16,8 @@ STOP, with or without a scan and a local map); and with per-robot
 from __future__ import annotations
 
 import importlib.util
+from collections.abc import Callable
+from typing import Any
 
 import numpy as np
 import pytest
@@ -24,27 +26,22 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 from vector_reference import random_actions
 
-from pointnav_core.maps import FREE, OBSTACLE, VOID
 from pointnav_core.scenes import Scene
+from pointnav_core.testing.strategies import cluttered_rooms
 
 DEVICES = ["numpy"] + (["cpu"] if importlib.util.find_spec("torch") else [])
 
 
-@st.composite
-def crowded_scenes(draw: st.DrawFn) -> Scene:
-    """A walled room, 16 to 30 cells a side, random obstacle cells, maybe a hole, a free 1.2 m patch."""
-    rows, cols = draw(st.integers(16, 30)), draw(st.integers(16, 30))
-    rng = np.random.default_rng(draw(st.integers(0, 2**31 - 1)))
-    grid = np.zeros((rows, cols), np.uint8)
-    grid[rng.random((rows, cols)) < draw(st.floats(0.0, 0.1))] = OBSTACLE
-    grid[0, :] = grid[-1, :] = grid[:, 0] = grid[:, -1] = OBSTACLE
-    if draw(st.booleans()):
-        r, c = draw(st.integers(1, rows - 4)), draw(st.integers(1, cols - 4))
-        grid[r : r + 3, c : c + 3] = VOID
-    # A free 12 x 12 patch, so that four robots and their goals always fit.
-    r, c = draw(st.integers(1, rows - 13)), draw(st.integers(1, cols - 13))
-    grid[r : r + 12, c : c + 12] = FREE
-    return Scene.from_array(grid, 0.1)
+def crowded_scenes() -> st.SearchStrategy[Scene]:
+    """Walled rooms of 16 to 30 cells a side with a free 12 x 12 patch, so that four robots
+    and their goals always fit."""
+    return cluttered_rooms(max_clutter=0.1, min_side=16, patch=12)
+
+
+def per_robot_lists(specs: Callable[[int], st.SearchStrategy[Any]]) -> st.SearchStrategy[tuple[Any, Any, int]]:
+    """(task, robot, n_robots) for 2 to 4 robots: one task dict or one per robot, and ``specs(n_robots)``."""
+    return st.integers(2, 4).flatmap(lambda r: st.tuples(
+        st.one_of(robot_tasks(), st.lists(robot_tasks(), min_size=r, max_size=r)), specs(r), st.just(r)))
 
 
 @pytest.mark.parametrize("device", DEVICES)
@@ -113,11 +110,7 @@ robot_specs = st.fixed_dictionaries({"radius": st.sampled_from([0.18, 0.05, 0.1,
     scene=crowded_scenes(),
     seed=st.integers(0, 2**31 - 1),
     n_worlds=st.integers(1, 3),
-    lists=st.integers(2, 4).flatmap(lambda r: st.tuples(
-        st.one_of(robot_tasks(), st.lists(robot_tasks(), min_size=r, max_size=r)),
-        st.one_of(st.none(), robot_specs, st.lists(robot_specs, min_size=r, max_size=r)),
-        st.just(r),
-    )),
+    lists=per_robot_lists(lambda r: st.one_of(st.none(), robot_specs, st.lists(robot_specs, min_size=r, max_size=r))),
     steps=st.integers(1, 120),
     max_cycles=st.integers(3, 70),
     finished=st.sampled_from(["park", "remove"]),
@@ -232,11 +225,7 @@ def test_fleet_discrete_matches_parallel_envs(
     scene=crowded_scenes(),
     seed=st.integers(0, 2**31 - 1),
     n_worlds=st.integers(1, 3),
-    lists=st.integers(2, 4).flatmap(lambda r: st.tuples(
-        st.one_of(robot_tasks(), st.lists(robot_tasks(), min_size=r, max_size=r)),
-        st.lists(robot_specs, min_size=r, max_size=r),
-        st.just(r),
-    )),
+    lists=per_robot_lists(lambda r: st.lists(robot_specs, min_size=r, max_size=r)),
     steps=st.integers(1, 60),
     max_cycles=st.integers(3, 50),
     finished=st.sampled_from(["park", "remove"]),

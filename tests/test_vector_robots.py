@@ -107,10 +107,7 @@ def test_random_crowds_among_walls_match_the_backend(device: str, n_robots: int)
     from pointnav_core.vector.floors import FloorTables
 
     rng = np.random.default_rng(10 + n_robots)
-    grid = (rng.random((30, 30)) < 0.12).astype(np.uint8)
-    grid[[0, -1], :] = grid[:, [0, -1]] = OBSTACLE
-    scene = Scene.from_array(grid, 0.1)
-    geom = FloorGeometry(scene.floors[0], 0.0)
+    scene, geom = _cluttered_room(rng)
     a = make_arrays(device)
     n_worlds, radius, travel = 120, 0.12, 0.05
     x = np.empty((n_worlds, n_robots))
@@ -174,6 +171,14 @@ def test_radii_01_and_03_touch_at_their_sum(device: str) -> None:
     assert (ey == 10.0).all() and c.tolist() == [[True, True], [True, True]]
 
 
+def _cluttered_room(rng: np.random.Generator) -> tuple[Scene, FloorGeometry]:
+    """A walled 3 x 3 m room of 0.1 m cells, 12 % of them OBSTACLE, and the backend's geometry of it."""
+    grid = (rng.random((30, 30)) < 0.12).astype(np.uint8)
+    grid[[0, -1], :] = grid[:, [0, -1]] = OBSTACLE
+    scene = Scene.from_array(grid, 0.1)
+    return scene, FloorGeometry(scene.floors[0], 0.0)
+
+
 def _mixed_crowds(rng: np.random.Generator, scene: Scene, n_worlds: int, n_robots: int) -> tuple[np.ndarray, ...]:
     """Robots of radii 0.05 to 0.2 m packed near each other and the clutter, starts clear
     of walls and of each other (by the sum of the radii)."""
@@ -203,10 +208,7 @@ def test_crowds_of_different_radii_among_walls_match_the_backend(device: str, pa
     from pointnav_core.vector.floors import FloorTables
 
     rng = np.random.default_rng(20 + n_robots)
-    grid = (rng.random((30, 30)) < 0.12).astype(np.uint8)
-    grid[[0, -1], :] = grid[:, [0, -1]] = OBSTACLE
-    scene = Scene.from_array(grid, 0.1)
-    geom = FloorGeometry(scene.floors[0], 0.0)
+    scene, geom = _cluttered_room(rng)
     a = make_arrays(device)
     n_worlds, travel = 120, 0.05
     x, y, radius = _mixed_crowds(rng, scene, n_worlds, n_robots)

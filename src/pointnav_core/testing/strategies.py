@@ -556,13 +556,14 @@ __all__ += ["scenes", "valid_poses", "robot_placements", "action_sequences"]
 
 
 @st.composite
-def cluttered_rooms(draw: st.DrawFn, max_clutter: float = 0.12) -> object:
-    """A walled room of 0.1 m cells, 12 to 30 cells a side: random OBSTACLE cells (up to
-    ``max_clutter`` of them), maybe a 3 x 3 VOID hole, and a free 6 x 6 patch, so that a
-    robot always fits. A :class:`~pointnav_core.scenes.Scene`."""
+def cluttered_rooms(draw: st.DrawFn, max_clutter: float = 0.12, min_side: int = 12, patch: int = 6) -> object:
+    """A walled room of 0.1 m cells, ``min_side`` to 30 cells a side: random OBSTACLE cells
+    (up to ``max_clutter`` of them), maybe a 3 x 3 VOID hole, and a free ``patch`` x
+    ``patch`` square, so that a robot (or a crowd, with a larger patch) always fits. A
+    :class:`~pointnav_core.scenes.Scene`."""
     from pointnav_core.scenes import Scene
 
-    rows, cols = draw(st.integers(12, 30)), draw(st.integers(12, 30))
+    rows, cols = draw(st.integers(min_side, 30)), draw(st.integers(min_side, 30))
     rng = np.random.default_rng(draw(st.integers(0, 2**31 - 1)))
     grid = np.zeros((rows, cols), np.uint8)
     grid[rng.random((rows, cols)) < draw(st.floats(0.0, max_clutter))] = OBSTACLE
@@ -570,8 +571,8 @@ def cluttered_rooms(draw: st.DrawFn, max_clutter: float = 0.12) -> object:
     if draw(st.booleans()):
         r, c = draw(st.integers(1, rows - 4)), draw(st.integers(1, cols - 4))
         grid[r : r + 3, c : c + 3] = VOID
-    r, c = draw(st.integers(1, rows - 7)), draw(st.integers(1, cols - 7))
-    grid[r : r + 6, c : c + 6] = FREE
+    r, c = draw(st.integers(1, rows - 1 - patch)), draw(st.integers(1, cols - 1 - patch))
+    grid[r : r + patch, c : c + patch] = FREE
     return Scene.from_array(grid, 0.1)
 
 
