@@ -4,7 +4,7 @@ Three modes; each prints the figures of one run, so that ratios are meaningful o
 machine.
 
 Speed (default): for generated houses on 200x200, 400x400 and 1000x1000 grids, the time to
-build the per-floor planner of :mod:`pointnav_core.tangent_graph` (erosion, corners and
+build the per-floor planner of :mod:`pointnav_core.geodesic.planner` (erosion, corners and
 their arcs), to build one goal field, to query a cached field (a distance lookup and a whole
 any-angle path), and, for the same start/goal pairs, one query of pyastar2d's C++ A* and of
 networkx A* on an 8-connected grid graph (how iGibson planned).
@@ -343,7 +343,7 @@ def load_case(path: str) -> dict[str, Any]:
     import pyastar2d  # noqa: F401
     from scipy.sparse import csgraph  # noqa: F401
 
-    import pointnav_core.tangent_graph  # noqa: F401
+    import pointnav_core.geodesic.planner  # noqa: F401
 
     with np.load(path) as f:
         case = {key: f[key] for key in f.files}
@@ -407,7 +407,7 @@ def job_astar(case: dict[str, Any], lap: Any) -> float:
 
 def job_tangent(case: dict[str, Any], lap: Any) -> float:
     """Tangent planner build, then its first exact shortest path; the length (m)."""
-    from pointnav_core.tangent_graph import Planner
+    from pointnav_core.geodesic.planner import Planner
 
     geo = FloorCollision(case["blocked"], float(case["resolution"]), tuple(case["origin"]))
     planner = Planner(geo, float(case["radius"]))
@@ -424,7 +424,7 @@ def breakdown(sizes: list[int]) -> None:
     """Time each stage of a goal field on cases A and B beside one grid Dijkstra."""
     from scipy.sparse import csgraph
 
-    from pointnav_core.tangent_graph import Planner
+    from pointnav_core.geodesic.planner import Planner
 
     print(f"machine: {machine()}")
     print(f"radius {RADIUS} m; times in s, and as multiples of the grid Dijkstra (x)")

@@ -1,12 +1,11 @@
-"""Settling a goal field's cells in batches makes exactly the one-cell decision.
+"""Settling a goal field's cells in batches makes exactly the one-point decision.
 
 For random grid scenes (cluttered rooms, walled rooms with blocks and a hole, and layouts
 mirrored left-right and/or top-bottom, with the goal on a mirror axis so that routes
 round mirrored corners tie), robot radii 0 and above, and random goals,
-``GoalField._settle_cells`` gives every cell of the map (in a random order, some twice)
-exactly the kind and label that ``GoalField._settle_cell`` gives it one call at a time on
-a copy of the same table; with numba's kernels and on their numpy paths alike. The
-reference is the one-point code the lazy single-env lookup uses.
+``GoalField.settle`` gives every cell of the map (its blocks in a random order, some twice)
+exactly the kind and label that the one-point exact query (``GoalField._best``) picks at
+the cell's centre; with numba's kernels and on their numpy paths alike.
 """
 
 from __future__ import annotations
@@ -70,58 +69,36 @@ def _goal(draw: st.DrawFn, scene: Scene, radius: float) -> np.ndarray:
 
 @st.composite
 def fields(draw: st.DrawFn):
-    """A goal field of a random scene, radius and goal, with its proposed (unsettled) table."""
+    """A goal field of a random scene, radius and goal, its table not settled yet."""
     scene = draw(st.one_of(cluttered_scenes(), mirrored_scenes(), nav_scenes()))
     radius = draw(st.one_of(st.just(0.0), st.floats(0.0, 0.2)))
     goal = _goal(draw, scene, radius)
     note(f"grid\n{np.asarray(scene.floors[0].codes)}\nradius {radius!r} goal {goal.tolist()!r}")
-    field = scene.planner(0, radius).goal_field(goal)
-    field._build_table()
-    return field
+    return scene.planner(0, radius).goal_field(goal)
 
 
-def _one_by_one(field, cells: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    t = field._table
+def _one_point(field, cells: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    geo = field.planner.geo
+    usable = field.planner.usable.ravel()
+    kinds, labels = [], []
     for i in cells.tolist():
-        field._settle_cell(int(i))
-    return t["kind"].copy(), t["label"].copy()
+        r, c = divmod(i, geo.shape[1])
+        _, lab, _ = field._best(geo.origin[0] + (c + 0.5) * geo.resolution, geo.origin[1] + (r + 0.5) * geo.resolution)
+        kinds.append(0 if lab == -2 or not usable[i] else 1 if lab == -1 else 2)
+        labels.append(max(lab, -1) if usable[i] else -1)
+    return np.array(kinds, np.int8), np.array(labels, np.int32)
 
 
 @settings(deadline=None, suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large])
 @given(field=fields(), data=st.data(), numpy_paths=st.booleans())
-def test_batched_settle_equals_one_cell_at_a_time(field, data, numpy_paths: bool) -> None:
-    t = field._table
-    n = len(t["kind"])
+def test_batched_settle_equals_the_one_point_query(field, data, numpy_paths: bool) -> None:
+    n = int(np.prod(field.planner.geo.shape))
     order = data.draw(st.permutations(range(n)))
     cells = np.array(order + order[: data.draw(st.integers(0, 5))], dtype=np.int64)
-    before = {k: v.copy() for k, v in t.items() if isinstance(v, np.ndarray)}
     with _compiled.numpy_paths() if numpy_paths else contextlib.nullcontext():
-        kinds = field._settle_cells(cells)
-        got_kind, got_label = t["kind"].copy(), t["label"].copy()
-        t.update({k: v.copy() for k, v in before.items()})
-        want_kind, want_label = _one_by_one(field, cells)
-    assert np.array_equal(got_kind, want_kind)
-    assert np.array_equal(got_label, want_label)
-    assert np.array_equal(kinds, want_kind[cells])
+        for chunk in np.array_split(cells, data.draw(st.integers(1, 4))):
+            kind, label = field.settle(chunk)
+    want_kind, want_label = _one_point(field, np.arange(n))
+    assert np.array_equal(kind, want_kind)
+    assert np.array_equal(label, want_label)
     note(f"kinds {np.bincount(want_kind, minlength=3).tolist()}")
-
-
-@settings(deadline=None, suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large])
-@given(field=fields())
-def test_batched_settle_of_the_left_over_cells_equals_the_lazy_lookup(field) -> None:
-    """After every block is checked, the cells left without a root (kind 3) settle alike."""
-    from pointnav_core.tangent_field import _BLOCK
-
-    t = field._table
-    h, w = field.planner.geo.shape
-    for r0 in range(0, h, _BLOCK):
-        for c0 in range(0, w, _BLOCK):
-            field._check_block(r0 * w + c0)
-    cells = np.flatnonzero(t["kind"] == 3)
-    before = {k: v.copy() for k, v in t.items() if isinstance(v, np.ndarray)}
-    field._settle_cells(cells)
-    got_kind, got_label = t["kind"].copy(), t["label"].copy()
-    t.update({k: v.copy() for k, v in before.items()})
-    want_kind, want_label = _one_by_one(field, cells)
-    assert np.array_equal(got_kind, want_kind)
-    assert np.array_equal(got_label, want_label)

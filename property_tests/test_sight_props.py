@@ -1,9 +1,12 @@
-"""The tangent graph's sight bounds: the compiled ray march equals the numpy one.
+"""The tangent graph's sight bounds: strict, and the compiled rays equal the plain ones.
 
-For random floors (random blocked cells, sometimes a closed outside), robot radii, points
-anywhere on and off the map and ray counts, :func:`pointnav_core.tangent_edges.sight_radii`
-gives the same bounds, bit for bit, with its numba kernel and with its numpy loop (the
-``fast`` extra's path and the path without it).
+- For random floors (random blocked cells, sometimes an open outside), robot radii and cell
+  sizes, :func:`pointnav_core.geodesic.sight.node_sights` gives the same bounds, bit for
+  bit, with numba and as plain Python (the ``fast`` extra's path and the path without it).
+- The bounds are strict: no clear tangent edge between two nodes is longer, checked by brute
+  force over every pair of nodes with the exact clearance test and no sight filter at all.
+- ``_misses_full`` (the cheap rejection of candidate tangent segments) gives the same answer
+  with its numba kernel and with its numpy samples.
 """
 
 from __future__ import annotations
@@ -14,46 +17,87 @@ import numpy as np
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
-from scipy import ndimage
 
-from pointnav_core import tangent_edges
 from pointnav_core._compiled import kernel, numpy_paths
+from pointnav_core.collision import FloorCollision
+from pointnav_core.geodesic import edges, sight
+from pointnav_core.geodesic.planner import Planner
 
 pytest.importorskip("numba")
 
 
-@settings(max_examples=60, deadline=None)
+def _floor(seed: int, rows: int, cols: int, density: float, resolution: float, outside: bool) -> FloorCollision:
+    rng = np.random.default_rng(seed)
+    blocked = rng.random((rows, cols)) < density
+    origin = (float(rng.uniform(-3, 3)), float(rng.uniform(-3, 3)))
+    return FloorCollision(blocked, resolution, origin, outside_blocked=outside)
+
+
+@settings(max_examples=40, deadline=None)
 @given(
     seed=st.integers(0, 2**31 - 1),
-    rows=st.integers(1, 60),
-    cols=st.integers(1, 60),
-    density=st.floats(0.0, 0.6),
-    radius=st.floats(0.0, 0.5),
-    resolution=st.sampled_from([0.05, 0.1, 0.25]),
-    n_points=st.integers(0, 40),
-    n_rays=st.integers(1, 48),
+    rows=st.integers(2, 40),
+    cols=st.integers(2, 40),
+    density=st.floats(0.0, 0.4),
+    radius=st.floats(1e-6, 0.5),
+    resolution=st.sampled_from([0.05, 0.1, 0.25, 0.5]),
+    outside=st.booleans(),
 )
-def test_compiled_sight_radii_equal_the_numpy_loop(
-    seed: int, rows: int, cols: int, density: float, radius: float, resolution: float, n_points: int, n_rays: int
-) -> None:
-    rng = np.random.default_rng(seed)
-    blocked = np.pad(rng.random((rows, cols)) < density, 1, constant_values=bool(rng.random() < 0.5))
-    edt = ndimage.distance_transform_edt(~blocked)
-    origin = (float(rng.uniform(-3, 3)), float(rng.uniform(-3, 3)))
-    # Points on the map, on cell edges, and off it.
-    xs = origin[0] + rng.uniform(-0.2, 1.2, n_points) * cols * resolution
-    ys = origin[1] + rng.uniform(-0.2, 1.2, n_points) * rows * resolution
-    xs[: n_points // 4] = origin[0] + np.round(xs[: n_points // 4] - origin[0], 1)
-    assert kernel("pointnav_core._sight_kernel", "march") is not None
-    got = tangent_edges.sight_radii(edt, xs, ys, origin, resolution, radius, n_rays)
+def test_compiled_sights_equal_the_plain_rays(seed, rows, cols, density, radius, resolution, outside) -> None:
+    geo = _floor(seed, rows, cols, density, resolution, outside)
+    planner = Planner(geo, radius)
+    assert kernel("pointnav_core.geodesic._sight_kernel", "sight_rays") is not None
+    got = sight.node_sights(geo, planner.radius, planner.cx, planner.cy, planner.phi0, planner.span)
     with numpy_paths():
-        assert kernel("pointnav_core._sight_kernel", "march") is None
-        want = tangent_edges.sight_radii(edt, xs, ys, origin, resolution, radius, n_rays)
+        assert kernel("pointnav_core.geodesic._sight_kernel", "sight_rays") is None
+        want = sight.node_sights(geo, planner.radius, planner.cx, planner.cy, planner.phi0, planner.span)
     np.testing.assert_array_equal(got, want)
-    assert got.shape == (n_points,) and not np.isnan(got).any()
-    # Every bound covers at least the two cells added to the longest ray.
-    assert (got >= 2.0 * resolution - 1e-12).all() or not n_points
-    assert math.isfinite(float(got.sum()))
+    assert (got > 0).all()
+
+
+@settings(max_examples=30, deadline=None)
+@given(
+    seed=st.integers(0, 2**31 - 1),
+    rows=st.integers(3, 24),
+    cols=st.integers(3, 24),
+    density=st.floats(0.02, 0.3),
+    ratio=st.floats(0.3, 5.0),
+    resolution=st.sampled_from([0.05, 0.1, 0.5]),
+)
+def test_no_clear_edge_is_longer_than_either_nodes_sight(seed, rows, cols, density, ratio, resolution) -> None:
+    """Brute force: every common tangent of every pair of nodes whose segment the exact test
+    finds clear is no longer than both nodes' sights (the bound the edge search relies on)."""
+    geo = _floor(seed, rows, cols, density, resolution, True)
+    radius = ratio * resolution
+    p = Planner(geo, radius)
+    if p.n_nodes < 2:
+        return
+    a, b = np.meshgrid(np.arange(p.n_nodes), np.arange(p.n_nodes), indexing="ij")
+    a, b = a.ravel(), b.ravel()
+    keep = a != b
+    a, b = a[keep], b[keep]
+    dx, dy = p.cx[b] - p.cx[a], p.cy[b] - p.cy[a]
+    dist = np.hypot(dx, dy)
+    base = np.arctan2(dy, dx)
+    r = p.radius
+    for s in (1, -1):
+        for sb in (s, -s):
+            if sb == s:
+                heading, ok, length = base, dist > 0, dist
+            else:
+                ok = dist > 2 * r
+                heading = base + s * np.arcsin(np.clip(2 * r / np.where(ok, dist, 1.0), -1, 1))
+                length = np.sqrt(np.maximum(dist**2 - 4 * r * r, 0))
+            dep, arr = heading - s * math.pi / 2, heading - sb * math.pi / 2
+            on_a = np.mod(dep - p.phi0[a], 2 * math.pi) <= p.span[a] + 1e-9
+            on_b = np.mod(arr - p.phi0[b], 2 * math.pi) <= p.span[b] + 1e-9
+            k = np.flatnonzero(ok & on_a & on_b)
+            pa = np.stack([p.cx[a[k]] + r * np.cos(dep[k]), p.cy[a[k]] + r * np.sin(dep[k])], 1)
+            pb = np.stack([p.cx[b[k]] + r * np.cos(arr[k]), p.cy[b[k]] + r * np.sin(arr[k])], 1)
+            clear = geo.segments_clear(pa, pb, r)
+            k = k[clear]
+            assert (length[k] <= p.sights[a[k]] + 1e-9).all()
+            assert (length[k] <= p.sights[b[k]] + 1e-9).all()
 
 
 @settings(max_examples=60, deadline=None)
@@ -75,13 +119,9 @@ def test_compiled_fully_blocked_samples_equal_the_numpy_ones(
     """``_misses_full`` (the cheap rejection of candidate tangent segments) gives the same
     answer, segment by segment, with its numba kernel and with its numpy samples, for
     segments on and off the map, of zero length, along cell edges and across the map."""
-    from pointnav_core.collision import FloorCollision
-    from pointnav_core.tangent_graph import Planner
-
     rng = np.random.default_rng(seed)
-    blocked = rng.random((rows, cols)) < density
-    origin = (float(rng.uniform(-3, 3)), float(rng.uniform(-3, 3)))
-    geo = FloorCollision(blocked, resolution, origin, outside_blocked=outside)
+    geo = _floor(seed, rows, cols, density, resolution, outside)
+    origin = geo.origin
     planner = Planner(geo, radius)
     lo = np.array(origin) - 0.2 * np.array([cols, rows]) * resolution
     hi = np.array(origin) + 1.2 * np.array([cols, rows]) * resolution
@@ -91,10 +131,10 @@ def test_compiled_fully_blocked_samples_equal_the_numpy_ones(
     # Along a row of cell edges.
     k = slice(n_segments // 5, 2 * n_segments // 5)
     a[k, 1] = b[k, 1] = origin[1] + resolution * rng.integers(0, rows + 1, len(a[k]))
-    assert kernel("pointnav_core._sight_kernel", "misses_full") is not None
-    got = tangent_edges._misses_full(planner, a, b, step)
+    assert kernel("pointnav_core.geodesic._sight_kernel", "misses_full") is not None
+    got = edges._misses_full(planner, a, b, step)
     with numpy_paths():
-        want = tangent_edges._misses_full(planner, a, b, step)
+        want = edges._misses_full(planner, a, b, step)
     np.testing.assert_array_equal(got, want)
     assert got.dtype == np.bool_ and got.shape == (n_segments,)
     # A segment with an end in a fully blocked cell (or off a closed map) is rejected.

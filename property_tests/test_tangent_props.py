@@ -33,7 +33,7 @@ from shapely.geometry import box
 
 from pointnav_core.maps import TraversableMap
 from pointnav_core.scenes import Scene
-from pointnav_core.tangent_graph import planner_for
+from pointnav_core.geodesic.planner import planner_for
 
 #: Largest drawn-length to distance ratio: an arc piece of 2 degrees, circumscribed.
 ARC_RATIO = math.tan(math.radians(1.0)) / math.radians(1.0)

@@ -9,8 +9,6 @@ import pytest
 
 from pointnav_core.maps import OBSTACLE
 from pointnav_core.scenes import Scene
-from pointnav_core.tangent_field import _BLOCK
-from pointnav_core.vector.fields import settle
 
 RES = 0.1
 
@@ -34,28 +32,32 @@ def _centre(row: int, col: int) -> tuple[float, float]:
     return ((col + 0.5) * RES, (row + 0.5) * RES)
 
 
+def _one_point(field, cell: int) -> tuple[int, int]:
+    """The kind and label the one-point exact query picks at a cell's centre."""
+    geo = field.planner.geo
+    r, c = divmod(cell, geo.shape[1])
+    _, lab, _ = field._best(geo.origin[0] + (c + 0.5) * geo.resolution, geo.origin[1] + (r + 0.5) * geo.resolution)
+    return (0 if lab == -2 else 1 if lab == -1 else 2), max(lab, -1)
+
+
 def test_hand_made_room_by_hand_and_cell_by_cell() -> None:
     goal = _centre(10, 3)  # (0.35, 1.05), left of the block on its mirror axis
     field = _room().planner(0, 0.0).goal_field(goal)
-    t = field._build_table()
     behind, seen, block, pocket = _cell(10, 17), _cell(10, 1), _cell(10, 10), _cell(2, 18)
     cells = np.array([behind, seen, block, pocket])
-    kinds = field._settle_cells(cells)
-    assert kinds.tolist() == [2, 1, 0, 0]
-    assert t["label"][cells].tolist()[1:] == [-1, -1, -1]
+    kind, label = field.settle(cells)
+    assert kind[cells].tolist() == [2, 1, 0, 0]
+    assert label[cells].tolist()[1:] == [-1, -1, -1]
     # Behind the block: round one of its near corners, along its 0.3 m side, to the goal;
     # both ways tie by symmetry (a point robot plans as a 1e-6 m disc).
-    node = int(field._search.node[t["label"][behind]])
+    node = int(field.labels.node[label[behind]])
     corner = (float(field.planner.cx[node]), float(field.planner.cy[node]))
     assert min(math.dist(corner, c) for c in ((1.2, 1.2), (1.2, 0.9))) < 1e-9
     x, y = _centre(10, 17)
     by_hand = 2 * math.hypot(1.75 - 1.2, 1.2 - 1.05) + 0.3
     assert field.distance(x, y) == pytest.approx(by_hand, abs=1e-5)
     # The same decisions, one cell at a time.
-    batched = t["kind"].copy(), t["label"].copy()
-    for i in cells.tolist():
-        field._settle_cell(i)
-    assert np.array_equal(batched[0], t["kind"]) and np.array_equal(batched[1], t["label"])
+    assert [_one_point(field, i) for i in cells.tolist()] == list(zip(kind[cells].tolist(), label[cells].tolist()))
 
 
 def test_settle_of_a_cluttered_map_equals_the_lazy_lookup() -> None:
@@ -68,19 +70,15 @@ def test_settle_of_a_cluttered_map_equals_the_lazy_lookup() -> None:
     scene = Scene.from_array(grid, RES)
     goal = scene.get_random_point(0, robot=0.18, rng=np.random.default_rng(1))[1][:2]
     lazy = Scene.from_array(grid, RES).planner(0, 0.18).goal_field(goal)
-    t = lazy._build_table()
     h, w = grid.shape
-    for r0 in range(0, h, _BLOCK):
-        for c0 in range(0, w, _BLOCK):
-            lazy._check_block(r0 * w + c0)
-    left = np.flatnonzero(t["kind"] == 3)
-    assert len(left) > 50  # the map leaves cells to settle exactly
-    for i in left.tolist():
-        lazy._settle_cell(i)
-    settled = settle(scene.planner(0, 0.18).goal_field(goal))
-    assert not np.isin(settled["kind"], (3, 4)).any()
-    assert np.array_equal(settled["kind"], t["kind"])
-    assert np.array_equal(settled["label"], t["label"])
+    for r, c in np.argwhere(lazy.planner.usable):  # each lookup settles its cell's block
+        lazy.distance((c + 0.5) * RES, (r + 0.5) * RES)
+    assert lazy._table["done"].sum() > 1
+    kind, label = scene.planner(0, 0.18).goal_field(goal).settle()
+    assert not np.isin(kind, (3, 4)).any()
+    assert np.array_equal(kind, lazy._table["kind"])
+    assert np.array_equal(label, lazy._table["label"])
+    assert (kind == 2).sum() > 100  # much of the map goes round a corner
 
 
 @pytest.mark.parametrize(
@@ -92,26 +90,28 @@ def test_settle_of_a_cluttered_map_equals_the_lazy_lookup() -> None:
         (np.array([-1]), r"cells must lie in \[0, 441\)"),
     ],
 )
-def test_settle_cells_rejects_bad_cells_and_leaves_the_table(cells: np.ndarray, match: str) -> None:
+def test_settle_rejects_bad_cells_and_leaves_the_table(cells: np.ndarray, match: str) -> None:
     field = _room().planner(0, 0.0).goal_field(_centre(10, 3))
-    t = field._build_table()
-    kind, label = t["kind"].copy(), t["label"].copy()
+    kind, label = (a.copy() for a in field.settle(np.zeros(0, np.int64)))
     with pytest.raises(ValueError, match=match):
-        field._settle_cells(cells)
-    assert np.array_equal(t["kind"], kind) and np.array_equal(t["label"], label)
+        field.settle(cells)
+    got = field.settle(np.zeros(0, np.int64))
+    assert np.array_equal(got[0], kind) and np.array_equal(got[1], label)
 
 
-def test_the_ball_query_orders_many_points_as_it_orders_one() -> None:
+def test_the_node_balls_answer_many_points_as_they_answer_one() -> None:
     """The batch takes each centre's candidates from one many-point query; the one-point code
-    keeps the first of equal totals in its query's order, so the orders must be the same."""
+    keeps the first of equal totals in its query's order, so the answers must be the same."""
     rng = np.random.default_rng(3)
     grid = (rng.random((40, 40)) < 0.15).astype(np.uint8)
     planner = Scene.from_array(grid, RES).planner(0, 0.1)
     pts = rng.uniform(0.0, 4.0, (200, 2))
-    radii = rng.uniform(0.0, 3.0, 200)
-    many = planner._tree.query_ball_point(pts, radii, return_sorted=False)
-    for p, r, got in zip(pts, radii, many):
-        assert list(got) == list(planner._tree.query_ball_point((float(p[0]), float(p[1])), float(r)))
+    owner, node = planner.nodes_seeing(pts[:, 0], pts[:, 1])
+    for i, (x, y) in enumerate(pts):
+        assert node[owner == i].tolist() == planner.nodes_seeing(np.array([x]), np.array([y]))[1].tolist()
+    # Brute force: a node is a candidate exactly when the point lies in its sight ball.
+    inside = np.hypot(pts[:, None, 0] - planner.cx[None], pts[:, None, 1] - planner.cy[None]) <= planner.sights + planner.radius
+    assert sorted(zip(owner.tolist(), node.tolist())) == sorted(map(tuple, np.argwhere(inside).tolist()))
 
 
 def _mod_two_pi(a: np.ndarray) -> np.ndarray:

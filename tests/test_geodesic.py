@@ -5,9 +5,9 @@ import math
 import numpy as np
 import pytest
 
-from pointnav_core import tangent_graph
+from pointnav_core.geodesic import planner as tangent_graph
 from pointnav_core.paths import path_length, resample_path
-from pointnav_core.tangent_graph import planner_for
+from pointnav_core.geodesic.planner import planner_for
 from pointnav_core.maps import OBSTACLE, VOID, TraversableMap
 from pointnav_core.scenes import Scene
 

@@ -20,7 +20,7 @@ def run(code: str) -> str:
     [
         "pointnav_core.scenes, pointnav_core.task",
         "pointnav_core.maps, pointnav_core.transforms, pointnav_core.metrics, pointnav_core.backend",
-        "pointnav_core.tangent_graph, pointnav_core.tangent_field, pointnav_core.collision",
+        "pointnav_core.geodesic.planner, pointnav_core.geodesic.field, pointnav_core.collision",
         "pointnav_kinematic, pointnav_pymunk",
     ],
 )

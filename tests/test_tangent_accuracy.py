@@ -35,7 +35,7 @@ from geodesic_reference import ContinuousGeodesic, blocked_cells
 from pointnav_core import scenes
 from pointnav_core.maps import TraversableMap
 from pointnav_core.scenes import Scene
-from pointnav_core.tangent_graph import planner_for
+from pointnav_core.geodesic.planner import planner_for
 
 #: Clearance margin (m) of sampled end points beyond the robot radius.
 MARGIN = 1e-3

@@ -37,8 +37,7 @@ from pointnav_core.errors import SamplingError
 from pointnav_core.floorplans import FloorPlan
 from pointnav_core.maps import OBSTACLE, TraversableMap
 from pointnav_core.paths import resample_path
-from pointnav_core.tangent_field import GoalField
-from pointnav_core.tangent_graph import Planner, planner_for
+from pointnav_core.geodesic import GoalField, Planner, planner_for
 
 __all__ = ["Scene", "FloorGoalField", "robot_radius", "rooms", "maze", "clutter"]
 

@@ -1,8 +1,9 @@
 """Goal fields as arrays: every cell's root, so that a geodesic lookup is one gather.
 
-:meth:`pointnav_core.tangent_field.GoalField.distance` answers from a per-cell root
-table that it fills lazily, a block of cells at a time. :func:`settle` fills the whole
-table once (the same blocks, the same rule), and :class:`FieldTables` stores the
+:meth:`pointnav_core.geodesic.GoalField.distance` answers from a per-cell root
+table that it fills lazily, a block of cells at a time. :meth:`GoalField.settle
+<pointnav_core.geodesic.GoalField.settle>` fills the blocks a pool needs at once (the same
+roots), and :class:`FieldTables` stores the
 tables of many goals end to end: per grid cell its kind (0 unreachable, 1 straight to
 the goal, 2 by a label of the Dijkstra search) and label, and per label the arc node
 and cost. :meth:`FieldTables.distance` then evaluates ``GoalField.distance``'s formula
@@ -25,41 +26,16 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from pointnav_core.tangent_field import _BLOCK, _UNCHECKED, GoalField
-from pointnav_core.tangent_graph import _ANG_TOL, _TWO_PI
+from pointnav_core.geodesic import GoalField
+from pointnav_core.geodesic.tangents import ANG_TOL, TWO_PI
 from pointnav_core.vector.xp import Arrays
 
-__all__ = ["FieldTables", "reach_window", "settle"]
+__all__ = ["FieldTables", "reach_window"]
 
 # Per Dijkstra label, in the order of the label table's columns.
 _PER_LABEL = ("cost", "cx", "cy", "side", "phi0", "span", "pos", "qx", "qy")
 _PER_FIELD_FLOAT = ("gx", "gy", "ox", "oy", "res", "radius")
 _INDICES = ("kind", "label", "offset", "rows", "width", "row0", "col0")
-
-
-def settle(field: GoalField, cells: NDArray[np.int64] | None = None) -> dict[str, Any]:
-    """Check the blocks of ``field``'s root table and settle the cells; the table.
-
-    ``cells`` (flat table indices) limits this to the blocks holding them, in the same
-    (row-major) order, and to settling those cells; default: every block and cell.
-    """
-    t = field._table if field._table is not None else field._build_table()
-    h, w = field.planner.geo.shape
-    bw = t["blocks_w"]
-    if cells is None:
-        blocks: Any = range(len(t["done"]))
-    else:
-        cells = np.unique(np.asarray(cells, dtype=np.int64))
-        blocks = np.unique((cells // w) // _BLOCK * bw + (cells % w) // _BLOCK).tolist()
-    # Each unchecked cell's proposal is checked once, however many blocks' margins hold it.
-    memo = np.zeros(len(t["kind"]), dtype=np.int8)
-    for b in blocks:
-        if not t["done"][b]:
-            field._check_block((b // bw) * _BLOCK * w + (b % bw) * _BLOCK, memo)
-    left = np.flatnonzero(t["kind"] == 3) if cells is None else cells[t["kind"][cells] == 3]
-    field._settle_cells(left)
-    assert not (t["kind"][slice(None) if cells is None else cells] == _UNCHECKED).any()
-    return t
 
 
 def reach_window(field: GoalField, starts: ArrayLike, reach: float) -> tuple[int, int, int, int]:
@@ -121,10 +97,10 @@ class FieldTables:
             near = np.asarray(p.near_usable, dtype=np.int64).reshape(h, w)[r0:r1, c0:c1].ravel()
             whole = (r0, r1, c0, c1) == (0, h, 0, w)
             # Only the cells the window's cells look up are settled (every one for the whole grid).
-            t = settle(field, None if whole else near[near >= 0])
-            kind = np.where(near >= 0, t["kind"][np.maximum(near, 0)], 0).astype(np.int64)
-            label = np.where(kind == 2, t["label"][np.maximum(near, 0)], 0).astype(np.int64)
-            s = field._search
+            kind_of, label_of = field.settle(None if whole else near[near >= 0])
+            kind = np.where(near >= 0, kind_of[np.maximum(near, 0)], 0).astype(np.int64)
+            label = np.where(kind == 2, label_of[np.maximum(near, 0)], 0).astype(np.int64)
+            s = field.labels
             node = np.asarray(s.node, dtype=np.int64)
             side = np.asarray(s.side, dtype=np.float64)
             pos = np.asarray(s.pos, dtype=np.float64)
@@ -211,14 +187,14 @@ class FieldTables:
         safe = xp.where(outside, big, 1.0)
         bend = xp.where(r > 0.0, side * xp.arcsin(xp.minimum(r / safe, xp.ones_like(safe))), 0.0)
         heading = xp.arctan2(dy, dx) + bend
-        ccw = xp.remainder(heading + side * (math.pi / 2) - self.phi0[lab], _TWO_PI)
-        ccw = xp.where(ccw > _TWO_PI - _ANG_TOL, 0.0, ccw)
+        ccw = xp.remainder(heading + side * (math.pi / 2) - self.phi0[lab], TWO_PI)
+        ccw = xp.where(ccw > TWO_PI - ANG_TOL, 0.0, ccw)
         span = self.span[lab]
-        on_arc = ccw <= span + _ANG_TOL
+        on_arc = ccw <= span + ANG_TOL
         clipped = xp.minimum(ccw, span)
         dep = xp.where(side > 0, clipped, span - clipped)
         lp = self.pos[lab]
-        tangent_ok = outside & on_arc & (dep >= lp - _ANG_TOL)
+        tangent_ok = outside & on_arc & (dep >= lp - ANG_TOL)
         tangent = self.cost[lab] + r * xp.maximum(dep - lp, xp.zeros_like(dep)) + xp.sqrt(
             xp.maximum(big * big - r * r, xp.zeros_like(big))
         )

@@ -1,14 +1,14 @@
 """Exact roots of many cell centres of a goal field at once (``GoalField._best`` on arrays).
 
-A goal field's root table leaves a few cells (kind 3) to be settled exactly: the best way
-to the goal from the cell centre, as :meth:`GoalField._best
-<pointnav_core.tangent_field.GoalField._best>` finds it one point at a time. :func:`cell_roots`
+A goal field's root table holds, per cell, the exact root of its centre: the best way to
+the goal from the cell centre, as :meth:`GoalField._best
+<pointnav_core.geodesic.field.GoalField._best>` finds it one point at a time. :func:`cell_roots`
 makes the same decision for whole arrays of cells, in chunks of at most :data:`CHUNK`
 cells, with the same floating-point expressions, so that each cell gets exactly the kind
 and label the one-point code gives it:
 
-- the candidate nodes are the kd-tree's ball around each centre (radius: the centre's sight
-  bound plus the robot radius), in the order the one-point query returns them;
+- the candidate nodes are those whose sight ball holds the centre (``Planner.nodes_seeing``),
+  in the order the one-point query takes them;
 - a link (a tangent from the centre landing on a node's arc, either winding side) is
   expanded to the reached labels on the arc it departs along (``FieldLabels.on_arc``'s
   order, from a table built once per call); a label counts where it lies at or before the
@@ -31,18 +31,18 @@ Everything is in world metres and radians.
 
 from __future__ import annotations
 
-import itertools
 import math
 from typing import TYPE_CHECKING
 
 import numpy as np
 from numpy.typing import NDArray
 
-from pointnav_core.tangent_graph import _ANG_TOL, Planner, _ccw_pos, _tangent_from_point
+from pointnav_core.geodesic.tangents import ANG_TOL, ccw_pos, tangent_from_point
 
 if TYPE_CHECKING:
-    from pointnav_core.arc_graph import FieldLabels
-    from pointnav_core.tangent_field import GoalField
+    from pointnav_core.geodesic.planner import Planner
+    from pointnav_core.geodesic.arc_graph import FieldLabels
+    from pointnav_core.geodesic.field import GoalField
 
 __all__ = ["CHUNK", "cell_roots"]
 
@@ -78,7 +78,7 @@ class _ArcTables:
 
 
 def cell_roots(field: GoalField, cells: NDArray[np.int64]) -> tuple[NDArray[np.int8], NDArray[np.int32]]:
-    """Table kind and label of each cell's centre, exactly as ``GoalField._settle_cell`` sets them.
+    """Table kind and label of each cell's centre, exactly as ``GoalField._best`` finds them.
 
     Parameters
     ----------
@@ -96,7 +96,7 @@ def cell_roots(field: GoalField, cells: NDArray[np.int64]) -> tuple[NDArray[np.i
 
     See Also
     --------
-    pointnav_core.tangent_field.GoalField._settle_cells : writes these into the root table.
+    pointnav_core.geodesic.field.GoalField.settle : writes these into the root table.
 
     Examples
     --------
@@ -206,20 +206,11 @@ def _candidates(
 ) -> tuple[NDArray[np.int64], NDArray[np.int64], NDArray[np.int64], int] | None:
     """The nodes each centre's one-point query finds: per candidate its centre, node and rank
     in the query's order, and their number; None when there are none."""
-    geo = p.geo
-    res = geo.resolution
-    # Planner.sight_radius of each centre: its cell's centre's rays, widened by a half diagonal.
-    scx = geo.origin[0] + (np.floor((x - geo.origin[0]) / res) + 0.5) * res
-    scy = geo.origin[1] + (np.floor((y - geo.origin[1]) / res) + 0.5) * res
-    reach = (p._sight_radii(scx, scy) + res * math.sqrt(0.5)) + p.radius
-    # Unsorted, as a one-point query returns them (the same tree walk per point).
-    balls = p._tree.query_ball_point(np.stack([x, y], axis=1), reach, return_sorted=False)
-    counts = np.fromiter((len(b) for b in balls), dtype=np.int64, count=len(balls))
-    total = int(counts.sum())
+    owner, cand = p.nodes_seeing(x, y)
+    total = len(cand)
     if not total:
         return None
-    cand = np.fromiter(itertools.chain.from_iterable(balls), dtype=np.int64, count=total)
-    owner = np.repeat(np.arange(len(x)), counts)
+    counts = np.bincount(owner, minlength=len(x))
     rank = np.arange(total) - np.repeat(np.cumsum(counts) - counts, counts)
     return owner, cand, rank, total
 
@@ -249,8 +240,8 @@ def _tangents(
     r = p.radius
     parts = []
     for side_rank, s in enumerate((1, -1)):
-        ang, length, _, ok = _tangent_from_point(x[owner], y[owner], p.cx[cand], p.cy[cand], r, s)
-        ccw, ok_arc = _ccw_pos(ang, p.phi0[cand], p.span[cand])
+        ang, length, _, ok = tangent_from_point(x[owner], y[owner], p.cx[cand], p.cy[cand], r, s)
+        ccw, ok_arc = ccw_pos(ang, p.phi0[cand], p.span[cand])
         ok &= ok_arc
         k = np.flatnonzero(ok)
         c = cand[k]
@@ -285,7 +276,7 @@ def _link_values(
     labs = tables.labels[np.repeat(first, count) + (np.arange(n_pairs) - np.repeat(begin, count))]
     lp = search.pos[labs]
     d = dep[link]
-    ok = lp <= d + _ANG_TOL
+    ok = lp <= d + ANG_TOL
     k = np.flatnonzero(ok)
     ok[k] = p.arcs_free(node[link[k]], -s[link[k]], lp[k], d[k])
     pair = np.where(ok, search.cost[labs] + p.radius * np.maximum(d - lp, 0.0) + length[link], math.inf)

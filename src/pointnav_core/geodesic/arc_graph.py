@@ -27,12 +27,13 @@ from numpy.typing import NDArray
 from scipy import sparse
 from scipy.sparse import csgraph
 
+from pointnav_core.geodesic.tangents import ANG_TOL
+
 if TYPE_CHECKING:
-    from pointnav_core.tangent_graph import Planner
+    from pointnav_core.geodesic.planner import Planner
 
 __all__ = ["ArcGraph", "FieldLabels"]
 
-_ANG_TOL = 1e-9
 #: Added to every weight: scipy reads a stored zero as no edge.
 _EPS_W = 1e-300
 
@@ -82,7 +83,7 @@ class ArcGraph:
         free = self._arcs_free(k, k + 1)
         k = k[free]
         d = self.pos[k + 1] - self.pos[k]
-        tie = k[d <= _ANG_TOL]  # positions equal within tolerance: both ways
+        tie = k[d <= ANG_TOL]  # positions equal within tolerance: both ways
         rows = [k, rank[:n_e], tie + 1]
         cols = [k + 1, rank[n_e:], tie]
         wts = [p.radius * np.maximum(d, 0.0), length, np.zeros(len(tie))]
@@ -120,7 +121,7 @@ class ArcGraph:
         for k, (c, s, q, _) in enumerate(links):
             gi = 2 * c + (s < 0)
             lo, hi = int(self.grp_start[gi]), int(self.grp_end[gi])
-            j = lo + int(np.searchsorted(self.pos[lo:hi], q - _ANG_TOL, side="left"))
+            j = lo + int(np.searchsorted(self.pos[lo:hi], q - ANG_TOL, side="left"))
             if j < hi and p._arc_free(c, s, q, float(self.pos[j])):
                 rows.append(np.array([n_v + k]))
                 cols.append(np.array([j]))
@@ -194,7 +195,7 @@ class FieldLabels:
         tracing stops at the first arc whose end lies ``max_length`` or more along the
         path from ``start``. Returns the points and whether the trace reached the source.
         """
-        from pointnav_core.tangent_arcs import arc_points
+        from pointnav_core.geodesic.arcs import arc_points
 
         p = self.graph.p
         pts: list[NDArray[np.float64]] = []

@@ -1,6 +1,6 @@
 """The tangent graph's arcs drawn as polylines, for ``entire_path=True``.
 
-A shortest path of the tangent-graph planner (:mod:`pointnav_core.tangent_graph`) bends
+A shortest path of the tangent-graph planner (:mod:`pointnav_core.geodesic.planner`) bends
 around blocked corners along arcs of the robot's radius. :func:`arc_points` draws such an
 arc as pieces of at most :data:`ARC_PIECE` whose vertices lie outside the circle, so that
 every piece is tangent to it and keeps the full radius from the corner; where a passage is
@@ -16,10 +16,10 @@ from typing import TYPE_CHECKING
 import numpy as np
 from numpy.typing import NDArray
 
-from pointnav_core.tangent_edges import _ANG_TOL, _TWO_PI
+from pointnav_core.geodesic.tangents import ANG_TOL, TWO_PI
 
 if TYPE_CHECKING:
-    from pointnav_core.tangent_graph import Planner
+    from pointnav_core.geodesic.planner import Planner
 
 __all__ = ["ARC_PIECE", "arc_points"]
 
@@ -45,7 +45,7 @@ def arc_points(p: Planner, node: int, s: int, pos_from: float, pos_to: float, sp
     if not len(bad):
         return out
     pos = _pinch_position(p, node, s, inner[bad[0]])
-    if pos is None or not pos_to + _ANG_TOL < pos < pos_from - _ANG_TOL:
+    if pos is None or not pos_to + ANG_TOL < pos < pos_from - ANG_TOL:
         return out
     first = arc_points(p, node, s, pos_from, pos, splits - 1)
     return first + arc_points(p, node, s, pos, pos_to, splits - 1)[1:]
@@ -57,7 +57,7 @@ def _drawn_arc(p: Planner, node: int, s: int, pos_from: float, pos_to: float) ->
     a = p.node_point(node, s, pos_from)
     delta = pos_from - pos_to
     out = [np.array(a)]
-    if delta <= _ANG_TOL or p.radius == 0.0:
+    if delta <= ANG_TOL or p.radius == 0.0:
         return out
     n = max(1, math.ceil(delta / ARC_PIECE))
     piece = delta / n
@@ -101,5 +101,5 @@ def _pinch_position(p: Planner, node: int, s: int, vertex: NDArray[np.float64]) 
         ang = 0.0 if qx[i] > cx else math.pi
     else:
         ang = 0.5 * math.pi if qy[i] > cy else -0.5 * math.pi
-    ccw = (ang - p._phi0[node]) % _TWO_PI
+    ccw = (ang - p._phi0[node]) % TWO_PI
     return ccw if s > 0 else p._span[node] - ccw

@@ -26,7 +26,7 @@ cheaply. Distances are exact in the geometry; paths keep at least ``r`` from the
 (within 1e-9 m), and arcs are drawn as polylines that circumscribe the circle, so that the
 drawn path never cuts the clearance.
 
-A goal field (:class:`~pointnav_core.tangent_field.GoalField`) holds a whole Dijkstra run from one goal (exact distance of every
+A goal field (:class:`~pointnav_core.geodesic.field.GoalField`) holds a whole Dijkstra run from one goal (exact distance of every
 node) and answers exact point queries by the tangents a point sees. For the per-step hot
 path it also builds a root table on first use: a seeded multi-source Dijkstra on the grid
 proposes each cell's root node, every proposal is checked (the tangent from the root to the
@@ -49,26 +49,23 @@ from scipy.spatial import cKDTree
 from pointnav_core.collision import TOUCH_TOL, FloorCollision, convex_corners
 from pointnav_core.frozen import ThawOnUnpickle
 from pointnav_core.paths import path_length, resample_path
-from pointnav_core.tangent_arcs import arc_points
-from pointnav_core.tangent_edges import build_edges, sight_radii
+from pointnav_core.geodesic.arc_graph import ArcGraph
+from pointnav_core.geodesic.arcs import arc_points
+from pointnav_core.geodesic.tangents import ANG_TOL, COST_TOL, TWO_PI, ccw_pos, tangent_from_point
+from pointnav_core.geodesic.edges import build_edges
+from pointnav_core.geodesic.field import GoalField
+from pointnav_core.geodesic.sight import NodeBalls, node_sights
 
 if TYPE_CHECKING:
-    from pointnav_core.arc_graph import ArcGraph
     from pointnav_core.maps import TraversableMap
-    from pointnav_core.tangent_field import GoalField
 
 __all__ = ["Planner", "planner_for", "resample_path", "path_length"]
 
 #: Nodes whose tangent edges are found together by build_all_edges.
 _EDGE_BATCH = 256
 
-_TWO_PI = 2.0 * math.pi
-_ANG_TOL = 1e-9
-_COST_TOL = 1e-12
 #: Samples along a node's arc used to find the parts of it within ``r`` of something else.
 _ARC_SAMPLES = 9
-#: Rays cast to bound how far a node can see.
-_SIGHT_RAYS = 128
 #: Side (cells) of the square tiles whose nodes get their edges built together.
 _TILE = 32
 #: Smallest radius (m) the planner uses.
@@ -81,38 +78,6 @@ def planner_for(tmap: TraversableMap, radius: float) -> Planner:
     """Return the cached tangent-graph :class:`Planner` of ``tmap`` for ``radius`` metres."""
     key = ("tangent", round(float(radius), 12))
     return tmap.planner_cache.get_or_create(key, lambda: Planner(FloorCollision.from_map(tmap), radius))
-
-
-# --------------------------------------------------------------------------- tangents
-def _tangent_from_point(
-    px: Any, py: Any, cx: Any, cy: Any, r: float, s: Any
-) -> tuple[Any, Any, Any, Any]:
-    """Tangent from point ``p`` to the circle at ``c`` that arrives winding on side ``s``.
-
-    Returns the arrival angle on the circle (rad), the tangent length, the tangent point
-    and a validity mask (``p`` outside the circle). ``s = +1`` winds counter-clockwise (the
-    corner on the path's left).
-    """
-    dx = cx - px
-    dy = cy - py
-    L = np.hypot(dx, dy)
-    # A point on the circle (within the touching tolerance: a robot following a path that
-    # wraps this corner stands there) is its own tangent point, at length 0.
-    ok = L >= r - TOUCH_TOL if r > 0 else L > 0
-    safe = np.where(ok, np.maximum(L, r), 1.0)
-    theta = -s * np.arcsin(np.clip(r / safe, -1.0, 1.0))
-    heading = np.arctan2(dy, dx) + theta
-    ang = heading - s * (math.pi / 2)
-    length = np.sqrt(np.maximum(L * L - r * r, 0.0))
-    return ang, length, heading, ok
-
-
-def _ccw_pos(ang: Any, phi0: Any, span: Any) -> tuple[Any, Any]:
-    """Counter-clockwise position of angles on arcs ``[phi0, phi0 + span]``, and validity."""
-    ccw = np.mod(ang - phi0, _TWO_PI)
-    ccw = np.where(ccw > _TWO_PI - _ANG_TOL, 0.0, ccw)
-    ok = ccw <= span + _ANG_TOL
-    return np.minimum(ccw, span), ok
 
 
 class Planner(ThawOnUnpickle):
@@ -134,14 +99,14 @@ class Planner(ThawOnUnpickle):
         self._build_nodes()
         # (node, side) -> departure positions, targets, target sides, arrivals, lengths.
         self._edges: dict[tuple[int, int], tuple[list[float], list[int], list[int], list[float], list[float]]] = {}
-        self._sights = np.full(self.n_nodes, np.nan)
-        self._cell_sights: dict[tuple[int, int], float] = {}
+        # Strict bounds (m) on every clear segment leaving a node's arc (geodesic.sight).
+        self.sights = node_sights(collision, self.radius, self.cx, self.cy, self.phi0, self.span)
+        self._balls = NodeBalls(self.cx, self.cy, self.sights + self.radius)
         self._arc_graph: ArcGraph | None = None
         self._fb_edt: NDArray[np.float64] | None = None
         self._fb_mask: NDArray[np.bool_] | None = None
         self._usable: NDArray[np.bool_] | None = None
         self._near: NDArray[np.int32] | None = None
-        self._cell_graph: Any = None
         self._fields: dict[tuple[float, float], GoalField] = {}
         self._field_bytes = 0
 
@@ -173,7 +138,7 @@ class Planner(ThawOnUnpickle):
                 span.append(turn[convex])
         cx = np.concatenate(xs).astype(np.float64)
         cy = np.concatenate(ys).astype(np.float64)
-        phi0_all = np.mod(np.concatenate(phi0).astype(np.float64), _TWO_PI)
+        phi0_all = np.mod(np.concatenate(phi0).astype(np.float64), TWO_PI)
         span_all = np.concatenate(span).astype(np.float64)
         # Which samples of each arc are clear of everything else.
         k = np.linspace(0.0, 1.0, _ARC_SAMPLES)
@@ -216,7 +181,7 @@ class Planner(ThawOnUnpickle):
         else:
             sp = self._span[node]
             lo, hi = sp - p2, sp - p1
-        return not any(lo + _ANG_TOL < b < hi - _ANG_TOL for b in blocked)
+        return not any(lo + ANG_TOL < b < hi - ANG_TOL for b in blocked)
 
     def arcs_free(
         self, nodes: NDArray[np.int64], sides: NDArray[np.int64], p1: NDArray[np.float64], p2: NDArray[np.float64]
@@ -240,7 +205,7 @@ class Planner(ThawOnUnpickle):
             hi = np.where(ccw, p2[k], sp - p1[k])
             b = self._blocked[node]
             with np.errstate(invalid="ignore"):
-                out[k] = ~((lo[:, None] + _ANG_TOL < b) & (b < hi[:, None] - _ANG_TOL)).any(axis=1)
+                out[k] = ~((lo[:, None] + ANG_TOL < b) & (b < hi[:, None] - ANG_TOL)).any(axis=1)
         return out
 
     # ------------------------------------------------------------------ sight
@@ -261,41 +226,6 @@ class Planner(ThawOnUnpickle):
         if self._fb_mask is None:
             self._fb_mask = self._fully_blocked_edt() < 0.5
         return self._fb_mask
-
-    def sight_radius(self, x: float, y: float) -> float:
-        """An upper bound (m) on how far a disc at ``(x, y)`` can move in a straight line.
-
-        Cast as :data:`_SIGHT_RAYS` rays marched through cells no disc can use; the bound
-        is the longest ray plus two cells (see :func:`~pointnav_core.tangent_edges.sight_radii`).
-        Rays are cast once per cell, from its centre, and the bound is widened by the half
-        diagonal of a cell; point queries (every step of a follower) then cost a lookup.
-        """
-        geo = self.geo
-        res = geo.resolution
-        col = math.floor((x - geo.origin[0]) / res)
-        row = math.floor((y - geo.origin[1]) / res)
-        key = (row, col)
-        sight = self._cell_sights.get(key)
-        if sight is None:
-            cx, cy = geo.origin[0] + (col + 0.5) * res, geo.origin[1] + (row + 0.5) * res
-            sight = float(self._sight_radii(np.array([cx]), np.array([cy]))[0]) + res * math.sqrt(0.5)
-            self._cell_sights[key] = sight
-        return sight
-
-    def _sight_radii(self, xs: NDArray[np.float64], ys: NDArray[np.float64]) -> NDArray[np.float64]:
-        geo = self.geo
-        return sight_radii(self._fully_blocked_edt(), xs, ys, geo.origin, geo.resolution, self.radius, _SIGHT_RAYS)
-
-    def node_sights(self, nodes: NDArray[np.int64]) -> NDArray[np.float64]:
-        """Sight bounds (m) of ``nodes``, from their arcs' midpoints plus the radius; cached."""
-        nodes = np.asarray(nodes, dtype=np.int64)
-        todo = nodes[np.isnan(self._sights[nodes])]
-        if len(todo):
-            mid = self.phi0[todo] + self.span[todo] / 2
-            x = self.cx[todo] + self.radius * np.cos(mid)
-            y = self.cy[todo] + self.radius * np.sin(mid)
-            self._sights[todo] = self._sight_radii(x, y) + self.radius
-        return self._sights[nodes]
 
     # ------------------------------------------------------------------ edges
     def edges(self, node: int, s: int) -> tuple[list[float], NDArray[Any]]:
@@ -330,10 +260,16 @@ class Planner(ThawOnUnpickle):
     def arc_graph(self) -> ArcGraph:
         """The whole tangent graph as a plain digraph (built on first use, then cached)."""
         if self._arc_graph is None:
-            from pointnav_core.arc_graph import ArcGraph
-
             self._arc_graph = ArcGraph(self)
         return self._arc_graph
+
+    def nodes_seeing(self, xs: NDArray[np.float64], ys: NDArray[np.float64]) -> tuple[NDArray[np.int64], NDArray[np.int64]]:
+        """The nodes each point ``(xs[i], ys[i])`` may see (m): ``(owner, node)`` pairs, sorted.
+
+        A node further from a point than its sight plus the radius cannot be reached from it
+        by a clear tangent (:mod:`pointnav_core.geodesic.sight`); the rest are candidates.
+        """
+        return self._balls.query(xs, ys)
 
     def point_links(
         self, x: float, y: float
@@ -346,13 +282,13 @@ class Planner(ThawOnUnpickle):
         if not self.n_nodes:
             return []
         r = self.radius
-        cand = np.asarray(self._tree.query_ball_point((x, y), self.sight_radius(x, y) + r), dtype=np.int64)
+        cand = self.nodes_seeing(np.array([x]), np.array([y]))[1]
         links: list[tuple[int, int, float, float]] = []
         if not len(cand):
             return links
         for s in (1, -1):
-            ang, length, _, ok = _tangent_from_point(x, y, self.cx[cand], self.cy[cand], r, s)
-            ccw, ok_arc = _ccw_pos(ang, self.phi0[cand], self.span[cand])
+            ang, length, _, ok = tangent_from_point(x, y, self.cx[cand], self.cy[cand], r, s)
+            ccw, ok_arc = ccw_pos(ang, self.phi0[cand], self.span[cand])
             ok &= ok_arc
             idx = np.flatnonzero(ok)
             if not len(idx):
@@ -389,8 +325,6 @@ class Planner(ThawOnUnpickle):
         key = (float(g[0]), float(g[1]))
         field = self._fields.pop(key, None)
         if field is None:
-            from pointnav_core.tangent_field import GoalField
-
             field = GoalField(self, g)
         self._fields[key] = field  # most recently used last
         self._trim_fields()
@@ -464,15 +398,6 @@ class Planner(ThawOnUnpickle):
                 self._near = np.full(h * w, -1, dtype=np.int32)
         return self._near
 
-    @property
-    def cell_graph(self) -> Any:
-        """8-connected graph (CSR, metres) of usable cells, shared by the goal fields' tables."""
-        if self._cell_graph is None:
-            from pointnav_core.tangent_field import _cell_graph
-
-            self._cell_graph = _cell_graph(self.usable, self.geo.resolution)
-        return self._cell_graph
-
 
 _EDGE_DTYPE = np.dtype([("to", np.int64), ("side", np.int8), ("arr", np.float64), ("length", np.float64)])
 
@@ -531,7 +456,7 @@ class _Search:
         r = self.p.radius
         for lab in labels:
             lp = self.pos[lab]
-            if lp <= pos + _ANG_TOL and self.cost[lab] + r * max(pos - lp, 0.0) <= g + _COST_TOL:
+            if lp <= pos + ANG_TOL and self.cost[lab] + r * max(pos - lp, 0.0) <= g + COST_TOL:
                 if self.p._arc_free(node, s, lp, pos):
                     return True
         return False
@@ -563,12 +488,12 @@ class _Search:
             self.settled.setdefault((node, s), []).append(lab)
             if finish is not None:
                 for fdep, flen in finish.get((node, s), ()):
-                    if fdep >= pos - _ANG_TOL and p._arc_free(node, s, pos, fdep):
+                    if fdep >= pos - ANG_TOL and p._arc_free(node, s, pos, fdep):
                         total = g + r * max(fdep - pos, 0.0) + flen
                         self.count += 1
                         heapq.heappush(heap, (total, total, self.count, -1, 0, 0.0, lab, fdep))
             deps, to, side, arr, length = p._edge_lists(node, s)
-            start = bisect.bisect_left(deps, pos - _ANG_TOL)
+            start = bisect.bisect_left(deps, pos - ANG_TOL)
             if start >= len(deps):
                 continue
             blocked = p._blocked_ccw[node]

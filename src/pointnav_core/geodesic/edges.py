@@ -1,6 +1,6 @@
 """Batched construction of the tangent graph's edges (sight bounds and common tangents).
 
-:class:`~pointnav_core.tangent_graph.Planner` finds the edges of a node lazily, but one
+:class:`~pointnav_core.geodesic.planner.Planner` finds the edges of a node lazily, but one
 node at a time is dominated by numpy call overhead: a sight bound marched ray by ray and a
 clearance test of a handful of segments. The functions here do the same work for many
 nodes at once (a tile of the map for a lazy search, every node for a goal field), so the
@@ -16,88 +16,15 @@ import numpy as np
 from numpy.typing import NDArray
 
 from pointnav_core import _compiled
+from pointnav_core.geodesic.tangents import TWO_PI, ccw_pos
 
 if TYPE_CHECKING:
-    from pointnav_core.tangent_graph import Planner
+    from pointnav_core.geodesic.planner import Planner
 
-__all__ = ["build_edges", "sight_radii"]
+__all__ = ["build_edges"]
 
-_TWO_PI = 2.0 * math.pi
-_ANG_TOL = 1e-9
 #: Segments tested for clearance per call (bounds the temporary arrays).
 _SEG_CHUNK = 200_000
-
-
-def sight_radii(
-    fb_edt: NDArray[np.float64],
-    xs: NDArray[np.float64],
-    ys: NDArray[np.float64],
-    origin: tuple[float, float],
-    resolution: float,
-    radius: float,
-    n_rays: int,
-) -> NDArray[np.float64]:
-    """Upper bounds (m) on how far discs at ``(xs, ys)`` can move in a straight line.
-
-    Every point casts ``n_rays`` rays through the distance field ``fb_edt`` (cells, padded by
-    one ring) of the cells no disc point can use; a ray advances by what the nearest such
-    cell leaves free and stops inside one. The bound is the longest ray plus two cells.
-    Only the rays still marching are updated, so the cost is the total ray length, not
-    the longest ray times the batch. With numba (the ``fast`` extra) the rays march in
-    compiled code (:mod:`pointnav_core._sight_kernel`), with the same expressions.
-
-    Parameters
-    ----------
-    fb_edt : ndarray, shape (H + 2, W + 2)
-        Distance (cells) from each padded cell centre to the nearest fully blocked cell.
-    xs, ys : ndarray, shape (P,)
-        World points (m).
-    origin, resolution, radius
-        The floor's origin (m), metres per cell and the robot radius (m).
-    n_rays : int
-        Rays per point.
-
-    Returns
-    -------
-    ndarray, shape (P,)
-    """
-    xs = np.asarray(xs, dtype=np.float64)
-    ys = np.asarray(ys, dtype=np.float64)
-    n_pts = len(xs)
-    if n_pts == 0:
-        return np.zeros(0)
-    h, w = fb_edt.shape
-    flat = fb_edt.ravel()
-    ang = np.linspace(0.0, _TWO_PI, n_rays, endpoint=False)
-    start = radius / resolution + 2.0
-    limit = math.hypot(h, w) + 2.0
-    kernel = _compiled.kernel("pointnav_core._sight_kernel", "march")
-    if kernel is not None:
-        longest = np.empty(n_pts)
-        kernel(np.ascontiguousarray(flat, dtype=np.float64), h, w, (xs - origin[0]) / resolution + 1.0,
-               (ys - origin[1]) / resolution + 1.0, np.cos(ang), np.sin(ang), start, limit, 4 * (h + w), longest)
-        return (longest + 2.0) * resolution
-    ux = np.tile(np.cos(ang), n_pts)
-    uy = np.tile(np.sin(ang), n_pts)
-    gx0 = np.repeat((xs - origin[0]) / resolution + 1.0, n_rays)  # +1: the padding ring
-    gy0 = np.repeat((ys - origin[1]) / resolution + 1.0, n_rays)
-    t = np.zeros(n_pts * n_rays)
-    live = np.arange(n_pts * n_rays)
-    for _ in range(4 * (h + w)):
-        if not len(live):
-            break
-        tl = t[live]
-        gx = gx0[live] + tl * ux[live]
-        gy = gy0[live] + tl * uy[live]
-        col = np.floor(gx).astype(np.int64)
-        row = np.floor(gy).astype(np.int64)
-        inside = (col >= 0) & (col < w) & (row >= 0) & (row < h)
-        d = np.where(inside, flat[np.clip(row, 0, h - 1) * w + np.clip(col, 0, w - 1)], 0.0)
-        stop = (~inside) | ((d < 0.5) & (tl > start)) | (tl > limit)
-        go = ~stop
-        live = live[go]
-        t[live] = tl[go] + np.maximum(d[go] - math.sqrt(2.0), 0.25)
-    return (t.reshape(n_pts, n_rays).max(axis=1) + 2.0) * resolution
 
 
 def build_edges(p: Planner, nodes: NDArray[np.int64]) -> None:
@@ -112,13 +39,14 @@ def build_edges(p: Planner, nodes: NDArray[np.int64]) -> None:
     if not len(nodes):
         return
     r = p.radius
-    sight = p.node_sights(nodes)
+    # An edge is a clear segment leaving both nodes' arcs, so the centres are at most either
+    # node's sight plus two radii apart (geodesic.sight).
     pts = np.stack([p.cx[nodes], p.cy[nodes]], axis=1)
-    lists = p._tree.query_ball_point(pts, sight)
+    lists = p._tree.query_ball_point(pts, p.sights[nodes] + 2 * r)
     counts = np.fromiter((len(v) for v in lists), dtype=np.int64, count=len(lists))
     src = np.repeat(nodes, counts)
     dst = np.fromiter((j for v in lists for j in v), dtype=np.int64, count=int(counts.sum()))
-    keep = src != dst
+    keep = (src != dst) & (np.hypot(p.cx[src] - p.cx[dst], p.cy[src] - p.cy[dst]) <= p.sights[dst] + 2 * r)
     src, dst = src[keep], dst[keep]
     ax, ay, bx, by = p.cx[src], p.cy[src], p.cx[dst], p.cy[dst]
     dx, dy = bx - ax, by - ay
@@ -139,8 +67,8 @@ def build_edges(p: Planner, nodes: NDArray[np.int64]) -> None:
                 seg = np.sqrt(np.maximum(L * L - 4 * r * r, 0.0))
             dep_ang = heading - s * (math.pi / 2)
             arr_ang = heading - sb * (math.pi / 2)
-            dep_ccw, ok_a = _ccw_pos(dep_ang, p.phi0[src], p.span[src])
-            arr_ccw, ok_b = _ccw_pos(arr_ang, p.phi0[dst], p.span[dst])
+            dep_ccw, ok_a = ccw_pos(dep_ang, p.phi0[src], p.span[src])
+            arr_ccw, ok_b = ccw_pos(arr_ang, p.phi0[dst], p.span[dst])
             idx = np.flatnonzero(ok & ok_a & ok_b)
             if not len(idx):
                 continue
@@ -209,14 +137,14 @@ def _misses_full(p: Planner, a: NDArray[np.float64], b: NDArray[np.float64], ste
     Every point of a clear segment is clear, so its cell is not fully blocked; samples
     every ``step`` cells therefore never reject a clear segment (they may miss a blocked one,
     which the exact test then rejects). With numba (the ``fast`` extra) the samples are
-    taken in compiled code (:mod:`pointnav_core._sight_kernel`), with the same expressions,
+    taken in compiled code (:mod:`pointnav_core.geodesic._sight_kernel`), with the same expressions,
     and a segment stops at its first bad sample.
     """
     geo = p.geo
     full = p.fully_blocked_mask()  # padded by one ring
     h, w = full.shape
     res = geo.resolution
-    kernel = _compiled.kernel("pointnav_core._sight_kernel", "misses_full")
+    kernel = _compiled.kernel("pointnav_core.geodesic._sight_kernel", "misses_full")
     if kernel is not None:  # the same samples, each segment stopping at its first bad one
         out = np.empty(len(a), dtype=np.bool_)
         kernel(np.ascontiguousarray(a[:, 0]), np.ascontiguousarray(a[:, 1]), np.ascontiguousarray(b[:, 0]),
@@ -234,11 +162,3 @@ def _misses_full(p: Planner, a: NDArray[np.float64], b: NDArray[np.float64], ste
     inside = (col >= 0) & (col < w) & (row >= 0) & (row < h)
     bad = np.where(inside, full[np.clip(row, 0, h - 1), np.clip(col, 0, w - 1)], geo.outside_blocked)
     return np.bincount(seg[bad], minlength=len(a)) == 0
-
-
-def _ccw_pos(ang: NDArray[np.float64], phi0: NDArray[np.float64], span: NDArray[np.float64]) -> tuple[NDArray[np.float64], NDArray[np.bool_]]:
-    """Counter-clockwise position of angles on arcs ``[phi0, phi0 + span]``, and validity."""
-    ccw = np.mod(ang - phi0, _TWO_PI)
-    ccw = np.where(ccw > _TWO_PI - _ANG_TOL, 0.0, ccw)
-    ok = ccw <= span + _ANG_TOL
-    return np.minimum(ccw, span), ok

@@ -1,0 +1,108 @@
+"""The geodesic layer's bounds on larger random floors: the triangle inequality over three
+legs, and the per-step lookup against the exact query within its documented bound.
+
+Floors are 20-60 cells a side with random boxes and long walls with slits (where a sight
+bound that misses a slit makes an exact path too long), radius/cell from 0.3 to 5, at
+0.05-0.5 m per cell. Points are drawn where the robot's disc fits (the planner's usable
+cells, then a random offset inside the cell where the disc still fits).
+
+- ``d(s, g) <= d(s, a) + d(a, b) + d(b, g)`` (1e-6 m), every leg exact;
+- the lookup of ``p`` is within ``|p - c| + d(p, c)`` of the exact distance, ``c`` the
+  centre of the cell the lookup reads (``geodesic.LOOKUP_BOUND``'s statement in general
+  form); at a usable cell's centre the two are equal.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from hypothesis import HealthCheck, assume, given, settings
+from hypothesis import strategies as st
+
+from pointnav_core.maps import OBSTACLE
+from pointnav_core.scenes import Scene
+
+
+@st.composite
+def slit_floors(draw: st.DrawFn) -> tuple[Scene, float]:
+    h, w = draw(st.integers(20, 60)), draw(st.integers(20, 60))
+    res = draw(st.sampled_from([0.05, 0.1, 0.25, 0.5]))
+    radius = draw(st.floats(0.3, 5.0)) * res
+    rng = np.random.default_rng(draw(st.integers(0, 2**31 - 1)))
+    grid = np.zeros((h, w), np.uint8)
+    grid[[0, -1], :] = grid[:, [0, -1]] = OBSTACLE
+    for _ in range(draw(st.integers(0, 12))):
+        r, c = rng.integers(1, h - 2), rng.integers(1, w - 2)
+        grid[r : r + rng.integers(1, 4), c : c + rng.integers(1, 4)] = OBSTACLE
+    for _ in range(draw(st.integers(0, 3))):  # a wall with slits one to four cells wide
+        if rng.random() < 0.5:
+            at = rng.integers(2, h - 2)
+            grid[at, :] = OBSTACLE
+            for _ in range(rng.integers(1, 3)):
+                c = rng.integers(1, w - 5)
+                grid[at, c : c + rng.integers(1, 5)] = 0
+        else:
+            at = rng.integers(2, w - 2)
+            grid[:, at] = OBSTACLE
+            for _ in range(rng.integers(1, 3)):
+                r = rng.integers(1, h - 5)
+                grid[r : r + rng.integers(1, 5), at] = 0
+    return Scene.from_array(grid, res), radius
+
+
+def _points(scene: Scene, radius: float, rng: np.random.Generator, n: int) -> list[np.ndarray]:
+    planner = scene.planner(0, radius)
+    cells = np.argwhere(planner.usable)
+    if not len(cells):
+        return []
+    res, origin = scene.floors[0].resolution, np.asarray(scene.floors[0].origin)
+    out = []
+    for r, c in cells[rng.integers(len(cells), size=n)]:
+        p = origin + (np.array([c, r]) + rng.uniform(0.02, 0.98, 2)) * res
+        out.append(p if planner.is_clear(*p) else origin + (np.array([c, r]) + 0.5) * res)
+    return out
+
+
+@settings(max_examples=30, deadline=None, suppress_health_check=[HealthCheck.too_slow, HealthCheck.filter_too_much])
+@given(floor=slit_floors(), seed=st.integers(0, 2**31 - 1))
+def test_the_triangle_inequality_over_three_legs(floor, seed) -> None:
+    scene, radius = floor
+    pts = _points(scene, radius, np.random.default_rng(seed), 4)
+    assume(len(pts) == 4)
+    s, a, b, g = pts
+
+    def d(u, v) -> float:
+        return scene.geodesic_distance(0, u, v, robot=radius)
+
+    whole = d(s, g)
+    legs = d(s, a) + d(a, b) + d(b, g)
+    assume(math.isfinite(legs))
+    assert whole <= legs + 1e-6
+
+
+@settings(max_examples=30, deadline=None, suppress_health_check=[HealthCheck.too_slow, HealthCheck.filter_too_much])
+@given(floor=slit_floors(), seed=st.integers(0, 2**31 - 1))
+def test_the_lookup_is_within_its_bound_of_the_exact_query(floor, seed) -> None:
+    scene, radius = floor
+    rng = np.random.default_rng(seed)
+    pts = _points(scene, radius, rng, 25)
+    assume(len(pts) > 1)
+    tmap = scene.floors[0]
+    planner = scene.planner(0, radius)
+    field = scene.goal_field(0, pts[0], robot=radius)
+    h, w = tmap.shape
+    for p in pts[1:]:
+        col, row = (int(v) for v in np.floor((p - np.asarray(tmap.origin)) / tmap.resolution))
+        i = int(planner.near_usable[row * w + col])
+        c = np.asarray(tmap.origin) + (np.array([i % w, i // w]) + 0.5) * tmap.resolution
+        exact = field.exact_distance(p)
+        lookup = field.distance(*p)
+        assert field.distance(*c) == field.exact_distance(c) or math.isclose(field.distance(*c), field.exact_distance(c), abs_tol=1e-9)
+        to_c = scene.geodesic_distance(0, p, c, robot=radius)
+        if not math.isfinite(to_c):
+            continue
+        if math.isinf(exact):
+            assert math.isinf(lookup)
+            continue
+        assert abs(lookup - exact) <= math.dist(p, c) + to_c + 1e-9

@@ -1,0 +1,256 @@
+"""Goal fields on the tangent graph: exact point queries and the per-step lookup table.
+
+A :class:`GoalField` is one Dijkstra run of :mod:`pointnav_core.geodesic.planner` from a goal:
+the exact distance of every node it reaches. :meth:`GoalField.point_distance` and
+:meth:`GoalField.path` are exact for any point (the tangents the point sees, then the
+settled labels). :meth:`GoalField.distance` is the per-step lookup through a root table:
+each cell holds the exact root of its centre (the goal directly, or the label its best path
+leaves by, :func:`pointnav_core.geodesic.roots.cell_roots`), settled one block of cells at a
+time when a lookup first lands in the block; a lookup is the tangent from the exact point to
+its cell's root. Everything is in world metres.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from pointnav_core.frozen import ThawOnUnpickle
+from pointnav_core.geodesic.arc_graph import FieldLabels
+from pointnav_core.geodesic.roots import cell_roots
+from pointnav_core.geodesic.tangents import ANG_TOL, TWO_PI
+
+if TYPE_CHECKING:
+    from pointnav_core.geodesic.planner import Planner
+
+__all__ = ["BLOCK", "GoalField", "LOOKUP_BOUND"]
+
+#: Side (cells) of the square blocks of the root table, each settled on its first lookup.
+BLOCK = 16
+#: Table kind of a cell not settled yet.
+UNSETTLED = 4
+#: The lookup's documented bound: ``|distance(p) - point_distance(p)| <= LOOKUP_BOUND * |p - c|``,
+#: ``c`` the centre of the cell whose root the lookup uses, where the segment from ``p`` to ``c``
+#: is clear (both values are within ``|p - c|`` of the exact value at ``c``).
+LOOKUP_BOUND = 2.0
+
+
+class GoalField(ThawOnUnpickle):
+    """Geodesic distances (m) to one goal from every point of the floor.
+
+    Build it through :meth:`Planner.goal_field` (cached). A Dijkstra run from the goal
+    settles every node the goal reaches; :meth:`point_distance` and :meth:`path` are exact
+    for any point; :meth:`distance` is the per-step lookup through a root table.
+
+    Parameters
+    ----------
+    planner : Planner
+    goal : array_like, shape (2,)
+        Goal in world metres.
+    """
+
+    def __init__(self, planner: Planner, goal: ArrayLike) -> None:
+        self.planner = planner
+        self.goal = np.asarray(goal, dtype=np.float64).reshape(-1)[:2].copy()
+        gx, gy = float(self.goal[0]), float(self.goal[1])
+        self.goal_usable = planner.is_clear(gx, gy)
+        links = planner.point_links(gx, gy) if self.goal_usable else []
+        self._search = planner.arc_graph().solve(links)
+        self._table: dict[str, Any] | None = None
+
+    @property
+    def reachable_from_anywhere(self) -> bool:
+        """False when the robot does not fit at the goal (nothing reaches it)."""
+        return self.goal_usable
+
+    @property
+    def nbytes(self) -> int:
+        """Approximate memory held by this field, in bytes."""
+        table = 0 if self._table is None else sum(v.nbytes for v in self._table.values() if isinstance(v, np.ndarray))
+        return self._search.nbytes + table
+
+    # ------------------------------------------------------------- exact queries
+    def _best(self, x: float, y: float) -> tuple[float, int, float]:
+        """Best way to the goal from ``(x, y)``: ``(cost, label, departure)``; label -1: direct."""
+        p = self.planner
+        if not self.goal_usable or not p.is_clear(x, y):
+            return math.inf, -2, 0.0
+        gx, gy = float(self.goal[0]), float(self.goal[1])
+        best = (math.inf, -2, 0.0)
+        if p.segment_clear((x, y), (gx, gy)):
+            best = (math.hypot(gx - x, gy - y), -1, 0.0)
+        r = p.radius
+        search = self._search
+        for c, s, pos, length in p.point_links(x, y):
+            side = -s
+            dep = p._span[c] - pos
+            for lab in search.on_arc(c, side):
+                lp = search.pos[lab]
+                if lp <= dep + ANG_TOL and p._arc_free(c, side, lp, dep):
+                    total = search.cost[lab] + r * max(dep - lp, 0.0) + length
+                    if total < best[0]:
+                        best = (total, lab, dep)
+        return best
+
+    def point_distance(self, xy: ArrayLike) -> float:
+        """Exact geodesic distance (m) from world point ``xy`` to the goal (inf if none)."""
+        x, y = (float(v) for v in np.asarray(xy, dtype=np.float64).reshape(-1)[:2])
+        return self._best(x, y)[0]
+
+    def path(
+        self, xy: ArrayLike, exact: bool = True, max_length: float = math.inf
+    ) -> tuple[NDArray[np.float64], float] | tuple[None, None]:
+        """Shortest path (N, 2) from world point ``xy`` to the goal and its length (m).
+
+        ``exact`` is kept for compatibility: every path is exact. With a finite
+        ``max_length`` (m) only the path's beginning is drawn: it ends at the first vertex
+        ``max_length`` or more along it (a follower needs no more); the length returned is
+        still the whole path's.
+        """
+        x, y = (float(v) for v in np.asarray(xy, dtype=np.float64).reshape(-1)[:2])
+        cost, label, dep = self._best(x, y)
+        if label == -2:
+            return None, None
+        pts = [np.array([x, y])]
+        whole = True
+        if label >= 0:
+            traced, whole = self._search.trace(label, dep, (x, y), max_length)
+            pts += traced
+        if whole:
+            pts.append(self.goal.copy())
+        return np.array(pts), cost
+
+    # ------------------------------------------------------------- lookup table
+    @property
+    def labels(self) -> FieldLabels:
+        """The Dijkstra run from the goal: every reached label's node, side, position and cost."""
+        return self._search
+
+    def distance(self, x: float, y: float) -> float:
+        """Per-step geodesic lookup (m) from world point ``(x, y)``; ``inf`` if unreachable.
+
+        The tangent from ``(x, y)`` to the exact root of its cell's centre (the nearest usable
+        cell where the point's own is not): within ``LOOKUP_BOUND * |p - c|`` of
+        :meth:`point_distance`, ``c`` that centre.
+        """
+        t = self._table if self._table is not None else self._new_table()
+        geo = self.planner.geo
+        col = math.floor((x - geo.origin[0]) / geo.resolution)
+        row = math.floor((y - geo.origin[1]) / geo.resolution)
+        h, w = geo.shape
+        if not (0 <= row < h and 0 <= col < w):
+            return math.inf
+        i = int(self.planner.near_usable[row * w + col])
+        if i < 0:
+            return math.inf
+        kind = t["kind"][i]
+        if kind == UNSETTLED:
+            self._settle_block(i)
+            kind = t["kind"][i]
+        if kind == 0:
+            return math.inf
+        if kind == 1:  # straight to the goal
+            return math.hypot(x - t["gx"], y - t["gy"])
+        lab = int(t["label"][i])
+        p = self.planner
+        search = self._search
+        c, side = int(search.node[lab]), int(search.side[lab])
+        r = p.radius
+        dx = p._cx[c] - x
+        dy = p._cy[c] - y
+        L = math.hypot(dx, dy)
+        if L > r:
+            # The tangent from (x, y) arriving winding -side is the one leaving the node.
+            heading = math.atan2(dy, dx) + side * math.asin(r / L) if r > 0 else math.atan2(dy, dx)
+            ccw = (heading + side * (math.pi / 2) - p._phi0[c]) % TWO_PI
+            if ccw > TWO_PI - ANG_TOL:
+                ccw = 0.0
+            span = p._span[c]
+            if ccw <= span + ANG_TOL:
+                dep = min(ccw, span) if side > 0 else span - min(ccw, span)
+                lp = search.pos[lab]
+                if dep >= lp - ANG_TOL:
+                    return search.cost[lab] + r * max(dep - lp, 0.0) + math.sqrt(L * L - r * r)
+        qx, qy = p.node_point(c, side, search.pos[lab])
+        return search.cost[lab] + math.hypot(x - qx, y - qy)
+
+    def settle(self, cells: ArrayLike | None = None) -> tuple[NDArray[np.int8], NDArray[np.int32]]:
+        """Settle the blocks of the root table that hold ``cells`` (default: every block).
+
+        Returns the whole table, read-only: per cell (row-major) its kind (0: no path,
+        1: straight to the goal, 2: by a label, 4: not settled) and label (-1 where none).
+
+        Parameters
+        ----------
+        cells : array_like of int, shape (N,), optional
+            Flat cell indices (``row * width + col``), each in ``[0, height * width)``.
+        """
+        t = self._table if self._table is not None else self._new_table()
+        h, w = self.planner.geo.shape
+        if cells is None:
+            idx = np.flatnonzero(t["kind"] == UNSETTLED)
+        else:
+            idx = np.asarray(cells)
+            if idx.ndim != 1 or (idx.size and not np.issubdtype(idx.dtype, np.integer)):
+                raise ValueError(f"cells must be a 1D array of integer cell indices, got shape {idx.shape} of {idx.dtype}")
+            idx = idx.astype(np.int64)
+            if idx.size and (idx.min() < 0 or idx.max() >= h * w):
+                raise ValueError(f"cells must lie in [0, {h * w}), got {idx.min()} to {idx.max()}")
+        b = BLOCK
+        blocks = np.unique((idx // w) // b * t["blocks_w"] + (idx % w) // b)
+        todo = [_block_cells(int(k), t["blocks_w"], h, w) for k in blocks.tolist() if not t["done"][k]]
+        if todo:
+            t["done"][blocks] = True
+            self._settle_cells(np.concatenate(todo))
+        kind, label = t["kind"].view(), t["label"].view()
+        kind.flags.writeable = label.flags.writeable = False
+        return kind, label
+
+    def _settle_block(self, i: int) -> None:
+        """Settle the block of the root table that holds cell ``i``."""
+        t = self._table
+        assert t is not None
+        w = self.planner.geo.shape[1]
+        k = (i // w) // BLOCK * t["blocks_w"] + (i % w) // BLOCK
+        t["done"][k] = True
+        self._settle_cells(_block_cells(k, t["blocks_w"], *self.planner.geo.shape))
+
+    def _settle_cells(self, cells: NDArray[np.int64]) -> None:
+        """Give the usable ``cells`` their centres' exact roots (the others have kind 0)."""
+        t = self._table
+        assert t is not None
+        cells = cells[t["kind"][cells] == UNSETTLED]
+        kind, label = cell_roots(self, cells)
+        t["kind"][cells] = kind
+        t["label"][cells] = label
+
+    def _new_table(self) -> dict[str, Any]:
+        """An empty root table: every usable cell unsettled, the rest with no path."""
+        p = self.planner
+        h, w = p.geo.shape
+        kind = np.where(p.usable.ravel() & self.goal_usable, UNSETTLED, 0).astype(np.int8)
+        blocks_w = -(-w // BLOCK)
+        table = {
+            "kind": kind,
+            "label": np.full(h * w, -1, dtype=np.int32),
+            # Whether each block (row-major, BLOCK cells square) has been settled.
+            "done": np.zeros(-(-h // BLOCK) * blocks_w, dtype=bool),
+            "blocks_w": blocks_w,
+            "gx": float(self.goal[0]),
+            "gy": float(self.goal[1]),
+        }
+        self._table = table
+        # The table made this field bigger: keep the planner's cache within its budget.
+        self.planner._trim_fields()
+        return table
+
+
+def _block_cells(k: int, blocks_w: int, h: int, w: int) -> NDArray[np.int64]:
+    """Flat indices of the cells of block ``k`` (row-major blocks, BLOCK cells square)."""
+    r0, c0 = (k // blocks_w) * BLOCK, (k % blocks_w) * BLOCK
+    rows = np.arange(r0, min(r0 + BLOCK, h))
+    cols = np.arange(c0, min(c0 + BLOCK, w))
+    return (rows[:, None] * w + cols[None, :]).ravel().astype(np.int64)

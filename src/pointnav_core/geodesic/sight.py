@@ -1,0 +1,210 @@
+"""How far a node of the tangent graph can see: strict bounds, and the nodes a point may see.
+
+Every tangent edge, and every tangent from a point to a node, is a straight segment that
+leaves (or, reversed, reaches) a point of a node's free arc and keeps the robot's disc clear
+of the blocked set. :func:`node_sights` bounds the length of every such segment per node,
+so that only nodes within that bound need an exact test. The bound is strict: a segment it
+leaves out cannot be clear.
+
+**Why it holds.** Directions are covered by rays, each owning a sector of half-width ``h``
+around its own direction ``theta``. A ray starts at the arc point a segment of direction
+``theta`` leaves from, and marches through the cells. A clear segment of direction
+``theta'`` in the sector, leaving from its own arc point, stays within
+``e(t) = (r + t) * h`` of the ray at every distance ``t`` (its start is within ``r * h``
+of the ray's, its direction within ``h``), and every point of it is at least ``r`` from the
+blocked set. So where the ray passes a point whose distance to the blocked set is surely
+below ``r - e(t)`` (measured to the nearest blocked cell's square, an upper bound), no clear
+segment of the sector reaches that far: the ray stops there, and its length bounds them
+all. A ray that goes on past ``e(t) >= r`` can no longer prove anything; its sector is split
+in two narrower ones. Marching skips ahead only by what the distance field leaves free, and
+any skipped sample can only make a ray longer: the bound stays an upper bound.
+
+The rays march in compiled code when numba is installed (the ``fast`` extra); the plain path
+runs the same function as Python (:func:`sight_rays`), and a property test holds the two
+equal. Lengths are in metres.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import TYPE_CHECKING
+
+import numpy as np
+from numpy.typing import NDArray
+from scipy import ndimage
+from scipy.spatial import cKDTree
+
+from pointnav_core import _compiled
+from pointnav_core.collision import TOUCH_TOL
+from pointnav_core.geodesic.tangents import ANG_TOL
+
+if TYPE_CHECKING:
+    from pointnav_core.collision import FloorCollision
+
+__all__ = ["NodeBalls", "node_sights", "sight_rays"]
+
+#: Half-width (rad) of the sectors rays start with: 64 rays over a grid corner's quarter arc.
+FIRST_HALF_WIDTH = math.pi / 256
+#: Narrowest sector (rad) before a ray gives up and bounds its node by the map's diagonal.
+MIN_HALF_WIDTH = 1e-5
+#: Most sectors waiting at once per node and side (the first ones plus one per split level).
+_STACK = 8192
+#: The bound of a node that sees past the edge of a map whose outside is open (m).
+_FAR = 1e300
+
+
+def sight_rays(cx, cy, phi0, span, r, margin, edt, near_r, near_c, outside, h0, min_h, limit, out):  # pragma: no cover
+    """Per node, the longest ray (cells) over both winding sides: ``out[n]``.
+
+    Everything is in padded grid units (the grid with one ring of blocked cells around it):
+    node centres ``(cx, cy)``, radius ``r``, ``margin`` (the clearance test's touching
+    tolerance, doubled), ``edt`` (distance from each cell centre to the nearest blocked cell
+    centre) and the row and column of that blocked cell (``near_r``, ``near_c``); and
+    whether everything off the grid is blocked (``outside``).
+    Plain Python on scalars, so that numba compiles the very same function.
+    """
+    n_rows, n_cols = edt.shape
+    stack_t = np.empty(_STACK)
+    stack_h = np.empty(_STACK)
+    for n in range(cx.shape[0]):
+        best = 0.0
+        gave_up = False
+        for side in (1.0, -1.0):
+            n0 = max(1, int(math.ceil(span[n] / (2.0 * h0))))
+            hw0 = span[n] / (2.0 * n0)
+            top = 0
+            for k in range(n0):
+                stack_t[top] = phi0[n] + (2 * k + 1) * hw0 + side * (math.pi / 2)
+                stack_h[top] = hw0
+                top += 1
+            while top > 0:
+                top -= 1
+                theta = stack_t[top]
+                hw = stack_h[top]
+                phi = theta - side * (math.pi / 2)
+                tx = cx[n] + r * math.cos(phi)
+                ty = cy[n] + r * math.sin(phi)
+                ux = math.cos(theta)
+                uy = math.sin(theta)
+                reach = (hw + ANG_TOL)
+                t = 0.0
+                length = -1.0
+                while True:
+                    e = (r + t) * reach
+                    if e >= r - margin:
+                        break  # past this the ray proves nothing: split its sector
+                    x = tx + t * ux
+                    y = ty + t * uy
+                    col = math.floor(x)
+                    row = math.floor(y)
+                    if col < 0 or col >= n_cols or row < 0 or row >= n_rows:
+                        length = t if outside else limit
+                        break
+                    nr = near_r[row, col]
+                    nc = near_c[row, col]
+                    dx = max(nc - x, 0.0, x - (nc + 1))
+                    dy = max(nr - y, 0.0, y - (nr + 1))
+                    if math.sqrt(dx * dx + dy * dy) + e < r - margin:
+                        length = t
+                        break
+                    if t > limit:
+                        length = limit
+                        break
+                    t += max(edt[row, col] - math.sqrt(2.0) - r, 0.25)
+                if length >= 0.0:
+                    best = max(best, length)
+                elif hw <= min_h or top + 2 > _STACK:
+                    gave_up = True
+                    break
+                else:
+                    stack_t[top] = theta - hw / 2
+                    stack_h[top] = hw / 2
+                    stack_t[top + 1] = theta + hw / 2
+                    stack_h[top + 1] = hw / 2
+                    top += 2
+            if gave_up:
+                break
+        out[n] = limit if gave_up else best
+
+
+def node_sights(
+    geo: FloorCollision, radius: float, cx: NDArray[np.float64], cy: NDArray[np.float64],
+    phi0: NDArray[np.float64], span: NDArray[np.float64],
+) -> NDArray[np.float64]:
+    """Strict bounds (m) on the length of a clear segment leaving each node's arc.
+
+    Parameters
+    ----------
+    geo : FloorCollision
+        The blocked set; only its cells are marched (a subset of the blocked set gives a
+        looser bound, never a wrong one).
+    radius : float
+        Robot radius (m), > 0.
+    cx, cy, phi0, span : ndarray, shape (N,)
+        Node centres (m) and free arcs (rad).
+    """
+    n = len(cx)
+    if not n:
+        return np.zeros(0)
+    res = geo.resolution
+    pad = np.pad(np.asarray(geo.blocked, dtype=bool), 1, constant_values=geo.outside_blocked)
+    if not pad.any():  # nothing to stop a ray: every node may see the whole map
+        return np.full(n, math.hypot(*pad.shape) * res + 2.0 * res) if geo.outside_blocked else np.full(n, _FAR)
+    edt, (near_r, near_c) = ndimage.distance_transform_edt(~pad, return_indices=True)
+    limit = math.hypot(*pad.shape) + 2.0
+    out = np.empty(n)
+    kernel = _compiled.kernel("pointnav_core.geodesic._sight_kernel", "sight_rays")
+    march = kernel if kernel is not None else sight_rays
+    march(
+        np.ascontiguousarray((cx - geo.origin[0]) / res + 1.0), np.ascontiguousarray((cy - geo.origin[1]) / res + 1.0),
+        np.ascontiguousarray(phi0, dtype=np.float64), np.ascontiguousarray(span, dtype=np.float64), radius / res,
+        2.0 * TOUCH_TOL / res, np.ascontiguousarray(edt, dtype=np.float64), near_r.astype(np.int64), near_c.astype(np.int64),
+        bool(geo.outside_blocked), FIRST_HALF_WIDTH, MIN_HALF_WIDTH, limit, out,
+    )
+    # One cell to spare for the rounding of grid coordinates; a ray that reached the limit on
+    # an open map proves nothing.
+    out = (out + 1.0) * res
+    if not geo.outside_blocked:
+        out[out >= limit * res] = _FAR
+    return out
+
+
+class NodeBalls:
+    """Which nodes a point may see: those whose sight ball (sight plus radius) holds it.
+
+    The nodes are grouped by the power of two above their ball's radius, one kd-tree per
+    group, so a query looks only as far as each group needs.
+
+    Parameters
+    ----------
+    cx, cy : ndarray, shape (N,)
+        Node centres (m).
+    reach : ndarray, shape (N,)
+        Each node's ball radius (m).
+    """
+
+    def __init__(self, cx: NDArray[np.float64], cy: NDArray[np.float64], reach: NDArray[np.float64]) -> None:
+        self.reach = np.asarray(reach, dtype=np.float64)
+        self.xy = np.stack([cx, cy], axis=1) if len(cx) else np.zeros((0, 2))
+        level = np.ceil(np.log2(np.maximum(self.reach, 1e-9))).astype(np.int64) if len(cx) else np.zeros(0, np.int64)
+        self.groups = []
+        for lv in np.unique(level).tolist():
+            ids = np.flatnonzero(level == lv)
+            self.groups.append((ids, cKDTree(self.xy[ids]), 2.0 ** lv))
+
+    def query(self, xs: NDArray[np.float64], ys: NDArray[np.float64]) -> tuple[NDArray[np.int64], NDArray[np.int64]]:
+        """Per point, the nodes whose ball holds it: ``(owner, node)`` pairs sorted by owner, then node."""
+        pts = np.stack([np.asarray(xs, dtype=np.float64), np.asarray(ys, dtype=np.float64)], axis=1).reshape(-1, 2)
+        owners, nodes = [np.zeros(0, np.int64)], [np.zeros(0, np.int64)]
+        for ids, tree, radius in self.groups:
+            found = tree.query_ball_point(pts, radius, return_sorted=False)
+            counts = np.fromiter((len(f) for f in found), dtype=np.int64, count=len(found))
+            if not counts.sum():
+                continue
+            owners.append(np.repeat(np.arange(len(pts)), counts))
+            nodes.append(ids[np.fromiter((j for f in found for j in f), dtype=np.int64, count=int(counts.sum()))])
+        owner, node = np.concatenate(owners), np.concatenate(nodes)
+        keep = np.hypot(*(self.xy[node] - pts[owner]).T) <= self.reach[node] if len(node) else np.zeros(0, bool)
+        owner, node = owner[keep], node[keep]
+        order = np.lexsort((node, owner))
+        return owner[order], node[order]
