@@ -8,8 +8,12 @@ else ``dev``.
 """
 
 import os
+import tempfile
 
 from hypothesis import HealthCheck, settings
+
+# The suite's geometry cache is its own, fresh each run: never a user's, never a stale one.
+os.environ["POINTNAV_CACHE_DIR"] = tempfile.mkdtemp(prefix="pointnav-cache-")
 
 settings.register_profile("dev", max_examples=25, deadline=None)
 settings.register_profile(

@@ -18,6 +18,7 @@ of a Python heap loop. Distances are exact; only the vertex set is fixed per pla
 
 from __future__ import annotations
 
+import heapq
 import itertools
 import math
 from typing import TYPE_CHECKING, Any
@@ -27,12 +28,13 @@ from numpy.typing import NDArray
 from scipy import sparse
 from scipy.sparse import csgraph
 
+from pointnav_core import _compiled
 from pointnav_core.geodesic.tangents import ANG_TOL
 
 if TYPE_CHECKING:
     from pointnav_core.geodesic.planner import Planner
 
-__all__ = ["ArcGraph", "FieldLabels"]
+__all__ = ["ArcGraph", "FieldLabels", "seeded_dijkstra"]
 
 #: Added to every weight: scipy reads a stored zero as no edge.
 _EPS_W = 1e-300
@@ -90,6 +92,9 @@ class ArcGraph:
         self._rows = np.concatenate(rows)
         self._cols = np.concatenate(cols)
         self._w = np.concatenate(wts) + _EPS_W
+        # The graph once, for the compiled search (which seeds the source's arrivals itself).
+        csr = sparse.csr_matrix((self._w, (self._rows, self._cols)), shape=(n_v, n_v))
+        self._indptr, self._indices, self._data = csr.indptr.astype(np.int64), csr.indices.astype(np.int64), csr.data
 
     def _arcs_free(self, i: NDArray[np.int64], j: NDArray[np.int64]) -> NDArray[np.bool_]:
         """Whether the arc between vertices ``i`` and ``j`` (same arc, ``pos_i <= pos_j``) is clear."""
@@ -102,34 +107,82 @@ class ArcGraph:
         return out
 
     def solve(self, links: list[tuple[int, int, float, float]]) -> FieldLabels:
-        """Dijkstra from a point whose tangents arrive at ``links``: ``(node, side, pos, length)``."""
+        """Dijkstra from a point whose tangents arrive at ``links``: ``(node, side, pos, length)``.
+
+        Each arrival is a vertex of its own (after the graph's), entered at its tangent's
+        length, that continues along its arc to the first vertex at or after it. With numba
+        the search runs compiled on the graph built once (:func:`seeded_dijkstra`); without
+        it, scipy's Dijkstra runs on the graph with a source vertex added. Same distances.
+        """
         p = self.p
         n_v = self.n_vertices
         n_x = len(links)
-        src = n_v + n_x
-        rows = [self._rows]
-        cols = [self._cols]
-        wts = [self._w]
         x_node = np.array([c for c, _, _, _ in links], dtype=np.int32)
         x_side = np.array([s for _, s, _, _ in links], dtype=np.int8)
         x_pos = np.array([q for _, _, q, _ in links], dtype=np.float64)
         x_len = np.array([ln for _, _, _, ln in links], dtype=np.float64)
-        rows.append(np.full(n_x, src))
-        cols.append(n_v + np.arange(n_x))
-        wts.append(x_len + _EPS_W)
         # Each arrival continues to the first vertex at or after it on its arc.
+        x_to = np.full(n_x, -1, dtype=np.int64)
+        x_w = np.zeros(n_x)
         for k, (c, s, q, _) in enumerate(links):
             gi = 2 * c + (s < 0)
             lo, hi = int(self.grp_start[gi]), int(self.grp_end[gi])
             j = lo + int(np.searchsorted(self.pos[lo:hi], q - ANG_TOL, side="left"))
             if j < hi and p._arc_free(c, s, q, float(self.pos[j])):
-                rows.append(np.array([n_v + k]))
-                cols.append(np.array([j]))
-                wts.append(np.array([p.radius * max(float(self.pos[j]) - q, 0.0) + _EPS_W]))
+                x_to[k] = j
+                x_w[k] = p.radius * max(float(self.pos[j]) - q, 0.0) + _EPS_W
+        kernel = _compiled.kernel("pointnav_core.geodesic._search_kernel", "seeded_dijkstra")
+        if kernel is not None:
+            dist = np.full(n_v + n_x, np.inf)
+            pred = np.full(n_v + n_x, -9999, dtype=np.int64)
+            kernel(self._indptr, self._indices, self._data, n_v, x_len + _EPS_W, x_to, x_w, dist, pred)
+            return FieldLabels(self, dist, pred, x_node, x_side, x_pos)
+        src = n_v + n_x
+        has = np.flatnonzero(x_to >= 0)
+        rows = np.concatenate([self._rows, np.full(n_x, src), n_v + has])
+        cols = np.concatenate([self._cols, n_v + np.arange(n_x), x_to[has]])
+        wts = np.concatenate([self._w, x_len + _EPS_W, x_w[has]])
         n = src + 1
-        graph = sparse.csr_matrix((np.concatenate(wts), (np.concatenate(rows), np.concatenate(cols))), shape=(n, n))
+        graph = sparse.csr_matrix((wts, (rows, cols)), shape=(n, n))
         dist, pred = csgraph.dijkstra(graph, directed=True, indices=src, return_predecessors=True)
         return FieldLabels(self, dist[:src], pred[:src], x_node, x_side, x_pos)
+
+
+def seeded_dijkstra(indptr, indices, data, n_v, x_cost, x_to, x_w, dist, pred):  # pragma: no cover
+    """Dijkstra over a CSR graph of ``n_v`` vertices from seeded arrivals, in place.
+
+    Arrival ``k`` is vertex ``n_v + k``, reached at ``x_cost[k]`` from the source (``pred``
+    -1) and continuing to vertex ``x_to[k]`` (if >= 0) at ``x_w[k]``. ``dist`` (inf) and
+    ``pred`` (-9999: not reached, as scipy writes it) have ``n_v + len(x_cost)`` entries.
+    Plain Python on scalars, so that numba compiles the very same function.
+    """
+    heap = [(0.0, 0)]
+    heap.pop()
+    for k in range(x_cost.shape[0]):
+        if x_cost[k] < dist[n_v + k]:
+            dist[n_v + k] = x_cost[k]
+            pred[n_v + k] = -1
+            heapq.heappush(heap, (x_cost[k], n_v + k))
+    while len(heap) > 0:
+        d, v = heapq.heappop(heap)
+        if d > dist[v]:
+            continue
+        if v >= n_v:
+            u = x_to[v - n_v]
+            if u >= 0:
+                nd = d + x_w[v - n_v]
+                if nd < dist[u]:
+                    dist[u] = nd
+                    pred[u] = v
+                    heapq.heappush(heap, (nd, u))
+            continue
+        for e in range(indptr[v], indptr[v + 1]):
+            u = indices[e]
+            nd = d + data[e]
+            if nd < dist[u]:
+                dist[u] = nd
+                pred[u] = v
+                heapq.heappush(heap, (nd, u))
 
 
 class FieldLabels:

@@ -60,6 +60,7 @@ class GoalField(ThawOnUnpickle):
         links = planner.point_links(gx, gy) if self.goal_usable else []
         self._search = planner.arc_graph().solve(links)
         self._table: dict[str, Any] | None = None
+        self._nbytes: int | None = None
 
     @property
     def reachable_from_anywhere(self) -> bool:
@@ -69,8 +70,10 @@ class GoalField(ThawOnUnpickle):
     @property
     def nbytes(self) -> int:
         """Approximate memory held by this field, in bytes."""
-        table = 0 if self._table is None else sum(v.nbytes for v in self._table.values() if isinstance(v, np.ndarray))
-        return self._search.nbytes + table
+        if self._nbytes is None:  # counted once: the planner's cache sums it on every insert
+            table = 0 if self._table is None else sum(v.nbytes for v in self._table.values() if isinstance(v, np.ndarray))
+            self._nbytes = self._search.nbytes + table
+        return self._nbytes
 
     # ------------------------------------------------------------- exact queries
     def _best(self, x: float, y: float) -> tuple[float, int, float]:
@@ -243,6 +246,7 @@ class GoalField(ThawOnUnpickle):
             "gy": float(self.goal[1]),
         }
         self._table = table
+        self._nbytes = None
         # The table made this field bigger: keep the planner's cache within its budget.
         self.planner._trim_fields()
         return table

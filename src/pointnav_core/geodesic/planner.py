@@ -39,16 +39,19 @@ from __future__ import annotations
 import bisect
 import heapq
 import math
+import time
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy import ndimage
 from scipy.spatial import cKDTree
+from tqdm.auto import tqdm
 
 from pointnav_core.collision import TOUCH_TOL, FloorCollision, convex_corners
 from pointnav_core.frozen import ThawOnUnpickle
 from pointnav_core.paths import path_length, resample_path
+from pointnav_core.geodesic import cache
 from pointnav_core.geodesic.arc_graph import ArcGraph
 from pointnav_core.geodesic.arcs import arc_points
 from pointnav_core.geodesic.tangents import ANG_TOL, COST_TOL, TWO_PI, ccw_pos, tangent_from_point
@@ -66,6 +69,8 @@ _EDGE_BATCH = 256
 
 #: Samples along a node's arc used to find the parts of it within ``r`` of something else.
 _ARC_SAMPLES = 9
+#: Nodes whose edges a build finds before it shows a progress bar (about 2 s of work).
+_PROGRESS_NODES = 20_000
 #: Side (cells) of the square tiles whose nodes get their edges built together.
 _TILE = 32
 #: Smallest radius (m) the planner uses.
@@ -96,11 +101,20 @@ class Planner(ThawOnUnpickle):
         # A point robot plans as a disc of 1 micrometre, so that paths wrap corners
         # rather than pass through the vertex two diagonal squares share.
         self.radius = max(float(radius), MIN_RADIUS)
+        started = time.perf_counter()
         self._build_nodes()
         # (node, side) -> departure positions, targets, target sides, arrivals, lengths.
         self._edges: dict[tuple[int, int], tuple[list[float], list[int], list[int], list[float], list[float]]] = {}
-        # Strict bounds (m) on every clear segment leaving a node's arc (geodesic.sight).
-        self.sights = node_sights(collision, self.radius, self.cx, self.cy, self.phi0, self.span)
+        # The per-floor build from the disk cache, if an earlier process kept it (geodesic.cache).
+        self._cache_key = cache.floor_key(collision, self.radius) if cache.cache_dir() is not None else None
+        stored = cache.load(self._cache_key, self.n_nodes) if self._cache_key is not None else None
+        if stored is not None:
+            self.sights = stored["sights"].astype(np.float64)
+            self._restore_edges(stored)
+        else:
+            # Strict bounds (m) on every clear segment leaving a node's arc (geodesic.sight).
+            self.sights = node_sights(collision, self.radius, self.cx, self.cy, self.phi0, self.span)
+        self._build_seconds = time.perf_counter() - started
         self._balls = NodeBalls(self.cx, self.cy, self.sights + self.radius)
         self._arc_graph: ArcGraph | None = None
         self._fb_edt: NDArray[np.float64] | None = None
@@ -250,12 +264,47 @@ class Planner(ThawOnUnpickle):
         return got
 
     def build_all_edges(self) -> None:
-        """Build the edges of every node (a goal field needs them all)."""
+        """Build the edges of every node (a goal field needs them all), and keep a slow build
+        in the disk cache (:mod:`pointnav_core.geodesic.cache`)."""
         todo = np.array([n for n in range(self.n_nodes) if (n, 1) not in self._edges], dtype=np.int64)
+        if not len(todo):
+            return
+        started = time.perf_counter()
         # Batches of nodes, each with all its candidates in memory at once: a few hundred
         # keep that near 0.5 GB on a map of thousands of obstacles (4,096 took 7 GB).
-        for i in range(0, len(todo), _EDGE_BATCH):
-            build_edges(self, todo[i : i + _EDGE_BATCH])
+        batches = range(0, len(todo), _EDGE_BATCH)
+        with tqdm(total=len(todo), desc="tangent edges", unit="node", leave=False,
+                  disable=len(todo) < _PROGRESS_NODES or None) as bar:
+            for i in batches:
+                build_edges(self, todo[i : i + _EDGE_BATCH])
+                bar.update(min(_EDGE_BATCH, len(todo) - i))
+        self._build_seconds += time.perf_counter() - started
+        if self._cache_key is not None and self._build_seconds >= cache.MIN_SECONDS:
+            cache.save(self._cache_key, self._stored_edges())
+
+    def _stored_edges(self) -> dict[str, NDArray[Any]]:
+        """The sights and every edge as flat arrays (what the disk cache keeps)."""
+        keys = sorted(self._edges)
+        lists = [self._edges[k] for k in keys]
+        return {
+            "sights": self.sights,
+            "node": np.array([k[0] for k in keys], dtype=np.int64),
+            "side": np.array([k[1] for k in keys], dtype=np.int8),
+            "count": np.array([len(v[0]) for v in lists], dtype=np.int64),
+            "dep": np.array([x for v in lists for x in v[0]], dtype=np.float64),
+            "to": np.array([x for v in lists for x in v[1]], dtype=np.int64),
+            "to_side": np.array([x for v in lists for x in v[2]], dtype=np.int8),
+            "arr": np.array([x for v in lists for x in v[3]], dtype=np.float64),
+            "length": np.array([x for v in lists for x in v[4]], dtype=np.float64),
+        }
+
+    def _restore_edges(self, stored: dict[str, NDArray[Any]]) -> None:
+        """Fill the edges from :meth:`_stored_edges`' arrays."""
+        ends = np.cumsum(stored["count"])
+        starts = ends - stored["count"]
+        cols = [stored[k].tolist() for k in ("dep", "to", "to_side", "arr", "length")]
+        for node, side, i, j in zip(stored["node"].tolist(), stored["side"].tolist(), starts.tolist(), ends.tolist()):
+            self._edges[(node, side)] = tuple(c[i:j] for c in cols)  # type: ignore[assignment]
 
     def arc_graph(self) -> ArcGraph:
         """The whole tangent graph as a plain digraph (built on first use, then cached)."""

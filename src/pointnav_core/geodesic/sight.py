@@ -49,6 +49,8 @@ FIRST_HALF_WIDTH = math.pi / 256
 MIN_HALF_WIDTH = 1e-5
 #: Most sectors waiting at once per node and side (the first ones plus one per split level).
 _STACK = 8192
+#: Most (point, node) pairs a query measures one by one rather than through the trees.
+_BRUTE = 2_000_000
 #: The bound of a node that sees past the edge of a map whose outside is open (m).
 _FAR = 1e300
 
@@ -195,16 +197,20 @@ class NodeBalls:
     def query(self, xs: NDArray[np.float64], ys: NDArray[np.float64]) -> tuple[NDArray[np.int64], NDArray[np.int64]]:
         """Per point, the nodes whose ball holds it: ``(owner, node)`` pairs sorted by owner, then node."""
         pts = np.stack([np.asarray(xs, dtype=np.float64), np.asarray(ys, dtype=np.float64)], axis=1).reshape(-1, 2)
+        n_nodes = len(self.reach)
+        if len(pts) * n_nodes <= _BRUTE:
+            # Few enough pairs to measure them all: faster than walking trees.
+            d = np.hypot(pts[:, 0, None] - self.xy[None, :, 0], pts[:, 1, None] - self.xy[None, :, 1])
+            owner, node = np.nonzero(d <= self.reach[None, :])
+            return owner.astype(np.int64), node.astype(np.int64)
         owners, nodes = [np.zeros(0, np.int64)], [np.zeros(0, np.int64)]
+        queries = cKDTree(pts)
         for ids, tree, radius in self.groups:
-            found = tree.query_ball_point(pts, radius, return_sorted=False)
-            counts = np.fromiter((len(f) for f in found), dtype=np.int64, count=len(found))
-            if not counts.sum():
-                continue
-            owners.append(np.repeat(np.arange(len(pts)), counts))
-            nodes.append(ids[np.fromiter((j for f in found for j in f), dtype=np.int64, count=int(counts.sum()))])
+            # The pairs within the group's radius, found in C (no per-point lists).
+            pairs = tree.sparse_distance_matrix(queries, radius, output_type="ndarray")
+            ok = pairs["v"] <= self.reach[ids[pairs["i"]]]
+            owners.append(pairs["j"][ok].astype(np.int64))
+            nodes.append(ids[pairs["i"][ok]])
         owner, node = np.concatenate(owners), np.concatenate(nodes)
-        keep = np.hypot(*(self.xy[node] - pts[owner]).T) <= self.reach[node] if len(node) else np.zeros(0, bool)
-        owner, node = owner[keep], node[keep]
         order = np.lexsort((node, owner))
         return owner[order], node[order]

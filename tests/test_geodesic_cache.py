@@ -1,0 +1,111 @@
+"""The geometry cache on disk (pointnav_core.geodesic.cache): hits, misses, faults, races."""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+import textwrap
+
+import numpy as np
+import pytest
+
+from pointnav_core.collision import FloorCollision
+from pointnav_core.geodesic import cache
+from pointnav_core.geodesic.planner import Planner
+from pointnav_core.maps import OBSTACLE
+from pointnav_core.scenes import Scene
+
+
+def _geo(shift: int = 0) -> FloorCollision:
+    grid = np.zeros((40, 50), np.uint8)
+    grid[[0, -1], :] = grid[:, [0, -1]] = OBSTACLE
+    grid[10:30, 20 + shift] = OBSTACLE
+    grid[5:9, 5:12] = OBSTACLE
+    return FloorCollision.from_map(Scene.from_array(grid, 0.1).floors[0])
+
+
+@pytest.fixture
+def folder(tmp_path, monkeypatch):
+    monkeypatch.setenv(cache.ENV_VAR, str(tmp_path))
+    monkeypatch.setattr(cache, "MIN_SECONDS", 0.0)  # keep every build, however quick
+    return tmp_path
+
+
+def _built(geo: FloorCollision, radius: float = 0.18) -> Planner:
+    p = Planner(geo, radius)
+    p.build_all_edges()
+    return p
+
+
+def _distances(p: Planner) -> list[float]:
+    return [p.shortest_path(a, b)[1] for a, b in (((0.5, 0.5), (4.5, 3.5)), ((0.4, 3.5), (4.6, 0.5)))]
+
+
+def test_a_rebuilt_floor_reads_the_same_graph_back(folder) -> None:
+    first = _built(_geo())
+    files = list(folder.glob("*.npz"))
+    assert len(files) == 1 and not list(folder.glob("*.tmp"))
+    second = Planner(_geo(), 0.18)
+    assert second._edges == first._edges  # every edge, before any search asks
+    np.testing.assert_array_equal(second.sights, first.sights)
+    assert _distances(second) == _distances(first)
+
+
+def test_a_changed_map_radius_or_version_misses(folder, monkeypatch) -> None:
+    _built(_geo())
+    keys = {cache.floor_key(_geo(), 0.18), cache.floor_key(_geo(shift=1), 0.18), cache.floor_key(_geo(), 0.2)}
+    monkeypatch.setattr("pointnav_core.__version__", "9.9.9")
+    keys.add(cache.floor_key(_geo(), 0.18))
+    assert len(keys) == 4
+    assert cache.load(cache.floor_key(_geo(shift=1), 0.18), 10) is None
+    _built(_geo(shift=1))
+    assert len(list(folder.glob("*.npz"))) == 2
+
+
+@pytest.mark.parametrize("damage", ["truncate", "garbage", "other floor"])
+def test_a_damaged_file_warns_and_is_rebuilt(folder, damage: str) -> None:
+    want = _distances(_built(_geo()))
+    (path,) = folder.glob("*.npz")
+    data = path.read_bytes()
+    if damage == "truncate":
+        path.write_bytes(data[: len(data) // 2])
+    elif damage == "garbage":
+        path.write_bytes(b"\x00" * 100)
+    else:  # a whole, readable file whose floor has another node count
+        with np.load(path) as z:
+            arrays = {k: z[k] for k in z.files}
+        arrays["sights"] = arrays["sights"][:-1]
+        np.savez(path.with_suffix(""), **arrays)  # numpy adds the .npz: the same file
+    with pytest.warns(RuntimeWarning, match="geometry cache file .* is unreadable"):
+        rebuilt = _built(_geo())
+    assert _distances(rebuilt) == want
+    assert cache.load(cache.floor_key(_geo(), 0.18), rebuilt.n_nodes) is not None  # written anew, valid
+
+
+def test_two_processes_building_one_entry_leave_one_valid_file(folder) -> None:
+    script = textwrap.dedent(
+        f"""
+        import sys
+        sys.path.insert(0, {str(__import__("pathlib").Path(__file__).parent)!r})
+        from pointnav_core.geodesic import cache
+        cache.MIN_SECONDS = 0.0
+        from test_geodesic_cache import _built, _geo
+        _built(_geo())
+        """
+    )
+    env = {**__import__("os").environ, cache.ENV_VAR: str(folder)}
+    procs = [subprocess.Popen([sys.executable, "-c", script], env=env) for _ in range(2)]
+    assert [p.wait(timeout=300) for p in procs] == [0, 0]
+    assert len(list(folder.glob("*.npz"))) == 1 and not list(folder.glob("*.tmp"))
+    p = Planner(_geo(), 0.18)
+    assert cache.load(cache.floor_key(_geo(), 0.18), p.n_nodes) is not None
+
+
+def test_the_cache_can_be_turned_off_and_follows_the_platform(monkeypatch, tmp_path) -> None:
+    for off in ("", "0", "off"):
+        monkeypatch.setenv(cache.ENV_VAR, off)
+        assert cache.cache_dir() is None
+    monkeypatch.delenv(cache.ENV_VAR)
+    monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path))
+    if sys.platform.startswith("linux"):
+        assert cache.cache_dir() == tmp_path / "pointnav-core"
