@@ -106,3 +106,27 @@ def test_the_lookup_is_within_its_bound_of_the_exact_query(floor, seed) -> None:
             assert math.isinf(lookup)
             continue
         assert abs(lookup - exact) <= math.dist(p, c) + to_c + 1e-9
+
+
+@settings(max_examples=30, deadline=None, suppress_health_check=[HealthCheck.too_slow, HealthCheck.filter_too_much])
+@given(floor=slit_floors(), seed=st.integers(0, 2**31 - 1))
+def test_the_compiled_goal_search_equals_scipys(floor, seed) -> None:
+    """A goal field's Dijkstra: numba's seeded heap on the graph built once gives the costs of
+    scipy's run on the graph with a source vertex added (the path without numba)."""
+    import pytest
+
+    from pointnav_core import _compiled
+
+    pytest.importorskip("numba")
+    scene, radius = floor
+    pts = _points(scene, radius, np.random.default_rng(seed), 1)
+    assume(len(pts) == 1)
+    planner = scene.planner(0, radius)
+    graph = planner.arc_graph()
+    links = planner.point_links(*pts[0])
+    fast = graph.solve(links)
+    with _compiled.numpy_paths():
+        plain = graph.solve(links)
+    assert np.array_equal(np.isfinite(fast.cost), np.isfinite(plain.cost))
+    ok = np.isfinite(fast.cost)
+    np.testing.assert_allclose(fast.cost[ok], plain.cost[ok], rtol=1e-12, atol=1e-12)

@@ -178,7 +178,7 @@ class GoalField(ThawOnUnpickle):
                 if dep >= lp - ANG_TOL:
                     return search.cost[lab] + r * max(dep - lp, 0.0) + math.sqrt(L * L - r * r)
         qx, qy = p.node_point(c, side, search.pos[lab])
-        return search.cost[lab] + math.hypot(x - qx, y - qy)
+        return search.cost[lab] + around_disc(x, y, p._cx[c], p._cy[c], r, qx, qy)
 
     def settle(self, cells: ArrayLike | None = None) -> tuple[NDArray[np.int8], NDArray[np.int32]]:
         """Settle the blocks of the root table that hold ``cells`` (default: every block).
@@ -250,6 +250,22 @@ class GoalField(ThawOnUnpickle):
         # The table made this field bigger: keep the planner's cache within its budget.
         self.planner._trim_fields()
         return table
+
+
+def around_disc(x: float, y: float, cx: float, cy: float, r: float, qx: float, qy: float) -> float:
+    """Length (m) of the shortest path from ``(x, y)`` to ``q`` on the circle of radius ``r``
+    at ``c`` that keeps out of its disc: straight where ``q`` is in sight, else the tangent
+    and the shorter arc. The lookup's value where the tangent to its root's arc does not
+    apply: it joins that value where the two meet, so the lookup moves no faster than the
+    point (the bound :data:`LOOKUP_BOUND` rests on that)."""
+    L = math.hypot(x - cx, y - cy)
+    if L <= r:
+        return math.hypot(x - qx, y - qy)
+    seen = math.acos(min(r / L, 1.0))
+    turn = abs((math.atan2(qy - cy, qx - cx) - math.atan2(y - cy, x - cx) + math.pi) % TWO_PI - math.pi)
+    if turn <= seen:
+        return math.hypot(x - qx, y - qy)
+    return math.sqrt(L * L - r * r) + r * (turn - seen)
 
 
 def _block_cells(k: int, blocks_w: int, h: int, w: int) -> NDArray[np.int64]:

@@ -198,6 +198,13 @@ class FieldTables:
         tangent = self.cost[lab] + r * xp.maximum(dep - lp, xp.zeros_like(dep)) + xp.sqrt(
             xp.maximum(big * big - r * r, xp.zeros_like(big))
         )
-        point = self.cost[lab] + xp.sqrt((x - self.qx[lab]) ** 2 + (y - self.qy[lab]) ** 2)
+        # GoalField's around_disc: straight to the label's point where it is in sight, else
+        # the tangent and the shorter arc.
+        qx, qy = self.qx[lab], self.qy[lab]
+        straight = xp.sqrt((x - qx) ** 2 + (y - qy) ** 2)
+        seen = xp.arccos(xp.minimum(r / safe, xp.ones_like(safe)))
+        turn = xp.abs(xp.remainder(xp.arctan2(qy - self.cy[lab], qx - self.cx[lab]) - xp.arctan2(-dy, -dx) + math.pi, TWO_PI) - math.pi)
+        wrap = xp.sqrt(xp.maximum(big * big - r * r, xp.zeros_like(big))) + r * (turn - seen)
+        point = self.cost[lab] + xp.where(outside & (turn > seen), wrap, straight)
         via = xp.where(tangent_ok, tangent, point)
         return xp.where(kind == 1, direct, xp.where(kind == 2, via, math.inf))
