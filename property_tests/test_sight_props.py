@@ -3,8 +3,9 @@
 - For random floors (random blocked cells, sometimes an open outside), robot radii and cell
   sizes, :func:`pointnav_core.geodesic.sight.node_sights` gives the same bounds, bit for
   bit, with numba and as plain Python (the ``fast`` extra's path and the path without it).
-- The bounds are strict: no clear tangent edge between two nodes is longer, checked by brute
-  force over every pair of nodes with the exact clearance test and no sight filter at all.
+- The bounds are strict: no clear tangent edge between two nodes is longer than either
+  node's sight, nor than its sight profile in the edge's direction, checked by brute force
+  over every pair of nodes with the exact clearance test and no sight filter at all.
 - ``_misses_full`` (the cheap rejection of candidate tangent segments) gives the same answer
   with its numba kernel and with its numpy samples.
 """
@@ -33,11 +34,11 @@ def _floor(seed: int, rows: int, cols: int, density: float, resolution: float, o
     return FloorCollision(blocked, resolution, origin, outside_blocked=outside)
 
 
-@settings(max_examples=40, deadline=None)
+@settings(max_examples=25, deadline=None)
 @given(
     seed=st.integers(0, 2**31 - 1),
-    rows=st.integers(2, 40),
-    cols=st.integers(2, 40),
+    rows=st.integers(2, 24),
+    cols=st.integers(2, 24),
     density=st.floats(0.0, 0.4),
     radius=st.floats(1e-6, 0.5),
     resolution=st.sampled_from([0.05, 0.1, 0.25, 0.5]),
@@ -47,12 +48,13 @@ def test_compiled_sights_equal_the_plain_rays(seed, rows, cols, density, radius,
     geo = _floor(seed, rows, cols, density, resolution, outside)
     planner = Planner(geo, radius)
     assert kernel("pointnav_core.geodesic._sight_kernel", "sight_rays") is not None
-    got = sight.node_sights(geo, planner.radius, planner.cx, planner.cy, planner.phi0, planner.span)
+    got, got_profile = sight.node_sights(geo, planner.radius, planner.cx, planner.cy, planner.phi0, planner.span)
     with numpy_paths():
         assert kernel("pointnav_core.geodesic._sight_kernel", "sight_rays") is None
-        want = sight.node_sights(geo, planner.radius, planner.cx, planner.cy, planner.phi0, planner.span)
+        want, want_profile = sight.node_sights(geo, planner.radius, planner.cx, planner.cy, planner.phi0, planner.span)
     np.testing.assert_array_equal(got, want)
-    assert (got > 0).all()
+    np.testing.assert_array_equal(got_profile, want_profile)
+    assert (got > 0).all() and (got_profile.max(axis=1) >= got * (1 - 1e-6)).all()
 
 
 @settings(max_examples=30, deadline=None)
@@ -95,9 +97,12 @@ def test_no_clear_edge_is_longer_than_either_nodes_sight(seed, rows, cols, densi
             pa = np.stack([p.cx[a[k]] + r * np.cos(dep[k]), p.cy[a[k]] + r * np.sin(dep[k])], 1)
             pb = np.stack([p.cx[b[k]] + r * np.cos(arr[k]), p.cy[b[k]] + r * np.sin(arr[k])], 1)
             clear = geo.segments_clear(pa, pb, r)
-            k = k[clear]
+            k, pa, pb = k[clear], pa[clear], pb[clear]
             assert (length[k] <= p.sights[a[k]] + 1e-9).all()
             assert (length[k] <= p.sights[b[k]] + 1e-9).all()
+            # ... and no longer than either node's profile in its direction of departure.
+            assert not sight.blocked_by_profile(p.sight_profile, a[k], *(pb - pa).T).any()
+            assert not sight.blocked_by_profile(p.sight_profile, b[k], *(pa - pb).T).any()
 
 
 @settings(max_examples=60, deadline=None)

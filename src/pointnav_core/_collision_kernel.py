@@ -57,50 +57,121 @@ def stadium_row(ax, ay, bx, by, rho, y):  # pragma: no cover
 
 
 @_jit
-def cells_hit(ax, ay, bx, by, rho, rowcum, outside_blocked, out):  # pragma: no cover
-    """``out[i]``: whether segment ``i``'s open ``rho``-stadium (grid cells) meets a blocked square."""
+def segment_hits_cells(sax, say, sbx, sby, rho, rowcum, outside_blocked):  # pragma: no cover
+    """Whether one segment's open ``rho``-stadium (grid cells) meets a blocked square."""
     h = rowcum.shape[0]
     w = rowcum.shape[1] - 1
+    ylo = min(say, sby) - rho
+    yhi = max(say, sby) + rho
+    k0 = math.floor(ylo)
+    k1 = max(math.ceil(yhi) - 1, k0)  # a band starting exactly at yhi only touches
+    left_is_a = sax <= sbx
+    lx = (sax if left_is_a else sbx) - rho
+    ly = say if left_is_a else sby
+    rx = (sbx if left_is_a else sax) + rho
+    ry = sby if left_is_a else say
+    for k in range(k0, k1 + 1):
+        y0 = max(float(k), ylo)
+        y1 = min(float(k + 1), yhi)
+        lo0, hi0 = stadium_row(sax, say, sbx, sby, rho, y0)
+        lo1, hi1 = stadium_row(sax, say, sbx, sby, rho, y1)
+        lo = min(lo0, lo1)
+        hi = max(hi0, hi1)
+        if ly >= y0 and ly <= y1:
+            lo = min(lo, lx)
+        if ry >= y0 and ry <= y1:
+            hi = max(hi, rx)
+        if not hi > lo:  # then lo, hi are finite: floor and ceil are safe
+            continue
+        c_lo = math.floor(lo)
+        c_hi = math.ceil(hi) - 1
+        if c_lo > c_hi:
+            continue
+        inside_row = k >= 0 and k < h
+        if inside_row:
+            cl = min(max(c_lo, 0), w)
+            ch = min(max(c_hi + 1, 0), w)
+            if ch > cl and rowcum[k, ch] - rowcum[k, min(cl, ch)] > 0:
+                return True
+        if outside_blocked and (not inside_row or c_lo < 0 or c_hi >= w):
+            return True
+    return False
+
+
+@_jit
+def cells_hit(ax, ay, bx, by, rho, rowcum, outside_blocked, out):  # pragma: no cover
+    """``out[i]``: whether segment ``i``'s open ``rho``-stadium (grid cells) meets a blocked square."""
     for i in range(ax.shape[0]):
-        sax = ax[i]
-        say = ay[i]
-        sbx = bx[i]
-        sby = by[i]
-        ylo = min(say, sby) - rho
-        yhi = max(say, sby) + rho
-        k0 = math.floor(ylo)
-        k1 = max(math.ceil(yhi) - 1, k0)  # a band starting exactly at yhi only touches
-        left_is_a = sax <= sbx
-        lx = (sax if left_is_a else sbx) - rho
-        ly = say if left_is_a else sby
-        rx = (sbx if left_is_a else sax) + rho
-        ry = sby if left_is_a else say
-        hit = False
-        for k in range(k0, k1 + 1):
-            y0 = max(float(k), ylo)
-            y1 = min(float(k + 1), yhi)
-            lo0, hi0 = stadium_row(sax, say, sbx, sby, rho, y0)
-            lo1, hi1 = stadium_row(sax, say, sbx, sby, rho, y1)
-            lo = min(lo0, lo1)
-            hi = max(hi0, hi1)
-            if ly >= y0 and ly <= y1:
-                lo = min(lo, lx)
-            if ry >= y0 and ry <= y1:
-                hi = max(hi, rx)
-            if not hi > lo:  # then lo, hi are finite: floor and ceil are safe
-                continue
-            c_lo = math.floor(lo)
-            c_hi = math.ceil(hi) - 1
-            if c_lo > c_hi:
-                continue
-            inside_row = k >= 0 and k < h
-            if inside_row:
-                cl = min(max(c_lo, 0), w)
-                ch = min(max(c_hi + 1, 0), w)
-                if ch > cl and rowcum[k, ch] - rowcum[k, min(cl, ch)] > 0:
-                    hit = True
-                    break
-            if outside_blocked and (not inside_row or c_lo < 0 or c_hi >= w):
-                hit = True
-                break
-        out[i] = hit
+        out[i] = segment_hits_cells(ax[i], ay[i], bx[i], by[i], rho, rowcum, outside_blocked)
+
+
+@_jit
+def _point_segment_d2(px, py, ax, ay, bx, by):  # pragma: no cover
+    # Squared distance from point p to segment a-b.
+    dx = bx - ax
+    dy = by - ay
+    n = dx * dx + dy * dy
+    t = 0.0
+    if n > 0:
+        t = min(max(((px - ax) * dx + (py - ay) * dy) / n, 0.0), 1.0)
+    ex = ax + t * dx - px
+    ey = ay + t * dy - py
+    return ex * ex + ey * ey
+
+
+@_jit
+def _orient(ax, ay, bx, by, cx, cy):  # pragma: no cover
+    return (bx - ax) * (cy - ay) - (by - ay) * (cx - ax)
+
+
+@_jit
+def _segments_d2(ax, ay, bx, by, cx, cy, dx, dy):  # pragma: no cover
+    # Squared distance between segments a-b and c-d: 0 where they cross.
+    o1 = _orient(ax, ay, bx, by, cx, cy)
+    o2 = _orient(ax, ay, bx, by, dx, dy)
+    o3 = _orient(cx, cy, dx, dy, ax, ay)
+    o4 = _orient(cx, cy, dx, dy, bx, by)
+    if ((o1 > 0 and o2 < 0) or (o1 < 0 and o2 > 0)) and ((o3 > 0 and o4 < 0) or (o3 < 0 and o4 > 0)):
+        return 0.0
+    return min(
+        min(_point_segment_d2(ax, ay, cx, cy, dx, dy), _point_segment_d2(bx, by, cx, cy, dx, dy)),
+        min(_point_segment_d2(cx, cy, ax, ay, bx, by), _point_segment_d2(dx, dy, ax, ay, bx, by)),
+    )
+
+
+@_jit
+def segment_hits_polygons(ax, ay, bx, by, reach, boxes, first, last, x0, y0, x1, y1):  # pragma: no cover
+    """Whether segment ``a -> b`` comes within ``reach`` (closed) of a polygon.
+
+    Polygon ``k`` has the bounding box ``boxes[k]`` (xmin, ymin, xmax, ymax) and the ring
+    edges ``first[k]:last[k]`` of ``(x0, y0) -> (x1, y1)`` (every ring, holes too). A
+    segment is within reach of it when an edge is, or when its first end lies inside it
+    (even-odd rule over the rings): then it does not cross the boundary, so it is inside.
+    """
+    r2 = reach * reach
+    lo_x = min(ax, bx) - reach
+    hi_x = max(ax, bx) + reach
+    lo_y = min(ay, by) - reach
+    hi_y = max(ay, by) + reach
+    for k in range(boxes.shape[0]):
+        if boxes[k, 0] > hi_x or boxes[k, 2] < lo_x or boxes[k, 1] > hi_y or boxes[k, 3] < lo_y:
+            continue
+        inside = False
+        for e in range(first[k], last[k]):
+            if _segments_d2(ax, ay, bx, by, x0[e], y0[e], x1[e], y1[e]) <= r2:
+                return True
+            # Crossings of a ray from the first end towards +x (even-odd rule).
+            if (y0[e] > ay) != (y1[e] > ay):
+                xc = x0[e] + (ay - y0[e]) * (x1[e] - x0[e]) / (y1[e] - y0[e])
+                if xc > ax:
+                    inside = not inside
+        if inside:
+            return True
+    return False
+
+
+@_jit
+def polygons_hit(ax, ay, bx, by, reach, boxes, first, last, x0, y0, x1, y1, out):  # pragma: no cover
+    """``out[i]``: :func:`segment_hits_polygons` of segment ``i``."""
+    for i in range(ax.shape[0]):
+        out[i] = segment_hits_polygons(ax[i], ay[i], bx[i], by[i], reach, boxes, first, last, x0, y0, x1, y1)

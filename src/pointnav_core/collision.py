@@ -94,6 +94,7 @@ class FloorCollision:
         self._rowcum = cum
         self.polygons = tuple(polygons)
         self._poly_tree = shapely.STRtree(list(self.polygons)) if self.polygons else None
+        self._poly_edges = _polygon_edges(self.polygons)
 
     @classmethod
     def from_map(cls, tmap: Any) -> FloorCollision:
@@ -115,6 +116,8 @@ class FloorCollision:
     def __setstate__(self, state: dict[str, Any]) -> None:
         self.__dict__.update(state)
         self._poly_tree = shapely.STRtree(list(self.polygons)) if self.polygons else None
+        if "_poly_edges" not in state:
+            self._poly_edges = _polygon_edges(self.polygons)
 
     # ------------------------------------------------------------------ queries
     def points_clear(self, points: ArrayLike, radius: float) -> NDArray[np.bool_]:
@@ -170,6 +173,12 @@ class FloorCollision:
     def _polygons_hit(self, a: NDArray[np.float64], b: NDArray[np.float64], radius: float) -> NDArray[np.bool_]:
         # dwithin is closed (distance <= d); touching at exactly the radius is allowed.
         reach = max(radius - 2 * TOUCH_TOL, TOUCH_TOL / 2)
+        kernel = _compiled.kernel("pointnav_core._collision_kernel", "polygons_hit")
+        if kernel is not None and self._poly_edges is not None:  # compiled: each edge's distance, and containment
+            out = np.empty(len(a), dtype=np.bool_)
+            kernel(np.ascontiguousarray(a[:, 0]), np.ascontiguousarray(a[:, 1]), np.ascontiguousarray(b[:, 0]),
+                   np.ascontiguousarray(b[:, 1]), reach, *self._poly_edges, out)
+            return out
         same = (a == b).all(axis=1)
         geoms = np.empty(len(a), dtype=object)
         if same.any():
@@ -238,6 +247,31 @@ class FloorCollision:
             hit |= nonempty & (~inside_row | (c_lo < 0) | (c_hi >= w))
         # bincount, not logical_or.at: the unbuffered ufunc loop is far slower.
         return np.bincount(seg[hit], minlength=len(a)) > 0
+
+
+def _polygon_edges(polygons: Sequence[Any]) -> tuple[NDArray[Any], ...] | None:
+    """Every polygon part's bounding box and ring edges, flat: ``boxes (K, 4), first (K,),
+    last (K,), x0, y0, x1, y1 (E,)`` (the compiled polygon test's layout); None when a part
+    is not a polygon (shapely's test then serves)."""
+    boxes, first, last, edges = [], [], [], []
+    n = 0
+    for poly in polygons:
+        for part in getattr(poly, "geoms", [poly]):
+            if part.is_empty:
+                continue
+            if part.geom_type != "Polygon":
+                return None
+            start = n
+            for ring in [part.exterior, *part.interiors]:
+                pts = np.asarray(ring.coords, dtype=np.float64)
+                edges.append(np.concatenate([pts[:-1], pts[1:]], axis=1))
+                n += len(pts) - 1
+            boxes.append(part.bounds)
+            first.append(start)
+            last.append(n)
+    cat = np.concatenate(edges) if edges else np.zeros((0, 4))
+    return (np.asarray(boxes, dtype=np.float64).reshape(-1, 4), np.asarray(first, dtype=np.int64),
+            np.asarray(last, dtype=np.int64), *(np.ascontiguousarray(cat[:, j]) for j in range(4)))
 
 
 def _stadium_row(

@@ -110,10 +110,12 @@ class Planner(ThawOnUnpickle):
         stored = cache.load(self._cache_key, self.n_nodes) if self._cache_key is not None else None
         if stored is not None:
             self.sights = stored["sights"].astype(np.float64)
+            self.sight_profile = stored["sight_profile"].astype(np.float32)
             self._restore_edges(stored)
         else:
             # Strict bounds (m) on every clear segment leaving a node's arc (geodesic.sight).
-            self.sights = node_sights(collision, self.radius, self.cx, self.cy, self.phi0, self.span)
+            # and per direction bin (geodesic.sight.blocked_by_profile).
+            self.sights, self.sight_profile = node_sights(collision, self.radius, self.cx, self.cy, self.phi0, self.span)
         self._build_seconds = time.perf_counter() - started
         self._balls = NodeBalls(self.cx, self.cy, self.sights + self.radius)
         self._arc_graph: ArcGraph | None = None
@@ -288,6 +290,7 @@ class Planner(ThawOnUnpickle):
         lists = [self._edges[k] for k in keys]
         return {
             "sights": self.sights,
+            "sight_profile": self.sight_profile,
             "node": np.array([k[0] for k in keys], dtype=np.int64),
             "side": np.array([k[1] for k in keys], dtype=np.int8),
             "count": np.array([len(v[0]) for v in lists], dtype=np.int64),

@@ -37,6 +37,8 @@ from typing import TYPE_CHECKING
 import numpy as np
 from numpy.typing import NDArray
 
+from pointnav_core import _compiled
+from pointnav_core.collision import TOUCH_TOL
 from pointnav_core.geodesic.tangents import ANG_TOL, ccw_pos, tangent_from_point
 
 if TYPE_CHECKING:
@@ -50,6 +52,8 @@ __all__ = ["CHUNK", "cell_roots"]
 CHUNK = 256
 #: Most (cell, node) candidates a chunk may hold when every node falls in every ball.
 _CANDIDATES = 2**20
+#: Most nodes for which the compiled path measures every (cell, node) pair rather than ask the trees.
+_BRUTE_NODES = 4096
 #: Width (cells) of the first band of candidate bounds evaluated per cell; each round doubles it.
 _FIRST_BAND = 8
 #: Relative loosening of the candidate bounds (m per m), far above rounding error.
@@ -125,6 +129,10 @@ def cell_roots(field: GoalField, cells: NDArray[np.int64]) -> tuple[NDArray[np.i
     ys = geo.origin[1] + (rows + 0.5) * geo.resolution
     clear = np.flatnonzero(geo.points_clear(np.stack([xs, ys], axis=1), p.radius))
     tables = _ArcTables(p, field._search) if p.n_nodes else None
+    if tables is not None and _compiled.kernel("pointnav_core.geodesic._roots_kernel", "best_links") is not None \
+            and (geo._poly_edges is not None or not geo.polygons):
+        kind[clear], label[clear] = _compiled_roots(field, tables, xs[clear], ys[clear])
+        return kind, label
     # Fewer cells per chunk where many nodes could fall in a centre's ball.
     chunk = max(16, min(CHUNK, _CANDIDATES // max(p.n_nodes, 1)))
     for i in range(0, len(clear), chunk):
@@ -199,6 +207,34 @@ def _chunk_roots(
     kind[got] = 2
     label[got] = best_lab[got]
     return kind, label
+
+
+def _compiled_roots(
+    field: GoalField, tables: _ArcTables, x: NDArray[np.float64], y: NDArray[np.float64]
+) -> tuple[NDArray[np.int8], NDArray[np.int32]]:
+    """:func:`_chunk_roots`' decision for clear centres, one cell at a time in compiled code."""
+    p = field.planner
+    geo = p.geo
+    search = field.labels
+    brute = _compiled.kernel("pointnav_core.geodesic._roots_kernel", "balls_holding")
+    best_links = _compiled.kernel("pointnav_core.geodesic._roots_kernel", "best_links")
+    if p.n_nodes <= _BRUTE_NODES:
+        start, cand = brute(x, y, p.cx, p.cy, p._balls.reach)
+    else:
+        owner, cand = p.nodes_seeing(x, y)
+        start = np.searchsorted(owner, np.arange(len(x) + 1)).astype(np.int64)
+    p.arcs_free(np.zeros(0, np.int64), np.zeros(0, np.int64), np.zeros(0), np.zeros(0))  # builds its tables
+    edges = geo._poly_edges if geo.polygons else (np.zeros((0, 4)), *(np.zeros(0, np.int64),) * 2, *(np.zeros(0),) * 4)
+    kind = np.zeros(len(x), dtype=np.int8)
+    label = np.full(len(x), -1, dtype=np.int64)
+    best_links(
+        x, y, float(field.goal[0]), float(field.goal[1]), start, cand, int(start[-1]), _SLACK,
+        p.cx, p.cy, p.phi0, p.span, p.radius, ANG_TOL, TOUCH_TOL,
+        p.sight_profile, tables.cheapest, tables.start.astype(np.int64), tables.labels.astype(np.int64), search.pos, search.cost,
+        p._blocked, p._has_blocked, float(geo.origin[0]), float(geo.origin[1]), float(geo.resolution), geo._rowcum,
+        geo.outside_blocked, *edges, bool(geo.polygons), kind, label,
+    )
+    return kind, label.astype(np.int32)
 
 
 def _candidates(

@@ -27,7 +27,7 @@ equal. Lengths are in metres.
 from __future__ import annotations
 
 import math
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from numpy.typing import NDArray
@@ -41,12 +41,14 @@ from pointnav_core.geodesic.tangents import ANG_TOL
 if TYPE_CHECKING:
     from pointnav_core.collision import FloorCollision
 
-__all__ = ["NodeBalls", "node_sights", "sight_rays"]
+__all__ = ["PROFILE_BINS", "NodeBalls", "blocked_by_profile", "node_sights", "sight_rays"]
 
 #: Half-width (rad) of the sectors rays start with: 64 rays over a grid corner's quarter arc.
 FIRST_HALF_WIDTH = math.pi / 256
 #: Narrowest sector (rad) before a ray gives up and bounds its node by the map's diagonal.
 MIN_HALF_WIDTH = 1e-5
+#: Direction bins of a node's sight profile.
+PROFILE_BINS = 128
 #: Most sectors waiting at once per node and side (the first ones plus one per split level).
 _STACK = 8192
 #: Most (point, node) pairs a query measures one by one rather than through the trees.
@@ -55,17 +57,21 @@ _BRUTE = 2_000_000
 _FAR = 1e300
 
 
-def sight_rays(cx, cy, phi0, span, r, margin, edt, near_r, near_c, outside, h0, min_h, limit, out):  # pragma: no cover
+def sight_rays(cx, cy, phi0, span, r, margin, edt, near_r, near_c, outside, h0, min_h, limit, out, profile):  # pragma: no cover
     """Per node, the longest ray (cells) over both winding sides: ``out[n]``.
 
     Everything is in padded grid units (the grid with one ring of blocked cells around it):
     node centres ``(cx, cy)``, radius ``r``, ``margin`` (the clearance test's touching
     tolerance, doubled), ``edt`` (distance from each cell centre to the nearest blocked cell
     centre) and the row and column of that blocked cell (``near_r``, ``near_c``); and
-    whether everything off the grid is blocked (``outside``).
-    Plain Python on scalars, so that numba compiles the very same function.
+    whether everything off the grid is blocked (``outside``). ``profile[n, b]`` (zeros on
+    entry) gets the longest ray of every sector that overlaps direction bin ``b`` (bins of
+    ``2 pi / B`` from angle 0): no clear segment leaving the arc in a direction of bin ``b``
+    is longer. Plain Python on scalars, so that numba compiles the very same function.
     """
     n_rows, n_cols = edt.shape
+    n_bins = profile.shape[1]
+    bin_width = 2.0 * math.pi / n_bins
     stack_t = np.empty(_STACK)
     stack_h = np.empty(_STACK)
     for n in range(cx.shape[0]):
@@ -115,6 +121,12 @@ def sight_rays(cx, cy, phi0, span, r, margin, edt, near_r, near_c, outside, h0, 
                     t += max(edt[row, col] - math.sqrt(2.0) - r, 0.25)
                 if length >= 0.0:
                     best = max(best, length)
+                    # Every direction bin the sector overlaps (its edges widened by the tolerance).
+                    b0 = math.floor((theta - reach) / bin_width)
+                    b1 = math.floor((theta + reach) / bin_width)
+                    for b in range(b0, b1 + 1):
+                        k = b % n_bins
+                        profile[n, k] = max(profile[n, k], length)
                 elif hw <= min_h or top + 2 > _STACK:
                     gave_up = True
                     break
@@ -127,13 +139,18 @@ def sight_rays(cx, cy, phi0, span, r, margin, edt, near_r, near_c, outside, h0, 
             if gave_up:
                 break
         out[n] = limit if gave_up else best
+        if gave_up:
+            for k in range(n_bins):
+                profile[n, k] = limit
 
 
 def node_sights(
     geo: FloorCollision, radius: float, cx: NDArray[np.float64], cy: NDArray[np.float64],
     phi0: NDArray[np.float64], span: NDArray[np.float64],
-) -> NDArray[np.float64]:
-    """Strict bounds (m) on the length of a clear segment leaving each node's arc.
+) -> tuple[NDArray[np.float64], NDArray[np.float32]]:
+    """Strict bounds (m) on the length of a clear segment leaving each node's arc: overall,
+    and per direction (:data:`PROFILE_BINS` bins of ``2 pi / PROFILE_BINS`` from angle 0,
+    float32 rounded up: :func:`blocked_by_profile`).
 
     Parameters
     ----------
@@ -147,28 +164,42 @@ def node_sights(
     """
     n = len(cx)
     if not n:
-        return np.zeros(0)
+        return np.zeros(0), np.zeros((0, PROFILE_BINS), np.float32)
     res = geo.resolution
     pad = np.pad(np.asarray(geo.blocked, dtype=bool), 1, constant_values=geo.outside_blocked)
     if not pad.any():  # nothing to stop a ray: every node may see the whole map
-        return np.full(n, math.hypot(*pad.shape) * res + 2.0 * res) if geo.outside_blocked else np.full(n, _FAR)
+        far = math.hypot(*pad.shape) * res + 2.0 * res if geo.outside_blocked else _FAR
+        return np.full(n, far), np.full((n, PROFILE_BINS), far if far < _FAR else np.inf, np.float32)
     edt, (near_r, near_c) = ndimage.distance_transform_edt(~pad, return_indices=True)
     limit = math.hypot(*pad.shape) + 2.0
     out = np.empty(n)
+    profile = np.zeros((n, PROFILE_BINS))
     kernel = _compiled.kernel("pointnav_core.geodesic._sight_kernel", "sight_rays")
     march = kernel if kernel is not None else sight_rays
     march(
         np.ascontiguousarray((cx - geo.origin[0]) / res + 1.0), np.ascontiguousarray((cy - geo.origin[1]) / res + 1.0),
         np.ascontiguousarray(phi0, dtype=np.float64), np.ascontiguousarray(span, dtype=np.float64), radius / res,
         2.0 * TOUCH_TOL / res, np.ascontiguousarray(edt, dtype=np.float64), near_r.astype(np.int64), near_c.astype(np.int64),
-        bool(geo.outside_blocked), FIRST_HALF_WIDTH, MIN_HALF_WIDTH, limit, out,
+        bool(geo.outside_blocked), FIRST_HALF_WIDTH, MIN_HALF_WIDTH, limit, out, profile,
     )
     # One cell to spare for the rounding of grid coordinates; a ray that reached the limit on
     # an open map proves nothing.
     out = (out + 1.0) * res
+    profile = (profile + 1.0) * res
     if not geo.outside_blocked:
         out[out >= limit * res] = _FAR
-    return out
+        profile[profile >= limit * res] = _FAR
+    # float32, rounded up: a bound stays a bound (past float32's range: no bound).
+    profile = np.where(profile >= _FAR, np.inf, profile).astype(np.float32)
+    return out, np.nextafter(profile, np.float32(np.inf))
+
+
+def blocked_by_profile(profile: NDArray[np.float32], node: Any, dx: Any, dy: Any) -> Any:
+    """Whether a segment leaving ``node``'s arc along ``(dx, dy)`` (m) is surely not clear:
+    longer than the node's sight profile allows in its direction bin."""
+    bins = profile.shape[1]
+    b = np.floor(np.mod(np.arctan2(dy, dx), 2 * np.pi) / (2 * np.pi / bins)).astype(np.int64) % bins
+    return np.hypot(dx, dy) > profile[node, b]
 
 
 class NodeBalls:

@@ -1,0 +1,168 @@
+"""The compiled path of :func:`pointnav_core.geodesic.roots.cell_roots` (imports numba).
+
+Imported only through :func:`pointnav_core._compiled.kernel` when numba is installed (the
+``fast`` extra). :func:`best_links` makes the numpy path's decision one cell at a time: of
+the direct segment and every visible link, the smallest ``(total, order)``. A cell's
+candidates are taken in the order of their lower bounds and the cell is done once the next
+bound passes its best, as the numpy path's bands do; the segment test is the collision
+kernel's (cell squares, then polygon edges), after the node's sight profile has ruled out
+the links that surely are hidden (:func:`pointnav_core.geodesic.sight.blocked_by_profile`). The scalar math may round differently from
+numpy's array loops in the last bit, so the two paths agree in value (a property test holds
+them equal within 1e-9 m), and in the root wherever two roots do not tie.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numba
+import numpy as np
+
+from pointnav_core._collision_kernel import segment_hits_cells, segment_hits_polygons
+
+__all__ = ["balls_holding", "best_links"]
+
+_jit = numba.njit(cache=True, nogil=True, error_model="numpy")
+
+
+@_jit
+def _arc_free(blocked, has_blocked, span, node, s, p1, p2, tol):  # pragma: no cover
+    # Planner.arcs_free for one arc piece: no blocked sample strictly between p1 and p2.
+    if not has_blocked[node]:
+        return True
+    if s > 0:
+        lo = p1
+        hi = p2
+    else:
+        lo = span[node] - p2
+        hi = span[node] - p1
+    for j in range(blocked.shape[1]):
+        b = blocked[node, j]
+        if lo + tol < b and b < hi - tol:
+            return False
+    return True
+
+
+@_jit
+def balls_holding(x, y, cx, cy, reach):  # pragma: no cover
+    """``NodeBalls.query`` by measuring every (point, node) pair: ``start`` (per point, CSR
+    offsets) and ``cand`` (nodes, ascending within a point)."""
+    n = x.shape[0]
+    start = np.zeros(n + 1, dtype=np.int64)
+    for i in range(n):
+        count = 0
+        for c in range(cx.shape[0]):
+            if math.hypot(cx[c] - x[i], cy[c] - y[i]) <= reach[c]:
+                count += 1
+        start[i + 1] = start[i] + count
+    cand = np.empty(start[n], dtype=np.int64)
+    for i in range(n):
+        k = start[i]
+        for c in range(cx.shape[0]):
+            if math.hypot(cx[c] - x[i], cy[c] - y[i]) <= reach[c]:
+                cand[k] = c
+                k += 1
+    return start, cand
+
+
+@_jit
+def best_links(  # pragma: no cover
+    x, y, gx, gy, start, cand, total, slack,
+    cx, cy, phi0, span, r, ang_tol, touch_tol,
+    profile, cheapest, lab_start, labels, lab_pos, lab_cost, blocked, has_blocked,
+    ox, oy, res, rowcum, outside_blocked, boxes, first, last, ex0, ey0, ex1, ey1, use_polygons,
+    kind, best_lab,
+):
+    """Per clear cell centre ``(x[i], y[i])``, over its candidate nodes ``start[i]:start[i + 1]``
+    of ``cand``: the kind (0 none, 1 the goal ``(gx, gy)`` directly, 2 a label) and label of
+    the smallest visible ``(total, order)``, the direct segment first. ``kind`` and
+    ``best_lab`` are written."""
+    two_pi = 2.0 * math.pi
+    n_bins = profile.shape[1]
+    bin_width = two_pi / n_bins
+    inv = 1.0 / res
+    rho = max(r - touch_tol, touch_tol) * inv
+    reach = max(r - 2 * touch_tol, touch_tol / 2)
+    for i in range(x.shape[0]):
+        px = x[i]
+        py = y[i]
+        best = math.inf
+        if not _hits(px, py, gx, gy, ox, oy, inv, rho, rowcum, outside_blocked, reach, boxes, first, last, ex0, ey0,
+                     ex1, ey1, use_polygons):
+            best = math.hypot(gx - px, gy - py)
+        kind[i] = 1 if best < math.inf else 0
+        best_lab[i] = -1
+        lo_i = start[i]
+        hi_i = start[i + 1]
+        # Each candidate's lower bound: its arcs' cheapest label plus the distance less r.
+        low = np.empty(hi_i - lo_i)
+        for k in range(lo_i, hi_i):
+            c = cand[k]
+            cheap = min(cheapest[2 * c], cheapest[2 * c + 1])
+            dist = math.hypot(cx[c] - px, cy[c] - py)
+            low[k - lo_i] = cheap + (dist - r) - slack * (1.0 + cheap + dist)
+        order_of = np.argsort(low, kind="mergesort")
+        best_order = -1
+        for kk in order_of:
+            if not low[kk] < best:
+                break
+            k = kk + lo_i
+            c = cand[k]
+            dx = cx[c] - px
+            dy = cy[c] - py
+            L = math.hypot(dx, dy)
+            if not (L >= r - touch_tol):
+                continue
+            safe = max(L, r)
+            for side_rank in range(2):
+                s = 1.0 if side_rank == 0 else -1.0
+                heading = math.atan2(dy, dx) + (-s * math.asin(min(max(r / safe, -1.0), 1.0)))
+                ang = heading - s * (math.pi / 2)
+                length = math.sqrt(max(L * L - r * r, 0.0))
+                ccw = (ang - phi0[c]) % two_pi
+                if ccw > two_pi - ang_tol:
+                    ccw = 0.0
+                if not ccw <= span[c] + ang_tol:
+                    continue
+                ccw = min(ccw, span[c])
+                pos = ccw if s > 0 else span[c] - ccw
+                dep = span[c] - pos
+                order = side_rank * total + kk
+                # Surely hidden: longer than the node's sight in the direction it would leave.
+                qx = cx[c] + r * math.cos(ang)
+                qy = cy[c] + r * math.sin(ang)
+                b = int(math.floor(((math.atan2(py - qy, px - qx)) % two_pi) / bin_width)) % n_bins
+                if length > profile[c, b]:
+                    continue
+                # The link's best label on the arc its reverse path leaves along (winding -s).
+                g = 2 * c + (1 if s > 0 else 0)
+                value = math.inf
+                lab = -1
+                for j in range(lab_start[g], lab_start[g + 1]):
+                    lb = labels[j]
+                    lp = lab_pos[lb]
+                    if lp <= dep + ang_tol and _arc_free(blocked, has_blocked, span, c, -s, lp, dep, ang_tol):
+                        v = lab_cost[lb] + r * max(dep - lp, 0.0) + length
+                        if v < value:
+                            value = v
+                            lab = lb
+                if lab < 0:
+                    continue
+                if not (value < best or (value == best and order < best_order)):
+                    continue
+                if _hits(px, py, qx, qy, ox, oy, inv, rho, rowcum, outside_blocked, reach, boxes, first, last, ex0, ey0,
+                         ex1, ey1, use_polygons):
+                    continue
+                best = value
+                best_order = order
+                best_lab[i] = lab
+                kind[i] = 2
+
+
+@_jit
+def _hits(ax, ay, bx, by, ox, oy, inv, rho, rowcum, outside_blocked, reach, boxes, first, last, ex0, ey0, ex1, ey1,
+          use_polygons):  # pragma: no cover
+    # FloorCollision.segments_clear's test, negated, for one segment in world metres.
+    if segment_hits_cells((ax - ox) * inv, (ay - oy) * inv, (bx - ox) * inv, (by - oy) * inv, rho, rowcum, outside_blocked):
+        return True
+    return use_polygons and segment_hits_polygons(ax, ay, bx, by, reach, boxes, first, last, ex0, ey0, ex1, ey1)
