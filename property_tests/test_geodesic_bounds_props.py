@@ -130,3 +130,23 @@ def test_the_compiled_goal_search_equals_scipys(floor, seed) -> None:
     assert np.array_equal(np.isfinite(fast.cost), np.isfinite(plain.cost))
     ok = np.isfinite(fast.cost)
     np.testing.assert_allclose(fast.cost[ok], plain.cost[ok], rtol=1e-12, atol=1e-12)
+
+
+@settings(max_examples=30, deadline=None, suppress_health_check=[HealthCheck.too_slow, HealthCheck.filter_too_much])
+@given(floor=slit_floors(), seed=st.integers(0, 2**31 - 1))
+def test_the_compiled_point_links_equal_the_numpy_ones(floor, seed) -> None:
+    """``Planner.point_links``: the compiled tangents (after the sight profile's cut) are the
+    numpy path's, node for node, in order."""
+    import pytest
+
+    from pointnav_core import _compiled
+
+    pytest.importorskip("numba")
+    scene, radius = floor
+    planner = scene.planner(0, radius)
+    for p in _points(scene, radius, np.random.default_rng(seed), 5):
+        fast = planner.point_links(*p)
+        with _compiled.numpy_paths():
+            plain = planner.point_links(*p)
+        assert [(n, s) for n, s, _, _ in fast] == [(n, s) for n, s, _, _ in plain]
+        np.testing.assert_allclose([v[2:] for v in fast], [v[2:] for v in plain], rtol=0, atol=1e-12)

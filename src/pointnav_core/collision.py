@@ -119,6 +119,13 @@ class FloorCollision:
         if "_poly_edges" not in state:
             self._poly_edges = _polygon_edges(self.polygons)
 
+    def polygon_edges(self) -> tuple[NDArray[Any], ...]:
+        """The polygons as the compiled tests read them: ``boxes (K, 4), first, last (K,),
+        x0, y0, x1, y1 (E,)`` (empty without polygons)."""
+        if self._poly_edges is not None and self.polygons:
+            return self._poly_edges
+        return (np.zeros((0, 4)), np.zeros(0, np.int64), np.zeros(0, np.int64), *(np.zeros(0),) * 4)
+
     # ------------------------------------------------------------------ queries
     def points_clear(self, points: ArrayLike, radius: float) -> NDArray[np.bool_]:
         """Whether discs of ``radius`` metres centred at world ``points`` miss the blocked set.

@@ -20,7 +20,7 @@ import numpy as np
 
 from pointnav_core._collision_kernel import segment_hits_cells, segment_hits_polygons
 
-__all__ = ["balls_holding", "best_links"]
+__all__ = ["balls_holding", "best_links", "point_links"]
 
 _jit = numba.njit(cache=True, nogil=True, error_model="numpy")
 
@@ -48,21 +48,17 @@ def balls_holding(x, y, cx, cy, reach):  # pragma: no cover
     """``NodeBalls.query`` by measuring every (point, node) pair: ``start`` (per point, CSR
     offsets) and ``cand`` (nodes, ascending within a point)."""
     n = x.shape[0]
+    m = cx.shape[0]
     start = np.zeros(n + 1, dtype=np.int64)
+    found = np.empty(n * m, dtype=np.int64)
+    k = 0
     for i in range(n):
-        count = 0
-        for c in range(cx.shape[0]):
+        for c in range(m):
             if math.hypot(cx[c] - x[i], cy[c] - y[i]) <= reach[c]:
-                count += 1
-        start[i + 1] = start[i] + count
-    cand = np.empty(start[n], dtype=np.int64)
-    for i in range(n):
-        k = start[i]
-        for c in range(cx.shape[0]):
-            if math.hypot(cx[c] - x[i], cy[c] - y[i]) <= reach[c]:
-                cand[k] = c
+                found[k] = c
                 k += 1
-    return start, cand
+        start[i + 1] = k
+    return start, found[:k].copy()
 
 
 @_jit
@@ -166,3 +162,54 @@ def _hits(ax, ay, bx, by, ox, oy, inv, rho, rowcum, outside_blocked, reach, boxe
     if segment_hits_cells((ax - ox) * inv, (ay - oy) * inv, (bx - ox) * inv, (by - oy) * inv, rho, rowcum, outside_blocked):
         return True
     return use_polygons and segment_hits_polygons(ax, ay, bx, by, reach, boxes, first, last, ex0, ey0, ex1, ey1)
+
+
+@_jit
+def point_links(  # pragma: no cover
+    px, py, cand, cx, cy, phi0, span, r, ang_tol, touch_tol, profile,
+    ox, oy, res, rowcum, outside_blocked, boxes, first, last, ex0, ey0, ex1, ey1, use_polygons,
+    node_out, side_out, pos_out, length_out,
+):
+    """``Planner.point_links`` of ``(px, py)`` over the candidate nodes ``cand``: each side
+    (+1 first), each candidate in order, the tangents that land on the node's arc and are
+    clear. Writes them into the ``*_out`` arrays (room for ``2 * len(cand)``); returns how many."""
+    two_pi = 2.0 * math.pi
+    n_bins = profile.shape[1]
+    bin_width = two_pi / n_bins
+    inv = 1.0 / res
+    rho = max(r - touch_tol, touch_tol) * inv
+    reach = max(r - 2 * touch_tol, touch_tol / 2)
+    n = 0
+    for side_rank in range(2):
+        s = 1.0 if side_rank == 0 else -1.0
+        for k in range(cand.shape[0]):
+            c = cand[k]
+            dx = cx[c] - px
+            dy = cy[c] - py
+            L = math.hypot(dx, dy)
+            if not (L >= r - touch_tol):
+                continue
+            safe = max(L, r)
+            heading = math.atan2(dy, dx) + (-s * math.asin(min(max(r / safe, -1.0), 1.0)))
+            ang = heading - s * (math.pi / 2)
+            length = math.sqrt(max(L * L - r * r, 0.0))
+            ccw = (ang - phi0[c]) % two_pi
+            if ccw > two_pi - ang_tol:
+                ccw = 0.0
+            if not ccw <= span[c] + ang_tol:
+                continue
+            ccw = min(ccw, span[c])
+            qx = cx[c] + r * math.cos(ang)
+            qy = cy[c] + r * math.sin(ang)
+            b = int(math.floor(((math.atan2(py - qy, px - qx)) % two_pi) / bin_width)) % n_bins
+            if length > profile[c, b]:
+                continue
+            if _hits(px, py, qx, qy, ox, oy, inv, rho, rowcum, outside_blocked, reach, boxes, first, last, ex0, ey0,
+                     ex1, ey1, use_polygons):
+                continue
+            node_out[n] = c
+            side_out[n] = side_rank
+            pos_out[n] = ccw if s > 0 else span[c] - ccw
+            length_out[n] = length
+            n += 1
+    return n

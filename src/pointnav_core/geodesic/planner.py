@@ -49,6 +49,7 @@ from scipy.spatial import cKDTree
 from tqdm.auto import tqdm
 
 from pointnav_core.collision import TOUCH_TOL, FloorCollision, convex_corners
+from pointnav_core import _compiled
 from pointnav_core.frozen import ThawOnUnpickle
 from pointnav_core.paths import path_length, resample_path
 from pointnav_core.geodesic import cache
@@ -338,6 +339,16 @@ class Planner(ThawOnUnpickle):
         links: list[tuple[int, int, float, float]] = []
         if not len(cand):
             return links
+        kernel = _compiled.kernel("pointnav_core.geodesic._roots_kernel", "point_links")
+        if kernel is not None and (self.geo._poly_edges is not None or not self.geo.polygons):
+            # The same tangents in compiled code (the sight profile first rules out hidden ones).
+            geo = self.geo
+            node, side = np.empty(2 * len(cand), np.int64), np.empty(2 * len(cand), np.int64)
+            pos, length = np.empty(2 * len(cand)), np.empty(2 * len(cand))
+            n = kernel(float(x), float(y), cand, self.cx, self.cy, self.phi0, self.span, r, ANG_TOL, TOUCH_TOL,
+                       self.sight_profile, float(geo.origin[0]), float(geo.origin[1]), float(geo.resolution),
+                       geo._rowcum, geo.outside_blocked, *geo.polygon_edges(), bool(geo.polygons), node, side, pos, length)
+            return list(zip(node[:n].tolist(), (1 - 2 * side[:n]).tolist(), pos[:n].tolist(), length[:n].tolist()))
         for s in (1, -1):
             ang, length, _, ok = tangent_from_point(x, y, self.cx[cand], self.cy[cand], r, s)
             ccw, ok_arc = ccw_pos(ang, self.phi0[cand], self.span[cand])

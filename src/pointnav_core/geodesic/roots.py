@@ -224,7 +224,7 @@ def _compiled_roots(
         owner, cand = p.nodes_seeing(x, y)
         start = np.searchsorted(owner, np.arange(len(x) + 1)).astype(np.int64)
     p.arcs_free(np.zeros(0, np.int64), np.zeros(0, np.int64), np.zeros(0), np.zeros(0))  # builds its tables
-    edges = geo._poly_edges if geo.polygons else (np.zeros((0, 4)), *(np.zeros(0, np.int64),) * 2, *(np.zeros(0),) * 4)
+    edges = geo.polygon_edges()
     kind = np.zeros(len(x), dtype=np.int8)
     label = np.full(len(x), -1, dtype=np.int64)
     best_links(
