@@ -16,7 +16,8 @@ import numpy as np
 from numpy.typing import NDArray
 
 from pointnav_core import _compiled
-from pointnav_core.geodesic.tangents import TWO_PI, ccw_pos
+from pointnav_core.geodesic.sight import blocked_by_profile
+from pointnav_core.geodesic.tangents import ccw_pos
 
 if TYPE_CHECKING:
     from pointnav_core.geodesic.planner import Planner
@@ -81,9 +82,14 @@ def build_edges(p: Planner, nodes: NDArray[np.int64]) -> None:
     if found:
         pa = np.concatenate(seg_a)
         pb = np.concatenate(seg_b)
-        # Cheap rejection first: a clear segment never enters a cell no disc point can use.
-        # Coarse samples reject most candidates at a fraction of the fine pass's cost.
-        sub = np.arange(len(pa))
+        # Cheap rejections first. A clear edge is no longer than either node's sight in its
+        # direction (geodesic.sight), and never enters a cell no disc point can use: coarse
+        # samples reject most candidates at a fraction of the fine pass's cost.
+        e_a = np.concatenate([f[0] for f in found])
+        e_b = np.concatenate([f[2] for f in found])
+        d = pb - pa
+        sub = np.flatnonzero(~blocked_by_profile(p.sight_profile, e_a, d[:, 0], d[:, 1])
+                             & ~blocked_by_profile(p.sight_profile, e_b, -d[:, 0], -d[:, 1]))
         for step in (2.0, 0.5):
             ok = np.concatenate(
                 [_misses_full(p, pa[sub[i : i + _SEG_CHUNK]], pb[sub[i : i + _SEG_CHUNK]], step) for i in range(0, len(sub), _SEG_CHUNK)]

@@ -24,7 +24,7 @@ from collections.abc import Sequence
 from typing import Any
 
 import numpy as np
-from numpy.typing import ArrayLike, NDArray
+from numpy.typing import ArrayLike
 
 from pointnav_core.geodesic import GoalField
 from pointnav_core.geodesic.tangents import ANG_TOL, TWO_PI
