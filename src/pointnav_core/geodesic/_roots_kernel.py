@@ -2,13 +2,15 @@
 
 Imported only through :func:`pointnav_core._compiled.kernel` when numba is installed (the
 ``fast`` extra). :func:`best_links` makes the numpy path's decision one cell at a time: of
-the direct segment and every visible link, the smallest ``(total, order)``. A cell's
-candidates are taken in the order of their lower bounds and the cell is done once the next
-bound passes its best, as the numpy path's bands do; the segment test is the collision
-kernel's (cell squares, then polygon edges), after the node's sight profile has ruled out
-the links that surely are hidden (:func:`pointnav_core.geodesic.sight.blocked_by_profile`). The scalar math may round differently from
-numpy's array loops in the last bit, so the two paths agree in value (a property test holds
-them equal within 1e-9 m), and in the root wherever two roots do not tie.
+the direct segment and every visible link, the smallest ``(total, order)``. The previous
+cell's winner is tried first (neighbours mostly share a root); every other candidate whose
+lower bound is below the best so far is evaluated, in any order, since the smallest
+``(total, order)`` does not depend on it. The segment test is the collision kernel's (cell
+squares, then polygon edges), after the node's sight profile has ruled out the links that
+surely are hidden (:func:`pointnav_core.geodesic.sight.blocked_by_profile`). The scalar
+math may round differently from numpy's array loops in the last bit, so the two paths agree
+in value (a property test holds them equal within 1e-9 m), and in the root wherever two
+roots do not tie.
 """
 
 from __future__ import annotations
@@ -65,7 +67,7 @@ def balls_holding(x, y, cx, cy, reach):  # pragma: no cover
 def best_links(  # pragma: no cover
     x, y, gx, gy, start, cand, total, slack,
     cx, cy, phi0, span, r, ang_tol, touch_tol,
-    profile, cheapest, lab_start, labels, lab_pos, lab_cost, blocked, has_blocked,
+    profile, cheapest, lab_start, graph_end, labels, lab_pos, lab_cost, blocked, has_blocked,
     ox, oy, res, rowcum, outside_blocked, boxes, first, last, ex0, ey0, ex1, ey1, use_polygons,
     kind, best_lab,
 ):
@@ -79,9 +81,11 @@ def best_links(  # pragma: no cover
     inv = 1.0 / res
     rho = max(r - touch_tol, touch_tol) * inv
     reach = max(r - 2 * touch_tol, touch_tol / 2)
+    hint = -1
     for i in range(x.shape[0]):
         px = x[i]
         py = y[i]
+        winner = -1
         best = math.inf
         if not _hits(px, py, gx, gy, ox, oy, inv, rho, rowcum, outside_blocked, reach, boxes, first, last, ex0, ey0,
                      ex1, ey1, use_polygons):
@@ -97,11 +101,21 @@ def best_links(  # pragma: no cover
             cheap = min(cheapest[2 * c], cheapest[2 * c + 1])
             dist = math.hypot(cx[c] - px, cy[c] - py)
             low[k - lo_i] = cheap + (dist - r) - slack * (1.0 + cheap + dist)
-        order_of = np.argsort(low, kind="mergesort")
+        # The previous cell's winner first (neighbours mostly share a root): its value bounds
+        # the rest, taken in list order and skipped where their bound is no better. The
+        # result is the smallest (total, order) whatever the order of evaluation.
         best_order = -1
-        for kk in order_of:
+        first_k = -1
+        if hint >= 0:
+            j = np.searchsorted(cand[lo_i:hi_i], hint)
+            if j < hi_i - lo_i and cand[lo_i + j] == hint:
+                first_k = j
+        for step in range(-1, hi_i - lo_i):
+            kk = first_k if step < 0 else step
+            if kk < 0 or (step >= 0 and kk == first_k):
+                continue
             if not low[kk] < best:
-                break
+                continue
             k = kk + lo_i
             c = cand[k]
             dx = cx[c] - px
@@ -131,10 +145,24 @@ def best_links(  # pragma: no cover
                 if length > profile[c, b]:
                     continue
                 # The link's best label on the arc its reverse path leaves along (winding -s).
+                # Along the arc, Dijkstra's costs grow by at most r per radian from vertex to
+                # vertex, so of the graph's vertices the last at or before the departure is
+                # the best (a blocked piece of arc between it and the departure blocks every
+                # earlier one too); the field's own arrivals are looked at one by one.
                 g = 2 * c + (1 if s > 0 else 0)
                 value = math.inf
                 lab = -1
-                for j in range(lab_start[g], lab_start[g + 1]):
+                lo_j = lab_start[g]
+                hi_j = graph_end[g]
+                while lo_j < hi_j:
+                    mid = (lo_j + hi_j) // 2
+                    if lab_pos[labels[mid]] <= dep + ang_tol:
+                        lo_j = mid + 1
+                    else:
+                        hi_j = mid
+                for j in range(max(lo_j - 1, lab_start[g]), lab_start[g + 1]):
+                    if j < graph_end[g] and j != lo_j - 1:
+                        continue
                     lb = labels[j]
                     lp = lab_pos[lb]
                     if lp <= dep + ang_tol and _arc_free(blocked, has_blocked, span, c, -s, lp, dep, ang_tol):
@@ -153,6 +181,8 @@ def best_links(  # pragma: no cover
                 best_order = order
                 best_lab[i] = lab
                 kind[i] = 2
+                winner = c
+        hint = winner
 
 
 @_jit

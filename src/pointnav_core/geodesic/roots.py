@@ -53,7 +53,9 @@ CHUNK = 256
 #: Most (cell, node) candidates a chunk may hold when every node falls in every ball.
 _CANDIDATES = 2**20
 #: Most nodes for which the compiled path measures every (cell, node) pair rather than ask the trees.
-_BRUTE_NODES = 4096
+_BRUTE_NODES = 1024
+#: Most (cell, node) pairs of one chunk of the compiled path.
+_COMPILED_PAIRS = 2**22
 #: Width (cells) of the first band of candidate bounds evaluated per cell; each round doubles it.
 _FIRST_BAND = 8
 #: Relative loosening of the candidate bounds (m per m), far above rounding error.
@@ -65,7 +67,9 @@ class _ArcTables:
 
     ``labels[start[g]:start[g + 1]]`` are ``search.on_arc(node, side)`` for the arc group
     ``g = 2 * node + (side < 0)``, in its order (graph vertices, then the field's own
-    arrivals); ``cheapest[g]`` is the cheapest reached label's cost of group ``g``.
+    arrivals); ``cheapest[g]`` is the cheapest reached label's cost of group ``g``;
+    ``labels[start[g]:graph_end[g]]`` are its graph vertices, in the order of their
+    positions on the arc (``ArcGraph`` sorts them so), the rest the field's own arrivals.
     """
 
     def __init__(self, planner: Planner, search: FieldLabels) -> None:
@@ -74,6 +78,8 @@ class _ArcTables:
         order = np.argsort(group, kind="stable")
         self.labels = labs[order]
         self.start = np.searchsorted(group[order], np.arange(2 * planner.n_nodes + 1), side="left")
+        graph = self.labels < search.graph.n_vertices
+        self.graph_end = self.start[:-1] + np.bincount(search.group[self.labels[graph]], minlength=2 * planner.n_nodes)
         # The cheapest reached label of each arc group (inf where none is reached).
         self.cheapest = np.full(2 * planner.n_nodes, math.inf)
         some = np.flatnonzero(self.start[1:] > self.start[:-1])
@@ -131,7 +137,11 @@ def cell_roots(field: GoalField, cells: NDArray[np.int64]) -> tuple[NDArray[np.i
     tables = _ArcTables(p, field._search) if p.n_nodes else None
     if tables is not None and _compiled.kernel("pointnav_core.geodesic._roots_kernel", "best_links") is not None \
             and (geo._poly_edges is not None or not geo.polygons):
-        kind[clear], label[clear] = _compiled_roots(field, tables, xs[clear], ys[clear])
+        # In chunks: the candidate lists of a chunk are held at once.
+        step = max(16, _COMPILED_PAIRS // max(p.n_nodes, 1))
+        for i in range(0, len(clear), step):
+            sub = clear[i : i + step]
+            kind[sub], label[sub] = _compiled_roots(field, tables, xs[sub], ys[sub])
         return kind, label
     # Fewer cells per chunk where many nodes could fall in a centre's ball.
     chunk = max(16, min(CHUNK, _CANDIDATES // max(p.n_nodes, 1)))
@@ -230,7 +240,8 @@ def _compiled_roots(
     best_links(
         x, y, float(field.goal[0]), float(field.goal[1]), start, cand, int(start[-1]), _SLACK,
         p.cx, p.cy, p.phi0, p.span, p.radius, ANG_TOL, TOUCH_TOL,
-        p.sight_profile, tables.cheapest, tables.start.astype(np.int64), tables.labels.astype(np.int64), search.pos, search.cost,
+        p.sight_profile, tables.cheapest, tables.start.astype(np.int64), tables.graph_end.astype(np.int64),
+        tables.labels.astype(np.int64), search.pos, search.cost,
         p._blocked, p._has_blocked, float(geo.origin[0]), float(geo.origin[1]), float(geo.resolution), geo._rowcum,
         geo.outside_blocked, *edges, bool(geo.polygons), kind, label,
     )
