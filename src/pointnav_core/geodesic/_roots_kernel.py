@@ -46,6 +46,36 @@ def _arc_free(blocked, has_blocked, span, node, s, p1, p2, tol):  # pragma: no c
 
 
 @_jit
+def _link(px, py, c, s, cx, cy, phi0, span, r, ang_tol, touch_tol, profile):  # pragma: no cover
+    """The tangent from ``(px, py)`` to node ``c`` arriving winding ``s`` (``tangents.
+    tangent_from_point`` and ``ccw_pos`` on scalars): ``(ok, ccw, length, qx, qy)``, ``ok``
+    False where the point is inside the circle, the tangent misses the arc, or the node's
+    sight profile says it is surely hidden."""
+    two_pi = 2.0 * math.pi
+    dx = cx[c] - px
+    dy = cy[c] - py
+    L = math.hypot(dx, dy)
+    if not (L >= r - touch_tol):
+        return False, 0.0, 0.0, 0.0, 0.0
+    heading = math.atan2(dy, dx) + (-s * math.asin(min(max(r / max(L, r), -1.0), 1.0)))
+    ang = heading - s * (math.pi / 2)
+    length = math.sqrt(max(L * L - r * r, 0.0))
+    ccw = (ang - phi0[c]) % two_pi
+    if ccw > two_pi - ang_tol:
+        ccw = 0.0
+    if not ccw <= span[c] + ang_tol:
+        return False, 0.0, 0.0, 0.0, 0.0
+    qx = cx[c] + r * math.cos(ang)
+    qy = cy[c] + r * math.sin(ang)
+    # Surely hidden: longer than the node's sight in the direction it would leave.
+    n_bins = profile.shape[1]
+    b = int(math.floor((math.atan2(py - qy, px - qx) % two_pi) / (two_pi / n_bins))) % n_bins
+    if length > profile[c, b]:
+        return False, 0.0, 0.0, 0.0, 0.0
+    return True, min(ccw, span[c]), length, qx, qy
+
+
+@_jit
 def balls_holding(x, y, cx, cy, reach):  # pragma: no cover
     """``NodeBalls.query`` by measuring every (point, node) pair: ``start`` (per point, CSR
     offsets) and ``cand`` (nodes, ascending within a point)."""
@@ -75,9 +105,6 @@ def best_links(  # pragma: no cover
     of ``cand``: the kind (0 none, 1 the goal ``(gx, gy)`` directly, 2 a label) and label of
     the smallest visible ``(total, order)``, the direct segment first. ``kind`` and
     ``best_lab`` are written."""
-    two_pi = 2.0 * math.pi
-    n_bins = profile.shape[1]
-    bin_width = two_pi / n_bins
     inv = 1.0 / res
     rho = max(r - touch_tol, touch_tol) * inv
     reach = max(r - 2 * touch_tol, touch_tol / 2)
@@ -118,32 +145,14 @@ def best_links(  # pragma: no cover
                 continue
             k = kk + lo_i
             c = cand[k]
-            dx = cx[c] - px
-            dy = cy[c] - py
-            L = math.hypot(dx, dy)
-            if not (L >= r - touch_tol):
-                continue
-            safe = max(L, r)
             for side_rank in range(2):
                 s = 1.0 if side_rank == 0 else -1.0
-                heading = math.atan2(dy, dx) + (-s * math.asin(min(max(r / safe, -1.0), 1.0)))
-                ang = heading - s * (math.pi / 2)
-                length = math.sqrt(max(L * L - r * r, 0.0))
-                ccw = (ang - phi0[c]) % two_pi
-                if ccw > two_pi - ang_tol:
-                    ccw = 0.0
-                if not ccw <= span[c] + ang_tol:
+                ok, ccw, length, qx, qy = _link(px, py, c, s, cx, cy, phi0, span, r, ang_tol, touch_tol, profile)
+                if not ok:
                     continue
-                ccw = min(ccw, span[c])
                 pos = ccw if s > 0 else span[c] - ccw
                 dep = span[c] - pos
                 order = side_rank * total + kk
-                # Surely hidden: longer than the node's sight in the direction it would leave.
-                qx = cx[c] + r * math.cos(ang)
-                qy = cy[c] + r * math.sin(ang)
-                b = int(math.floor(((math.atan2(py - qy, px - qx)) % two_pi) / bin_width)) % n_bins
-                if length > profile[c, b]:
-                    continue
                 # The link's best label on the arc its reverse path leaves along (winding -s).
                 # Along the arc, Dijkstra's costs grow by at most r per radian from vertex to
                 # vertex, so of the graph's vertices the last at or before the departure is
@@ -203,9 +212,6 @@ def point_links(  # pragma: no cover
     """``Planner.point_links`` of ``(px, py)`` over the candidate nodes ``cand``: each side
     (+1 first), each candidate in order, the tangents that land on the node's arc and are
     clear. Writes them into the ``*_out`` arrays (room for ``2 * len(cand)``); returns how many."""
-    two_pi = 2.0 * math.pi
-    n_bins = profile.shape[1]
-    bin_width = two_pi / n_bins
     inv = 1.0 / res
     rho = max(r - touch_tol, touch_tol) * inv
     reach = max(r - 2 * touch_tol, touch_tol / 2)
@@ -214,25 +220,8 @@ def point_links(  # pragma: no cover
         s = 1.0 if side_rank == 0 else -1.0
         for k in range(cand.shape[0]):
             c = cand[k]
-            dx = cx[c] - px
-            dy = cy[c] - py
-            L = math.hypot(dx, dy)
-            if not (L >= r - touch_tol):
-                continue
-            safe = max(L, r)
-            heading = math.atan2(dy, dx) + (-s * math.asin(min(max(r / safe, -1.0), 1.0)))
-            ang = heading - s * (math.pi / 2)
-            length = math.sqrt(max(L * L - r * r, 0.0))
-            ccw = (ang - phi0[c]) % two_pi
-            if ccw > two_pi - ang_tol:
-                ccw = 0.0
-            if not ccw <= span[c] + ang_tol:
-                continue
-            ccw = min(ccw, span[c])
-            qx = cx[c] + r * math.cos(ang)
-            qy = cy[c] + r * math.sin(ang)
-            b = int(math.floor(((math.atan2(py - qy, px - qx)) % two_pi) / bin_width)) % n_bins
-            if length > profile[c, b]:
+            ok, ccw, length, qx, qy = _link(px, py, c, s, cx, cy, phi0, span, r, ang_tol, touch_tol, profile)
+            if not ok:
                 continue
             if _hits(px, py, qx, qy, ox, oy, inv, rho, rowcum, outside_blocked, reach, boxes, first, last, ex0, ey0,
                      ex1, ey1, use_polygons):
