@@ -150,3 +150,24 @@ def test_the_compiled_point_links_equal_the_numpy_ones(floor, seed) -> None:
             plain = planner.point_links(*p)
         assert [(n, s) for n, s, _, _ in fast] == [(n, s) for n, s, _, _ in plain]
         np.testing.assert_allclose([v[2:] for v in fast], [v[2:] for v in plain], rtol=0, atol=1e-12)
+
+
+@settings(max_examples=30, deadline=None, suppress_health_check=[HealthCheck.too_slow, HealthCheck.filter_too_much])
+@given(floor=slit_floors(), seed=st.integers(0, 2**31 - 1))
+def test_the_compiled_exact_query_equals_the_one_point_search(floor, seed) -> None:
+    """``GoalField.point_distance`` (compiled with numba) gives ``_best``'s value (the one-point
+    query on numpy arrays) within 1e-9 m, at random points, reachable or not."""
+    import pytest
+
+    from pointnav_core import _compiled
+
+    pytest.importorskip("numba")
+    scene, radius = floor
+    pts = _points(scene, radius, np.random.default_rng(seed), 12)
+    assume(len(pts) > 1)
+    field = scene.goal_field(0, pts[0], robot=radius).field
+    for p in pts[1:]:
+        fast = field.point_distance(p)
+        with _compiled.numpy_paths():
+            plain = field.point_distance(p)
+        assert fast == plain or abs(fast - plain) <= 1e-9

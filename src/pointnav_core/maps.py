@@ -153,6 +153,7 @@ class TraversableMap:
         self.geometry = geometry
         self._usable = BoundedCache(8)
         self._labels = BoundedCache(8)
+        self._component_cells = BoundedCache(32)
         # Owned by ``geodesic``; kept here so that planners live exactly as long as the map.
         self.planner_cache = BoundedCache(8)
         self._collision: FloorCollision | None = None
@@ -300,6 +301,19 @@ class TraversableMap:
         radius = _check_radius(radius)
         key = round(radius, 12)
         return self._labels.get_or_create(key, lambda: self._label(radius))
+
+    def component_cells(self, radius: float, label: int) -> tuple[NDArray[np.intp], NDArray[np.float64]]:
+        """The cells of component ``label`` of :meth:`components` (row-major flat indices) and
+        their centres (world metres, ``(N, 2)``); cached, so that sampling many points in one
+        component scans it once."""
+        radius = _check_radius(radius)
+
+        def build() -> tuple[NDArray[np.intp], NDArray[np.float64]]:
+            flat = np.flatnonzero(self.components(radius) == label)
+            rr, cc = np.divmod(flat, self.shape[1])
+            return flat, self.cell_to_world(np.stack([rr, cc], axis=-1))
+
+        return self._component_cells.get_or_create((round(radius, 12), int(label)), build)
 
     def _label(self, radius: float) -> NDArray[np.int32]:
         from scipy.sparse import coo_matrix

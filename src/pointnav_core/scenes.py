@@ -355,7 +355,7 @@ class Scene:
                     f"reference_point {ref.tolist()} is not usable on floor {floor} for a robot "
                     f"of radius {radius} m (blocked, too close to an obstacle, or off the map)"
                 )
-            cells = _cells_of(tmap.components(radius), label, tmap, ref, max_distance)
+            cells = _cells_of(tmap, radius, label, ref, max_distance)
         if len(cells) == 0:
             within = "" if max_distance is None else f" within {max_distance} m of the reference point"
             raise SamplingError(
@@ -453,22 +453,11 @@ def clutter(seed: int | None = None, resolution: float = 0.1, **kwargs: Any) -> 
     return Scene.from_polygons(plan.outline, plan.obstacles, resolution=resolution)
 
 
-def _cells_of(
-    labels: NDArray[np.integer], label: int, tmap: TraversableMap, ref: NDArray[np.float64], max_distance: float | None
-) -> NDArray[np.intp]:
-    """Flat indices of the cells labelled ``label``, with centres within ``max_distance``
-    (m) of ``ref`` if given (only the window around ``ref`` is scanned)."""
+def _cells_of(tmap: TraversableMap, radius: float, label: int, ref: NDArray[np.float64], max_distance: float | None) -> NDArray[np.intp]:
+    """Flat indices (row-major) of the cells of component ``label``, with centres within
+    ``max_distance`` (m) of ``ref`` if given."""
+    flat, xy = tmap.component_cells(radius, label)
     if max_distance is None or not math.isfinite(max_distance):
-        return np.flatnonzero(labels == label)
-    rows, cols = labels.shape
-    corners = tmap.world_to_cell(np.array([ref - max_distance, ref + max_distance]))
-    lo, hi = corners.min(axis=0), corners.max(axis=0)  # whichever way rows run
-    r0, r1 = max(int(lo[0]), 0), min(int(hi[0]) + 1, rows)
-    c0, c1 = max(int(lo[1]), 0), min(int(hi[1]) + 1, cols)
-    if r0 >= r1 or c0 >= c1:
-        return np.zeros(0, dtype=np.intp)
-    rr, cc = np.nonzero(labels[r0:r1, c0:c1] == label)
-    rr, cc = rr + r0, cc + c0
-    xy = tmap.cell_to_world(np.stack([rr, cc], axis=-1))
+        return flat
     near = np.hypot(xy[:, 0] - ref[0], xy[:, 1] - ref[1]) <= max_distance
-    return np.ravel_multi_index((rr[near], cc[near]), labels.shape)
+    return flat[near]

@@ -99,7 +99,7 @@ def best_links(  # pragma: no cover
     cx, cy, phi0, span, r, ang_tol, touch_tol,
     profile, cheapest, lab_start, graph_end, labels, lab_pos, lab_cost, blocked, has_blocked,
     ox, oy, res, rowcum, outside_blocked, boxes, first, last, ex0, ey0, ex1, ey1, use_polygons,
-    kind, best_lab,
+    kind, best_lab, best_value,
 ):
     """Per clear cell centre ``(x[i], y[i])``, over its candidate nodes ``start[i]:start[i + 1]``
     of ``cand``: the kind (0 none, 1 the goal ``(gx, gy)`` directly, 2 a label) and label of
@@ -192,6 +192,7 @@ def best_links(  # pragma: no cover
                 kind[i] = 2
                 winner = c
         hint = winner
+        best_value[i] = best
 
 
 @_jit

@@ -18,9 +18,10 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from pointnav_core import _compiled
 from pointnav_core.frozen import ThawOnUnpickle
 from pointnav_core.geodesic.arc_graph import FieldLabels
-from pointnav_core.geodesic.roots import cell_roots
+from pointnav_core.geodesic.roots import ArcTables, cell_roots, compiled_roots
 from pointnav_core.geodesic.tangents import ANG_TOL, TWO_PI
 
 if TYPE_CHECKING:
@@ -62,6 +63,7 @@ class GoalField(ThawOnUnpickle):
         self._search = planner.arc_graph().solve(links)
         self._table: dict[str, Any] | None = None
         self._nbytes: int | None = None
+        self._arc_tables: ArcTables | None = None
 
     @property
     def reachable_from_anywhere(self) -> bool:
@@ -100,8 +102,17 @@ class GoalField(ThawOnUnpickle):
         return best
 
     def point_distance(self, xy: ArrayLike) -> float:
-        """Exact geodesic distance (m) from world point ``xy`` to the goal (inf if none)."""
+        """Exact geodesic distance (m) from world point ``xy`` to the goal (inf if none).
+
+        With numba the one-point query runs compiled (``geodesic.roots.compiled_roots``):
+        the same value as :meth:`_best`'s within rounding (a property test)."""
         x, y = (float(v) for v in np.asarray(xy, dtype=np.float64).reshape(-1)[:2])
+        p = self.planner
+        if p.n_nodes and _compiled.kernel("pointnav_core.geodesic._roots_kernel", "best_links") is not None \
+                and (p.geo._poly_edges is not None or not p.geo.polygons):
+            if not self.goal_usable or not p.is_clear(x, y):
+                return math.inf
+            return float(compiled_roots(self, self.arc_tables(), np.array([x]), np.array([y]))[2][0])
         return self._best(x, y)[0]
 
     def path(
@@ -126,6 +137,12 @@ class GoalField(ThawOnUnpickle):
         if whole:
             pts.append(self.goal.copy())
         return np.array(pts), cost
+
+    def arc_tables(self) -> ArcTables:
+        """The reached labels grouped by arc, as the cell roots read them (built once)."""
+        if self._arc_tables is None:
+            self._arc_tables = ArcTables(self.planner, self._search)
+        return self._arc_tables
 
     # ------------------------------------------------------------- lookup table
     @property

@@ -46,7 +46,7 @@ if TYPE_CHECKING:
     from pointnav_core.geodesic.arc_graph import FieldLabels
     from pointnav_core.geodesic.field import GoalField
 
-__all__ = ["CHUNK", "cell_roots"]
+__all__ = ["CHUNK", "ArcTables", "cell_roots", "compiled_roots"]
 
 #: Most cells settled together: bounds the (cell, node) and (link, label) arrays of one pass.
 CHUNK = 256
@@ -62,7 +62,7 @@ _FIRST_BAND = 8
 _SLACK = 1e-9
 
 
-class _ArcTables:
+class ArcTables:
     """What the one-point search reads per arc and per node, as flat arrays.
 
     ``labels[start[g]:start[g + 1]]`` are ``search.on_arc(node, side)`` for the arc group
@@ -134,14 +134,14 @@ def cell_roots(field: GoalField, cells: NDArray[np.int64]) -> tuple[NDArray[np.i
     xs = geo.origin[0] + (cols + 0.5) * geo.resolution
     ys = geo.origin[1] + (rows + 0.5) * geo.resolution
     clear = np.flatnonzero(geo.points_clear(np.stack([xs, ys], axis=1), p.radius))
-    tables = _ArcTables(p, field._search) if p.n_nodes else None
+    tables = field.arc_tables() if p.n_nodes else None
     if tables is not None and _compiled.kernel("pointnav_core.geodesic._roots_kernel", "best_links") is not None \
             and (geo._poly_edges is not None or not geo.polygons):
         # In chunks: the candidate lists of a chunk are held at once.
         step = max(16, _COMPILED_PAIRS // max(p.n_nodes, 1))
         for i in range(0, len(clear), step):
             sub = clear[i : i + step]
-            kind[sub], label[sub] = _compiled_roots(field, tables, xs[sub], ys[sub])
+            kind[sub], label[sub], _ = compiled_roots(field, tables, xs[sub], ys[sub])
         return kind, label
     # Fewer cells per chunk where many nodes could fall in a centre's ball.
     chunk = max(16, min(CHUNK, _CANDIDATES // max(p.n_nodes, 1)))
@@ -152,7 +152,7 @@ def cell_roots(field: GoalField, cells: NDArray[np.int64]) -> tuple[NDArray[np.i
 
 
 def _chunk_roots(
-    field: GoalField, tables: _ArcTables | None, x: NDArray[np.float64], y: NDArray[np.float64]
+    field: GoalField, tables: ArcTables | None, x: NDArray[np.float64], y: NDArray[np.float64]
 ) -> tuple[NDArray[np.int8], NDArray[np.int32]]:
     """Kinds and labels of clear centres ``(x, y)``: the direct segment, then the links."""
     p = field.planner
@@ -219,10 +219,11 @@ def _chunk_roots(
     return kind, label
 
 
-def _compiled_roots(
-    field: GoalField, tables: _ArcTables, x: NDArray[np.float64], y: NDArray[np.float64]
-) -> tuple[NDArray[np.int8], NDArray[np.int32]]:
-    """:func:`_chunk_roots`' decision for clear centres, one cell at a time in compiled code."""
+def compiled_roots(
+    field: GoalField, tables: ArcTables, x: NDArray[np.float64], y: NDArray[np.float64]
+) -> tuple[NDArray[np.int8], NDArray[np.int32], NDArray[np.float64]]:
+    """:func:`_chunk_roots`' decision for clear points (cell centres or any), one at a time
+    in compiled code: kinds, labels and the exact distances (m). Needs numba."""
     p = field.planner
     geo = p.geo
     search = field.labels
@@ -237,15 +238,16 @@ def _compiled_roots(
     edges = geo.polygon_edges()
     kind = np.zeros(len(x), dtype=np.int8)
     label = np.full(len(x), -1, dtype=np.int64)
+    value = np.empty(len(x))
     best_links(
         x, y, float(field.goal[0]), float(field.goal[1]), start, cand, int(start[-1]), _SLACK,
         p.cx, p.cy, p.phi0, p.span, p.radius, ANG_TOL, TOUCH_TOL,
         p.sight_profile, tables.cheapest, tables.start.astype(np.int64), tables.graph_end.astype(np.int64),
         tables.labels.astype(np.int64), search.pos, search.cost,
         p._blocked, p._has_blocked, float(geo.origin[0]), float(geo.origin[1]), float(geo.resolution), geo._rowcum,
-        geo.outside_blocked, *edges, bool(geo.polygons), kind, label,
+        geo.outside_blocked, *edges, bool(geo.polygons), kind, label, value,
     )
-    return kind, label.astype(np.int32)
+    return kind, label.astype(np.int32), value
 
 
 def _candidates(
@@ -300,7 +302,7 @@ def _tangents(
 
 def _link_values(
     field: GoalField,
-    tables: _ArcTables,
+    tables: ArcTables,
     node: NDArray[np.int64],
     s: NDArray[np.int64],
     dep: NDArray[np.float64],
