@@ -18,11 +18,10 @@ from __future__ import annotations
 import math
 
 import numba
-import numpy as np
 
 from pointnav_core._collision_kernel import segment_hits_cells, segment_hits_polygons
 
-__all__ = ["balls_holding", "best_links", "point_links"]
+__all__ = ["best_links", "point_links"]
 
 _jit = numba.njit(cache=True, nogil=True, error_model="numpy")
 
@@ -76,38 +75,23 @@ def _link(px, py, c, s, cx, cy, phi0, span, r, ang_tol, touch_tol, profile):  # 
 
 
 @_jit
-def balls_holding(x, y, cx, cy, reach):  # pragma: no cover
-    """``NodeBalls.query`` by measuring every (point, node) pair: ``start`` (per point, CSR
-    offsets) and ``cand`` (nodes, ascending within a point)."""
-    n = x.shape[0]
-    m = cx.shape[0]
-    start = np.zeros(n + 1, dtype=np.int64)
-    found = np.empty(n * m, dtype=np.int64)
-    k = 0
-    for i in range(n):
-        for c in range(m):
-            if math.hypot(cx[c] - x[i], cy[c] - y[i]) <= reach[c]:
-                found[k] = c
-                k += 1
-        start[i + 1] = k
-    return start, found[:k].copy()
-
-
-@_jit
 def best_links(  # pragma: no cover
-    x, y, gx, gy, start, cand, total, slack,
-    cx, cy, phi0, span, r, ang_tol, touch_tol,
+    x, y, gx, gy, cand, cand_lo, cand_hi, by_cheap, slack,
+    cx, cy, phi0, span, r, ang_tol, touch_tol, ball,
     profile, cheapest, lab_start, graph_end, labels, lab_pos, lab_cost, blocked, has_blocked,
     ox, oy, res, rowcum, outside_blocked, boxes, first, last, ex0, ey0, ex1, ey1, use_polygons,
     kind, best_lab, best_value,
 ):
-    """Per clear cell centre ``(x[i], y[i])``, over its candidate nodes ``start[i]:start[i + 1]``
-    of ``cand``: the kind (0 none, 1 the goal ``(gx, gy)`` directly, 2 a label) and label of
-    the smallest visible ``(total, order)``, the direct segment first. ``kind`` and
-    ``best_lab`` are written."""
+    """Per clear point ``(x[i], y[i])``, over the candidate nodes ``cand[cand_lo[i]:cand_hi[i]]``
+    (those whose sight ball, radius ``ball``, holds the point count): the kind (0 none, 1 the
+    goal ``(gx, gy)`` directly, 2 a label), label and total (m; inf: none) of the smallest
+    visible ``(total, order)``, the direct segment first, written into ``kind``, ``best_lab``
+    and ``best_value``. With ``by_cheap`` the candidates are in ascending order of their
+    arcs' cheapest label, and the scan stops where that alone passes the best."""
     inv = 1.0 / res
     rho = max(r - touch_tol, touch_tol) * inv
     reach = max(r - 2 * touch_tol, touch_tol / 2)
+    n_nodes = cx.shape[0]
     hint = -1
     for i in range(x.shape[0]):
         px = x[i]
@@ -119,32 +103,30 @@ def best_links(  # pragma: no cover
             best = math.hypot(gx - px, gy - py)
         kind[i] = 1 if best < math.inf else 0
         best_lab[i] = -1
-        lo_i = start[i]
-        hi_i = start[i + 1]
-        # Each candidate's lower bound: its arcs' cheapest label plus the distance less r.
-        low = np.empty(hi_i - lo_i)
-        for k in range(lo_i, hi_i):
-            c = cand[k]
-            cheap = min(cheapest[2 * c], cheapest[2 * c + 1])
-            dist = math.hypot(cx[c] - px, cy[c] - py)
-            low[k - lo_i] = cheap + (dist - r) - slack * (1.0 + cheap + dist)
-        # The previous cell's winner first (neighbours mostly share a root): its value bounds
-        # the rest, taken in list order and skipped where their bound is no better. The
-        # result is the smallest (total, order) whatever the order of evaluation.
         best_order = -1
-        first_k = -1
-        if hint >= 0:
-            j = np.searchsorted(cand[lo_i:hi_i], hint)
-            if j < hi_i - lo_i and cand[lo_i + j] == hint:
-                first_k = j
-        for step in range(-1, hi_i - lo_i):
-            kk = first_k if step < 0 else step
-            if kk < 0 or (step >= 0 and kk == first_k):
+        # The previous point's winner first (neighbours mostly share a root): its total bounds
+        # the rest, which are skipped where their lower bound (the arcs' cheapest label plus
+        # the distance less r) is no better. The smallest (total, order) does not depend on
+        # the order of evaluation.
+        for step in range(cand_lo[i] - 1, cand_hi[i]):
+            if step < cand_lo[i]:
+                c = hint
+                if c < 0:
+                    continue
+            else:
+                c = cand[step]
+                if c == hint:
+                    continue
+            cheap = min(cheapest[2 * c], cheapest[2 * c + 1])
+            if by_cheap and step >= cand_lo[i] and not cheap - r - slack * (1.0 + cheap) < best:
+                break
+            dx = cx[c] - px
+            dy = cy[c] - py
+            if dx * dx + dy * dy > ball[c] * ball[c]:
                 continue
-            if not low[kk] < best:
+            dist = math.sqrt(dx * dx + dy * dy)
+            if not cheap + (dist - r) - slack * (1.0 + cheap + dist) < best:
                 continue
-            k = kk + lo_i
-            c = cand[k]
             for side_rank in range(2):
                 s = 1.0 if side_rank == 0 else -1.0
                 ok, ccw, length, qx, qy = _link(px, py, c, s, cx, cy, phi0, span, r, ang_tol, touch_tol, profile)
@@ -152,7 +134,7 @@ def best_links(  # pragma: no cover
                     continue
                 pos = ccw if s > 0 else span[c] - ccw
                 dep = span[c] - pos
-                order = side_rank * total + kk
+                order = side_rank * n_nodes + c
                 # The link's best label on the arc its reverse path leaves along (winding -s).
                 # Along the arc, Dijkstra's costs grow by at most r per radian from vertex to
                 # vertex, so of the graph's vertices the last at or before the departure is

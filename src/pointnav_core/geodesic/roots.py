@@ -53,7 +53,7 @@ CHUNK = 256
 #: Most (cell, node) candidates a chunk may hold when every node falls in every ball.
 _CANDIDATES = 2**20
 #: Most nodes for which the compiled path measures every (cell, node) pair rather than ask the trees.
-_BRUTE_NODES = 1024
+_BRUTE_NODES = 1 << 15
 #: Most (cell, node) pairs of one chunk of the compiled path.
 _COMPILED_PAIRS = 2**22
 #: Width (cells) of the first band of candidate bounds evaluated per cell; each round doubles it.
@@ -85,6 +85,10 @@ class ArcTables:
         some = np.flatnonzero(self.start[1:] > self.start[:-1])
         if len(some):
             self.cheapest[some] = np.minimum.reduceat(search.cost[self.labels], self.start[some])
+        # The nodes with a reached arc, by their cheapest label.
+        node_cheap = np.minimum(self.cheapest[0::2], self.cheapest[1::2])
+        reached = np.flatnonzero(np.isfinite(node_cheap))
+        self.by_cheap = reached[np.argsort(node_cheap[reached], kind="stable")].astype(np.int64)
 
 
 def cell_roots(field: GoalField, cells: NDArray[np.int64]) -> tuple[NDArray[np.int8], NDArray[np.int32]]:
@@ -138,7 +142,7 @@ def cell_roots(field: GoalField, cells: NDArray[np.int64]) -> tuple[NDArray[np.i
     if tables is not None and _compiled.kernel("pointnav_core.geodesic._roots_kernel", "best_links") is not None \
             and (geo._poly_edges is not None or not geo.polygons):
         # In chunks: the candidate lists of a chunk are held at once.
-        step = max(16, _COMPILED_PAIRS // max(p.n_nodes, 1))
+        step = max(len(clear), 1) if p.n_nodes <= _BRUTE_NODES else max(16, _COMPILED_PAIRS // p.n_nodes)
         for i in range(0, len(clear), step):
             sub = clear[i : i + step]
             kind[sub], label[sub], _ = compiled_roots(field, tables, xs[sub], ys[sub])
@@ -227,21 +231,23 @@ def compiled_roots(
     p = field.planner
     geo = p.geo
     search = field.labels
-    brute = _compiled.kernel("pointnav_core.geodesic._roots_kernel", "balls_holding")
     best_links = _compiled.kernel("pointnav_core.geodesic._roots_kernel", "best_links")
     if p.n_nodes <= _BRUTE_NODES:
-        start, cand = brute(x, y, p.cx, p.cy, p._balls.reach)
+        # Every node, cheapest arcs first: the scan of a point stops where they pass its best.
+        cand = tables.by_cheap
+        lo, hi = np.zeros(len(x), np.int64), np.full(len(x), len(cand), np.int64)
     else:
         owner, cand = p.nodes_seeing(x, y)
         start = np.searchsorted(owner, np.arange(len(x) + 1)).astype(np.int64)
+        lo, hi = start[:-1], start[1:]
     p.arcs_free(np.zeros(0, np.int64), np.zeros(0, np.int64), np.zeros(0), np.zeros(0))  # builds its tables
     edges = geo.polygon_edges()
     kind = np.zeros(len(x), dtype=np.int8)
     label = np.full(len(x), -1, dtype=np.int64)
     value = np.empty(len(x))
     best_links(
-        x, y, float(field.goal[0]), float(field.goal[1]), start, cand, int(start[-1]), _SLACK,
-        p.cx, p.cy, p.phi0, p.span, p.radius, ANG_TOL, TOUCH_TOL,
+        x, y, float(field.goal[0]), float(field.goal[1]), cand, lo, hi, p.n_nodes <= _BRUTE_NODES, _SLACK,
+        p.cx, p.cy, p.phi0, p.span, p.radius, ANG_TOL, TOUCH_TOL, p._balls.reach,
         p.sight_profile, tables.cheapest, tables.start.astype(np.int64), tables.graph_end.astype(np.int64),
         tables.labels.astype(np.int64), search.pos, search.cost,
         p._blocked, p._has_blocked, float(geo.origin[0]), float(geo.origin[1]), float(geo.resolution), geo._rowcum,
