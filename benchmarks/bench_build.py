@@ -14,10 +14,15 @@ Run: ``python benchmarks/bench_build.py [--side 1000] [--boxes 760] [--robots 4]
 from __future__ import annotations
 
 import argparse
+import os
 import resource
 import time
 
 import numpy as np
+
+# Cold builds: the geometry cache on disk would reload a floor built by an earlier run
+# (run with POINTNAV_CACHE_DIR set to a folder to measure a warm one).
+os.environ.setdefault("POINTNAV_CACHE_DIR", "off")
 
 from pointnav_core import scenes
 from pointnav_core.vector import VectorPointNavEnv

@@ -24,7 +24,7 @@ memory after imports and loading the case, so C allocations count):
   free, infinite blocked, ``allow_diagonal=True``). Its diagonal moves may cut blocked
   corners and cost as much as straight ones, so its length, measured in metres along its
   cells, can be longer or shorter than Dijkstra's;
-- ``tangent``: ``tangent_graph.Planner(FloorCollision(blocked, res, origin), r)`` (the
+- ``tangent``: ``geodesic.Planner(FloorCollision(blocked, res, origin), r)`` (the
   ``build`` lap), then its first ``shortest_path(start, goal)``.
 
 The grid searches plan a point on the cell grid (no erosion for the radius), the cheapest
@@ -61,6 +61,11 @@ Run::
 """
 
 from __future__ import annotations
+
+import os
+
+# Cold builds: the geometry cache on disk would reload a floor built by an earlier run.
+os.environ.setdefault("POINTNAV_CACHE_DIR", "off")
 
 import argparse
 import math
