@@ -91,6 +91,7 @@ class FloorCollision:
         h, w = mask.shape
         cum = np.zeros((h, w + 1), dtype=np.int32)
         np.cumsum(mask, axis=1, out=cum[:, 1:])
+        cum.flags.writeable = False
         self._rowcum = cum
         self.polygons = tuple(polygons)
         self._poly_tree = shapely.STRtree(list(self.polygons)) if self.polygons else None
@@ -118,6 +119,17 @@ class FloorCollision:
         self._poly_tree = shapely.STRtree(list(self.polygons)) if self.polygons else None
         if "_poly_edges" not in state:
             self._poly_edges = _polygon_edges(self.polygons)
+
+    @property
+    def compiled_polygons(self) -> bool:
+        """Whether the compiled tests can read every polygon (none, or all of them polygons)."""
+        return self._poly_edges is not None or not self.polygons
+
+    @property
+    def row_counts(self) -> NDArray[np.int32]:
+        """Per grid row, the running count of blocked cells, ``(H, W + 1)`` (read-only):
+        what the compiled cell test reads."""
+        return self._rowcum
 
     def polygon_edges(self) -> tuple[NDArray[Any], ...]:
         """The polygons as the compiled tests read them: ``boxes (K, 4), first, last (K,),

@@ -109,7 +109,7 @@ class GoalField(ThawOnUnpickle):
         x, y = (float(v) for v in np.asarray(xy, dtype=np.float64).reshape(-1)[:2])
         p = self.planner
         if p.n_nodes and _compiled.kernel("pointnav_core.geodesic._roots_kernel", "best_links") is not None \
-                and (p.geo._poly_edges is not None or not p.geo.polygons):
+                and p.geo.compiled_polygons:
             if not self.goal_usable or not p.is_clear(x, y):
                 return math.inf
             return float(compiled_roots(self, self.arc_tables(), np.array([x]), np.array([y]))[2][0])

@@ -340,14 +340,14 @@ class Planner(ThawOnUnpickle):
         if not len(cand):
             return links
         kernel = _compiled.kernel("pointnav_core.geodesic._roots_kernel", "point_links")
-        if kernel is not None and (self.geo._poly_edges is not None or not self.geo.polygons):
+        if kernel is not None and self.geo.compiled_polygons:
             # The same tangents in compiled code (the sight profile first rules out hidden ones).
             geo = self.geo
             node, side = np.empty(2 * len(cand), np.int64), np.empty(2 * len(cand), np.int64)
             pos, length = np.empty(2 * len(cand)), np.empty(2 * len(cand))
             n = kernel(float(x), float(y), cand, self.cx, self.cy, self.phi0, self.span, r, ANG_TOL, TOUCH_TOL,
                        self.sight_profile, float(geo.origin[0]), float(geo.origin[1]), float(geo.resolution),
-                       geo._rowcum, geo.outside_blocked, *geo.polygon_edges(), bool(geo.polygons), node, side, pos, length)
+                       geo.row_counts, geo.outside_blocked, *geo.polygon_edges(), bool(geo.polygons), node, side, pos, length)
             return list(zip(node[:n].tolist(), (1 - 2 * side[:n]).tolist(), pos[:n].tolist(), length[:n].tolist()))
         for s in (1, -1):
             ang, length, _, ok = tangent_from_point(x, y, self.cx[cand], self.cy[cand], r, s)

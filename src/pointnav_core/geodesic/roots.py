@@ -140,7 +140,7 @@ def cell_roots(field: GoalField, cells: NDArray[np.int64]) -> tuple[NDArray[np.i
     clear = np.flatnonzero(geo.points_clear(np.stack([xs, ys], axis=1), p.radius))
     tables = field.arc_tables() if p.n_nodes else None
     if tables is not None and _compiled.kernel("pointnav_core.geodesic._roots_kernel", "best_links") is not None \
-            and (geo._poly_edges is not None or not geo.polygons):
+            and geo.compiled_polygons:
         # In chunks: the candidate lists of a chunk are held at once.
         step = max(len(clear), 1) if p.n_nodes <= _BRUTE_NODES else max(16, _COMPILED_PAIRS // p.n_nodes)
         for i in range(0, len(clear), step):
@@ -250,7 +250,7 @@ def compiled_roots(
         p.cx, p.cy, p.phi0, p.span, p.radius, ANG_TOL, TOUCH_TOL, p._balls.reach,
         p.sight_profile, tables.cheapest, tables.start.astype(np.int64), tables.graph_end.astype(np.int64),
         tables.labels.astype(np.int64), search.pos, search.cost,
-        p._blocked, p._has_blocked, float(geo.origin[0]), float(geo.origin[1]), float(geo.resolution), geo._rowcum,
+        p._blocked, p._has_blocked, float(geo.origin[0]), float(geo.origin[1]), float(geo.resolution), geo.row_counts,
         geo.outside_blocked, *edges, bool(geo.polygons), kind, label, value,
     )
     return kind, label.astype(np.int32), value
