@@ -89,7 +89,7 @@ def _one_point(field, cells: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return np.array(kinds, np.int8), np.array(labels, np.int32)
 
 
-@settings(max_examples=60, deadline=None, suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large])
+@settings(max_examples=40, deadline=None, suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large])
 @given(field=fields(), data=st.data(), numpy_paths=st.booleans())
 def test_batched_settle_equals_the_one_point_query(field, data, numpy_paths: bool) -> None:
     """The numpy path makes the one-point decision exactly, root for root. The compiled path
