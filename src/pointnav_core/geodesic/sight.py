@@ -33,6 +33,7 @@ import numpy as np
 from numpy.typing import NDArray
 from scipy import ndimage
 from scipy.spatial import cKDTree
+from tqdm.auto import tqdm
 
 from pointnav_core import _compiled
 from pointnav_core.collision import TOUCH_TOL
@@ -51,6 +52,10 @@ MIN_HALF_WIDTH = 1e-5
 PROFILE_BINS = 128
 #: Most sectors waiting at once per node and side (the first ones plus one per split level).
 _STACK = 8192
+#: Nodes whose sights a build finds before it shows a progress bar (about 2 s of work).
+_PROGRESS_NODES = 20_000
+#: Nodes marched per call (a progress bar's step).
+_BATCH = 4096
 #: Most (point, node) pairs a query measures one by one rather than through the trees.
 _BRUTE = 2_000_000
 #: The bound of a node that sees past the edge of a map whose outside is open (m).
@@ -176,12 +181,19 @@ def node_sights(
     profile = np.zeros((n, PROFILE_BINS))
     kernel = _compiled.kernel("pointnav_core.geodesic._sight_kernel", "sight_rays")
     march = kernel if kernel is not None else sight_rays
-    march(
-        np.ascontiguousarray((cx - geo.origin[0]) / res + 1.0), np.ascontiguousarray((cy - geo.origin[1]) / res + 1.0),
-        np.ascontiguousarray(phi0, dtype=np.float64), np.ascontiguousarray(span, dtype=np.float64), radius / res,
-        2.0 * TOUCH_TOL / res, np.ascontiguousarray(edt, dtype=np.float64), near_r.astype(np.int64), near_c.astype(np.int64),
-        bool(geo.outside_blocked), FIRST_HALF_WIDTH, MIN_HALF_WIDTH, limit, out, profile,
-    )
+    gx = (np.asarray(cx, dtype=np.float64) - geo.origin[0]) / res + 1.0
+    gy = (np.asarray(cy, dtype=np.float64) - geo.origin[1]) / res + 1.0
+    phi0 = np.asarray(phi0, dtype=np.float64)
+    span = np.asarray(span, dtype=np.float64)
+    edt = np.ascontiguousarray(edt, dtype=np.float64)
+    near_r, near_c = near_r.astype(np.int64), near_c.astype(np.int64)
+    # In batches, so that a large floor shows its progress (each node's rays are its own).
+    with tqdm(total=n, desc="sight bounds", unit="node", leave=False, disable=n < _PROGRESS_NODES or None) as bar:
+        for i in range(0, n, _BATCH):
+            j = min(i + _BATCH, n)
+            march(gx[i:j], gy[i:j], phi0[i:j], span[i:j], radius / res, 2.0 * TOUCH_TOL / res, edt, near_r, near_c,
+                  bool(geo.outside_blocked), FIRST_HALF_WIDTH, MIN_HALF_WIDTH, limit, out[i:j], profile[i:j])
+            bar.update(j - i)
     # One cell to spare for the rounding of grid coordinates; a ray that reached the limit on
     # an open map proves nothing.
     out = (out + 1.0) * res
