@@ -26,6 +26,10 @@ and label the one-point code gives it:
   further on can win, so neither its tangents, nor its labels, nor its segments are looked
   at.
 
+With numba (the ``fast`` extra) :func:`compiled_roots` makes the same decision one point at
+a time (:mod:`pointnav_core.geodesic._roots_kernel`), equal in value; it also serves the
+exact one-point query (``GoalField.point_distance``).
+
 Everything is in world metres and radians.
 """
 
@@ -52,7 +56,8 @@ __all__ = ["CHUNK", "ArcTables", "cell_roots", "compiled_roots"]
 CHUNK = 256
 #: Most (cell, node) candidates a chunk may hold when every node falls in every ball.
 _CANDIDATES = 2**20
-#: Most nodes for which the compiled path measures every (cell, node) pair rather than ask the trees.
+#: Most nodes for which the compiled path scans every node per point (cheapest arcs first)
+#: rather than ask the trees for each point's candidates.
 _BRUTE_NODES = 1 << 15
 #: Most (cell, node) pairs of one chunk of the compiled path.
 _COMPILED_PAIRS = 2**22
