@@ -43,7 +43,7 @@ ENV_VAR = "POINTNAV_CACHE_DIR"
 #: Builds (s) shorter than this are not written to the cache.
 MIN_SECONDS = 0.5
 #: Bumped whenever what is stored, or how it is computed, changes.
-FORMAT = 2
+FORMAT = 3
 
 
 def cache_dir() -> Path | None:

@@ -50,6 +50,9 @@ FIRST_HALF_WIDTH = math.pi / 256
 MIN_HALF_WIDTH = 1e-5
 #: Direction bins of a node's sight profile.
 PROFILE_BINS = 128
+#: Most rays one node may cast before its bound gives up (the map's diagonal): a robot far
+#: thinner than a cell in open space needs ever narrower sectors.
+_RAY_BUDGET = 16384
 #: Most sectors waiting at once per node and side (the first ones plus one per split level).
 _STACK = 8192
 #: Nodes whose sights a build finds before it shows a progress bar (about 2 s of work).
@@ -79,9 +82,17 @@ def sight_rays(cx, cy, phi0, span, r, margin, edt, near_r, near_c, outside, h0, 
     bin_width = 2.0 * math.pi / n_bins
     stack_t = np.empty(_STACK)
     stack_h = np.empty(_STACK)
+    if r * (1.0 / min_h - 1.0) < 1.0:
+        # Even the narrowest sector proves nothing a cell away (a point robot): no bound.
+        for n in range(cx.shape[0]):
+            out[n] = limit
+            for k in range(n_bins):
+                profile[n, k] = limit
+        return
     for n in range(cx.shape[0]):
         best = 0.0
         gave_up = False
+        cast = 0
         for side in (1.0, -1.0):
             n0 = max(1, int(math.ceil(span[n] / (2.0 * h0))))
             hw0 = span[n] / (2.0 * n0)
@@ -94,6 +105,7 @@ def sight_rays(cx, cy, phi0, span, r, margin, edt, near_r, near_c, outside, h0, 
                 top -= 1
                 theta = stack_t[top]
                 hw = stack_h[top]
+                cast += 1
                 phi = theta - side * (math.pi / 2)
                 tx = cx[n] + r * math.cos(phi)
                 ty = cy[n] + r * math.sin(phi)
@@ -132,8 +144,8 @@ def sight_rays(cx, cy, phi0, span, r, margin, edt, near_r, near_c, outside, h0, 
                     for b in range(b0, b1 + 1):
                         k = b % n_bins
                         profile[n, k] = max(profile[n, k], length)
-                elif hw <= min_h or top + 2 > _STACK:
-                    gave_up = True
+                elif hw <= min_h or top + 2 > _STACK or cast >= _RAY_BUDGET:
+                    gave_up = True  # a robot this thin in so open a space: no useful bound
                     break
                 else:
                     stack_t[top] = theta - hw / 2
