@@ -125,11 +125,13 @@ class FloorCollision:
         """Whether the compiled tests can read every polygon (none, or all of them polygons)."""
         return self._poly_edges is not None or not self.polygons
 
-    @property
-    def row_counts(self) -> NDArray[np.int32]:
-        """Per grid row, the running count of blocked cells, ``(H, W + 1)`` (read-only):
-        what the compiled cell test reads."""
-        return self._rowcum
+    def kernel_geometry(self) -> tuple[Any, ...]:
+        """Everything the compiled clearance tests read, in their argument order: origin x, y
+        (m), resolution (m), each grid row's running count of blocked cells ``(H, W + 1)``,
+        whether off the map is blocked,
+        :meth:`polygon_edges`' seven arrays, and whether there are polygons to test."""
+        return (float(self.origin[0]), float(self.origin[1]), float(self.resolution), self._rowcum,
+                self.outside_blocked, *self.polygon_edges(), bool(self.polygons))
 
     def polygon_edges(self) -> tuple[NDArray[Any], ...]:
         """The polygons as the compiled tests read them: ``boxes (K, 4), first, last (K,),

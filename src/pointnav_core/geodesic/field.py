@@ -18,10 +18,9 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from pointnav_core import _compiled
 from pointnav_core.frozen import ThawOnUnpickle
 from pointnav_core.geodesic.arc_graph import FieldLabels
-from pointnav_core.geodesic.roots import ArcTables, cell_roots, compiled_roots
+from pointnav_core.geodesic.roots import ArcTables, cell_roots, compiled, compiled_roots
 from pointnav_core.geodesic.tangents import ANG_TOL, TWO_PI
 
 if TYPE_CHECKING:
@@ -108,8 +107,7 @@ class GoalField(ThawOnUnpickle):
         the same value as :meth:`_best`'s within rounding (a property test)."""
         x, y = (float(v) for v in np.asarray(xy, dtype=np.float64).reshape(-1)[:2])
         p = self.planner
-        if p.n_nodes and _compiled.kernel("pointnav_core.geodesic._roots_kernel", "best_links") is not None \
-                and p.geo.compiled_polygons:
+        if compiled(p, "best_links") is not None:
             if not self.goal_usable or not p.is_clear(x, y):
                 return math.inf
             return float(compiled_roots(self, self.arc_tables(), np.array([x]), np.array([y]))[2][0])

@@ -28,10 +28,9 @@ drawn path never cuts the clearance.
 
 A goal field (:class:`~pointnav_core.geodesic.field.GoalField`) holds a whole Dijkstra run from one goal (exact distance of every
 node) and answers exact point queries by the tangents a point sees. For the per-step hot
-path it also builds a root table on first use: a seeded multi-source Dijkstra on the grid
-proposes each cell's root node, every proposal is checked (the tangent from the root to the
-cell centre is clear and leaves the arc forward), and a lookup is the tangent length from
-the root plus the root's arc and distance. Everything is in world metres.
+path it keeps a root table, each cell's centre's exact root, settled a block of cells at a
+time; a lookup is the tangent length from the point to its cell's root plus the root's arc
+and distance. Everything is in world metres.
 """
 
 from __future__ import annotations
@@ -49,7 +48,6 @@ from scipy.spatial import cKDTree
 from tqdm.auto import tqdm
 
 from pointnav_core.collision import TOUCH_TOL, FloorCollision, convex_corners
-from pointnav_core import _compiled
 from pointnav_core.frozen import ThawOnUnpickle
 from pointnav_core.paths import path_length, resample_path
 from pointnav_core.geodesic import cache
@@ -58,6 +56,7 @@ from pointnav_core.geodesic.arcs import arc_points
 from pointnav_core.geodesic.tangents import ANG_TOL, COST_TOL, TWO_PI, ccw_pos, tangent_from_point
 from pointnav_core.geodesic.edges import build_edges
 from pointnav_core.geodesic.field import GoalField
+from pointnav_core.geodesic.roots import compiled
 from pointnav_core.geodesic.sight import NodeBalls, node_sights
 
 if TYPE_CHECKING:
@@ -200,27 +199,32 @@ class Planner(ThawOnUnpickle):
             lo, hi = sp - p2, sp - p1
         return not any(lo + ANG_TOL < b < hi - ANG_TOL for b in blocked)
 
-    def arcs_free(
-        self, nodes: NDArray[np.int64], sides: NDArray[np.int64], p1: NDArray[np.float64], p2: NDArray[np.float64]
-    ) -> NDArray[np.bool_]:
-        """Vectorised :meth:`_arc_free`, with its expressions (only nodes with a blocked arc
-        sample are looked at)."""
+    def blocked_arcs(self) -> tuple[NDArray[np.float64], NDArray[np.bool_]]:
+        """Each node's blocked arc samples (ccw positions, rad) as a row, NaN padded (NaN
+        compares false), and which nodes have any; built once."""
         if getattr(self, "_blocked", None) is None:
-            # Each node's blocked samples as a row, NaN padded (NaN compares false).
             widest = max((len(b) for b in self._blocked_ccw), default=0)
             self._blocked = np.full((self.n_nodes, max(widest, 1)), np.nan)
             for n, b in enumerate(self._blocked_ccw):
                 self._blocked[n, : len(b)] = b
             self._has_blocked = np.fromiter((bool(b) for b in self._blocked_ccw), dtype=bool, count=self.n_nodes)
+        return self._blocked, self._has_blocked
+
+    def arcs_free(
+        self, nodes: NDArray[np.int64], sides: NDArray[np.int64], p1: NDArray[np.float64], p2: NDArray[np.float64]
+    ) -> NDArray[np.bool_]:
+        """Vectorised :meth:`_arc_free`, with its expressions (only nodes with a blocked arc
+        sample are looked at)."""
+        blocked, has_blocked = self.blocked_arcs()
         out = np.ones(len(nodes), dtype=bool)
-        k = np.flatnonzero(self._has_blocked[nodes])
+        k = np.flatnonzero(has_blocked[nodes])
         if len(k):
             node = nodes[k]
             sp = self.span[node]
             ccw = sides[k] > 0
             lo = np.where(ccw, p1[k], sp - p2[k])
             hi = np.where(ccw, p2[k], sp - p1[k])
-            b = self._blocked[node]
+            b = blocked[node]
             with np.errstate(invalid="ignore"):
                 out[k] = ~((lo[:, None] + ANG_TOL < b) & (b < hi[:, None] - ANG_TOL)).any(axis=1)
         return out
@@ -339,15 +343,13 @@ class Planner(ThawOnUnpickle):
         links: list[tuple[int, int, float, float]] = []
         if not len(cand):
             return links
-        kernel = _compiled.kernel("pointnav_core.geodesic._roots_kernel", "point_links")
-        if kernel is not None and self.geo.compiled_polygons:
+        kernel = compiled(self, "point_links")
+        if kernel is not None:
             # The same tangents in compiled code (the sight profile first rules out hidden ones).
-            geo = self.geo
             node, side = np.empty(2 * len(cand), np.int64), np.empty(2 * len(cand), np.int64)
             pos, length = np.empty(2 * len(cand)), np.empty(2 * len(cand))
             n = kernel(float(x), float(y), cand, self.cx, self.cy, self.phi0, self.span, r, ANG_TOL, TOUCH_TOL,
-                       self.sight_profile, float(geo.origin[0]), float(geo.origin[1]), float(geo.resolution),
-                       geo.row_counts, geo.outside_blocked, *geo.polygon_edges(), bool(geo.polygons), node, side, pos, length)
+                       self.sight_profile, *self.geo.kernel_geometry(), node, side, pos, length)
             return list(zip(node[:n].tolist(), (1 - 2 * side[:n]).tolist(), pos[:n].tolist(), length[:n].tolist()))
         for s in (1, -1):
             ang, length, _, ok = tangent_from_point(x, y, self.cx[cand], self.cy[cand], r, s)

@@ -36,7 +36,7 @@ Everything is in world metres and radians.
 from __future__ import annotations
 
 import math
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from numpy.typing import NDArray
@@ -50,7 +50,7 @@ if TYPE_CHECKING:
     from pointnav_core.geodesic.arc_graph import FieldLabels
     from pointnav_core.geodesic.field import GoalField
 
-__all__ = ["CHUNK", "ArcTables", "cell_roots", "compiled_roots"]
+__all__ = ["CHUNK", "ArcTables", "cell_roots", "compiled", "compiled_roots"]
 
 #: Most cells settled together: bounds the (cell, node) and (link, label) arrays of one pass.
 CHUNK = 256
@@ -81,8 +81,8 @@ class ArcTables:
         labs = np.flatnonzero(np.isfinite(search.cost))
         group = search.group[labs]
         order = np.argsort(group, kind="stable")
-        self.labels = labs[order]
-        self.start = np.searchsorted(group[order], np.arange(2 * planner.n_nodes + 1), side="left")
+        self.labels = labs[order].astype(np.int64)
+        self.start = np.searchsorted(group[order], np.arange(2 * planner.n_nodes + 1), side="left").astype(np.int64)
         graph = self.labels < search.graph.n_vertices
         self.graph_end = self.start[:-1] + np.bincount(search.group[self.labels[graph]], minlength=2 * planner.n_nodes)
         # The cheapest reached label of each arc group (inf where none is reached).
@@ -144,8 +144,7 @@ def cell_roots(field: GoalField, cells: NDArray[np.int64]) -> tuple[NDArray[np.i
     ys = geo.origin[1] + (rows + 0.5) * geo.resolution
     clear = np.flatnonzero(geo.points_clear(np.stack([xs, ys], axis=1), p.radius))
     tables = field.arc_tables() if p.n_nodes else None
-    if tables is not None and _compiled.kernel("pointnav_core.geodesic._roots_kernel", "best_links") is not None \
-            and geo.compiled_polygons:
+    if tables is not None and compiled(p, "best_links") is not None:
         # In chunks: the candidate lists of a chunk are held at once.
         step = max(len(clear), 1) if p.n_nodes <= _BRUTE_NODES else max(16, _COMPILED_PAIRS // p.n_nodes)
         for i in range(0, len(clear), step):
@@ -228,15 +227,23 @@ def _chunk_roots(
     return kind, label
 
 
+def compiled(planner: Planner, name: str) -> Any:
+    """The compiled kernel ``name`` of :mod:`pointnav_core.geodesic._roots_kernel` for
+    ``planner``'s floor, or None: without numba, without nodes, or with a floor part the
+    compiled polygon test cannot read (the numpy paths then serve)."""
+    if not planner.n_nodes or not planner.geo.compiled_polygons:
+        return None
+    return _compiled.kernel("pointnav_core.geodesic._roots_kernel", name)
+
+
 def compiled_roots(
     field: GoalField, tables: ArcTables, x: NDArray[np.float64], y: NDArray[np.float64]
 ) -> tuple[NDArray[np.int8], NDArray[np.int32], NDArray[np.float64]]:
     """:func:`_chunk_roots`' decision for clear points (cell centres or any), one at a time
     in compiled code: kinds, labels and the exact distances (m). Needs numba."""
     p = field.planner
-    geo = p.geo
     search = field.labels
-    best_links = _compiled.kernel("pointnav_core.geodesic._roots_kernel", "best_links")
+    best_links = compiled(p, "best_links")
     if p.n_nodes <= _BRUTE_NODES:
         # Every node, cheapest arcs first: the scan of a point stops where they pass its best.
         cand = tables.by_cheap
@@ -245,18 +252,15 @@ def compiled_roots(
         owner, cand = p.nodes_seeing(x, y)
         start = np.searchsorted(owner, np.arange(len(x) + 1)).astype(np.int64)
         lo, hi = start[:-1], start[1:]
-    p.arcs_free(np.zeros(0, np.int64), np.zeros(0, np.int64), np.zeros(0), np.zeros(0))  # builds its tables
-    edges = geo.polygon_edges()
+    blocked, has_blocked = p.blocked_arcs()
     kind = np.zeros(len(x), dtype=np.int8)
     label = np.full(len(x), -1, dtype=np.int64)
     value = np.empty(len(x))
     best_links(
         x, y, float(field.goal[0]), float(field.goal[1]), cand, lo, hi, p.n_nodes <= _BRUTE_NODES, _SLACK,
         p.cx, p.cy, p.phi0, p.span, p.radius, ANG_TOL, TOUCH_TOL, p._balls.reach,
-        p.sight_profile, tables.cheapest, tables.start.astype(np.int64), tables.graph_end.astype(np.int64),
-        tables.labels.astype(np.int64), search.pos, search.cost,
-        p._blocked, p._has_blocked, float(geo.origin[0]), float(geo.origin[1]), float(geo.resolution), geo.row_counts,
-        geo.outside_blocked, *edges, bool(geo.polygons), kind, label, value,
+        p.sight_profile, tables.cheapest, tables.start, tables.graph_end, tables.labels, search.pos, search.cost,
+        blocked, has_blocked, *p.geo.kernel_geometry(), kind, label, value,
     )
     return kind, label.astype(np.int32), value
 
