@@ -29,7 +29,7 @@ if TYPE_CHECKING:
 __all__ = ["BLOCK", "GoalField", "LOOKUP_BOUND"]
 
 #: Side (cells) of the square blocks of the root table, each settled on its first lookup
-#: (8: a reset's first lookup settles 64 cells, about 1 ms on the default house).
+#: (8: a reset's first lookup settles 64 cells, about 0.6 ms on the default house).
 BLOCK = 8
 #: Table kind of a cell not settled yet.
 UNSETTLED = 4
