@@ -220,9 +220,10 @@ def main(argv: Sequence[str] | None = None) -> int:
     )
     demo.add_argument("--quiet", action="store_true", help="no progress bar")
     demo.set_defaults(func=_demo)
-    from pointnav_core.cli_datasets import add_commands
+    from pointnav_core import cli_datasets, cli_scenes
 
-    add_commands(sub, _positive_int)
+    cli_datasets.add_commands(sub, _positive_int)
+    cli_scenes.add_commands(sub, _positive_int, cli_datasets.reporting)
     args = parser.parse_args(argv)
     return int(args.func(args))
 

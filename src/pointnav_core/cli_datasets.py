@@ -17,7 +17,7 @@ import sys
 from collections.abc import Callable
 from typing import Any
 
-__all__ = ["add_commands"]
+__all__ = ["add_commands", "reporting"]
 
 
 def _dataset_generate(args: argparse.Namespace) -> int:
@@ -90,7 +90,7 @@ def _eval(args: argparse.Namespace) -> int:
     return 0
 
 
-def _reporting(
+def reporting(
     command: str, func: Callable[[argparse.Namespace], int]
 ) -> Callable[[argparse.Namespace], int]:
     """Run ``func``; bad input (a ValueError, a missing file, a sampling failure) is printed
@@ -149,7 +149,7 @@ def add_commands(sub: Any, positive_int: Callable[[str], int]) -> None:
     )
     gen.add_argument("--habitat-frame", action="store_true", help="write Habitat's y-up frame")
     gen.add_argument("--quiet", action="store_true", help="no progress bar")
-    gen.set_defaults(func=_reporting("dataset generate", _dataset_generate))
+    gen.set_defaults(func=reporting("dataset generate", _dataset_generate))
 
     ev = sub.add_parser("eval", help="evaluate a policy on an episode dataset")
     ev.add_argument("--dataset", required=True, metavar="FILE")
@@ -179,4 +179,4 @@ def add_commands(sub: Any, positive_int: Callable[[str], int]) -> None:
         help="PNG of SPL and success against geodesic distance",
     )
     ev.add_argument("--quiet", action="store_true", help="no progress bar")
-    ev.set_defaults(func=_reporting("eval", _eval))
+    ev.set_defaults(func=reporting("eval", _eval))
