@@ -144,6 +144,8 @@ def test_cli_eval_prints_and_writes(dataset_file, tmp_path, capsys):
                 str(results),
                 "--plot",
                 str(plot),
+                "--scenes-dir",
+                str(dataset_file.parent),
                 "--quiet",
             ]
         )
