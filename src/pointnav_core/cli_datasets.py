@@ -64,7 +64,13 @@ def _default_output(dataset: str, suffix: str) -> str:
 def _eval(args: argparse.Namespace) -> int:
     from pointnav_core.datasets import EpisodeDataset
     from pointnav_core.errors import PointNavError
-    from pointnav_core.evaluation import evaluate, make_policy, plot_results, summarize
+    from pointnav_core.evaluation import (
+        check_scene_ids,
+        evaluate,
+        make_policy,
+        plot_results,
+        summarize,
+    )
     from pointnav_core.evaluation_log import ResultsLog
     from pointnav_core.outputs import check_output
 
@@ -78,6 +84,7 @@ def _eval(args: argparse.Namespace) -> int:
         raise ValueError(f"--scenes-dir {scenes_dir!r} is not a folder")
     make_policy(args.policy, args.sb3_algo, args.trust_policy_file)
     dataset = EpisodeDataset.load(args.dataset)
+    check_scene_ids(dataset.episodes, scenes_dir)
     settings = {
         "dataset": os.path.abspath(args.dataset), "policy": args.policy, "sb3_algo": args.sb3_algo,
         "backend": args.backend, "drive": args.drive, "max_steps": args.max_steps,

@@ -52,6 +52,7 @@ from pointnav_core.workers import WorkerError, WorkerPool, usable_cores
 
 __all__ = [
     "EpisodeResult",
+    "check_scene_ids",
     "evaluate",
     "make_policy",
     "plot_results",
@@ -217,13 +218,13 @@ class _Runner:
     def outcome(self, ep: PointNavEpisode) -> tuple[str, Any]:
         """Play ``ep``: ``("ok", EpisodeResult)``, ``("input", message)`` for an episode that
         does not suit its scene, or ``("error", message)`` for a policy that raised."""
-        try:
-            env = self.env_for(ep)
-            obs, info = env.reset(seed=episode_seed(ep), options={"episode": ep})
-        except (ValueError, FileNotFoundError) as err:
-            return "input", str(err)
         step = 0
         try:
+            try:
+                env = self.env_for(ep)
+                obs, info = env.reset(seed=episode_seed(ep), options={"episode": ep})
+            except (ValueError, FileNotFoundError) as err:
+                return "input", str(err)
             policy = self.factory(env)
             done = False
             while not done:
@@ -268,8 +269,9 @@ def _play(runner: _Runner, ep: PointNavEpisode) -> tuple[str, Any]:
     return runner.outcome(ep)
 
 
-def _check_scenes(episodes: Sequence[PointNavEpisode], scenes_root: str | None) -> None:
-    """Refuse an unknown, missing or escaping scene before any episode is played."""
+def check_scene_ids(episodes: Sequence[PointNavEpisode], scenes_root: str | None) -> None:
+    """Refuse an unknown, missing or escaping scene (a ValueError naming the first episode
+    that has it) without building any scene."""
     seen: set[str] = set()
     for ep in episodes:
         if ep.scene_id not in seen:
@@ -350,7 +352,7 @@ def evaluate(
         raise ValueError(f"on_error must be one of {list(ON_ERROR)}, got {on_error!r}")
     if isinstance(policy, str):
         make_policy(policy, sb3_algo, trust_policy_file)  # a bad spec is refused here, once
-    _check_scenes(episodes, scenes_root)
+    check_scene_ids(episodes, scenes_root)
     args = (policy, backend, max_steps, drive, scenes_root, sb3_algo, trust_policy_file)
     results: list[EpisodeResult | None] = [None] * len(episodes)
     from tqdm import tqdm

@@ -52,13 +52,15 @@ class ResultsLog:
         """Open the log: read it back with ``resume``, else create it. Returns the finished
         results it holds, by episode id.
 
+        A log that holds no finished episode is started again.
+
         Raises
         ------
         ValueError
             For a log left by another run while ``resume`` is False, a log written with
             other settings, or one naming an episode the dataset does not have.
         """
-        if os.path.exists(self.path):
+        if os.path.exists(self.path) and os.path.getsize(self.path) > len(self.header.encode()):
             if not resume:
                 raise ValueError(
                     f"{self.path} holds the finished episodes of an earlier run: add --resume "

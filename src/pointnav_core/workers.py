@@ -58,6 +58,8 @@ def _describe(error: BaseException) -> str:
 
 def _worker_main(conn: Any, parent: int, init: Callable[..., Any], initargs: tuple, task: Callable[[Any, Any], Any]) -> None:
     signal.signal(signal.SIGINT, signal.SIG_IGN)
+    if hasattr(signal, "pthread_sigmask"):  # blocked since birth (see WorkerPool): now ignored
+        signal.pthread_sigmask(signal.SIG_UNBLOCK, {signal.SIGINT})
     threading.Thread(target=_watch_parent, args=(parent,), daemon=True).start()
     try:
         state = init(*initargs)
@@ -89,6 +91,15 @@ class WorkerPool:
     def __init__(self, workers: int, init: Callable[..., Any], initargs: tuple, task: Callable[[Any, Any], Any]) -> None:
         context = get_context("spawn")
         self._procs, self._conns = [], []
+        # A worker is born with SIGINT blocked (the mask survives fork and exec), so that a
+        # Ctrl-C while it is still starting does not kill it with a traceback; here a Ctrl-C
+        # waits until the workers are started.
+        blocking = hasattr(signal, "pthread_sigmask")
+        if blocking:  # it would unblock SIGINT if it started in the middle (it blocks its own)
+            from multiprocessing import resource_tracker
+
+            resource_tracker.ensure_running()
+        mask = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT}) if blocking else None
         try:
             for _ in range(workers):
                 ours, theirs = context.Pipe()
@@ -102,6 +113,9 @@ class WorkerPool:
         except BaseException:
             self.close()
             raise
+        finally:
+            if blocking:
+                signal.pthread_sigmask(signal.SIG_SETMASK, mask)
 
     def __enter__(self) -> WorkerPool:
         return self
