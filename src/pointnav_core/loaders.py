@@ -173,7 +173,7 @@ def _open_image(path: str | os.PathLike[str], where: str):  # -> PIL.Image.Image
         return Image.open(path)
     except Image.DecompressionBombError:
         raise ValueError(
-            f"{where} (image) is over the cell budget of {validation.MAX_CELLS} pixels "
+            f"{where} (image) is over the cell budget of {validation.MAX_CELLS} "
             "(pointnav_core.validation.MAX_CELLS)"
         ) from None
 
