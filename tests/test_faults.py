@@ -123,7 +123,7 @@ def test_signals_at_random_moments_lose_nothing(work, tmp_path):
                 stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True,
             )
             ready = Path(str(results) + ".partial")
-            runs.append(dict(proc=proc, sig=sig, results=results, ready=ready, delay=rng.uniform(0.0, 1.0)))
+            runs.append({"proc": proc, "sig": sig, "results": results, "ready": ready, "delay": rng.uniform(0.0, 1.0)})
         old = tmp_path / f"old-{sig.name}.json.gz"
         old.write_bytes(dataset.read_bytes())
         gen = ["dataset", "generate", "--scenes", str(folder), "--split", "train", "--seed", "1",
@@ -132,7 +132,7 @@ def test_signals_at_random_moments_lose_nothing(work, tmp_path):
         with open(progress, "w") as bar:
             proc = subprocess.Popen(_cli(*gen), env=_env(), start_new_session=True,
                                     stdout=subprocess.DEVNULL, stderr=bar, text=True)
-        runs.append(dict(proc=proc, sig=sig, old=old, ready=progress, delay=rng.uniform(0.0, 1.5)))
+        runs.append({"proc": proc, "sig": sig, "old": old, "ready": progress, "delay": rng.uniform(0.0, 1.5)})
     start, seen = time.monotonic(), {id(r): set() for r in runs}
     while any("killed" not in r for r in runs):
         for r in runs:
@@ -187,7 +187,7 @@ def test_full_disk_keeps_finished_episodes_and_old_files(work, tmp_path):
     limit = len(reference) * 2 // 3  # the log's first line, then about three results
     run = subprocess.run(
         _cli(*_eval_args(folder, results)), env=_env(), capture_output=True, text=True,
-        preexec_fn=_limit_file_size(limit), timeout=60,
+        preexec_fn=_limit_file_size(limit), timeout=60, check=False,
     )
     assert run.returncode == 1, run.stderr
     assert "cannot write" in run.stderr and "r.jsonl.partial" in run.stderr and "Traceback" not in run.stderr
@@ -202,7 +202,7 @@ def test_full_disk_keeps_finished_episodes_and_old_files(work, tmp_path):
     gen = ["dataset", "generate", "--scenes", str(folder), "--split", "train", "--seed", "3",
            "--episodes", "40", "--out", str(old), "--quiet"]
     run = subprocess.run(_cli(*gen), env=_env(), capture_output=True, text=True,
-                         preexec_fn=_limit_file_size(len(dataset.read_bytes()) // 2), timeout=60)
+                         preexec_fn=_limit_file_size(len(dataset.read_bytes()) // 2), timeout=60, check=False)
     assert run.returncode == 2 and "Traceback" not in run.stderr, run.stderr
     assert old.read_bytes() == dataset.read_bytes()
     assert sorted(p.name for p in tmp_path.iterdir() if p.name.startswith(".old")) == []
@@ -294,7 +294,7 @@ def _sb3_zip(path: Path, marker: Path) -> None:
 
 def test_sb3_zip_runs_no_code_without_trust(work, tmp_path, capsys):
     pytest.importorskip("stable_baselines3")
-    folder, _, _ = work
+    folder = work[0]
     model, marker = tmp_path / "model.zip", tmp_path / "marker"
     _sb3_zip(model, marker)
     assert main(_eval_args(folder, tmp_path / "r.jsonl", "--policy", str(model))) == 2
@@ -307,7 +307,7 @@ def test_sb3_zip_runs_no_code_without_trust(work, tmp_path, capsys):
 
 
 def test_scene_paths_stay_under_the_scenes_folder(work, tmp_path, capsys):
-    folder, dataset, _ = work
+    dataset = work[1]
     secret = tmp_path / "secret.map"
     secret.write_text("hunter2 is the password\n")
     scenes = tmp_path / "scenes"
