@@ -146,12 +146,13 @@ def test_signals_at_random_moments_lose_nothing(work, tmp_path):
                     os.killpg(r["proc"].pid, signal.SIGINT)
                 else:
                     r["proc"].send_signal(r["sig"])
-                r["killed"] = True
+                r["killed"] = time.monotonic()
         assert time.monotonic() - start < 60, "a run never started"
         time.sleep(0.02)
     for r in runs:
         rc = r["proc"].wait(timeout=20)
         died = time.monotonic()
+        assert died - r["killed"] < 10, "the run went on after the signal"  # (waits are in turn)
         if r["proc"].stderr is not None:
             with r["proc"].stderr as pipe:
                 err = pipe.read()
@@ -200,7 +201,7 @@ def test_full_disk_keeps_finished_episodes_and_old_files(work, tmp_path):
     old = tmp_path / "old.json.gz"
     old.write_bytes(dataset.read_bytes())
     gen = ["dataset", "generate", "--scenes", str(folder), "--split", "train", "--seed", "3",
-           "--episodes", "40", "--out", str(old), "--quiet"]
+           "--episodes", "15", "--out", str(old), "--quiet"]
     run = subprocess.run(_cli(*gen), env=_env(), capture_output=True, text=True,
                          preexec_fn=_limit_file_size(len(dataset.read_bytes()) // 2), timeout=60, check=False)
     assert run.returncode == 2 and "Traceback" not in run.stderr, run.stderr

@@ -3,7 +3,8 @@
 ``pointnav dataset generate --scenes SET --split val --episodes N --out FILE`` writes an
 episode dataset (:mod:`pointnav_core.datasets`); the same arguments give the same bytes.
 
-``pointnav eval --dataset FILE --policy oracle|MODULE:CALLABLE|MODEL.zip`` plays every
+``pointnav eval --dataset FILE --policy oracle|MODULE:CALLABLE|MODEL.zip`` (a ``.zip`` with
+``--trust-policy-file``: loading one runs the code pickled in it) plays every
 episode once (:mod:`pointnav_core.evaluation`), prints success, SPL, SoftSPL, the mean
 distance to the goal and collisions, and writes per-episode results (JSON lines, or CSV for
 a ``.csv`` path) and a PNG of SPL and success against geodesic distance.
