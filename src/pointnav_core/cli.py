@@ -142,6 +142,11 @@ def run_demo(
 
 
 def _demo(args: argparse.Namespace) -> int:
+    from pointnav_core.outputs import check_output
+
+    for name, path in (("--gif", args.gif), ("--png", args.png)):
+        if path:  # before any episode is played
+            check_output(name, path, [args.scene] if args.scene else [])
     frames: list | None = [] if (args.gif or args.png) else None
     summary = run_demo(
         episodes=args.episodes,
@@ -197,10 +202,10 @@ def main(argv: Sequence[str] | None = None) -> int:
     parser = argparse.ArgumentParser(prog="pointnav", description="pointnav-core command line")
     sub = parser.add_subparsers(dest="command", required=True)
     demo = sub.add_parser("demo", help="drive the oracle to goals in generated houses")
-    demo.add_argument("--episodes", type=int, default=20)
-    demo.add_argument("--houses", type=int, default=4)
+    demo.add_argument("--episodes", type=_positive_int, default=20, metavar="N")
+    demo.add_argument("--houses", type=_positive_int, default=4, metavar="N")
     demo.add_argument("--seed", type=int, default=0)
-    demo.add_argument("--max-steps", type=int, default=1000)
+    demo.add_argument("--max-steps", type=_positive_int, default=1000, metavar="N")
     demo.add_argument("--backend", default="kinematic")
     demo.add_argument("--drive", choices=("differential", "holonomic"), default="differential")
     demo.add_argument(
@@ -219,8 +224,9 @@ def main(argv: Sequence[str] | None = None) -> int:
         help="a MovingAI .map, an OmniGibson floor_trav_<n>.png or a folder of them, instead of generated houses",
     )
     demo.add_argument("--quiet", action="store_true", help="no progress bar")
-    demo.set_defaults(func=_demo)
     from pointnav_core import cli_datasets, cli_scenes
+
+    demo.set_defaults(func=cli_datasets.reporting("demo", _demo))
 
     cli_datasets.add_commands(sub, _positive_int)
     cli_scenes.add_commands(sub, _positive_int, cli_datasets.reporting)

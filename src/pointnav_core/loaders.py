@@ -14,6 +14,7 @@ from __future__ import annotations
 import math
 import os
 import re
+import warnings
 
 import numpy as np
 from numpy.typing import NDArray
@@ -125,7 +126,13 @@ def read_trav_png(
     from PIL import Image, UnidentifiedImageError  # only this reader needs Pillow
 
     try:
-        with Image.open(path) as image:
+        with warnings.catch_warnings():
+            # Pillow's own bomb check is replaced by the library's cell budget, applied below
+            # to the header's size before any pixel is decoded.
+            warnings.simplefilter("ignore", Image.DecompressionBombWarning)
+            image = _open_image(path, where)
+        with image:
+            validation.cell_budget(f"{where} (image)", image.size[1], image.size[0])
             image.load()
             mode, (width, height) = image.mode, image.size
             if mode != "L":
@@ -156,6 +163,19 @@ def read_trav_png(
     codes = np.where(any_cells, OBSTACLE, FREE).astype(np.uint8)
     half = n_cells * resolution / 2.0
     return codes, (-half, -half)
+
+
+def _open_image(path: str | os.PathLike[str], where: str):  # -> PIL.Image.Image
+    """Open (not decode) an image; an image beyond Pillow's bomb limit is over the budget too."""
+    from PIL import Image
+
+    try:
+        return Image.open(path)
+    except Image.DecompressionBombError:
+        raise ValueError(
+            f"{where} (image) is over the cell budget of {validation.MAX_CELLS} "
+            "(pointnav_core.validation.MAX_CELLS)"
+        ) from None
 
 
 def _pixel_spans(lo: NDArray[np.float64], factor: float) -> tuple[NDArray[np.int64], NDArray[np.int64]]:
@@ -253,7 +273,7 @@ def _parse_movingai(text: str, source: str) -> NDArray[np.uint8]:
         match = _HEADER_LINE.match(stripped)
         if match is None or match.group(1) in header:
             raise ValueError(
-                f"{where}: bad MovingAI header at line {number}: {line!r}; expected the lines "
+                f"{where}: bad MovingAI header at line {number}; expected the lines "
                 "'type octile', 'height <H>', 'width <W>' (once each), then 'map'"
             )
         header[match.group(1)] = match.group(2)
@@ -271,6 +291,7 @@ def _parse_movingai(text: str, source: str) -> NDArray[np.uint8]:
             raise ValueError(f"{where}: bad MovingAI header: {key} must be an integer >= 1, got {value!r}")
         size[key] = int(value)
     height, width = size["height"], size["width"]
+    validation.cell_budget(f"{where} (map)", height, width)
 
     rows = lines[body_start:]
     while rows and not rows[-1].strip():  # trailing blank lines are harmless

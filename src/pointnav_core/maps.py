@@ -130,6 +130,7 @@ class TraversableMap:
         codes = np.asarray(grid)
         if codes.ndim != 2 or codes.shape[0] < 1 or codes.shape[1] < 1:
             raise ValueError(f"grid must be a non-empty 2D array, got shape {codes.shape}")
+        validation.cell_budget("grid", *codes.shape)
         if codes.dtype == bool:
             codes = np.where(codes, FREE, OBSTACLE)
         elif not np.issubdtype(codes.dtype, np.integer):

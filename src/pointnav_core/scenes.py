@@ -255,8 +255,8 @@ class Scene:
         the origin moves out by one cell so that character ``(row, col)`` still covers
         ``[col, col + 1) x [row, row + 1)`` times ``resolution``.
         """
+        res = validation.real("resolution", resolution, minimum=0.0, strict=True, unit="m per character")
         codes = np.pad(loaders.read_movingai(path), 1, constant_values=OBSTACLE)
-        res = float(resolution)
         return cls([TraversableMap(codes, res, origin=(-res, -res))], **kwargs)
 
     @staticmethod

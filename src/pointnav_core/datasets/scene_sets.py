@@ -14,7 +14,8 @@ scene_id                       scene
                                one ``floor_trav_<n>.png`` file
 =============================  ==========================================================
 
-Relative paths are read relative to ``root`` (the working directory by default). A plain
+Relative paths are read relative to ``root`` (the working directory by default); with a
+``root``, a path must stay under it once resolved (:func:`locate_scene`). A plain
 path is accepted too: ``.map`` is a MovingAI map, ``.png`` a traversability image, a folder
 an OmniGibson scene.
 
@@ -46,6 +47,7 @@ __all__ = [
     "folder_scene_set",
     "generated_scene_set",
     "load_scene",
+    "locate_scene",
     "scene_set",
 ]
 
@@ -193,7 +195,8 @@ def load_scene(scene_id: str, root: str | os.PathLike[str] | None = None) -> Sce
     Raises
     ------
     ValueError
-        For a scene_id of no known form, naming the forms.
+        For a scene_id of no known form, naming the forms, or a path that leaves ``root``
+        (see :func:`locate_scene`).
     FileNotFoundError
         For a path that does not exist.
     """
@@ -201,25 +204,53 @@ def load_scene(scene_id: str, root: str | os.PathLike[str] | None = None) -> Sce
     return _CACHE.get_or_create(key, lambda: _build(scene_id, root))
 
 
-def _build(scene_id: Any, root: str | os.PathLike[str] | None) -> Scene:
-    forms = "rooms:<seed>, maze:<seed>, clutter:<seed>, movingai:<path>, trav:<path>, or a .map/.png/folder path"
+_FORMS = "rooms:<seed>, maze:<seed>, clutter:<seed>, movingai:<path>, trav:<path>, or a .map/.png/folder path"
+
+
+def locate_scene(scene_id: Any, root: str | os.PathLike[str] | None = None) -> tuple[str, str | None]:
+    """Check a ``scene_id`` without building its scene: ``(scheme, path)``.
+
+    ``scheme`` is a generator name (``rooms``, ...; ``path`` None), ``movingai``, ``trav``
+    or ``""`` (a plain path). With ``root``, a path is resolved (links followed) and must
+    stay under ``root``: a dataset cannot make the reader open files elsewhere.
+
+    Raises
+    ------
+    ValueError
+        For a scene_id of no known form, naming the forms, or a path outside ``root``.
+    FileNotFoundError
+        For a path that does not exist.
+    """
     if not isinstance(scene_id, str) or not scene_id:
-        raise ValueError(f"scene_id must be a non-empty string ({forms}), got {scene_id!r}")
+        raise ValueError(f"scene_id must be a non-empty string ({_FORMS}), got {scene_id!r}")
     scheme, _, rest = scene_id.partition(":")
     if scheme in GENERATORS:
         if not re.fullmatch(r"-?\d+", rest):
             raise ValueError(f"unknown scene_id {scene_id!r}: {scheme}: takes an integer seed")
-        return GENERATORS[scheme](seed=int(rest))
+        return scheme, None
     if scheme in ("movingai", "trav") and rest:
         path = rest
     elif ":" not in scene_id or re.match(r"^[A-Za-z]:[\\/]", scene_id):  # a plain (or Windows) path
         path, scheme = scene_id, ""
     else:
-        raise ValueError(f"unknown scene_id {scene_id!r}: expected one of {forms}")
-    if root is not None and not os.path.isabs(path):
-        path = os.path.join(os.fspath(root), path)
+        raise ValueError(f"unknown scene_id {scene_id!r}: expected one of {_FORMS}")
+    if root is not None:
+        base = os.path.realpath(root)
+        path = os.path.realpath(os.path.join(base, path))
+        if os.path.commonpath([base, path]) != base:
+            raise ValueError(
+                f"scene_id {scene_id!r}: the path leaves the scenes folder {os.fspath(root)!r} "
+                "(scenes_root, --scenes-dir)"
+            )
     if not os.path.exists(path):
         raise FileNotFoundError(f"scene_id {scene_id!r}: no such file or folder {path!r}")
+    return scheme, path
+
+
+def _build(scene_id: Any, root: str | os.PathLike[str] | None) -> Scene:
+    scheme, path = locate_scene(scene_id, root)
+    if path is None:
+        return GENERATORS[scheme](seed=int(scene_id.partition(":")[2]))
     if scheme == "movingai" or (not scheme and path.endswith(".map")):
         return Scene.from_movingai(path)
     if os.path.isdir(path):
@@ -229,4 +260,4 @@ def _build(scene_id: Any, root: str | os.PathLike[str] | None) -> Scene:
         return Scene.from_png(images)
     if path.endswith(".png"):
         return Scene.from_png(path)
-    raise ValueError(f"unknown scene_id {scene_id!r}: expected one of {forms}")
+    raise ValueError(f"unknown scene_id {scene_id!r}: expected one of {_FORMS}")
