@@ -23,6 +23,10 @@ from pointnav_core.maps import FREE, OBSTACLE
 
 __all__ = ["MOVINGAI_CELLS", "read_movingai", "read_trav_png"]
 
+_ROS_HINT = (
+    "read a ROS map with Scene.from_ros_map(<its map.yaml>), any other grid with Scene.from_array"
+)
+_ROS_SHADES = np.array([205, 254], np.uint8)
 # Tolerance used when snapping pixel edges that should be whole numbers (0.1 / 0.01 is not 10).
 _EDGE_TOL = 1e-6
 
@@ -84,8 +88,9 @@ def read_trav_png(
         When ``path`` does not exist.
     ValueError
         When the file is not a readable image, is not 8-bit greyscale (mode ``"L"``; RGB,
-        palette or 16-bit images are refused, not converted), is not square, or a resolution
-        is not a finite positive number.
+        palette or 16-bit images are refused, not converted), is not square, is a PGM or
+        holds map_saver's free (254) and unknown (205) shades (a ROS map: use
+        ``Scene.from_ros_map``), or a resolution is not a finite positive number.
 
     See Also
     --------
@@ -133,14 +138,22 @@ def read_trav_png(
                     f"{where} must be an 8-bit greyscale image (mode 'L'), got mode {mode!r}; "
                     "convert it explicitly if its values mean traversability"
                 )
+            if image.format == "PPM":
+                raise ValueError(f"{where} is a PGM image, as ROS map_server maps are: {_ROS_HINT}")
             if width != height:
-                raise ValueError(f"{where} must be a square image, got {width}x{height} pixels")
+                raise ValueError(
+                    f"{where} must be a square image (OmniGibson's are), got {width}x{height} "
+                    f"pixels: {_ROS_HINT}"
+                )
             pixels = np.asarray(image)
     except FileNotFoundError:
         raise
     except (UnidentifiedImageError, OSError, SyntaxError) as exc:
         # Pillow reports undecodable or truncated files as any of these.
         raise ValueError(f"{where} is not a readable image: {exc}") from exc
+    if np.isin(_ROS_SHADES, pixels).all():
+        # map_saver's free (254) and unknown (205) would all read as blocked here.
+        raise ValueError(f"{where} holds ROS map_saver's free (254) and unknown (205) shades: {_ROS_HINT}")
     blocked = pixels < 255
     n_pixels = blocked.shape[0]
     factor = resolution / source_resolution  # source pixels per cell, along one axis

@@ -259,6 +259,41 @@ class Scene:
         res = float(resolution)
         return cls([TraversableMap(codes, res, origin=(-res, -res))], **kwargs)
 
+    @classmethod
+    def from_ros_map(cls, yaml_path: str | PathLike[str], *, unknown: str = "void", lethal_threshold: int = 100,
+                     ignore_yaw: bool = False, height: float = 0.0, **kwargs: Any) -> Scene:
+        """Scene of one floor from a ROS map_server ``map.yaml`` and its PGM / PNG image, read by
+        map_server's rules (see :func:`pointnav_core.ros_maps.ros_map_floor`)."""
+        from pointnav_core import ros_maps
+
+        floor = ros_maps.ros_map_floor(yaml_path, unknown=unknown, lethal_threshold=lethal_threshold,
+                                       ignore_yaw=ignore_yaw, height=height)
+        return cls([floor], **kwargs)
+
+    @classmethod
+    def from_procthor(cls, house_json: str | PathLike[str], resolution: float = 0.05, wall_thickness: float = 0.1,
+                      object_sizes: Any = None, **kwargs: Any) -> Scene:
+        """Scene of a ProcTHOR ``house.json``: rooms as floor, walls with door holes as obstacles,
+        exact polygons (see :func:`pointnav_core.floorplan_files.read_procthor`)."""
+        from pointnav_core.floorplan_files import read_procthor
+
+        plan = read_procthor(house_json, wall_thickness=wall_thickness, object_sizes=object_sizes)
+        return cls.from_polygons(plan.outline, plan.obstacles, resolution=resolution, **kwargs)
+
+    @classmethod
+    def from_houseexpo(cls, path: str | PathLike[str], resolution: float = 0.05, **kwargs: Any) -> Scene:
+        """Scene of a HouseExpo ``<id>.json``: its ``verts`` (m) as the exact floor outline."""
+        from pointnav_core.floorplan_files import read_houseexpo
+
+        plan = read_houseexpo(path)
+        return cls.from_polygons(plan.outline, plan.obstacles, resolution=resolution, **kwargs)
+
+    def to_ros_map(self, yaml_path: str | PathLike[str], floor: int = 0) -> str:
+        """Write ``floor``'s grid as a trinary map_server map (yaml + PGM); returns the image path."""
+        from pointnav_core import ros_maps
+
+        return ros_maps.write_ros_map(self._floor(floor), yaml_path)
+
     @staticmethod
     def _heights(heights: Sequence[float] | None, n: int) -> list[float]:
         if heights is None:
