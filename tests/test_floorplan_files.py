@@ -11,6 +11,7 @@ import math
 from pathlib import Path
 
 import pytest
+from shapely.geometry import Polygon
 
 from pointnav_core.datasets import load_scene
 from pointnav_core.scenes import Scene
@@ -154,3 +155,30 @@ def test_bad_houseexpo_and_json_files_are_refused(tmp_path):
     path.write_text('{"verts": [[0, 0], [1')
     with pytest.raises(ValueError, match=r"bad\.json'? is not valid JSON"):
         Scene.from_houseexpo(path)
+
+
+def test_a_real_procthor_house_gives_its_rooms_doors_and_open_sides():
+    path = DATA / "procthor" / "procthor_train_1.json"
+    doc = json.loads(path.read_text())
+    rooms = [Polygon([(p["x"], p["z"]) for p in r["floorPolygon"]]) for r in doc["rooms"]]
+    walls = {w["id"]: [(p["x"], p["z"]) for p in w["polygon"] if p["y"] == 0] for w in doc["walls"]}
+    scene = Scene.from_procthor(path, resolution=0.1)
+    assert scene.floors[0].geometry.outline.area == pytest.approx(sum(r.area for r in rooms))
+    for door in doc["doors"]:  # the middle of each hole, along wall0 from its first base point
+        (x0, z0), (x1, z1) = walls[door["wall0"]]
+        s = (door["holePolygon"][0]["x"] + door["holePolygon"][1]["x"]) / 2
+        length = math.hypot(x1 - x0, z1 - z0)
+        middle = (x0 + (x1 - x0) * s / length, z0 + (z1 - z0) * s / length)
+        assert scene.is_usable(0, middle), door["id"]
+    for wall_id, (a, b) in walls.items():
+        middle = ((a[0] + b[0]) / 2, (a[1] + b[1]) / 2)
+        doored = any(d["wall0"] == wall_id or d["wall1"] == wall_id for d in doc["doors"])
+        empty = any(w["id"] == wall_id and w.get("empty") for w in doc["walls"])
+        if empty:  # an open side between two rooms of one space
+            assert scene.is_usable(0, middle), wall_id
+        elif not doored:
+            assert not scene.is_usable(0, middle), wall_id
+    # Every room reaches every other for the default robot, through doors and open sides.
+    inside = [r.buffer(-0.3).representative_point() for r in rooms]
+    for p in inside[1:]:
+        assert math.isfinite(scene.geodesic_distance(0, (inside[0].x, inside[0].y), (p.x, p.y), robot=0.18))

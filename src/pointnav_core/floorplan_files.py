@@ -7,9 +7,10 @@ as the floor's exact collision geometry.
 * **ProcTHOR** (``house.json`` of ai2thor / procthor, schema 1.0): the floor is the union of
   the rooms' ``floorPolygon`` (their ``x`` and ``z``; THOR's y is up, so THOR ``(x, z)`` is
   world ``(x, y)``, the same picture seen from above). Each wall (its two base points,
-  ``y = 0``) becomes a ``wall_thickness`` slab centred on it, and each door's
-  ``holePolygon`` (``x`` from wall0's first base point along the wall) is cut out of the
-  walls. Objects carry no size in the house file, so they become obstacles only when
+  ``y = 0``) becomes a ``wall_thickness`` slab centred on it, except ``empty`` walls (the
+  open side between two rooms of one space), and each door's ``holePolygon`` (``x`` from
+  wall0's first base point along the wall) is cut out of the walls; windows are above the
+  floor and cut nothing. Objects carry no size in the house file, so they become obstacles only when
   ``object_sizes`` gives their footprint: ``assetId -> (size_x, size_z)`` metres, turned by
   their y rotation (degrees, clockwise seen from above, as Unity turns).
 * **HouseExpo** (``<id>.json``): ``verts`` is the outline of the free space in metres (the
@@ -97,6 +98,7 @@ def _walls(doc: dict[str, Any], where: str, thickness: float) -> tuple[dict[str,
     if not isinstance(walls, list):
         raise ValueError(f"{where}: walls must be a list, got {walls!r:.80}")
     bases: dict[str, LineString] = {}
+    empty: set[str] = set()
     for i, wall in enumerate(walls):
         field = f"{where}: walls[{i}].polygon"
         if not isinstance(wall, dict) or not isinstance(wall.get("id"), str):
@@ -107,7 +109,9 @@ def _walls(doc: dict[str, Any], where: str, thickness: float) -> tuple[dict[str,
         if len(base) < 2 or base[0] == base[1]:
             raise ValueError(f"{field} must have two distinct points at its lowest y")
         bases[wall["id"]] = LineString(base[:2])
-    slabs = [line.buffer(thickness / 2, cap_style="square") for line in bases.values()]
+        if wall.get("empty") is True:  # an open side between two rooms: no wall is built
+            empty.add(wall["id"])
+    slabs = [line.buffer(thickness / 2, cap_style="square") for k, line in bases.items() if k not in empty]
     return bases, shapely.unary_union(slabs)
 
 
