@@ -224,3 +224,12 @@ def test_a_truncated_pgm_is_refused_and_nothing_half_built_is_kept(tmp_path):
         load_scene(str(yaml_path))
     (tmp_path / "cut.pgm").write_bytes(whole)  # mended: the same scene_id now builds afresh
     assert load_scene(str(yaml_path)).floors[0].free.sum() == 1600
+
+
+def test_a_16_bit_pgm_is_read_at_its_own_depth(tmp_path):
+    # occupancy 1 - v / 65535: 0 -> 1 (occupied), 65535 -> 0 (free), 50000 -> 0.237 (unknown)
+    body = np.array([[0, 65535, 50000]], ">u2").tobytes()
+    (tmp_path / "deep.pgm").write_bytes(b"P5\n3 1\n65535\n" + body)
+    (tmp_path / "deep.yaml").write_text("image: deep.pgm\nresolution: 0.1\norigin: [0, 0, 0]\nnegate: 0\n"
+                                        "occupied_thresh: 0.65\nfree_thresh: 0.196\n")
+    assert read_ros_map(tmp_path / "deep.yaml").data.tolist() == [[100, 0, U]]
