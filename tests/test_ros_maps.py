@@ -187,6 +187,12 @@ def test_to_ros_map_round_trips(tmp_path):
     back = Scene.from_ros_map(tmp_path / "out.yaml").floors[0]
     np.testing.assert_array_equal(back.codes, codes)
     assert back.origin == (-1.25, 3.5) and back.resolution == 0.05
+    for name in ("tb3_sandbox", "depot"):  # real maps: the same cells after a save and a load
+        real = Scene.from_ros_map(DATA / "nav2_maps" / f"{name}.yaml")
+        real.to_ros_map(tmp_path / f"{name}.yaml")
+        again = Scene.from_ros_map(tmp_path / f"{name}.yaml").floors[0]
+        np.testing.assert_array_equal(again.codes, real.floors[0].codes)
+        assert again.origin == real.floors[0].origin
 
 
 def test_from_png_refuses_a_ros_map_and_names_from_ros_map(tmp_path):
