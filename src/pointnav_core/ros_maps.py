@@ -73,8 +73,8 @@ class RosMap:
 
 def _shade(pixels: NDArray[Any], full: float) -> NDArray[np.float64]:
     """Mean of the channels (last axis) over ``full``, as map_server's 16-bit pixels give it."""
-    # GraphicsMagick holds 8-bit values as v * 257 of 65535; dividing the same way keeps the
-    # shade bit for bit what map_server compares with the thresholds.
+    # map_server's GraphicsMagick (16-bit quanta) holds an 8-bit value as v * 257 of 65535 and
+    # divides the channels' mean by 65535; the same operations give the same doubles.
     scale = 65535.0 / full
     total = pixels.astype(np.float64).sum(axis=-1) * scale
     return total / pixels.shape[-1] / 65535.0
@@ -127,10 +127,7 @@ def occupancy(
 def _field(doc: dict[str, Any], key: str, where: str, **bounds: Any) -> float:
     if key not in doc:
         raise ValueError(f"{where}: no {key!r} (map_server needs it)")
-    try:
-        return validation.real(f"{where}: {key}", doc[key], **bounds)
-    except ValueError as exc:
-        raise ValueError(str(exc)) from None
+    return validation.real(f"{where}: {key}", doc[key], **bounds)
 
 
 def _parse_yaml(path: str) -> dict[str, Any]:
