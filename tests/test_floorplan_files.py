@@ -13,7 +13,7 @@ from pathlib import Path
 import pytest
 from shapely.geometry import Polygon
 
-from pointnav_core.datasets import load_scene
+from pointnav_core.datasets import load_scene, scene_set
 from pointnav_core.scenes import Scene
 
 DATA = Path(__file__).parent / "data"
@@ -103,8 +103,11 @@ def test_plain_json_paths_are_told_apart_by_their_keys(house, tmp_path):
     assert load_scene(str(house)).floors[0].geometry.outline.area == pytest.approx(24.0)
     other = tmp_path / "other.json"
     other.write_text('{"hello": 1}')
-    with pytest.raises(ValueError, match=r"other\.json.*neither a ProcTHOR house nor a HouseExpo plan"):
+    with pytest.raises(ValueError, match=r"other\.json.*neither a ProcTHOR house .* nor a HouseExpo plan"):
         load_scene(str(other))
+    # In a folder too: a .json that is no floor plan is named, not skipped.
+    with pytest.raises(ValueError, match=r"other\.json.*neither a ProcTHOR house"):
+        scene_set(str(tmp_path))
 
 
 def broken(field: str) -> dict:

@@ -50,17 +50,18 @@ def _load(path: str | os.PathLike[str]) -> tuple[dict[str, Any], str]:
     return doc, where
 
 
-def sniff_plan_format(path: str | os.PathLike[str]) -> str | None:
-    """``"procthor"``, ``"houseexpo"`` or None for a JSON file, by its top-level keys."""
-    try:
-        doc, _ = _load(path)
-    except (ValueError, UnicodeDecodeError):
-        return None
-    if "rooms" in doc and "walls" in doc:
-        return "procthor"
+def sniff_plan_format(path: str | os.PathLike[str]) -> str:
+    """``"procthor"`` or ``"houseexpo"`` for a JSON file, by its top-level keys (a house's
+    ``rooms``, ``walls`` or ``doors``; a plan's ``verts``); ``ValueError`` naming the file
+    otherwise."""
+    doc, where = _load(path)
     if "verts" in doc:
         return "houseexpo"
-    return None
+    if {"rooms", "walls", "doors"} & doc.keys():
+        return "procthor"
+    raise ValueError(
+        f"{where} is neither a ProcTHOR house (rooms, walls, doors) nor a HouseExpo plan (verts)"
+    )
 
 
 def _xz(points: Any, where: str) -> list[tuple[float, float]]:

@@ -138,7 +138,8 @@ def _trav_images(folder: str) -> list[str]:
 
 
 def _file_scheme(path: str) -> str | None:
-    """The scene_id scheme of a scene file by its name (and a JSON file's keys), or None."""
+    """The scene_id scheme of a scene file by its name (and a JSON file's keys), or None
+    for a file that is no scene; a ``.json`` that is neither floor-plan format is an error."""
     if path.endswith(".map"):
         return "movingai"
     if path.endswith((".yaml", ".yml")):
@@ -253,8 +254,6 @@ def _build(scene_id: Any, root: str | os.PathLike[str] | None) -> Scene:
         raise FileNotFoundError(f"scene_id {scene_id!r}: no such file or folder {path!r}")
     if not scheme and os.path.isfile(path):
         scheme = _file_scheme(path) or ""
-        if not scheme and path.endswith(".json"):
-            raise ValueError(f"scene_id {scene_id!r}: {path!r} is neither a ProcTHOR house nor a HouseExpo plan")
     if scheme in FILE_SCHEMES and scheme != "trav":
         return FILE_SCHEMES[scheme](path)
     if os.path.isdir(path):
