@@ -4,7 +4,8 @@
 (:class:`~pointnav_core.policies.ShortestPathFollower`) to sampled goals on the default
 kinematic backend, and prints success, SPL, SoftSPL, path length, collisions and speed.
 
-``pointnav demo --scene FILE`` drives on a MovingAI map or a traversability PNG instead.
+``pointnav demo --scene FILE`` drives on a scene file instead: a ROS map ``.yaml``, a ProcTHOR
+or HouseExpo ``.json``, a MovingAI ``.map`` or a traversability PNG (any ``scene_id``).
 ``pointnav dataset generate`` and ``pointnav eval`` are in :mod:`pointnav_core.cli_datasets`.
 
 ``--gif FILE`` writes the first episode as an animated GIF and ``--png FILE`` its last frame
@@ -73,8 +74,9 @@ def run_demo(
         With ``frames``: the picture scale (default 20 px/m, see
         :func:`pointnav_core.recording.render_env`).
     scene : str, optional
-        A scene file instead of generated houses: a MovingAI ``.map``, an OmniGibson
-        ``floor_trav_<n>.png`` or a folder of them (any ``scene_id``, see
+        A scene file instead of generated houses: a ROS map ``.yaml``, a ProcTHOR or
+        HouseExpo ``.json``, a MovingAI ``.map``, an OmniGibson ``floor_trav_<n>.png`` or a
+        folder of them (any ``scene_id``, see
         :func:`pointnav_core.datasets.load_scene`); ``houses`` is then ignored.
 
     Returns
@@ -221,7 +223,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     )
     demo.add_argument(
         "--scene", metavar="FILE",
-        help="a MovingAI .map, an OmniGibson floor_trav_<n>.png or a folder of them, instead of generated houses",
+        help="a scene file instead of generated houses: a ROS map .yaml, a ProcTHOR or HouseExpo .json, "
+        "a MovingAI .map, an OmniGibson floor_trav_<n>.png or a folder of them",
     )
     demo.add_argument("--quiet", action="store_true", help="no progress bar")
     from pointnav_core import cli_datasets, cli_scenes

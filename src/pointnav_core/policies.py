@@ -145,7 +145,8 @@ class ShortestPathFollower:
     Parameters
     ----------
     env : PointNavEnv or a multi-robot env
-        Anything with ``scene``, ``backend``, ``robots`` and a ``task`` (or pass ``task``).
+        Anything with ``scene``, ``backend``, ``robots`` and a ``task`` (or pass ``task``);
+        a wrapped env (``gymnasium.make``) is unwrapped.
     task : PointNavigationTask, optional
         The task whose robot this policy drives (default ``env.task``).
     margin : float
@@ -191,6 +192,8 @@ class ShortestPathFollower:
         margin: float = 0.02,
         lookahead: float = 0.3,
     ) -> None:
+        # gymnasium.make's wrappers do not forward ``task``: drive the env they wrap.
+        env = getattr(env, "unwrapped", env)
         self.env = env
         self.task = task if task is not None else env.task
         if isinstance(margin, bool) or not isinstance(margin, (int, float)) or not math.isfinite(margin) or margin < 0:
