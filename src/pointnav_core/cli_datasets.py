@@ -109,13 +109,13 @@ def _eval(args: argparse.Namespace) -> int:
             trust_policy_file=args.trust_policy_file,
             on_error=args.on_error,
             on_result=log.append,
-            on_failure=lambda _ep, message: failed.append(message),
+            on_failure=_Signals.failure(failed),
         )
         results = log.finish(dataset.episodes)
     except (KeyboardInterrupt, PointNavError, ValueError) as err:
         log.close()
         kept = f"{len(log.done)} of {len(dataset)} episodes finished, kept in {log.path}; rerun with --resume to finish"
-        if isinstance(err, KeyboardInterrupt):
+        if isinstance(err, KeyboardInterrupt) or _Signals.arrived:
             print(f"pointnav eval: {_Signals.name}: {kept}", file=sys.stderr)
             return 130
         if isinstance(err, ValueError):
@@ -147,19 +147,36 @@ def _eval(args: argparse.Namespace) -> int:
 
 
 class _Signals:
-    """SIGTERM raises KeyboardInterrupt as Ctrl-C does; ``name`` says which arrived."""
+    """SIGTERM raises KeyboardInterrupt as Ctrl-C does; ``name`` says which arrived.
+
+    ``arrived`` stays set once one has: a KeyboardInterrupt raised inside an import (the
+    policy's first step imports numba) comes out as an ImportError, or as an episode's
+    error, and must still end the run as an interruption.
+    """
 
     name = "interrupted"
+    arrived = False
 
     @classmethod
     def handler(cls, signum: int, _frame: Any) -> None:
-        cls.name = f"interrupted by {signal.Signals(signum).name}"
+        cls.name, cls.arrived = f"interrupted by {signal.Signals(signum).name}", True
         raise KeyboardInterrupt
 
     @classmethod
     def install(cls) -> list[Any]:
-        cls.name = "interrupted"
+        cls.name, cls.arrived = "interrupted", False
         return [signal.signal(s, cls.handler) for s in (signal.SIGINT, signal.SIGTERM)]
+
+    @classmethod
+    def failure(cls, failed: list[str]) -> Callable[[Any, str], None]:
+        """An ``on_failure`` that keeps each message, or stops the run once a signal came."""
+
+        def note(_episode: Any, message: str) -> None:
+            if cls.arrived:
+                raise KeyboardInterrupt
+            failed.append(message)
+
+        return note
 
 
 def reporting(
@@ -179,6 +196,9 @@ def reporting(
             print(f"pointnav {command}: {_Signals.name}", file=sys.stderr)
             return 130
         except (ValueError, OSError, PointNavError) as err:
+            if _Signals.arrived:  # an interruption that surfaced as another error
+                print(f"pointnav {command}: {_Signals.name}", file=sys.stderr)
+                return 130
             print(f"pointnav {command}: error: {err}", file=sys.stderr)
             return 2
         finally:
