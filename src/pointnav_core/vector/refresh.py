@@ -71,10 +71,11 @@ class PoolRefresh:
             self._outcome = self.worker.answer(0.0)
         return self._outcome is not None
 
-    def wait(self) -> None:
-        """Wait until :meth:`done`."""
+    def wait(self, timeout: float | None = None) -> bool:
+        """Wait until :meth:`done`, at most ``timeout`` s (None: no limit); whether it is."""
         if self._outcome is None:
-            self._outcome = self.worker.answer(None)
+            self._outcome = self.worker.answer(timeout)
+        return self._outcome is not None
 
     def result(self) -> Any:
         """The new pool on the env's device, waiting for the build if needed.
@@ -90,7 +91,7 @@ class PoolRefresh:
             return pool_to(value, self._arrays)
         if kind == "failed":
             raise RefreshFailed(f"the pool refresh's build failed in its worker process: {value}")
-        raise RefreshFailed(f"{value} while building a pool")
+        raise RefreshFailed(value)
 
 
 def pool_to(pool: Any, arrays: Arrays) -> Any:
@@ -174,7 +175,7 @@ class PoolRefreshing:
             self._swap_pool(self._pool_kind()(self._samplers, self.pool_size, seeds, self.arrays))
             return
         if self._worker is not None and not self._worker.alive():  # died while idle
-            self._report(self._worker.death() + " while idle; a new one is started")
+            self._report(self._worker.death("while idle") + "; a new one is started")
         if self._worker is None:
             self._worker = RefreshWorker()
         self._refresh = PoolRefresh(self._worker, self._pool_kind(), self._samplers, self.pool_size, seeds, self.arrays)
@@ -202,7 +203,7 @@ class PoolRefreshing:
             new = refresh.result()
         except RefreshFailed as failure:
             if not refresh.worker.alive():
-                self._report(str(failure) + "; the next refresh_pool() starts a new worker")
+                self._report(f"{failure}; the next refresh_pool() starts a new worker")
             else:
                 warnings.warn(f"{failure}; the worlds go on with their current episodes", PoolRefreshWarning, stacklevel=4)
             return

@@ -129,13 +129,23 @@ class RefreshWorker:
                 if not self._eof and self._conn.poll():  # answered just before it ended
                     continue
                 self._busy = False
-                return "died", self.death()
+                return "died", self.death("while building a pool")
             if not wait([self._conn, self._process.sentinel], timeout):
                 return None
 
-    def death(self) -> str:
-        """Why the (ended) worker process ended, for a message."""
+    def death(self, doing: str) -> str:
+        """Why the (ended) worker process ended, for a message; ``doing``: what it was doing
+        ("while building a pool", "while idle")."""
         code = self._process.exitcode
+        name = f"the pool refresh's worker process (pid {self.pid})"
+        if not self._started and code is not None and code > 0:
+            # The spawned worker imports the main script; without the guard it runs the
+            # script again, whose own refresh fails while the worker is still starting.
+            return (
+                f"{name} exited with code {code} before it could start: a script that starts one must "
+                "guard its entry point with `if __name__ == '__main__':` (the worker is spawned and "
+                "imports it), as for any spawned process, or call refresh_pool(wait=True)"
+            )
         if code is not None and code < 0:
             try:
                 how = f"was killed by signal {signal.Signals(-code).name}"
@@ -143,15 +153,7 @@ class RefreshWorker:
                 how = f"was killed by signal {-code}"
         else:
             how = f"exited with code {code}"
-        if not self._started and code is not None and code > 0:
-            # The spawned worker imports the main script; without the guard it runs the
-            # script again, whose own refresh fails while the worker is still starting.
-            how += (
-                " before it started: a script that starts one must guard its entry point with "
-                "`if __name__ == '__main__':` (the worker is spawned and imports it), as for any "
-                "spawned process, or call refresh_pool(wait=True)"
-            )
-        return f"the pool refresh's worker process (pid {self.pid}) {how}"
+        return f"{name} {how} {doing}"
 
     def close(self) -> None:
         """Stop the worker: a busy one at once (its job is dropped), an idle one when it sees
