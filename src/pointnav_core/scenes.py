@@ -120,6 +120,12 @@ class Scene:
     floor_plans : sequence of FloorPlan or None, optional
         Accepted for compatibility: a floor's plan is its map's ``geometry`` (give it to
         :class:`TraversableMap`), so an entry must be None or that same plan.
+    scene_id : str, optional
+        The name a dataset's episodes give this scene (``rooms:0``, a file's path, ...;
+        see :func:`pointnav_core.datasets.load_scene`, which sets it, as the generators
+        :func:`rooms`, :func:`maze` and :func:`clutter` do for their ``<name>:<seed>``).
+        Every env refuses a dataset episode of another ``scene_id``; None (a scene built
+        by hand) checks nothing.
 
     Examples
     --------
@@ -138,6 +144,7 @@ class Scene:
         num_waypoints: int = 10,
         waypoint_spacing: float = 0.2,
         floor_plans: Sequence[FloorPlan | None] | None = None,
+        scene_id: str | None = None,
     ) -> None:
         floors = list(floors)
         if not floors or not all(isinstance(f, TraversableMap) for f in floors):
@@ -158,6 +165,9 @@ class Scene:
                         f"floor_plans[{i}] is not floor {i}'s geometry: a floor's plan lives on "
                         f"its map, TraversableMap(..., geometry=plan)"
                     )
+        if scene_id is not None and (not isinstance(scene_id, str) or not scene_id):
+            raise ValueError(f"scene_id must be None or a non-empty string, got {scene_id!r}")
+        self.scene_id = scene_id
         self.floors = floors
         self.num_waypoints = int(num_waypoints)
         self.waypoint_spacing = float(waypoint_spacing)
@@ -437,20 +447,25 @@ class Scene:
 
 def rooms(seed: int | None = None, resolution: float = 0.1, **kwargs: Any) -> Scene:
     """A generated house: rooms with walls, doors and furniture (see ``floorplans.rooms``)."""
-    plan = floorplans.rooms(seed, **kwargs)
-    return Scene.from_polygons(plan.outline, plan.obstacles, resolution=resolution)
+    return _generated("rooms", floorplans.rooms(seed, **kwargs), seed, resolution, kwargs)
 
 
 def maze(seed: int | None = None, resolution: float = 0.1, **kwargs: Any) -> Scene:
     """A generated maze of corridors (see ``floorplans.maze``)."""
-    plan = floorplans.maze(seed, **kwargs)
-    return Scene.from_polygons(plan.outline, plan.obstacles, resolution=resolution)
+    return _generated("maze", floorplans.maze(seed, **kwargs), seed, resolution, kwargs)
 
 
 def clutter(seed: int | None = None, resolution: float = 0.1, **kwargs: Any) -> Scene:
     """A generated open space cluttered with obstacles (see ``floorplans.clutter``)."""
-    plan = floorplans.clutter(seed, **kwargs)
-    return Scene.from_polygons(plan.outline, plan.obstacles, resolution=resolution)
+    return _generated("clutter", floorplans.clutter(seed, **kwargs), seed, resolution, kwargs)
+
+
+def _generated(name: str, plan: FloorPlan, seed: Any, resolution: float, kwargs: dict[str, Any]) -> Scene:
+    """The generator's scene; with a seed and the defaults, named as datasets name it
+    (``<name>:<seed>``, what ``load_scene`` builds), so that its episodes are checked."""
+    plain = isinstance(seed, (int, np.integer)) and not isinstance(seed, bool) and resolution == 0.1 and not kwargs
+    scene_id = f"{name}:{int(seed)}" if plain else None
+    return Scene.from_polygons(plan.outline, plan.obstacles, resolution=resolution, scene_id=scene_id)
 
 
 def _cells_of(tmap: TraversableMap, radius: float, label: int, ref: NDArray[np.float64], max_distance: float | None) -> NDArray[np.intp]:

@@ -121,12 +121,19 @@ def episode_poses(
     Raises
     ------
     ValueError
-        Naming the episode and the field (``info.floor``, ``start_position``,
-        ``goals[0].position``) that does not suit the env.
+        Naming the episode and the field (``scene_id``: not the scene's own
+        :attr:`~pointnav_core.scenes.Scene.scene_id`, when it has one; ``info.floor``,
+        ``start_position``, ``goals[0].position``) that does not suit the env.
     """
     if not isinstance(episode, PointNavEpisode):
         raise ValueError(f"episode must be a PointNavEpisode, got {episode!r}")
     name = f"episode {episode.episode_id!r} (scene {episode.scene_id!r})"
+    here = getattr(scene, "scene_id", None)
+    if here is not None and episode.scene_id != here:  # another house: its geodesics mean nothing here
+        raise ValueError(
+            f"{name}: field 'scene_id' is {episode.scene_id!r}, but the env's scene is {here!r}; "
+            "play it on an env of its own scene (datasets.load_scene)"
+        )
     if episode.floor != floor:
         raise ValueError(
             f"{name}: field 'info.floor' is {episode.floor}, but robot {robot_idn}'s task navigates "
