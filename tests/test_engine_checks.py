@@ -9,7 +9,6 @@ straight-line geometry.
 
 from __future__ import annotations
 
-import dataclasses
 import importlib.util
 import math
 
@@ -62,7 +61,7 @@ def play(kind: str, env, ep: PointNavEpisode, other: PointNavEpisode):
         env.reset(options={"episodes": [ep, other]})
         return tuple(env.backend.get_pose(0)[0][:2])
     episodes = [ep] if kind == "vector" else [[ep, other]]
-    obs, info = env.reset(options={"episodes": episodes})
+    _, info = env.reset(options={"episodes": episodes})
     d0 = np.asarray(info["geodesic_dist"]).reshape(-1)[0]
     assert d0 == pytest.approx(math.dist(ep.start_xy, ep.goal_xy), abs=1e-6)  # open floor: a straight line
     return float(env.arrays.numpy(env._state["x"]).reshape(-1)[0]), float(env.arrays.numpy(env._state["y"]).reshape(-1)[0])
