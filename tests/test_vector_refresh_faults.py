@@ -13,6 +13,9 @@ import copy
 import os
 import pickle
 import signal
+import subprocess
+import sys
+import textwrap
 import threading
 import time
 from pathlib import Path
@@ -47,8 +50,8 @@ def steps(env: VectorPointNavEnv, n: int = 3) -> None:
         assert np.isfinite(obs).all()
 
 
-def until(predicate, what: str) -> None:
-    deadline = time.monotonic() + WAIT
+def until(predicate, what: str, limit: float = WAIT) -> None:
+    deadline = time.monotonic() + limit
     while not predicate():
         assert time.monotonic() < deadline, f"timed out waiting for {what}"
         time.sleep(0.02)
@@ -135,3 +138,41 @@ def test_copies_with_a_refresh_pending_work_and_a_failed_copy_hurts_nothing() ->
     steps(env, 1)
     assert not env.refresh_pending and goals(env)[1:] == before
     env.close()
+
+
+def gone(pid: int) -> bool:
+    """Whether process ``pid`` has ended (a zombie waiting for its reaper counts)."""
+    try:
+        with open(f"/proc/{pid}/stat") as stat:
+            return stat.read().rsplit(")", 1)[1].split()[0] in ("Z", "X")
+    except FileNotFoundError:
+        return True
+
+
+@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="reads /proc")
+def test_the_worker_ends_with_the_env_process_even_mid_build(tmp_path: Path) -> None:
+    marker = tmp_path / "started"
+    code = textwrap.dedent(f"""
+        import os, time
+        from pathlib import Path
+        import numpy as np
+        from refresh_faults import StalledBuild
+        from pointnav_core.scenes import Scene
+        from pointnav_core.vector import VectorPointNavEnv
+        grid = np.zeros((20, 30), np.uint8)
+        grid[[0, -1], :] = grid[:, [0, -1]] = 1
+        env = VectorPointNavEnv(1, scene=Scene.from_array(grid, 0.1), seed=0, pool_size=1)
+        env.reset(seed=0)
+        env._pool_kind = lambda: StalledBuild(Path({str(marker)!r}))
+        env.refresh_pool()
+        while not Path({str(marker)!r}).exists():
+            time.sleep(0.02)
+        print(env._worker.pid, flush=True)
+        os.kill(os.getpid(), 9)
+    """)
+    path = os.pathsep.join(p for p in sys.path if p)
+    done = subprocess.run([sys.executable, "-c", code], check=False, capture_output=True, text=True, timeout=120,
+                          env={**os.environ, "PYTHONPATH": path})
+    assert done.returncode == -signal.SIGKILL, done.stderr
+    pid = int(done.stdout.split()[0])
+    until(lambda: gone(pid), "the orphaned worker to end", 10.0)  # its build sleeps 120 s

@@ -9,6 +9,11 @@ it in at the start of a step once it is ready, with :func:`join_pools`: the new 
 come first, so autoresets draw from them only, and the old ones after, so that the worlds
 still in an old episode keep its goal field (their field index shifted by the new pool's
 length). When no world is left in an old episode, the env keeps the new pool alone.
+
+The worker (:mod:`~pointnav_core.vector.refresh_worker`) may fail: its build raises, or it
+is killed while building or idle. The env then warns once (:class:`PoolRefreshWarning`,
+with the cause), keeps its pool, and starts a new worker at the next refresh if the old one
+died. Copies and pickles of the env leave the worker, and a pending refresh, behind.
 """
 
 from __future__ import annotations

@@ -4,13 +4,15 @@ A plain process and a pipe rather than a ``ProcessPoolExecutor``: the env must t
 build that raised (the worker lives on) from a worker that died (killed mid-build or while
 idle, or never started because the script has no ``__main__`` guard), say which, and start
 a new worker after a death; an executor only reports ``BrokenProcessPool`` and stays broken.
-The worker stops when its pipe closes: at :meth:`RefreshWorker.close`, or when the env's
-process dies (it is also a daemon, ended at the interpreter's exit).
+The worker stops when its pipe closes (at :meth:`RefreshWorker.close`), at once when the
+env's process ends, however it ends (even mid-build), and ignores Ctrl-C (the env's
+process decides); it is also a daemon, ended at the interpreter's exit.
 """
 
 from __future__ import annotations
 
 import multiprocessing
+import os
 import signal
 import threading
 import traceback
@@ -35,12 +37,24 @@ def _describe(error: BaseException) -> str:
     return summary
 
 
+def _leave_with_parent() -> None:
+    """Exit as soon as the env's process ends, even in the middle of a build (a thread)."""
+    parent = multiprocessing.parent_process()
+    if parent is not None:
+        wait([parent.sentinel])
+        os._exit(0)
+
+
 def _serve(conn: Connection) -> None:
     """The worker's loop: say it started, then answer each job until the pipe closes.
 
     A job is ``(function, args)``; the answer ``("done", result)``, or ``("failed", cause)``
     when the job could not be read, raised, or its result could not be sent.
     """
+    # Ctrl-C reaches the whole process group: the env's process decides, and the worker
+    # leaves when the env closes its pipe or exits (a traceback from here would only confuse).
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    threading.Thread(target=_leave_with_parent, name="pointnav-pool-refresh-parent", daemon=True).start()
     try:
         conn.send(("ready", None))
         while True:
