@@ -350,7 +350,9 @@ class VectorPointNavEnv(PoolRefreshing, VectorEnv):
     def reset(self, *, seed: int | None = None, options: dict[str, Any] | None = None) -> tuple[Any, dict[str, Any]]:
         """Reset every world. ``options={"episodes": [(start_xy, yaw, goal_xy), ...]}`` (one per
         world, yaw in rad) fixes each world's episode, at this reset and every autoreset, until a
-        reset without it; a new ``seed`` redraws the pools."""
+        reset without it; an entry may also be a dataset episode (``PointNavEpisode``), checked
+        as the single env checks it (its ``scene_id`` against the world's scene's, its floor,
+        start and goal). A new ``seed`` redraws the pools."""
         self._reset_pools(seed, options)
         a = self.arrays
         with np.errstate(invalid="ignore", divide="ignore"):
