@@ -124,7 +124,7 @@ def test_unknown_scene_ids(scene_folder, scene_id, error, match):
 def test_unknown_set_and_bad_folder(tmp_path):
     with pytest.raises(ValueError, match=r"one of \['clutter', 'houses', 'mazes'\] or a folder"):
         scene_set("castles")
-    with pytest.raises(ValueError, match="holds no .map file"):
+    with pytest.raises(ValueError, match="holds no scene: no .map, map_server .yaml"):
         folder_scene_set(tmp_path)
 
 

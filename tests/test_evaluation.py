@@ -144,6 +144,8 @@ def test_cli_eval_prints_and_writes(dataset_file, tmp_path, capsys):
                 str(results),
                 "--plot",
                 str(plot),
+                "--scenes-dir",
+                str(dataset_file.parent),
                 "--quiet",
             ]
         )
@@ -250,6 +252,6 @@ def test_sb3_zip_policy(dataset_file, tmp_path):
     )
     model.save(tmp_path / "ppo.zip")
     data = list(EpisodeDataset.load(dataset_file))[:2]
-    first = evaluate(data, str(tmp_path / "ppo.zip"), max_steps=10)
+    first = evaluate(data, str(tmp_path / "ppo.zip"), max_steps=10, trust_policy_file=True)
     assert [r.steps for r in first] == [10, 10] and all(r.path_length > 0 for r in first)
-    assert evaluate(data[::-1], str(tmp_path / "ppo.zip"), max_steps=10)[::-1] == first
+    assert evaluate(data[::-1], str(tmp_path / "ppo.zip"), max_steps=10, trust_policy_file=True)[::-1] == first

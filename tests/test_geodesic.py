@@ -52,10 +52,10 @@ def test_unreachable_blocked_and_off_map_targets_give_none():
     grid = np.ones((10, 10), bool)
     grid[:, 5] = False
     scene = Scene.from_array(grid, resolution=1.0)
-    assert scene.get_shortest_path(0, (1.5, 1.5), (8.5, 1.5)) == (None, None)  # other side
-    assert scene.get_shortest_path(0, (1.5, 1.5), (5.5, 1.5)) == (None, None)  # on the wall
-    assert scene.get_shortest_path(0, (1.5, 1.5), (50.0, 1.5)) == (None, None)  # off map
-    assert scene.get_shortest_path(0, (-3.0, 1.5), (2.5, 1.5)) == (None, None)  # source off
+    assert scene.get_shortest_path(0, (1.5, 1.5), (8.5, 1.5)) == (None, math.inf)  # other side
+    assert scene.get_shortest_path(0, (1.5, 1.5), (5.5, 1.5)) == (None, math.inf)  # on the wall
+    assert scene.get_shortest_path(0, (1.5, 1.5), (50.0, 1.5)) == (None, math.inf)  # off map
+    assert scene.get_shortest_path(0, (-3.0, 1.5), (2.5, 1.5)) == (None, math.inf)  # source off
     assert scene.geodesic_distance(0, (1.5, 1.5), (8.5, 1.5)) == math.inf
 
 
@@ -65,13 +65,13 @@ def test_robot_radius_closes_a_narrow_door():
     grid[15, 14:17] = True  # a 0.3 m door at 0.1 m cells
     scene = Scene.from_array(grid, resolution=0.1)
     assert scene.get_shortest_path(0, (1.5, 0.5), (1.5, 2.5), robot=0.1)[1] is not None
-    assert scene.get_shortest_path(0, (1.5, 0.5), (1.5, 2.5), robot=0.2) == (None, None)
+    assert scene.get_shortest_path(0, (1.5, 0.5), (1.5, 2.5), robot=0.2) == (None, math.inf)
 
 
 def test_diagonal_squeeze_between_blocked_corners_is_not_a_path():
     grid = np.array([[1, 0], [0, 1]], bool)
     scene = Scene.from_array(grid, resolution=1.0)
-    assert scene.get_shortest_path(0, (0.5, 0.5), (1.5, 1.5)) == (None, None)
+    assert scene.get_shortest_path(0, (0.5, 0.5), (1.5, 1.5)) == (None, math.inf)
 
 
 def test_goal_field_is_cached_and_queries_are_lookups():
@@ -99,7 +99,7 @@ def test_floors_are_planned_separately():
     upper = np.ones((10, 10), bool)
     upper[:, 5] = False
     scene = Scene.from_array([ground, upper], resolution=1.0, heights=[0.0, 3.0])
-    assert scene.get_shortest_path(1, (1.5, 1.5), (8.5, 1.5)) == (None, None)
+    assert scene.get_shortest_path(1, (1.5, 1.5), (8.5, 1.5)) == (None, math.inf)
     assert scene.get_shortest_path(0, (1.5, 1.5), (8.5, 1.5))[1] == pytest.approx(7.0)
     assert scene.get_floor_height(1) == 3.0
 
@@ -125,7 +125,7 @@ def test_void_cells_are_not_paths():
     grid = np.zeros((5, 5), np.uint8)
     grid[:, 2] = VOID
     scene = Scene.from_array(grid, resolution=1.0)
-    assert scene.get_shortest_path(0, (0.5, 0.5), (4.5, 0.5)) == (None, None)
+    assert scene.get_shortest_path(0, (0.5, 0.5), (4.5, 0.5)) == (None, math.inf)
     grid[:, 2] = OBSTACLE
     grid[2, 2] = 0
     assert Scene.from_array(grid, 1.0).get_shortest_path(0, (0.5, 0.5), (4.5, 0.5))[1] is not None

@@ -109,3 +109,38 @@ def test_the_cache_can_be_turned_off_and_follows_the_platform(monkeypatch, tmp_p
     monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path))
     if sys.platform.startswith("linux"):
         assert cache.cache_dir() == tmp_path / "pointnav-core"
+
+
+# ---------------------------------------------------------------- pointnav scene build
+def test_scene_build_keeps_every_floor_for_later_processes(folder, capsys):
+    from pointnav_core import scenes
+    from pointnav_core.cli import main
+    from pointnav_core.geodesic import planner_for
+
+    assert main(["scene", "build", "maze:3", "--robot-radius", "0.1", "0.15", "--quiet"]) == 0
+    assert "2 kept" in capsys.readouterr().out
+    assert len(list(folder.glob("*.npz"))) == 2
+    # A fresh build of the same scene (as in another process) reads it back, and a radius
+    # that was not built misses.
+    tmap = scenes.maze(seed=3).floors[0]
+    assert planner_for(tmap, 0.1).cached and planner_for(tmap, 0.15).cached
+    assert not planner_for(tmap, 0.12).cached
+
+
+@pytest.mark.parametrize(
+    ("argv", "env", "message"),
+    [
+        (["scene", "build"], None, "give at least one SCENE"),
+        (["scene", "build", "rooms:0"], "off", "the geometry cache is off"),
+        (["scene", "build", "nope:1"], None, "unknown scene_id 'nope:1'"),
+        (["scene", "build", "rooms:0", "--robot-radius", "0"], None, "--robot-radius must be > 0"),
+    ],
+)
+def test_scene_build_refuses_bad_input_in_one_line(folder, monkeypatch, capsys, argv, env, message):
+    from pointnav_core.cli import main
+
+    if env is not None:
+        monkeypatch.setenv(cache.ENV_VAR, env)
+    assert main(argv) == 2
+    err = capsys.readouterr().err
+    assert message in err and "Traceback" not in err and len(err.strip().splitlines()) == 1

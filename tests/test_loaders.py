@@ -223,7 +223,7 @@ def test_movingai_refuses_wrong_row_length_or_count(tmp_path, rows, kwargs, mess
 @pytest.mark.parametrize(
     ("header", "message"),
     [
-        (["type octile", "height 1", "width 1"], r"header at line 4: '\.'; .*then 'map'"),
+        (["type octile", "height 1", "width 1"], r"header at line 4; .*then 'map'"),
         (["height 1", "width 1", "map"], r"missing type"),
         (["type octile", "width 1", "map"], r"missing height"),
         (["type grid", "height 1", "width 1", "map"], r"type must be 'octile', got 'grid'"),

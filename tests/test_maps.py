@@ -125,3 +125,25 @@ def test_bounded_cache_drops_least_recently_used():
     assert "a" in cache and "c" in cache and "b" not in cache
     with pytest.raises(ValueError, match="maxsize"):
         BoundedCache(0)
+
+
+def test_a_usable_cell_centre_belongs_to_its_own_cells_component_and_a_nudged_point_agrees():
+    # Two rooms joined by nothing: a wall down the middle. A cell centre's component is its
+    # own cell's label (it reaches itself at distance 0); a point a hair off the centre
+    # takes the general path (nearest centre it reaches straight) and must agree.
+    grid = np.zeros((12, 21), np.uint8)
+    grid[[0, -1], :] = grid[:, [0, -1]] = OBSTACLE
+    grid[:, 10] = OBSTACLE
+    tmap = TraversableMap(grid, resolution=0.1)
+    labels = tmap.components(0.05)
+    usable = np.argwhere(labels > 0)
+    centres = tmap.cell_to_world(usable)
+    got = tmap.component_at(centres, 0.05)
+    assert np.array_equal(got, labels[usable[:, 0], usable[:, 1]])
+    assert len(set(got.tolist())) == 2
+    nudged = centres + 1e-7
+    fits = tmap.is_usable(nudged, 0.05)  # a centre touching a wall may not fit once nudged
+    assert fits.sum() > len(fits) // 2
+    assert np.array_equal(tmap.component_at(nudged[fits], 0.05), got[fits])
+    # Blocked and off-map points are in no component.
+    assert tmap.component_at(np.array([[1.05, 0.55], [-1.0, -1.0]]), 0.05).tolist() == [0, 0]

@@ -315,7 +315,7 @@ def test_waypoints_hide_when_the_robot_loses_its_path_and_come_back_with_it(monk
     before = env.task.markers
     field = env.task._goal_field  # the field the task holds: make it find no path once
     real_path = field.path
-    monkeypatch.setattr(field, "path", lambda xy, exact=True: (None, None))
+    monkeypatch.setattr(field, "path", lambda xy, exact=True: (None, math.inf))
     env.step(FORWARD)
     hidden = env.task.markers
     assert not any(m.visible for m in hidden)

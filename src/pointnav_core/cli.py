@@ -4,7 +4,8 @@
 (:class:`~pointnav_core.policies.ShortestPathFollower`) to sampled goals on the default
 kinematic backend, and prints success, SPL, SoftSPL, path length, collisions and speed.
 
-``pointnav demo --scene FILE`` drives on a MovingAI map or a traversability PNG instead.
+``pointnav demo --scene FILE`` drives on a scene file instead: a ROS map ``.yaml``, a ProcTHOR
+or HouseExpo ``.json``, a MovingAI ``.map`` or a traversability PNG (any ``scene_id``).
 ``pointnav dataset generate`` and ``pointnav eval`` are in :mod:`pointnav_core.cli_datasets`.
 
 ``--gif FILE`` writes the first episode as an animated GIF and ``--png FILE`` its last frame
@@ -73,8 +74,9 @@ def run_demo(
         With ``frames``: the picture scale (default 20 px/m, see
         :func:`pointnav_core.recording.render_env`).
     scene : str, optional
-        A scene file instead of generated houses: a MovingAI ``.map``, an OmniGibson
-        ``floor_trav_<n>.png`` or a folder of them (any ``scene_id``, see
+        A scene file instead of generated houses: a ROS map ``.yaml``, a ProcTHOR or
+        HouseExpo ``.json``, a MovingAI ``.map``, an OmniGibson ``floor_trav_<n>.png`` or a
+        folder of them (any ``scene_id``, see
         :func:`pointnav_core.datasets.load_scene`); ``houses`` is then ignored.
 
     Returns
@@ -142,6 +144,11 @@ def run_demo(
 
 
 def _demo(args: argparse.Namespace) -> int:
+    from pointnav_core.outputs import check_output
+
+    for name, path in (("--gif", args.gif), ("--png", args.png)):
+        if path:  # before any episode is played
+            check_output(name, path, [args.scene] if args.scene else [])
     frames: list | None = [] if (args.gif or args.png) else None
     summary = run_demo(
         episodes=args.episodes,
@@ -197,10 +204,10 @@ def main(argv: Sequence[str] | None = None) -> int:
     parser = argparse.ArgumentParser(prog="pointnav", description="pointnav-core command line")
     sub = parser.add_subparsers(dest="command", required=True)
     demo = sub.add_parser("demo", help="drive the oracle to goals in generated houses")
-    demo.add_argument("--episodes", type=int, default=20)
-    demo.add_argument("--houses", type=int, default=4)
+    demo.add_argument("--episodes", type=_positive_int, default=20, metavar="N")
+    demo.add_argument("--houses", type=_positive_int, default=4, metavar="N")
     demo.add_argument("--seed", type=int, default=0)
-    demo.add_argument("--max-steps", type=int, default=1000)
+    demo.add_argument("--max-steps", type=_positive_int, default=1000, metavar="N")
     demo.add_argument("--backend", default="kinematic")
     demo.add_argument("--drive", choices=("differential", "holonomic"), default="differential")
     demo.add_argument(
@@ -216,13 +223,16 @@ def main(argv: Sequence[str] | None = None) -> int:
     )
     demo.add_argument(
         "--scene", metavar="FILE",
-        help="a MovingAI .map, an OmniGibson floor_trav_<n>.png or a folder of them, instead of generated houses",
+        help="a scene file instead of generated houses: a ROS map .yaml, a ProcTHOR or HouseExpo .json, "
+        "a MovingAI .map, an OmniGibson floor_trav_<n>.png or a folder of them",
     )
     demo.add_argument("--quiet", action="store_true", help="no progress bar")
-    demo.set_defaults(func=_demo)
-    from pointnav_core.cli_datasets import add_commands
+    from pointnav_core import cli_datasets, cli_scenes
 
-    add_commands(sub, _positive_int)
+    demo.set_defaults(func=cli_datasets.reporting("demo", _demo))
+
+    cli_datasets.add_commands(sub, _positive_int)
+    cli_scenes.add_commands(sub, _positive_int, cli_datasets.reporting)
     args = parser.parse_args(argv)
     return int(args.func(args))
 

@@ -3,21 +3,29 @@
 ``pointnav dataset generate --scenes SET --split val --episodes N --out FILE`` writes an
 episode dataset (:mod:`pointnav_core.datasets`); the same arguments give the same bytes.
 
-``pointnav eval --dataset FILE --policy oracle|MODULE:CALLABLE|MODEL.zip`` plays every
+``pointnav eval --dataset FILE --policy oracle|MODULE:CALLABLE|MODEL.zip`` (a ``.zip`` with
+``--trust-policy-file``: loading one runs the code pickled in it) plays every
 episode once (:mod:`pointnav_core.evaluation`), prints success, SPL, SoftSPL, the mean
 distance to the goal and collisions, and writes per-episode results (JSON lines, or CSV for
 a ``.csv`` path) and a PNG of SPL and success against geodesic distance.
+
+Faults (see :mod:`pointnav_core.evaluation_log`): every output path is checked before the
+first episode; each finished episode is on disk (``RESULTS.partial``) as it ends; Ctrl-C or
+SIGTERM stops the run at once, keeps what is finished and exits with status 130, and
+``--resume`` finishes it. Bad input is one line on stderr and exit status 2; a run that
+fails (a policy error with ``--on-error stop``, a full disk) exits with status 1.
 """
 
 from __future__ import annotations
 
 import argparse
 import os
+import signal
 import sys
 from collections.abc import Callable
 from typing import Any
 
-__all__ = ["add_commands"]
+__all__ = ["add_commands", "reporting"]
 
 
 def _dataset_generate(args: argparse.Namespace) -> int:
@@ -32,6 +40,9 @@ def _dataset_generate(args: argparse.Namespace) -> int:
         ratio_threshold=args.ratio_threshold,
         island_radius_limit=args.island_radius,
     )
+    from pointnav_core.outputs import check_output
+
+    check_output("--out", args.out)
     scenes = scene_set(args.scenes, seed=args.seed)
     with tqdm(total=args.episodes, disable=args.quiet, desc="episodes", unit="ep") as bar:
         dataset = generate_split(
@@ -47,32 +58,77 @@ def _dataset_generate(args: argparse.Namespace) -> int:
 def _default_output(dataset: str, suffix: str) -> str:
     name = os.path.basename(dataset)
     for ext in (".json.gz", ".json"):
-        if name.endswith(ext):
-            name = name[: -len(ext)]
+        name = name.removesuffix(ext)
     return f"{name}.eval{suffix}"
 
 
 def _eval(args: argparse.Namespace) -> int:
     from pointnav_core.datasets import EpisodeDataset
-    from pointnav_core.evaluation import evaluate, plot_results, summarize, write_results
-
-    dataset = EpisodeDataset.load(args.dataset)
-    results = evaluate(
-        dataset,
-        args.policy,
-        backend=args.backend,
-        workers=args.workers,
-        max_steps=args.max_steps,
-        drive=args.drive,
-        scenes_root=args.scenes_dir,
-        sb3_algo=args.sb3_algo,
-        progress=not args.quiet,
+    from pointnav_core.errors import PointNavError
+    from pointnav_core.evaluation import (
+        check_scene_ids,
+        evaluate,
+        make_policy,
+        plot_results,
+        summarize,
     )
-    summary = summarize(results)
-    results_path = args.results or _default_output(args.dataset, ".jsonl")
-    plot_path = args.plot or _default_output(args.dataset, ".png")
-    write_results(results, results_path)
+    from pointnav_core.evaluation_log import ResultsLog
+    from pointnav_core.outputs import check_output
+
+    if os.getcwd() not in sys.path:  # MODULE:CALLABLE from here, as `python -m` would find it
+        sys.path.insert(0, os.getcwd())
+    inputs = [args.dataset] + ([args.policy] if args.policy.endswith(".zip") else [])
+    results_path = check_output("--results", args.results or _default_output(args.dataset, ".jsonl"), inputs)
+    plot_path = check_output("--plot", args.plot or _default_output(args.dataset, ".png"), [*inputs, results_path])
+    scenes_dir = args.scenes_dir if args.scenes_dir is not None else "."
+    if not os.path.isdir(scenes_dir):
+        raise ValueError(f"--scenes-dir {scenes_dir!r} is not a folder")
+    make_policy(args.policy, args.sb3_algo, args.trust_policy_file)
+    dataset = EpisodeDataset.load(args.dataset)
+    check_scene_ids(dataset.episodes, scenes_dir)
+    settings = {
+        "dataset": os.path.abspath(args.dataset), "policy": args.policy, "sb3_algo": args.sb3_algo,
+        "backend": args.backend, "drive": args.drive, "max_steps": args.max_steps,
+        "scenes_dir": os.path.abspath(scenes_dir),
+    }
+    log = ResultsLog(results_path, settings)
+    check_output("--results (its log)", log.path, inputs)
+    done = log.start(args.resume, dataset.episodes)
+    failed: list[str] = []
+    try:
+        evaluate(
+            [ep for ep in dataset if ep.episode_id not in done],
+            args.policy,
+            backend=args.backend,
+            workers=args.workers,
+            max_steps=args.max_steps,
+            drive=args.drive,
+            scenes_root=scenes_dir,
+            sb3_algo=args.sb3_algo,
+            progress=not args.quiet,
+            trust_policy_file=args.trust_policy_file,
+            on_error=args.on_error,
+            on_result=log.append,
+            on_failure=lambda _ep, message: failed.append(message),
+        )
+        results = log.finish(dataset.episodes)
+    except (KeyboardInterrupt, PointNavError, ValueError) as err:
+        log.close()
+        kept = f"{len(log.done)} of {len(dataset)} episodes finished, kept in {log.path}; rerun with --resume to finish"
+        if isinstance(err, KeyboardInterrupt):
+            print(f"pointnav eval: {_Signals.name}: {kept}", file=sys.stderr)
+            return 130
+        if isinstance(err, ValueError):
+            raise
+        print(f"pointnav eval: error: {err}; {kept}", file=sys.stderr)
+        return 1
+    for message in failed:
+        print(f"pointnav eval: skipped: {message}", file=sys.stderr)
+    if not results:
+        print("pointnav eval: error: no episode finished", file=sys.stderr)
+        return 1
     plot_results(results, plot_path)
+    summary = summarize(results)
     rows = [
         ("episodes", f"{int(summary['episodes'])}"),
         ("success", f"{summary['success']:.4f}"),
@@ -87,22 +143,47 @@ def _eval(args: argparse.Namespace) -> int:
     for name, value in rows:
         print(f"  {name:<{width}}  {value}")
     print(f"wrote {results_path} and {plot_path}")
-    return 0
+    return 1 if failed else 0
 
 
-def _reporting(
+class _Signals:
+    """SIGTERM raises KeyboardInterrupt as Ctrl-C does; ``name`` says which arrived."""
+
+    name = "interrupted"
+
+    @classmethod
+    def handler(cls, signum: int, _frame: Any) -> None:
+        cls.name = f"interrupted by {signal.Signals(signum).name}"
+        raise KeyboardInterrupt
+
+    @classmethod
+    def install(cls) -> list[Any]:
+        cls.name = "interrupted"
+        return [signal.signal(s, cls.handler) for s in (signal.SIGINT, signal.SIGTERM)]
+
+
+def reporting(
     command: str, func: Callable[[argparse.Namespace], int]
 ) -> Callable[[argparse.Namespace], int]:
-    """Run ``func``; bad input (a ValueError, a missing file, a sampling failure) is printed
-    as one line ``pointnav COMMAND: error: ...`` on stderr, with exit status 2."""
-    from pointnav_core.errors import SamplingError
+    """Run ``func``; bad input (a ValueError, a file that cannot be read or written, a
+    sampling failure, any of the library's errors) is printed as one line
+    ``pointnav COMMAND: error: ...`` on stderr, with exit status 2. Ctrl-C and SIGTERM end
+    it with one line and exit status 130."""
+    from pointnav_core.errors import PointNavError
 
     def run(args: argparse.Namespace) -> int:
+        previous = _Signals.install()
         try:
             return func(args)
-        except (ValueError, FileNotFoundError, SamplingError) as err:
+        except KeyboardInterrupt:
+            print(f"pointnav {command}: {_Signals.name}", file=sys.stderr)
+            return 130
+        except (ValueError, OSError, PointNavError) as err:
             print(f"pointnav {command}: error: {err}", file=sys.stderr)
             return 2
+        finally:
+            for signum, old in zip((signal.SIGINT, signal.SIGTERM), previous):
+                signal.signal(signum, old)
 
     return run
 
@@ -149,7 +230,7 @@ def add_commands(sub: Any, positive_int: Callable[[str], int]) -> None:
     )
     gen.add_argument("--habitat-frame", action="store_true", help="write Habitat's y-up frame")
     gen.add_argument("--quiet", action="store_true", help="no progress bar")
-    gen.set_defaults(func=_reporting("dataset generate", _dataset_generate))
+    gen.set_defaults(func=reporting("dataset generate", _dataset_generate))
 
     ev = sub.add_parser("eval", help="evaluate a policy on an episode dataset")
     ev.add_argument("--dataset", required=True, metavar="FILE")
@@ -167,7 +248,7 @@ def add_commands(sub: Any, positive_int: Callable[[str], int]) -> None:
         "--scenes-dir",
         default=None,
         metavar="DIR",
-        help="folder relative scene paths are read from",
+        help="folder the dataset's scene paths are read from, and must stay in (default: the current folder)",
     )
     ev.add_argument(
         "--results", default=None, metavar="FILE", help="per-episode results (.jsonl, or .csv)"
@@ -179,4 +260,20 @@ def add_commands(sub: Any, positive_int: Callable[[str], int]) -> None:
         help="PNG of SPL and success against geodesic distance",
     )
     ev.add_argument("--quiet", action="store_true", help="no progress bar")
-    ev.set_defaults(func=_reporting("eval", _eval))
+    ev.add_argument(
+        "--resume",
+        action="store_true",
+        help="finish an interrupted run: play only the episodes missing from RESULTS.partial",
+    )
+    ev.add_argument(
+        "--on-error",
+        choices=("stop", "skip"),
+        default="stop",
+        help="when the policy raises in an episode: stop the run (default), or leave the episode out and go on",
+    )
+    ev.add_argument(
+        "--trust-policy-file",
+        action="store_true",
+        help="allow an SB3 .zip policy: loading one runs the Python code pickled in it",
+    )
+    ev.set_defaults(func=reporting("eval", _eval))

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-__all__ = ["PointNavError", "SamplingError", "BackendError"]
+__all__ = ["PointNavError", "SamplingError", "BackendError", "EpisodeError"]
 
 
 class PointNavError(Exception):
@@ -18,3 +18,10 @@ class SamplingError(PointNavError, RuntimeError):
 
 class BackendError(PointNavError, TypeError):
     """A backend is unknown, or does not implement the Backend protocol."""
+
+
+class EpisodeError(PointNavError, RuntimeError):
+    """Playing an episode failed: its policy raised, or the process playing it died.
+
+    The message names the episode (its id and scene) and the cause.
+    """

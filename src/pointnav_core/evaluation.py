@@ -17,82 +17,58 @@ Policies (``policy`` argument, or ``pointnav eval --policy``):
 - a path to a Stable-Baselines3 ``.zip``: the model (``sb3_algo``, PPO by default) acts
   deterministically; it gets the flat observation when its observation space is a ``Box``.
 
+An SB3 ``.zip`` holds pickled Python objects that run code when they are loaded: it is
+loaded only with ``trust_policy_file=True`` (``--trust-policy-file``).
+
+A run survives its faults (:func:`evaluate`): each result is handed to ``on_result`` as
+its episode ends, an episode whose policy raises is named and stopped on or skipped
+(``on_error``), and worker processes end with the run, whatever ends it.
+
 This module drives the envs, so it is not part of the core; the CLI uses it.
 """
 
 from __future__ import annotations
 
-import csv
 import importlib
-import json
-import math
 import os
-from collections.abc import Callable, Iterable, Sequence
-from concurrent.futures import ProcessPoolExecutor, as_completed
-from dataclasses import asdict, dataclass, fields
-from multiprocessing import get_context
+import warnings
+from collections.abc import Callable, Sequence
 from typing import Any
-
-import numpy as np
 
 from pointnav_core import metrics
 from pointnav_core.datasets.format import EpisodeDataset, PointNavEpisode
 from pointnav_core.datasets.playback import episode_seed
-from pointnav_core.datasets.scene_sets import load_scene
+from pointnav_core.datasets.scene_sets import load_scene, locate_scene
+from pointnav_core.errors import EpisodeError
+from pointnav_core.evaluation_report import (
+    EpisodeResult,
+    plot_results,
+    read_results,
+    result_line,
+    summarize,
+    write_results,
+)
+from pointnav_core.workers import WorkerError, WorkerPool, usable_cores
 
 __all__ = [
     "EpisodeResult",
+    "check_scene_ids",
     "evaluate",
     "make_policy",
     "plot_results",
+    "read_results",
+    "result_line",
     "summarize",
     "write_results",
 ]
 
 #: Default step limit: a 30 m geodesic at 0.5 m/s and 10 Hz takes 600 steps, plus turns.
 DEFAULT_MAX_STEPS = 1000
-#: Episodes handed to a worker process at once (all of one scene, so it builds few envs).
-_CHUNK = 8
+#: What ``on_error`` may say when an episode's policy raises.
+ON_ERROR = ("stop", "skip")
 
 Policy = Callable[[Any], Any]
 PolicyFactory = Callable[[Any], Policy]
-
-
-@dataclass(frozen=True)
-class EpisodeResult:
-    """What happened in one episode.
-
-    Attributes
-    ----------
-    episode_id, scene_id : str
-    floor : int
-    geodesic_distance : float
-        Recorded in the dataset (m).
-    success : bool
-    spl, soft_spl : float
-    distance_to_goal : float
-        Geodesic distance (m) from where the robot ended to the goal.
-    path_length : float
-        Distance driven (m).
-    collisions : int
-        Steps in which the robot touched something.
-    steps : int
-    ended_by : str
-        The termination conditions that ended the episode, joined by ``+``.
-    """
-
-    episode_id: str
-    scene_id: str
-    floor: int
-    geodesic_distance: float
-    success: bool
-    spl: float
-    soft_spl: float
-    distance_to_goal: float
-    path_length: float
-    collisions: int
-    steps: int
-    ended_by: str
 
 
 # ---------------------------------------------------------------------- policies
@@ -141,14 +117,17 @@ class _SB3Policy:
         return lambda obs: model.predict(obs, deterministic=True)[0]
 
 
-def make_policy(spec: str, sb3_algo: str = "PPO") -> PolicyFactory:
+def make_policy(spec: str, sb3_algo: str = "PPO", trust_policy_file: bool = False) -> PolicyFactory:
     """The policy factory named by ``spec`` (see the module notes).
+
+    ``trust_policy_file`` must be True for an SB3 ``.zip``: loading one unpickles Python
+    objects stored in it, which can run any code (see the module notes).
 
     Raises
     ------
     ValueError
         For a spec of no known form, a module or attribute that does not exist, or a
-        ``.zip`` that does not exist.
+        ``.zip`` that does not exist or is not trusted.
     """
     if not isinstance(spec, str) or not spec:
         raise ValueError(
@@ -159,6 +138,12 @@ def make_policy(spec: str, sb3_algo: str = "PPO") -> PolicyFactory:
     if spec.endswith(".zip"):
         if not os.path.isfile(spec):
             raise ValueError(f"policy {spec!r}: no such SB3 .zip file")
+        if trust_policy_file is not True:
+            raise ValueError(
+                f"policy {spec!r}: an SB3 .zip holds pickled Python objects that can run any "
+                "code when loaded; load only a file you trust, with --trust-policy-file "
+                "(trust_policy_file=True)"
+            )
         return _SB3Policy(spec, sb3_algo)
     module_name, sep, attr = spec.partition(":")
     if not sep or not module_name or not attr:
@@ -190,8 +175,11 @@ class _Runner:
         drive: str,
         scenes_root: str | None,
         sb3_algo: str,
+        trust_policy_file: bool = False,
     ) -> None:
-        self.factory = make_policy(policy, sb3_algo) if isinstance(policy, str) else policy
+        self.factory = (
+            make_policy(policy, sb3_algo, trust_policy_file) if isinstance(policy, str) else policy
+        )
         self.backend, self.max_steps, self.drive = backend, max_steps, drive
         self.scenes_root, self.envs = scenes_root, {}
 
@@ -227,14 +215,31 @@ class _Runner:
             )
         return self.envs[key]
 
-    def play(self, ep: PointNavEpisode) -> EpisodeResult:
-        env = self.env_for(ep)
-        obs, info = env.reset(seed=episode_seed(ep), options={"episode": ep})
-        policy = self.factory(env)
-        done = False
-        while not done:
-            obs, _, terminated, truncated, info = env.step(policy(obs))
-            done = terminated or truncated
+    def outcome(self, ep: PointNavEpisode) -> tuple[str, Any]:
+        """Play ``ep``: ``("ok", EpisodeResult)``, ``("input", message)`` for an episode that
+        does not suit its scene, or ``("error", message)`` for a policy that raised."""
+        step = 0
+        try:
+            try:
+                env = self.env_for(ep)
+                obs, info = env.reset(seed=episode_seed(ep), options={"episode": ep})
+            except (ValueError, FileNotFoundError) as err:
+                return "input", str(err)
+            policy = self.factory(env)
+            done = False
+            while not done:
+                obs, _, terminated, truncated, info = env.step(policy(obs))
+                done = terminated or truncated
+                step += 1
+        except Exception as err:  # whatever the user's policy raises names its episode
+            return "error", (
+                f"episode {ep.episode_id!r} (scene {ep.scene_id!r}) failed at step {step}: "
+                f"{type(err).__name__}: {err}"
+            )
+        return "ok", self.result(ep, env, info)
+
+    def result(self, ep: PointNavEpisode, env: Any, info: dict[str, Any]) -> EpisodeResult:
+        """The record of ``ep``, played to its end in ``env`` (last step's ``info``)."""
         ended = "+".join(name for name, r in info["termination_conditions"].items() if r["done"])
         # The step infos read distances from the goal field's lookup table, whose cells settle
         # as queries arrive, so a value can depend on what this worker played before (within
@@ -258,17 +263,23 @@ class _Runner:
         )
 
 
-_WORKER: _Runner | None = None
+
+def _play(runner: _Runner, ep: PointNavEpisode) -> tuple[str, Any]:
+    """A worker's task (module level, so that ``spawn`` can find it)."""
+    return runner.outcome(ep)
 
 
-def _init_worker(*args: Any) -> None:
-    global _WORKER
-    _WORKER = _Runner(*args)
-
-
-def _play_chunk(indexed: list[tuple[int, PointNavEpisode]]) -> list[tuple[int, EpisodeResult]]:
-    assert _WORKER is not None
-    return [(i, _WORKER.play(ep)) for i, ep in indexed]
+def check_scene_ids(episodes: Sequence[PointNavEpisode], scenes_root: str | None) -> None:
+    """Refuse an unknown, missing or escaping scene (a ValueError naming the first episode
+    that has it) without building any scene."""
+    seen: set[str] = set()
+    for ep in episodes:
+        if ep.scene_id not in seen:
+            seen.add(ep.scene_id)
+            try:
+                locate_scene(ep.scene_id, scenes_root)
+            except (ValueError, FileNotFoundError) as err:
+                raise ValueError(f"episode {ep.episode_id!r}: field 'scene_id': {err}") from None
 
 
 def evaluate(
@@ -282,8 +293,12 @@ def evaluate(
     scenes_root: str | None = None,
     sb3_algo: str = "PPO",
     progress: bool = False,
+    trust_policy_file: bool = False,
+    on_error: str = "stop",
+    on_result: Callable[[EpisodeResult], None] | None = None,
+    on_failure: Callable[[PointNavEpisode, str], None] | None = None,
 ) -> list[EpisodeResult]:
-    """Play every episode once; results in the episodes' order.
+    """Play every episode once; the results in the episodes' order.
 
     Parameters
     ----------
@@ -294,156 +309,87 @@ def evaluate(
     backend : str
         Registered backend name.
     workers : int
-        Worker processes (1: play here).
+        Worker processes (1: play here); at most one per episode and per usable core.
     max_steps : int
         Step limit per episode.
     drive : str
         ``"differential"`` or ``"holonomic"``.
     scenes_root : str, optional
-        Folder relative scene paths in ``scene_id`` are read from.
+        Folder relative scene paths in ``scene_id`` are read from; a scene path must then
+        stay under it (:func:`~pointnav_core.datasets.scene_sets.locate_scene`).
     sb3_algo : str
         Stable-Baselines3 algorithm class of a ``.zip`` policy.
     progress : bool
         Show a progress bar.
+    trust_policy_file : bool
+        Allow an SB3 ``.zip`` policy (see the module notes).
+    on_error : {"stop", "skip"}
+        When the policy raises in an episode: raise :class:`~pointnav_core.errors.EpisodeError`
+        at once, or leave the episode out and go on.
+    on_result : callable, optional
+        Called with each result as its episode ends (in the order they end), so that a
+        caller can keep it whatever happens to the run later.
+    on_failure : callable, optional
+        With ``on_error="skip"``: called with each failed episode and the message naming
+        it (by default a ``RuntimeWarning``).
 
     Raises
     ------
     ValueError
         For a bad argument, or an episode that does not suit its scene or robot (naming the
-        episode and the field).
+        episode and the field); scene ids are checked before any episode is played.
+    EpisodeError
+        With ``on_error="stop"``, for the first episode whose policy raised, or a worker
+        process that died; its message names the episode.
+    KeyboardInterrupt
+        Passed on, after every worker process has ended.
     """
     episodes = list(episodes)
     for name, value in (("workers", workers), ("max_steps", max_steps)):
         if isinstance(value, bool) or not isinstance(value, int) or value < 1:
             raise ValueError(f"{name} must be an integer >= 1, got {value!r}")
-    args = (policy, backend, max_steps, drive, scenes_root, sb3_algo)
+    if on_error not in ON_ERROR:
+        raise ValueError(f"on_error must be one of {list(ON_ERROR)}, got {on_error!r}")
+    if isinstance(policy, str):
+        make_policy(policy, sb3_algo, trust_policy_file)  # a bad spec is refused here, once
+    check_scene_ids(episodes, scenes_root)
+    args = (policy, backend, max_steps, drive, scenes_root, sb3_algo, trust_policy_file)
+    results: list[EpisodeResult | None] = [None] * len(episodes)
     from tqdm import tqdm
 
     bar = tqdm(total=len(episodes), disable=not progress, desc="episodes", unit="ep")
-    results: list[EpisodeResult | None] = [None] * len(episodes)
+
+    def record(i: int, kind: str, payload: Any) -> None:
+        if kind == "input":
+            raise ValueError(payload)
+        if kind == "error":
+            if on_error == "stop":
+                raise EpisodeError(payload)
+            (on_failure or (lambda _ep, msg: warnings.warn(msg, RuntimeWarning, stacklevel=4)))(episodes[i], payload)
+        else:
+            results[i] = payload
+            if on_result is not None:
+                on_result(payload)
+        bar.update(1)
+
     try:
-        if workers == 1:
+        n_workers = min(workers, len(episodes), usable_cores())
+        if n_workers <= 1:
             runner = _Runner(*args)
             for i, ep in enumerate(episodes):
-                results[i] = runner.play(ep)
-                bar.update(1)
+                record(i, *runner.outcome(ep))
         else:
-            # Chunks of one scene each, so that a worker builds few envs.
-            by_scene: dict[str, list[tuple[int, PointNavEpisode]]] = {}
-            for i, ep in enumerate(episodes):
-                by_scene.setdefault(ep.scene_id, []).append((i, ep))
-            chunks = [
-                group[k : k + _CHUNK]
-                for group in by_scene.values()
-                for k in range(0, len(group), _CHUNK)
-            ]
-            with ProcessPoolExecutor(
-                workers, mp_context=get_context("spawn"), initializer=_init_worker, initargs=args
-            ) as pool:
-                futures = [pool.submit(_play_chunk, chunk) for chunk in chunks]
-                for future in as_completed(futures):
-                    for i, result in future.result():
-                        results[i] = result
-                        bar.update(1)
+            with WorkerPool(n_workers, _Runner, args, _play) as pool:
+                try:
+                    for i, (kind, payload) in pool.imap_unordered(enumerate(episodes)):
+                        record(i, kind, payload)  # type: ignore[arg-type]
+                except WorkerError as err:
+                    if err.key is None:
+                        raise EpisodeError(str(err)) from None
+                    ep = episodes[err.key]  # type: ignore[index]
+                    raise EpisodeError(
+                        f"episode {ep.episode_id!r} (scene {ep.scene_id!r}): {err.cause}"
+                    ) from None
     finally:
         bar.close()
-    return results  # type: ignore[return-value]
-
-
-# ---------------------------------------------------------------------- reporting
-def summarize(results: Sequence[EpisodeResult]) -> dict[str, float]:
-    """Means over episodes: ``success``, ``spl``, ``soft_spl``, ``distance_to_goal`` (m),
-    ``path_length`` (m), ``collisions`` (per episode), ``steps``; and ``episodes``."""
-    if not results:
-        raise ValueError("no results to summarize")
-    keys = ("success", "spl", "soft_spl", "distance_to_goal", "path_length", "collisions", "steps")
-    summary = {k: float(np.mean([float(getattr(r, k)) for r in results])) for k in keys}
-    summary["episodes"] = float(len(results))
-    return summary
-
-
-def write_results(results: Iterable[EpisodeResult], path: str | os.PathLike[str]) -> None:
-    """Write one row per episode: CSV for a ``.csv`` path, else JSON lines."""
-    results = list(results)
-    names = [f.name for f in fields(EpisodeResult)]
-    with open(path, "w", newline="", encoding="utf-8") as fh:
-        if os.fspath(path).endswith(".csv"):
-            writer = csv.DictWriter(fh, fieldnames=names, lineterminator="\n")
-            writer.writeheader()
-            for r in results:
-                writer.writerow(
-                    {k: repr(v) if isinstance(v, float) else v for k, v in asdict(r).items()}
-                )
-        else:
-            for r in results:
-                fh.write(json.dumps(asdict(r), sort_keys=False, allow_nan=True) + "\n")
-
-
-def read_results(path: str | os.PathLike[str]) -> list[EpisodeResult]:
-    """Read results written by :func:`write_results` as JSON lines."""
-    with open(path, encoding="utf-8") as fh:
-        return [EpisodeResult(**json.loads(line)) for line in fh if line.strip()]
-
-
-def plot_results(
-    results: Sequence[EpisodeResult], path: str | os.PathLike[str], bin_width: float = 2.0
-) -> None:
-    """Draw SPL and success rate against geodesic distance as a PNG (Pillow).
-
-    Each episode is a faint dot at its SPL; the lines join the means over bins of
-    ``bin_width`` metres of geodesic distance (success green, SPL blue, SoftSPL orange).
-    """
-    from PIL import Image, ImageDraw
-
-    if not results:
-        raise ValueError("no results to plot")
-    width, height, left, right, top, bottom = 720, 420, 60, 20, 40, 50
-    geo = np.array([r.geodesic_distance for r in results])
-    spl = np.array([r.spl for r in results])
-    success = np.array([float(r.success) for r in results])
-    x_max = max(bin_width, math.ceil(geo.max() / bin_width) * bin_width)
-    image = Image.new("RGB", (width, height), "white")
-    draw = ImageDraw.Draw(image)
-    pw, ph = width - left - right, height - top - bottom
-
-    def px(x: float, y: float) -> tuple[float, float]:
-        return left + pw * x / x_max, top + ph * (1.0 - y)
-
-    for k in range(11):  # grid and y ticks
-        y = k / 10
-        draw.line([px(0, y), px(x_max, y)], fill=(230, 230, 230))
-        draw.text((left - 30, px(0, y)[1] - 6), f"{y:.1f}", fill="black")
-    step = bin_width * max(1, round(x_max / bin_width / 10))
-    x = 0.0
-    while x <= x_max + 1e-9:
-        draw.line([px(x, 0), (px(x, 0)[0], px(x, 0)[1] + 4)], fill="black")
-        draw.text((px(x, 0)[0] - 8, px(x, 0)[1] + 8), f"{x:g}", fill="black")
-        x += step
-    draw.rectangle([px(0, 1), px(x_max, 0)], outline="black")
-    for g, s in zip(geo, spl):
-        cx, cy = px(g, s)
-        draw.ellipse([cx - 1.5, cy - 1.5, cx + 1.5, cy + 1.5], fill=(170, 190, 235))
-    edges = np.arange(0.0, x_max + bin_width / 2, bin_width)
-    soft = np.array([r.soft_spl for r in results])
-    # Success under the others, wider, so that equal curves stay visible.
-    for values, colour, line in (
-        (success, (20, 150, 60), 5),
-        (soft, (230, 140, 20), 2),
-        (spl, (30, 70, 200), 2),
-    ):
-        points = []
-        for lo, hi in zip(edges[:-1], edges[1:]):
-            sel = (geo >= lo) & (geo < hi)
-            if sel.any():
-                points.append(px((lo + hi) / 2, float(values[sel].mean())))
-        if len(points) > 1:
-            draw.line(points, fill=colour, width=line)
-        for cx, cy in points:
-            draw.ellipse([cx - 3, cy - 3, cx + 3, cy + 3], fill=colour)
-    draw.text(
-        (left, 12),
-        f"success (green), SPL (blue) and SoftSPL (orange) vs geodesic distance, {len(results)} episodes",
-        fill="black",
-    )
-    draw.text((left + pw / 2 - 60, height - 20), "geodesic distance (m)", fill="black")
-    image.save(path)
+    return [r for r in results if r is not None]

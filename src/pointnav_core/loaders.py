@@ -14,6 +14,7 @@ from __future__ import annotations
 import math
 import os
 import re
+import warnings
 
 import numpy as np
 from numpy.typing import NDArray
@@ -21,8 +22,12 @@ from numpy.typing import NDArray
 from pointnav_core import validation
 from pointnav_core.maps import FREE, OBSTACLE
 
-__all__ = ["MOVINGAI_CELLS", "read_movingai", "read_trav_png"]
+__all__ = ["MOVINGAI_CELLS", "open_image", "read_movingai", "read_trav_png"]
 
+_ROS_HINT = (
+    "read a ROS map with Scene.from_ros_map(<its map.yaml>), any other grid with Scene.from_array"
+)
+_ROS_SHADES = np.array([205, 254], np.uint8)
 # Tolerance used when snapping pixel edges that should be whole numbers (0.1 / 0.01 is not 10).
 _EDGE_TOL = 1e-6
 
@@ -84,8 +89,9 @@ def read_trav_png(
         When ``path`` does not exist.
     ValueError
         When the file is not a readable image, is not 8-bit greyscale (mode ``"L"``; RGB,
-        palette or 16-bit images are refused, not converted), is not square, or a resolution
-        is not a finite positive number.
+        palette or 16-bit images are refused, not converted), is not square, is a PGM or
+        holds map_saver's free (254) and unknown (205) shades (a ROS map: use
+        ``Scene.from_ros_map``), or a resolution is not a finite positive number.
 
     See Also
     --------
@@ -122,10 +128,10 @@ def read_trav_png(
     resolution = _check_resolution(resolution, "resolution")
     source_resolution = _check_resolution(source_resolution, "source_resolution")
     where = f"path {os.fspath(path)!r}"
-    from PIL import Image, UnidentifiedImageError  # only this reader needs Pillow
+    from PIL import UnidentifiedImageError  # only this reader needs Pillow
 
     try:
-        with Image.open(path) as image:
+        with open_image(path, where) as image:
             image.load()
             mode, (width, height) = image.mode, image.size
             if mode != "L":
@@ -133,14 +139,22 @@ def read_trav_png(
                     f"{where} must be an 8-bit greyscale image (mode 'L'), got mode {mode!r}; "
                     "convert it explicitly if its values mean traversability"
                 )
+            if image.format == "PPM":
+                raise ValueError(f"{where} is a PGM image, as ROS map_server maps are: {_ROS_HINT}")
             if width != height:
-                raise ValueError(f"{where} must be a square image, got {width}x{height} pixels")
+                raise ValueError(
+                    f"{where} must be a square image (OmniGibson's are), got {width}x{height} "
+                    f"pixels: {_ROS_HINT}"
+                )
             pixels = np.asarray(image)
     except FileNotFoundError:
         raise
     except (UnidentifiedImageError, OSError, SyntaxError) as exc:
         # Pillow reports undecodable or truncated files as any of these.
         raise ValueError(f"{where} is not a readable image: {exc}") from exc
+    if np.isin(_ROS_SHADES, pixels).all():
+        # map_saver's free (254) and unknown (205) would all read as blocked here.
+        raise ValueError(f"{where} holds ROS map_saver's free (254) and unknown (205) shades: {_ROS_HINT}")
     blocked = pixels < 255
     n_pixels = blocked.shape[0]
     factor = resolution / source_resolution  # source pixels per cell, along one axis
@@ -156,6 +170,31 @@ def read_trav_png(
     codes = np.where(any_cells, OBSTACLE, FREE).astype(np.uint8)
     half = n_cells * resolution / 2.0
     return codes, (-half, -half)
+
+
+def open_image(path: str | os.PathLike[str], where: str):  # -> PIL.Image.Image
+    """Open (not decode) an image within the cell budget (:func:`validation.cell_budget`).
+
+    Pillow's own bomb check is replaced by the library's budget, applied to the header's
+    size before any pixel is decoded; an image beyond Pillow's hard limit is over it too.
+    """
+    from PIL import Image
+
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", Image.DecompressionBombWarning)
+            image = Image.open(path)
+    except Image.DecompressionBombError:
+        raise ValueError(
+            f"{where} (image) is over the cell budget of {validation.MAX_CELLS} "
+            "(pointnav_core.validation.MAX_CELLS)"
+        ) from None
+    try:
+        validation.cell_budget(f"{where} (image)", image.size[1], image.size[0])
+    except ValueError:
+        image.close()
+        raise
+    return image
 
 
 def _pixel_spans(lo: NDArray[np.float64], factor: float) -> tuple[NDArray[np.int64], NDArray[np.int64]]:
@@ -253,7 +292,7 @@ def _parse_movingai(text: str, source: str) -> NDArray[np.uint8]:
         match = _HEADER_LINE.match(stripped)
         if match is None or match.group(1) in header:
             raise ValueError(
-                f"{where}: bad MovingAI header at line {number}: {line!r}; expected the lines "
+                f"{where}: bad MovingAI header at line {number}; expected the lines "
                 "'type octile', 'height <H>', 'width <W>' (once each), then 'map'"
             )
         header[match.group(1)] = match.group(2)
@@ -271,6 +310,7 @@ def _parse_movingai(text: str, source: str) -> NDArray[np.uint8]:
             raise ValueError(f"{where}: bad MovingAI header: {key} must be an integer >= 1, got {value!r}")
         size[key] = int(value)
     height, width = size["height"], size["width"]
+    validation.cell_budget(f"{where} (map)", height, width)
 
     rows = lines[body_start:]
     while rows and not rows[-1].strip():  # trailing blank lines are harmless

@@ -130,6 +130,7 @@ class TraversableMap:
         codes = np.asarray(grid)
         if codes.ndim != 2 or codes.shape[0] < 1 or codes.shape[1] < 1:
             raise ValueError(f"grid must be a non-empty 2D array, got shape {codes.shape}")
+        validation.cell_budget("grid", *codes.shape)
         if codes.dtype == bool:
             codes = np.where(codes, FREE, OBSTACLE)
         elif not np.issubdtype(codes.dtype, np.integer):
@@ -375,8 +376,16 @@ class TraversableMap:
         labels = self.components(radius)
         out = np.zeros(len(flat), dtype=np.int32)
         clear = self.is_usable(flat, radius)
+        # A usable point on a labelled cell's centre (every sampled point) is that cell's:
+        # the nearest candidate, at distance 0, which the loop below would find first.
+        cells = self.world_to_cell(flat)
+        inside = self.in_bounds(cells)
+        rows, cols = np.where(inside, cells[:, 0], 0), np.where(inside, cells[:, 1], 0)
+        own = labels[rows, cols]
+        centred = clear & inside & (own > 0) & (self.cell_to_world(cells) == flat).all(axis=1)
+        out[centred] = own[centred]
         span = np.arange(-2, 3)
-        for i in np.flatnonzero(clear):
+        for i in np.flatnonzero(clear & ~centred):
             cell = self.world_to_cell(flat[i])
             cand = np.stack(np.meshgrid(cell[0] + span, cell[1] + span, indexing="ij"), -1).reshape(-1, 2)
             cand = cand[self.in_bounds(cand)]

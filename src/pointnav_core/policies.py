@@ -8,6 +8,7 @@ observation) and steers along the exact any-angle shortest path (pure pursuit).
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
@@ -41,6 +42,16 @@ _OUT_DIRECTIONS = 16
 _DETOUR = 0.5
 #: Chords of a driven arc checked for clearance.
 _ARC_CHORDS = 4
+#: Metres off its plan a robot may be and still follow it; further, the follower plans
+#: afresh (a shortest path from a point that far off is at most twice as much longer).
+_LEAVE = 0.05
+#: Legs of the plan ahead of the last one the robot was on that it may be found on.
+_WINDOW = 16
+#: Metres short of a leg's end that a proven chord stops (a leg ends tangent to an obstacle
+#: at exactly the planned radius; 1 cm back the gap is ~1e-4 m), and how far (m) off a
+#: proven chord the robot may be for it to stay proven (a straight drive strays ~1e-7 m).
+_SHORT = 0.01
+_ON_CHORD = 1e-5
 
 
 def _wrap(angle: float) -> float:
@@ -67,6 +78,14 @@ def _nearest_usable(tmap: Any, xy: NDArray[np.float64], radius: float, reach: in
     return centres[int(np.argmin(np.hypot(*(centres - xy).T)))]
 
 
+def _off_segment(p: NDArray[np.float64], a: NDArray[np.float64], b: NDArray[np.float64]) -> float:
+    """Distance (m) from point ``p`` to the segment from ``a`` to ``b``."""
+    d = b - a
+    length2 = float(d @ d)
+    t = min(max(float((p - a) @ d) / length2, 0.0), 1.0) if length2 > 0.0 else 0.0
+    return math.dist(p, a + t * d)
+
+
 def _float32_move(dx: float, dy: float, yaw: float, scale: float) -> NDArray[np.float32]:
     """The float32 body-frame action ``(a0, a1)`` of a holonomic robot heading ``yaw`` (rad)
     whose world motion ``scale * R(yaw) a`` (m) strays least sideways from ``(dx, dy)`` (m).
@@ -87,13 +106,47 @@ def _float32_move(dx: float, dy: float, yaw: float, scale: float) -> NDArray[np.
     return a[int(np.argmin(side))].astype(np.float32)
 
 
+@dataclass
+class _Plan:
+    """The beginning of a shortest path, kept while the robot follows it.
+
+    ``points`` (N, 2) m is the drawn path (clear at ``radius`` m, its arcs circumscribed)
+    up to its first vertex ``lookahead`` or more along; ``leg`` is the leg the robot was
+    last found on (it only moves forward); ``goal`` is the ``(x, y, floor)`` it leads to.
+    """
+
+    points: NDArray[np.float64]
+    radius: float
+    goal: tuple[float, float, int]
+    leg: int = 0
+    #: ``(start, leg)``: the chord from ``start`` to the end of ``leg`` (less _SHORT) was
+    #: found clear for a disc _ON_CHORD wider than ``radius``.
+    chord: tuple[NDArray[np.float64], int] | None = None
+
+    def locate(self, xy: NDArray[np.float64]) -> tuple[int, float] | None:
+        """``(leg, distance)``: the nearest of the next :data:`_WINDOW` legs to ``xy`` and
+        its distance (m); None when that is over :data:`_LEAVE` (the robot left the path)."""
+        stop = min(self.leg + _WINDOW, len(self.points) - 1)
+        a, b = self.points[self.leg : stop], self.points[self.leg + 1 : stop + 1]
+        d = b - a
+        length2 = np.einsum("ij,ij->i", d, d)
+        t = np.clip(np.einsum("ij,ij->i", xy - a, d) / np.maximum(length2, 1e-300), 0.0, 1.0)
+        off = np.hypot(*(a + t[:, None] * d - xy).T)
+        i = int(np.argmin(off))
+        if off[i] > _LEAVE:
+            return None
+        self.leg += i
+        return self.leg, float(off[i])
+
+
 class ShortestPathFollower:
     """Drive one robot along the geodesic to its task's goal, without touching anything.
 
     Parameters
     ----------
     env : PointNavEnv or a multi-robot env
-        Anything with ``scene``, ``backend``, ``robots`` and a ``task`` (or pass ``task``).
+        Anything with ``scene``, ``backend``, ``robots`` and a ``task`` (or pass ``task``);
+        a wrapped env (``gymnasium.make``) is unwrapped.
     task : PointNavigationTask, optional
         The task whose robot this policy drives (default ``env.task``).
     margin : float
@@ -139,6 +192,8 @@ class ShortestPathFollower:
         margin: float = 0.02,
         lookahead: float = 0.3,
     ) -> None:
+        # gymnasium.make's wrappers do not forward ``task``: drive the env they wrap.
+        env = getattr(env, "unwrapped", env)
         self.env = env
         self.task = task if task is not None else env.task
         if isinstance(margin, bool) or not isinstance(margin, (int, float)) or not math.isfinite(margin) or margin < 0:
@@ -148,12 +203,53 @@ class ShortestPathFollower:
         self.margin = float(margin)
         self.lookahead = float(lookahead)
         self._aims: dict[tuple[float, float, float], NDArray[np.float64] | None] = {}
+        self._plan: _Plan | None = None
+        # Metres the carrot's chord leaves beyond the robot's radius for the step's arc (the
+        # chord was proven clear that much wider); None: the arc is tested.
+        self._room: float | None = None
 
     def _carrot(self, xy: NDArray[np.float64]) -> NDArray[np.float64] | None:
         """The point to head for from ``xy`` (see the class notes), or None if there is none."""
+        self._room = None
+        goal = np.asarray(self.task.get_goal_pos(), dtype=np.float64)[:2]
+        plan = self._plan
+        same_goal = plan is not None and plan.goal == (float(goal[0]), float(goal[1]), self.task.floor)
+        if same_goal and (carrot := self._follow(plan, xy)) is not None:
+            return carrot
+        self._plan = None
+        return self._replan(xy, goal)
+
+    def _follow(self, plan: _Plan, xy: NDArray[np.float64]) -> NDArray[np.float64] | None:
+        """The carrot from ``xy`` along the stored plan; None when the robot has left it or
+        nears its next turn (the plan is then made again from where the robot is)."""
+        at = plan.locate(xy)
+        if at is None:
+            return None
+        # Mid-leg, the shortest way from a point near the path heads for the leg's end, as
+        # a fresh plan from there would; round a turn only a fresh plan knows the tangent.
+        leg, _ = at
+        turn = plan.points[leg + 1]
+        span = math.dist(xy, turn)
+        if span < self.lookahead + _SHORT:
+            return None
+        ahead = xy + (turn - xy) * (self.lookahead / span)
+        if plan.chord is None or plan.chord[1] != leg or _off_segment(xy, plan.chord[0], turn) > _ON_CHORD:
+            # Every candidate lies on the chord from here to the turn: if the chord up to a
+            # little short of the turn is clear for a disc _ON_CHORD wider, so is the way to
+            # the farthest candidate from any point within _ON_CHORD of it (no more tests
+            # while the robot drives along it).
+            tmap = self.env.scene.floors[self.task.floor]
+            short = turn + (xy - turn) * (_SHORT / span)
+            if not tmap.collision.segments_clear(xy, short, plan.radius + _ON_CHORD):
+                return self._pick(xy, np.vstack([xy, plan.points[leg + 1 :]]), plan.radius, tmap, fallback=False)
+            plan.chord = (xy.copy(), leg)
+        self._room = plan.radius - self.env.robots[self.task.robot_idn].radius
+        return ahead
+
+    def _replan(self, xy: NDArray[np.float64], goal: NDArray[np.float64]) -> NDArray[np.float64] | None:
+        """The carrot from a fresh shortest path from ``xy``, which is kept as the plan."""
         env, task = self.env, self.task
         spec = env.robots[task.robot_idn]
-        goal = np.asarray(task.get_goal_pos(), dtype=np.float64)[:2]
         tmap = env.scene.floors[task.floor]
         # Wider first; then a hair wider than the robot, so that the path never quite
         # touches a wall (a rigid-body solver counts touching as contact); then exact. A
@@ -183,6 +279,15 @@ class ShortestPathFollower:
             if path is None:
                 return None
             return centre
+        self._plan = _Plan(path, radius, (float(goal[0]), float(goal[1]), task.floor))
+        return self._pick(xy, path, radius, tmap, fallback=True)
+
+    def _pick(
+        self, xy: NDArray[np.float64], path: NDArray[np.float64], radius: float, tmap: Any, fallback: bool
+    ) -> NDArray[np.float64] | None:
+        """The farthest clear candidate on ``path`` (which starts at ``xy``); with no clear
+        one, the path's next vertex if ``fallback`` (a fresh shortest path's first leg is
+        clear), else None."""
         # Candidates, farthest first: points up to ``lookahead`` along the path, then the
         # path's next vertex. The drawn path circumscribes its arcs, so the straight move to
         # the next vertex is always clear, while a chord to a point further round an arc
@@ -201,7 +306,9 @@ class ShortestPathFollower:
         along = path[0] + first * (max(self._step_length(), span) / span)
         ahead = np.vstack([resample_path(path, self.lookahead / 4, 5)[1:][::-1], along, path[1]])
         clear = tmap.collision.segments_clear(np.broadcast_to(xy, ahead.shape), ahead, radius)
-        return ahead[int(np.argmax(clear))] if clear.any() else ahead[-1]
+        if clear.any():
+            return ahead[int(np.argmax(clear))]
+        return ahead[-1] if fallback else None
 
     def _aim(self, goal: NDArray[np.float64], radius: float) -> NDArray[np.float64] | None:
         """Where a robot of ``radius`` plans to: the goal, or for a wider robot that does not
@@ -297,9 +404,13 @@ class ShortestPathFollower:
             axis=1,
         )
         sagitta = (s / _ARC_CHORDS) ** 2 * abs(kappa) / 8.0
-        tmap = self.env.scene.floors[self.task.floor]
-        if not tmap.collision.segments_clear(pts[:-1], pts[1:], spec.radius + _HAIR + sagitta).all():
-            return None
+        # Along a proven chord (see _follow) the arc and its chords bulge at most ``bulge``
+        # off the chord to the carrot (the whole arc's sagitta), which left ``_room``.
+        bulge = 0.5 * dist * math.tan(0.5 * abs(bearing))
+        if self._room is None or bulge + sagitta + _HAIR > self._room:
+            tmap = self.env.scene.floors[self.task.floor]
+            if not tmap.collision.segments_clear(pts[:-1], pts[1:], spec.radius + _HAIR + sagitta).all():
+                return None
         v = s / (spec.max_linear_velocity * dt)
         w = kappa * s / (spec.max_angular_velocity * dt)
         return float(np.clip(v, 0.0, 1.0)), float(np.clip(w, -1.0, 1.0))

@@ -12,6 +12,7 @@ from numpy.typing import ArrayLike, NDArray
 from PIL import Image
 
 from pointnav_core.maps import BoundedCache, TraversableMap
+from pointnav_core.outputs import atomic_writer
 from pointnav_core.render import (
     DEFAULT_PIXELS_PER_METER,
     MARKER_COLORS,
@@ -53,7 +54,9 @@ def save_png(frame: ArrayLike, path: PathArg) -> None:
     ValueError
         When ``frame`` is not a uint8 (H, W, 3) array.
     """
-    Image.fromarray(_check_frame(frame, "frame")).save(path, format="PNG")
+    image = Image.fromarray(_check_frame(frame, "frame"))
+    with atomic_writer(path) as fh:  # whole or not at all
+        image.save(fh, format="PNG")
 
 
 def save_gif(frames: Iterable[ArrayLike], path: PathArg, fps: float = 10) -> None:
@@ -89,15 +92,16 @@ def save_gif(frames: Iterable[ArrayLike], path: PathArg, fps: float = 10) -> Non
     if not images:
         raise ValueError("frames must hold at least one frame, got none")
     duration = max(20, 10 * round(100.0 / rate))
-    images[0].save(
-        path,
-        format="GIF",
-        save_all=True,
-        append_images=images[1:],
-        duration=duration,
-        loop=0,
-        optimize=True,
-    )
+    with atomic_writer(path) as fh:  # whole or not at all
+        images[0].save(
+            fh,
+            format="GIF",
+            save_all=True,
+            append_images=images[1:],
+            duration=duration,
+            loop=0,
+            optimize=True,
+        )
 
 
 # ------------------------------------------------------------------------------ environments

@@ -12,14 +12,16 @@ member                                         meaning
 robot, rng) -> (floor, xyz)``                  the reference point's component if given
 ``get_shortest_path(floor, source_xy,          any-angle path (N, 2) from the true source
 target_xy, entire_path, robot)``               to the true target and its length (m)
-``geodesic_distance(floor, source, target)``   the length alone (``inf`` when unreachable)
+``geodesic_distance(floor, source, target)``   the length alone
 ``goal_field(floor, goal_xy, robot)``          cached per-goal distance field (hot path)
 =============================================  ==========================================
 
+Unreachable is ``math.inf`` everywhere (``get_shortest_path``: ``(None, inf)``), proven by two
+label lookups when the points lie in different :mod:`~pointnav_core.reachability` components.
+
 ``robot`` is anything with a ``radius`` attribute (a ``RobotSpec``), a radius in metres, or
 None for a point robot. Scenes are built from arrays, shapely polygons, OmniGibson
-traversability PNGs or MovingAI maps, or generated (:func:`rooms`, :func:`maze`,
-:func:`clutter`).
+traversability PNGs, MovingAI maps, ROS maps, ProcTHOR or HouseExpo plans, or generated.
 """
 
 from __future__ import annotations
@@ -32,7 +34,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from pointnav_core import floorplans, loaders, validation
+from pointnav_core import floorplans, loaders, reachability, validation
 from pointnav_core.errors import SamplingError
 from pointnav_core.floorplans import FloorPlan
 from pointnav_core.maps import OBSTACLE, TraversableMap
@@ -93,16 +95,14 @@ class FloorGoalField:
 
     def path(
         self, source_xy: ArrayLike, exact: bool = True, max_length: float = math.inf
-    ) -> tuple[NDArray[np.float64], float] | tuple[None, None]:
-        """Shortest path (N, 2) in world metres from ``source_xy`` to the goal, and its length.
-
-        Every path is exact; ``exact`` is accepted for compatibility. A finite
-        ``max_length`` (m) draws only the path's beginning, to its first vertex at least
-        that far along; the length is still the whole path's.
-        """
+    ) -> tuple[NDArray[np.float64] | None, float]:
+        """Shortest path (N, 2) in world metres from ``source_xy`` to the goal, and its length
+        (``(None, inf)`` when unreachable). ``exact`` is accepted for compatibility: every path
+        is exact. A finite ``max_length`` (m) draws only the path's beginning, to its first
+        vertex at least that far along; the length is still the whole path's."""
         points, length = self.field.path(_as_xy(source_xy, "source_xy"), max_length=max_length)
         if points is None:
-            return None, None
+            return None, math.inf
         return points, float(length)
 
 
@@ -265,9 +265,43 @@ class Scene:
         the origin moves out by one cell so that character ``(row, col)`` still covers
         ``[col, col + 1) x [row, row + 1)`` times ``resolution``.
         """
+        res = validation.real("resolution", resolution, minimum=0.0, strict=True, unit="m per character")
         codes = np.pad(loaders.read_movingai(path), 1, constant_values=OBSTACLE)
-        res = float(resolution)
         return cls([TraversableMap(codes, res, origin=(-res, -res))], **kwargs)
+
+    @classmethod
+    def from_ros_map(cls, yaml_path: str | PathLike[str], *, unknown: str = "void", lethal_threshold: int = 100,
+                     ignore_yaw: bool = False, height: float = 0.0, **kwargs: Any) -> Scene:
+        """Scene of one floor from a ROS map_server ``map.yaml`` and its PGM / PNG image, read by
+        map_server's rules (see :func:`pointnav_core.ros_maps.ros_map_floor`)."""
+        from pointnav_core.ros_maps import ros_map_floor
+
+        return cls([ros_map_floor(yaml_path, unknown=unknown, lethal_threshold=lethal_threshold,
+                                  ignore_yaw=ignore_yaw, height=height)], **kwargs)
+
+    @classmethod
+    def from_procthor(cls, house_json: str | PathLike[str], resolution: float = 0.05, wall_thickness: float = 0.1,
+                      object_sizes: Any = None, **kwargs: Any) -> Scene:
+        """Scene of a ProcTHOR ``house.json``: rooms as floor, walls with door holes as obstacles,
+        exact polygons (see :func:`pointnav_core.floorplan_files.read_procthor`)."""
+        from pointnav_core.floorplan_files import read_procthor
+
+        plan = read_procthor(house_json, wall_thickness=wall_thickness, object_sizes=object_sizes)
+        return cls.from_polygons(plan.outline, plan.obstacles, resolution=resolution, **kwargs)
+
+    @classmethod
+    def from_houseexpo(cls, path: str | PathLike[str], resolution: float = 0.05, **kwargs: Any) -> Scene:
+        """Scene of a HouseExpo ``<id>.json``: its ``verts`` (m) as the exact floor outline."""
+        from pointnav_core.floorplan_files import read_houseexpo
+
+        plan = read_houseexpo(path)
+        return cls.from_polygons(plan.outline, plan.obstacles, resolution=resolution, **kwargs)
+
+    def to_ros_map(self, yaml_path: str | PathLike[str], floor: int = 0) -> str:
+        """Write ``floor``'s grid as a trinary map_server map (yaml + PGM); returns the image path."""
+        from pointnav_core import ros_maps
+
+        return ros_maps.write_ros_map(self._floor(floor), yaml_path)
 
     @staticmethod
     def _heights(heights: Sequence[float] | None, n: int) -> list[float]:
@@ -394,8 +428,11 @@ class Scene:
     def _shortest(
         self, floor: int, source_xy: ArrayLike, target_xy: ArrayLike, robot: Any
     ) -> tuple[NDArray[np.float64] | None, float]:
-        planner = planner_for(self._floor(floor), robot_radius(robot))
+        tmap, radius = self._floor(floor), robot_radius(robot)
         src, tgt = _as_xy(source_xy, "source_xy"), _as_xy(target_xy, "target_xy")
+        if reachability.disconnected(tmap, radius, src, tgt):  # proven in O(1), no search
+            return None, math.inf
+        planner = planner_for(tmap, radius)
         if planner.has_field(tgt):
             points, length = planner.goal_field(tgt).path(src)
         else:
@@ -411,7 +448,7 @@ class Scene:
         target_xy: ArrayLike,
         entire_path: bool = False,
         robot: Any = None,
-    ) -> tuple[NDArray[np.float64], float] | tuple[None, None]:
+    ) -> tuple[NDArray[np.float64] | None, float]:
         """Shortest collision-free path of the robot's centre and its geodesic length.
 
         Parameters
@@ -429,14 +466,14 @@ class Scene:
         Returns
         -------
         waypoints : ndarray (N, 2) or None
-        geodesic_distance : float or None
+        geodesic_distance : float
             Exact length in metres of the shortest path of the disc's centre. ``(None,
-            None)`` when the target is unreachable from the source, or the robot does not
-            fit at either.
+            math.inf)`` when the target is unreachable from the source, or the robot does not
+            fit at either (the same ``inf`` as :meth:`geodesic_distance` and goal fields).
         """
         points, length = self._shortest(floor, source_xy, target_xy, robot)
         if points is None:
-            return None, None
+            return None, math.inf
         if not entire_path:
             points = resample_path(points, self.waypoint_spacing, self.num_waypoints)
         return points, length

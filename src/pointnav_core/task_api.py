@@ -430,8 +430,8 @@ class OmniGibsonTaskAPI:
         -------
         waypoints : ndarray (N, 2) or None
             World (x, y) in metres.
-        geodesic_distance : float or None
-            Metres; ``(None, None)`` when the goal is not reachable from the start.
+        geodesic_distance : float
+            Metres; ``(None, math.inf)`` when the goal is not reachable from the start.
         """
         self._require_episode("get_shortest_path_to_goal()")
         if start_xy_pos is None:

@@ -32,9 +32,17 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-__all__ = ["boolean", "goal_tolerance", "integer", "is_real", "is_real_array", "known_keys", "real", "vector"]
+__all__ = [
+    "MAX_CELLS", "boolean", "cell_budget", "goal_tolerance", "integer", "is_real", "is_real_array",
+    "known_keys", "real", "vector",
+]
 
 _REAL_KINDS = "biuf"  # numpy dtype kinds that hold real numbers (b: refused below)
+
+#: The cell budget of every grid and image a loader accepts: a floor grid, an image's pixels,
+#: a MovingAI map's characters. A floor's derived tables take tens of bytes per cell, so
+#: 1e8 cells already need gigabytes. Read at each call: a program may raise it.
+MAX_CELLS = 100_000_000
 
 
 def is_real(value: Any) -> bool:
@@ -151,6 +159,24 @@ def known_keys(name: str, keys: Any, valid: Any) -> None:
     for key in keys:
         if key not in valid:
             raise ValueError(f"{name} has an unknown key {key!r}; valid keys are {list(valid)}")
+
+
+def cell_budget(name: str, rows: int, cols: int) -> None:
+    """Refuse a grid of ``rows x cols`` cells beyond :data:`MAX_CELLS`, before it is built.
+
+    Every grid and image loader calls this with the size it is about to read or build, so
+    the same budget holds everywhere and a huge file is refused before it is decoded.
+
+    >>> cell_budget("grid", 20000, 20000)
+    Traceback (most recent call last):
+    ...
+    ValueError: grid is 20000 x 20000 = 400000000 cells, over the cell budget of 100000000 (pointnav_core.validation.MAX_CELLS)
+    """
+    if rows * cols > MAX_CELLS:
+        raise ValueError(
+            f"{name} is {rows} x {cols} = {rows * cols} cells, over the cell budget of "
+            f"{MAX_CELLS} (pointnav_core.validation.MAX_CELLS)"
+        )
 
 
 def boolean(name: str, value: Any) -> bool:

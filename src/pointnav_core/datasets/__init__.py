@@ -30,7 +30,13 @@ from pointnav_core.datasets.generator import (
     generate_split,
     island_radius,
 )
-from pointnav_core.datasets.scene_sets import SCENE_SETS, SceneSet, load_scene, scene_set
+from pointnav_core.datasets.scene_sets import (
+    SCENE_SETS,
+    SceneSet,
+    load_scene,
+    locate_scene,
+    scene_set,
+)
 
 #: The shipped validation dataset: 300 episodes on the ``val`` houses (see the module notes).
 VALIDATION_DATASET = Path(__file__).parent / "data" / "houses_val_300.json.gz"
@@ -52,6 +58,7 @@ __all__ = [
     "generate_split",
     "island_radius",
     "load_scene",
+    "locate_scene",
     "scene_set",
     "validation_dataset",
 ]

@@ -33,20 +33,27 @@ import io
 import json
 import math
 import os
+import zlib
 from collections.abc import Iterable, Iterator, Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import Any
+
+from pointnav_core import validation
 
 __all__ = [
     "EpisodeDataset",
     "PointNavEpisode",
     "FORMAT_VERSION",
+    "MAX_DATASET_BYTES",
     "from_habitat_position",
     "from_habitat_rotation",
     "to_habitat_position",
     "to_habitat_rotation",
 ]
 
+#: Default budget (bytes) of a dataset's JSON text after decompression: about 700,000
+#: episodes. :meth:`EpisodeDataset.load` takes another as ``max_bytes``.
+MAX_DATASET_BYTES = 256 * 1024 * 1024
 #: Version of the ``pointnav_core`` metadata block.
 FORMAT_VERSION = 1
 #: How far a stored quaternion's norm may be from 1, and its tilt from a pure yaw.
@@ -376,22 +383,71 @@ class EpisodeDataset:
         return buffer.getvalue()
 
     def save(self, path: str | os.PathLike[str], frame: str = "z-up") -> None:
-        """Write the dataset to ``path`` (``.json.gz``; a ``.json`` path is written plain)."""
+        """Write the dataset to ``path`` (``.json.gz``; a ``.json`` path is written plain).
+
+        The file is written whole or not at all (a temporary file renamed over ``path``,
+        :func:`pointnav_core.outputs.atomic_writer`): a full disk leaves an existing file as
+        it was.
+        """
+        from pointnav_core.outputs import atomic_writer
+
         data = self.to_bytes(frame)
         if os.fspath(path).endswith(".json"):
             data = gzip.decompress(data)
-        with open(path, "wb") as fh:
+        with atomic_writer(path) as fh:
             fh.write(data)
 
     @classmethod
-    def load(cls, path: str | os.PathLike[str]) -> EpisodeDataset:
-        """Read a ``.json.gz`` (or plain ``.json``) dataset; see :meth:`from_json`."""
-        with open(path, "rb") as fh:
+    def load(
+        cls, path: str | os.PathLike[str], max_bytes: int | None = None
+    ) -> EpisodeDataset:
+        """Read a ``.json.gz`` (or plain ``.json``) dataset; see :meth:`from_json`.
+
+        Parameters
+        ----------
+        path : str or os.PathLike
+        max_bytes : int, optional
+            Budget of the JSON text, in bytes, after decompression (default
+            :data:`MAX_DATASET_BYTES`): a gzip bomb is refused once it inflates past it.
+
+        Raises
+        ------
+        ValueError
+            For a file that is not gzip or JSON, is truncated or corrupt, or is over budget;
+            the message names the file.
+        """
+        where = os.fspath(path)
+        limit = MAX_DATASET_BYTES if max_bytes is None else validation.integer("max_bytes", max_bytes, minimum=1)
+        if os.path.getsize(where) > limit:
+            raise ValueError(f"{where} is over the dataset budget of {limit} bytes (max_bytes)")
+        with open(where, "rb") as fh:
             raw = fh.read()
         if raw[:2] == b"\x1f\x8b":
-            raw = gzip.decompress(raw)
+            raw = _gunzip(raw, limit, where)
         try:
             data = json.loads(raw.decode("utf-8"))
         except (UnicodeDecodeError, json.JSONDecodeError) as err:
-            raise ValueError(f"{os.fspath(path)} is not a JSON dataset: {err}") from None
-        return cls.from_json(data, source=os.path.basename(os.fspath(path)))
+            raise ValueError(f"{where} is not a JSON dataset: {err}") from None
+        return cls.from_json(data, source=os.path.basename(where))
+
+
+def _gunzip(raw: bytes, limit: int, where: str) -> bytes:
+    """Inflate gzip ``raw`` (one or more members), refusing more than ``limit`` bytes out."""
+    out = bytearray()
+    try:
+        while raw:
+            inflate = zlib.decompressobj(16 + zlib.MAX_WBITS)
+            while raw and not inflate.eof:
+                # At most one byte past the budget: enough to know it is over.
+                out += inflate.decompress(raw, limit + 1 - len(out))
+                if len(out) > limit:
+                    raise ValueError(
+                        f"{where} inflates past the dataset budget of {limit} bytes (max_bytes)"
+                    )
+                raw = inflate.unconsumed_tail
+            if not inflate.eof:
+                raise ValueError(f"{where} is a truncated gzip file")
+            raw = inflate.unused_data
+    except zlib.error as err:
+        raise ValueError(f"{where} is a corrupt gzip file: {err}") from None
+    return bytes(out)

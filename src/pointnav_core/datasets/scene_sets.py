@@ -12,15 +12,20 @@ scene_id                       scene
 ``trav:<path>``                OmniGibson scene folder: its ``floor_trav_<n>.png`` images
                                (in the folder or its ``layout/``), one floor each, or
                                one ``floor_trav_<n>.png`` file
+``ros:<path>``                 ROS map_server ``map.yaml`` (:meth:`Scene.from_ros_map`)
+``procthor:<path>``            ProcTHOR ``house.json`` (:meth:`Scene.from_procthor`)
+``houseexpo:<path>``           HouseExpo ``<id>.json`` (:meth:`Scene.from_houseexpo`)
 =============================  ==========================================================
 
-Relative paths are read relative to ``root`` (the working directory by default). A plain
-path is accepted too: ``.map`` is a MovingAI map, ``.png`` a traversability image, a folder
-an OmniGibson scene.
+Relative paths are read relative to ``root`` (the working directory by default); with a
+``root``, a path must stay under it once resolved (:func:`locate_scene`). A plain
+path is accepted too: ``.map`` is a MovingAI map, ``.png`` a traversability image,
+``.yaml``/``.yml`` a ROS map, ``.json`` a ProcTHOR house or a HouseExpo plan (told apart by
+their keys), a folder an OmniGibson scene.
 
 Named sets (:data:`SCENE_SETS`) are generated scenes whose seeds are split into
 consecutive, disjoint blocks: train, then val, then test, so no scene is in two splits.
-A folder of MovingAI maps and OmniGibson scenes is a set too (:func:`folder_scene_set`):
+A folder of scene files (any of the above) is a set too (:func:`folder_scene_set`):
 its scenes, sorted by name and shuffled by a seed, are cut into the three splits.
 """
 
@@ -46,6 +51,7 @@ __all__ = [
     "folder_scene_set",
     "generated_scene_set",
     "load_scene",
+    "locate_scene",
     "scene_set",
 ]
 
@@ -53,6 +59,14 @@ __all__ = [
 SPLITS = ("train", "val", "test")
 #: Scene generators a ``scene_id`` may name.
 GENERATORS = {"rooms": scenes.rooms, "maze": scenes.maze, "clutter": scenes.clutter}
+#: Scene files a ``scene_id`` may name, by scheme (``trav`` is handled apart: a folder or a PNG).
+FILE_SCHEMES = {
+    "movingai": Scene.from_movingai,
+    "ros": Scene.from_ros_map,
+    "procthor": Scene.from_procthor,
+    "houseexpo": Scene.from_houseexpo,
+    "trav": Scene.from_png,
+}
 _TRAV = re.compile(r"floor_trav_(\d+)\.png$")
 
 
@@ -125,16 +139,31 @@ def _trav_images(folder: str) -> list[str]:
     return []
 
 
+def _file_scheme(path: str) -> str | None:
+    """The scene_id scheme of a scene file by its name (and a JSON file's keys), or None
+    for a file that is no scene; a ``.json`` that is neither floor-plan format is an error."""
+    if path.endswith(".map"):
+        return "movingai"
+    if path.endswith((".yaml", ".yml")):
+        return "ros"
+    if path.endswith(".json"):
+        from pointnav_core.floorplan_files import sniff_plan_format
+
+        return sniff_plan_format(path)
+    return None
+
+
 def folder_scene_set(
     folder: str | os.PathLike[str],
     seed: int = 0,
     fractions: tuple[float, float, float] = (0.8, 0.1, 0.1),
 ) -> SceneSet:
-    """The MovingAI maps (``*.map``) and OmniGibson scene folders (with ``floor_trav_*.png``)
-    directly inside ``folder``, sorted by name, shuffled by ``seed`` and cut into train / val
+    """The scene files (MovingAI ``*.map``, map_server ``*.yaml``, ProcTHOR and HouseExpo
+    ``*.json``) and OmniGibson scene folders (with ``floor_trav_*.png``) directly inside
+    ``folder``, sorted by name, shuffled by ``seed`` and cut into train / val
     / test by ``fractions`` (val and test get at least one scene each when there are three or
-    more). Scene ids are ``movingai:<folder>/<name>`` and ``trav:<folder>/<name>``, with
-    ``folder`` as given.
+    more). Scene ids are ``<scheme>:<folder>/<name>`` (``movingai``, ``ros``, ``procthor``,
+    ``houseexpo`` or ``trav``), with ``folder`` as given.
     """
     folder = os.fspath(folder)
     if not os.path.isdir(folder):
@@ -148,13 +177,15 @@ def folder_scene_set(
     ids = []
     for name in sorted(os.listdir(folder)):
         path = os.path.join(folder, name).replace(os.sep, "/")
-        if name.endswith(".map") and os.path.isfile(path):
-            ids.append(f"movingai:{path}")
+        scheme = _file_scheme(path) if os.path.isfile(path) else None
+        if scheme is not None:
+            ids.append(f"{scheme}:{path}")
         elif os.path.isdir(path) and _trav_images(path):
             ids.append(f"trav:{path}")
     if not ids:
         raise ValueError(
-            f"scene folder {folder!r} holds no .map file and no folder with floor_trav_*.png"
+            f"scene folder {folder!r} holds no scene: no .map, map_server .yaml, ProcTHOR or "
+            "HouseExpo .json file, and no folder with floor_trav_*.png"
         )
     order = np.random.default_rng(seed).permutation(len(ids))
     n = len(ids)
@@ -193,7 +224,8 @@ def load_scene(scene_id: str, root: str | os.PathLike[str] | None = None) -> Sce
     Raises
     ------
     ValueError
-        For a scene_id of no known form, naming the forms.
+        For a scene_id of no known form, naming the forms, or a path that leaves ``root``
+        (see :func:`locate_scene`).
     FileNotFoundError
         For a path that does not exist.
     """
@@ -207,27 +239,61 @@ def _named(scene: Scene, scene_id: str) -> Scene:
     return scene
 
 
-def _build(scene_id: Any, root: str | os.PathLike[str] | None) -> Scene:
-    forms = "rooms:<seed>, maze:<seed>, clutter:<seed>, movingai:<path>, trav:<path>, or a .map/.png/folder path"
+_FORMS = (
+    "rooms:<seed>, maze:<seed>, clutter:<seed>, movingai:<path>, trav:<path>, ros:<path>, "
+    "procthor:<path>, houseexpo:<path>, or a .map/.png/.yaml/.json/folder path"
+)
+
+
+def locate_scene(scene_id: Any, root: str | os.PathLike[str] | None = None) -> tuple[str, str | None]:
+    """Check a ``scene_id`` without building its scene: ``(scheme, path)``.
+
+    ``scheme`` is a generator name (``rooms``, ...; ``path`` None), a file scheme of
+    :data:`FILE_SCHEMES`, or ``""`` (a plain path). With ``root``, a path is resolved (links
+    followed) and must stay under ``root``: a dataset cannot make the reader open files
+    elsewhere.
+
+    Raises
+    ------
+    ValueError
+        For a scene_id of no known form, naming the forms, or a path outside ``root``.
+    FileNotFoundError
+        For a path that does not exist.
+    """
     if not isinstance(scene_id, str) or not scene_id:
-        raise ValueError(f"scene_id must be a non-empty string ({forms}), got {scene_id!r}")
+        raise ValueError(f"scene_id must be a non-empty string ({_FORMS}), got {scene_id!r}")
     scheme, _, rest = scene_id.partition(":")
     if scheme in GENERATORS:
         if not re.fullmatch(r"-?\d+", rest):
             raise ValueError(f"unknown scene_id {scene_id!r}: {scheme}: takes an integer seed")
-        return GENERATORS[scheme](seed=int(rest))
-    if scheme in ("movingai", "trav") and rest:
+        return scheme, None
+    if scheme in FILE_SCHEMES and rest:
         path = rest
     elif ":" not in scene_id or re.match(r"^[A-Za-z]:[\\/]", scene_id):  # a plain (or Windows) path
         path, scheme = scene_id, ""
     else:
-        raise ValueError(f"unknown scene_id {scene_id!r}: expected one of {forms}")
-    if root is not None and not os.path.isabs(path):
-        path = os.path.join(os.fspath(root), path)
+        raise ValueError(f"unknown scene_id {scene_id!r}: expected one of {_FORMS}")
+    if root is not None:
+        base = os.path.realpath(root)
+        path = os.path.realpath(os.path.join(base, path))
+        if os.path.commonpath([base, path]) != base:
+            raise ValueError(
+                f"scene_id {scene_id!r}: the path leaves the scenes folder {os.fspath(root)!r} "
+                "(scenes_root, --scenes-dir)"
+            )
     if not os.path.exists(path):
         raise FileNotFoundError(f"scene_id {scene_id!r}: no such file or folder {path!r}")
-    if scheme == "movingai" or (not scheme and path.endswith(".map")):
-        return Scene.from_movingai(path)
+    return scheme, path
+
+
+def _build(scene_id: Any, root: str | os.PathLike[str] | None) -> Scene:
+    scheme, path = locate_scene(scene_id, root)
+    if path is None:
+        return GENERATORS[scheme](seed=int(scene_id.partition(":")[2]))
+    if not scheme and os.path.isfile(path):
+        scheme = _file_scheme(path) or ""
+    if scheme in FILE_SCHEMES and scheme != "trav":
+        return FILE_SCHEMES[scheme](path)
     if os.path.isdir(path):
         images = _trav_images(path)
         if not images:
@@ -235,4 +301,4 @@ def _build(scene_id: Any, root: str | os.PathLike[str] | None) -> Scene:
         return Scene.from_png(images)
     if path.endswith(".png"):
         return Scene.from_png(path)
-    raise ValueError(f"unknown scene_id {scene_id!r}: expected one of {forms}")
+    raise ValueError(f"unknown scene_id {scene_id!r}: expected one of {_FORMS}")

@@ -11,6 +11,7 @@ import shapely
 from numpy.typing import NDArray
 from shapely.geometry import Polygon, box
 
+from pointnav_core import validation
 from pointnav_core.floorplans.args import check_polygon, check_positive
 from pointnav_core.maps import FREE, OBSTACLE, VOID
 
@@ -18,8 +19,6 @@ __all__ = ["SNAP_TOL", "FloorPlan", "rasterize", "walled_box"]
 
 # Tolerance for snapping a bound that should be a whole number of cells (0.3 / 0.1 is not 3).
 SNAP_TOL = 1e-9
-# Refuse grids beyond this many cells: the cell-centre arrays alone would take gigabytes.
-_MAX_CELLS = 100_000_000
 
 
 @dataclass(frozen=True, kw_only=True, repr=False)
@@ -162,12 +161,13 @@ def rasterize(
     row0 = math.floor(ymin / resolution + SNAP_TOL)
     width = max(1, math.ceil(xmax / resolution - SNAP_TOL) - col0)
     height = max(1, math.ceil(ymax / resolution - SNAP_TOL) - row0)
-    if width * height > _MAX_CELLS:
+    try:  # the cell-centre arrays alone would take gigabytes
+        validation.cell_budget("the rasterised outline", height, width)
+    except ValueError as err:
         raise ValueError(
             f"resolution {resolution} m/cell is too fine for an outline of "
-            f"{xmax - xmin:.3g} x {ymax - ymin:.3g} m: {height} x {width} cells "
-            f"(at most {_MAX_CELLS} allowed)"
-        )
+            f"{xmax - xmin:.3g} x {ymax - ymin:.3g} m: {err}"
+        ) from None
     origin = (col0 * resolution, row0 * resolution)
     xs = origin[0] + (np.arange(width) + 0.5) * resolution
     ys = origin[1] + (np.arange(height) + 0.5) * resolution

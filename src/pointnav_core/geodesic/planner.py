@@ -108,6 +108,7 @@ class Planner(ThawOnUnpickle):
         # The per-floor build from the disk cache, if an earlier process kept it (geodesic.cache).
         self._cache_key = cache.floor_key(collision, self.radius) if cache.cache_dir() is not None else None
         stored = cache.load(self._cache_key, self.n_nodes) if self._cache_key is not None else None
+        self._in_cache = stored is not None
         if stored is not None:
             self.sights = stored["sights"].astype(np.float64)
             self.sight_profile = stored["sight_profile"].astype(np.float32)
@@ -287,7 +288,12 @@ class Planner(ThawOnUnpickle):
                 bar.update(min(_EDGE_BATCH, len(todo) - i))
         self._build_seconds += time.perf_counter() - started
         if self._cache_key is not None and self._build_seconds >= cache.MIN_SECONDS:
-            cache.save(self._cache_key, self._stored_edges())
+            self._in_cache = cache.save(self._cache_key, self._stored_edges()) is not None
+
+    @property
+    def cached(self) -> bool:
+        """Whether this floor's build is in the disk cache (read from it, or written to it)."""
+        return self._in_cache
 
     def _stored_edges(self) -> dict[str, NDArray[Any]]:
         """The sights and every edge as flat arrays (what the disk cache keeps)."""

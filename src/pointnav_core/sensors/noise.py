@@ -208,12 +208,8 @@ _KERNEL: list[Any] = []  # the compiled loop, or None without numba, once looked
 def _kernel() -> Any:
     """The compiled loop of :func:`_ray_uniforms`, or None without numba (looked up once)."""
     if not _KERNEL:
-        try:
-            from pointnav_core.sensors._noise_kernel import ray_uniforms
-        except ModuleNotFoundError as error:
-            if error.name not in ("numba", "llvmlite"):
-                raise
-            _KERNEL.append(None)
-        else:
-            _KERNEL.append(ray_uniforms)
+        from pointnav_core._compiled import kernel_module
+
+        module = kernel_module("pointnav_core.sensors._noise_kernel")
+        _KERNEL.append(None if module is None else module.ray_uniforms)
     return _KERNEL[0]

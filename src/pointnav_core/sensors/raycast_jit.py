@@ -41,14 +41,10 @@ def kernel() -> Any:
     global _KERNEL, _TRIED
     if not _TRIED:
         _TRIED = True
-        try:
-            from pointnav_core.sensors._raycast_kernel import cast
-        except ModuleNotFoundError as error:
-            if error.name not in ("numba", "llvmlite"):
-                raise
-            _KERNEL = None
-        else:
-            _KERNEL = cast
+        from pointnav_core._compiled import kernel_module
+
+        module = kernel_module("pointnav_core.sensors._raycast_kernel")
+        _KERNEL = None if module is None else module.cast
     return _KERNEL
 
 

@@ -1,0 +1,179 @@
+"""Worker processes that die with their parent, fed one task at a time.
+
+:class:`WorkerPool` starts ``spawn`` processes, each of which builds its state once
+(``init(*initargs)``) and then runs ``task(state, item)`` for every item it is sent, one at
+a time, so the parent always knows which item a worker holds. Unlike a
+``ProcessPoolExecutor``:
+
+- a worker watches its parent and exits within half a second once the parent is gone,
+  even after a SIGKILL that gave the parent no chance to clean up;
+- workers ignore SIGINT (a Ctrl-C reaches the whole process group): the parent decides, and
+  :meth:`WorkerPool.close` ends them (SIGTERM, then SIGKILL), so an interrupted run stops
+  at once instead of playing every queued item;
+- a worker that dies or raises is reported as :class:`WorkerError` naming its item.
+"""
+
+from __future__ import annotations
+
+import os
+import signal
+import threading
+import time
+from collections.abc import Callable, Hashable, Iterable, Iterator
+from multiprocessing import connection, get_context
+from typing import Any
+
+__all__ = ["WorkerError", "WorkerPool", "usable_cores"]
+
+#: How often (s) a worker checks that its parent is alive.
+_WATCH_PERIOD = 0.2
+
+
+class WorkerError(RuntimeError):
+    """A worker died, or raised, while it held an item (``key``; None: while starting)."""
+
+    def __init__(self, key: Hashable | None, cause: str) -> None:
+        self.key, self.cause = key, cause
+        what = "while starting" if key is None else f"on {key!r}"
+        super().__init__(f"a worker process failed {what}: {cause}")
+
+
+def usable_cores() -> int:
+    """The CPU cores this process may run on."""
+    try:
+        return len(os.sched_getaffinity(0))
+    except AttributeError:  # not on Linux
+        return os.cpu_count() or 1
+
+
+def _watch_parent(parent: int) -> None:
+    while os.getppid() == parent:
+        time.sleep(_WATCH_PERIOD)
+    os._exit(1)  # the parent is gone: nobody reads what this worker would produce
+
+
+def _describe(error: BaseException) -> str:
+    return f"{type(error).__name__}: {error}"
+
+
+def _worker_main(conn: Any, parent: int, init: Callable[..., Any], initargs: tuple, task: Callable[[Any, Any], Any]) -> None:
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    if hasattr(signal, "pthread_sigmask"):  # blocked since birth (see WorkerPool): now ignored
+        signal.pthread_sigmask(signal.SIG_UNBLOCK, {signal.SIGINT})
+    threading.Thread(target=_watch_parent, args=(parent,), daemon=True).start()
+    try:
+        state = init(*initargs)
+    except Exception as error:
+        conn.send(("raised", None, _describe(error)))
+        return
+    conn.send(("ready", None, None))
+    while True:
+        try:
+            message = conn.recv()
+        except (EOFError, OSError):
+            return
+        if message is None:
+            return
+        key, item = message
+        try:
+            conn.send(("done", key, task(state, item)))
+        except Exception as error:
+            conn.send(("raised", key, _describe(error)))
+
+
+class WorkerPool:
+    """``workers`` processes running ``task(init(*initargs), item)`` (see the module notes).
+
+    ``init`` and ``task`` must be importable module-level functions, and ``initargs`` and
+    the items picklable. Use as a context manager: leaving the block ends every worker.
+    """
+
+    def __init__(self, workers: int, init: Callable[..., Any], initargs: tuple, task: Callable[[Any, Any], Any]) -> None:
+        context = get_context("spawn")
+        self._procs, self._conns = [], []
+        # A worker is born with SIGINT blocked (the mask survives fork and exec), so that a
+        # Ctrl-C while it is still starting does not kill it with a traceback; here a Ctrl-C
+        # waits until the workers are started.
+        blocking = hasattr(signal, "pthread_sigmask")
+        if blocking:  # it would unblock SIGINT if it started in the middle (it blocks its own)
+            from multiprocessing import resource_tracker
+
+            resource_tracker.ensure_running()
+        mask = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT}) if blocking else None
+        try:
+            for _ in range(workers):
+                ours, theirs = context.Pipe()
+                proc = context.Process(
+                    target=_worker_main, args=(theirs, os.getpid(), init, initargs, task), daemon=True
+                )
+                proc.start()
+                theirs.close()
+                self._procs.append(proc)
+                self._conns.append(ours)
+        except BaseException:
+            self.close()
+            raise
+        finally:
+            if blocking:
+                signal.pthread_sigmask(signal.SIG_SETMASK, mask)
+
+    def __enter__(self) -> WorkerPool:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
+
+    def imap_unordered(self, items: Iterable[tuple[Hashable, Any]]) -> Iterator[tuple[Hashable, Any]]:
+        """Run every ``(key, item)``; yield ``(key, task's return)`` as each finishes.
+
+        Raises
+        ------
+        WorkerError
+            When a worker raises or ends before returning, naming the item it held.
+        """
+        todo = iter(items)
+        held: dict[int, Hashable | None] = dict.fromkeys(range(len(self._procs)))  # None: starting
+        while held:
+            connection.wait([self._conns[k] for k in held] + [self._procs[k].sentinel for k in held])
+            for k in list(held):
+                conn, proc = self._conns[k], self._procs[k]
+                try:
+                    if not conn.poll():
+                        if not proc.is_alive():
+                            raise WorkerError(held[k], f"the process ended (exit code {proc.exitcode})")
+                        continue
+                    kind, key, out = conn.recv()
+                    if kind == "raised":
+                        raise WorkerError(key, out)
+                    if kind == "done":
+                        yield key, out
+                    nxt = next(todo, None)
+                    if nxt is None:
+                        del held[k]
+                        continue
+                    held[k] = nxt[0]
+                    conn.send(nxt)
+                except (EOFError, OSError):
+                    proc.join(1.0)
+                    raise WorkerError(held[k], f"the process ended (exit code {proc.exitcode})") from None
+
+    def close(self) -> None:
+        """End every worker: a polite stop, SIGTERM, then SIGKILL for one that lingers."""
+        for conn in self._conns:
+            try:
+                conn.send(None)
+            except (OSError, ValueError):
+                pass
+        deadline = time.monotonic() + 0.5
+        for proc in self._procs:
+            proc.join(max(0.0, deadline - time.monotonic()))
+            if proc.is_alive():
+                proc.terminate()
+        for proc in self._procs:
+            proc.join(2.0)
+            if proc.is_alive():
+                proc.kill()
+                proc.join()
+        for conn in self._conns:
+            conn.close()
+        self._procs, self._conns = [], []
