@@ -121,11 +121,9 @@ class Scene:
         Accepted for compatibility: a floor's plan is its map's ``geometry`` (give it to
         :class:`TraversableMap`), so an entry must be None or that same plan.
     scene_id : str, optional
-        The name a dataset's episodes give this scene (``rooms:0``, a file's path, ...;
-        see :func:`pointnav_core.datasets.load_scene`, which sets it, as the generators
-        :func:`rooms`, :func:`maze` and :func:`clutter` do for their ``<name>:<seed>``).
-        Every env refuses a dataset episode of another ``scene_id``; None (a scene built
-        by hand) checks nothing.
+        The name datasets give this scene (``rooms:0``, a path), set by
+        :func:`pointnav_core.datasets.load_scene` and the generators (``rooms`` ...). Every
+        env refuses a dataset episode of another ``scene_id``; None checks nothing.
 
     Examples
     --------
@@ -482,29 +480,6 @@ class Scene:
         return f"Scene(n_floors={self.n_floors}, floors={self.floors!r})"
 
 
-def rooms(seed: int | None = None, resolution: float = 0.1, **kwargs: Any) -> Scene:
-    """A generated house: rooms with walls, doors and furniture (see ``floorplans.rooms``)."""
-    return _generated("rooms", floorplans.rooms(seed, **kwargs), seed, resolution, kwargs)
-
-
-def maze(seed: int | None = None, resolution: float = 0.1, **kwargs: Any) -> Scene:
-    """A generated maze of corridors (see ``floorplans.maze``)."""
-    return _generated("maze", floorplans.maze(seed, **kwargs), seed, resolution, kwargs)
-
-
-def clutter(seed: int | None = None, resolution: float = 0.1, **kwargs: Any) -> Scene:
-    """A generated open space cluttered with obstacles (see ``floorplans.clutter``)."""
-    return _generated("clutter", floorplans.clutter(seed, **kwargs), seed, resolution, kwargs)
-
-
-def _generated(name: str, plan: FloorPlan, seed: Any, resolution: float, kwargs: dict[str, Any]) -> Scene:
-    """The generator's scene; with a seed and the defaults, named as datasets name it
-    (``<name>:<seed>``, what ``load_scene`` builds), so that its episodes are checked."""
-    plain = isinstance(seed, (int, np.integer)) and not isinstance(seed, bool) and resolution == 0.1 and not kwargs
-    scene_id = f"{name}:{int(seed)}" if plain else None
-    return Scene.from_polygons(plan.outline, plan.obstacles, resolution=resolution, scene_id=scene_id)
-
-
 def _cells_of(tmap: TraversableMap, radius: float, label: int, ref: NDArray[np.float64], max_distance: float | None) -> NDArray[np.intp]:
     """Flat indices (row-major) of the cells of component ``label``, with centres within
     ``max_distance`` (m) of ``ref`` if given."""
@@ -513,3 +488,8 @@ def _cells_of(tmap: TraversableMap, radius: float, label: int, ref: NDArray[np.f
         return flat
     near = np.hypot(xy[:, 0] - ref[0], xy[:, 1] - ref[1]) <= max_distance
     return flat[near]
+
+
+# The generators name their scenes as datasets do (a module of their own, imported last:
+# they build Scenes).
+from pointnav_core.generated_scenes import clutter, maze, rooms
