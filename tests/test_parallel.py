@@ -529,10 +529,11 @@ def test_bad_arguments_fail_at_construction_naming_the_parameter(kwargs, match):
         parallel.parallel_env(**kwargs)
 
 
-def test_goals_of_point_robots_without_tolerance_are_still_a_cell_apart():
+def test_goals_of_point_robots_with_next_to_no_tolerance_are_still_a_cell_apart():
+    # A tolerance of 0 is refused (no episode could succeed); 1 mm is next to none.
     tasks = [
-        {"goal_tolerance": 0.0, "goal_pos": (1.0, 1.0)},
-        {"goal_tolerance": 0.0, "goal_pos": (1.05, 1.0)},
+        {"goal_tolerance": 0.001, "goal_pos": (1.0, 1.0)},
+        {"goal_tolerance": 0.001, "goal_pos": (1.05, 1.0)},
     ]
     with pytest.raises(ValueError, match=r"goals must be distinct.* = 0\.1 m apart"):
         parallel.parallel_env(scene=small_scene(), n_robots=2, robot={"radius": 0.0}, task=tasks)

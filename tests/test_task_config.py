@@ -44,7 +44,7 @@ def test_positions_and_the_quaternion_are_normalised():
         ("floor", -1, "^floor must be an integer >= 0"),
         ("initial_pos", "12", "^initial_pos must be None or a finite position"),
         ("initial_quat", [0, 0, 0, 2], "^initial_quat must be a unit quaternion"),
-        ("goal_tolerance", True, "^goal_tolerance must be a finite number >= 0"),
+        ("goal_tolerance", True, "^goal_tolerance must be a finite number > 0"),
         ("goal_in_polar", 1, "^goal_in_polar must be True or False"),
         ("path_range", "12", "^path_range must be None or \\(min, max\\)"),
         ("path_range", (3.0, 1.0), "^path_range must be \\(min, max\\) with 0 <= min < max"),

@@ -60,7 +60,7 @@ def _run(env: VectorPointNavEnv, actions: np.ndarray, refresh_at: int | None = N
             env.refresh_pool(wait=wait)
             if not wait:  # the build runs beside the steps; here it is ready by the next one
                 assert env._refresh is not None
-                env._refresh._future.result()
+                env._refresh.wait()
         obs, reward, terminated, truncated, info = env.step(env.arrays.asarray(act))
         rows.append((
             to_np(obs), to_np(reward), to_np(terminated | truncated), to_np(info["geodesic_dist"]),
@@ -72,7 +72,7 @@ def _run(env: VectorPointNavEnv, actions: np.ndarray, refresh_at: int | None = N
 @pytest.mark.parametrize("device", DEVICES)
 @pytest.mark.parametrize("wait", [True, False])
 def test_a_refresh_keeps_running_episodes_and_draws_new_ones_after(device: str, wait: bool) -> None:
-    make = lambda: VectorPointNavEnv(  # noqa: E731
+    make = lambda: VectorPointNavEnv(
         6, scene=walled_room(), device=device, seed=1, pool_size=3,
         task={"termination_config": {"max_steps": 12}, "reward_type": "geodesic"},
     )

@@ -354,12 +354,7 @@ def check_action(
     if not (type(action) is np.ndarray and action.shape == shape and action.dtype.kind == "f"):
         # Real numbers only: no strings ("1"), bools or complex values.
         raw = action
-        real = (
-            raw.dtype.kind in "iuf"
-            if isinstance(raw, np.ndarray)
-            else isinstance(raw, (list, tuple)) and all(validation.is_real(v) for v in raw)
-        )
-        if not real:
+        if not isinstance(raw, (np.ndarray, list, tuple)) or not validation.is_real_array(raw):
             raise ValueError(
                 f"{name} must be an array of {shape[0]} real numbers in [-1, 1], got {raw!r}"
             )

@@ -120,6 +120,10 @@ class Scene:
     floor_plans : sequence of FloorPlan or None, optional
         Accepted for compatibility: a floor's plan is its map's ``geometry`` (give it to
         :class:`TraversableMap`), so an entry must be None or that same plan.
+    scene_id : str, optional
+        The name datasets give this scene (``rooms:0``, a path), set by
+        :func:`pointnav_core.datasets.load_scene` and the generators (``rooms`` ...). Every
+        env refuses a dataset episode of another ``scene_id``; None checks nothing.
 
     Examples
     --------
@@ -138,6 +142,7 @@ class Scene:
         num_waypoints: int = 10,
         waypoint_spacing: float = 0.2,
         floor_plans: Sequence[FloorPlan | None] | None = None,
+        scene_id: str | None = None,
     ) -> None:
         floors = list(floors)
         if not floors or not all(isinstance(f, TraversableMap) for f in floors):
@@ -158,6 +163,9 @@ class Scene:
                         f"floor_plans[{i}] is not floor {i}'s geometry: a floor's plan lives on "
                         f"its map, TraversableMap(..., geometry=plan)"
                     )
+        if scene_id is not None and (not isinstance(scene_id, str) or not scene_id):
+            raise ValueError(f"scene_id must be None or a non-empty string, got {scene_id!r}")
+        self.scene_id = scene_id
         self.floors = floors
         self.num_waypoints = int(num_waypoints)
         self.waypoint_spacing = float(waypoint_spacing)
@@ -472,24 +480,6 @@ class Scene:
         return f"Scene(n_floors={self.n_floors}, floors={self.floors!r})"
 
 
-def rooms(seed: int | None = None, resolution: float = 0.1, **kwargs: Any) -> Scene:
-    """A generated house: rooms with walls, doors and furniture (see ``floorplans.rooms``)."""
-    plan = floorplans.rooms(seed, **kwargs)
-    return Scene.from_polygons(plan.outline, plan.obstacles, resolution=resolution)
-
-
-def maze(seed: int | None = None, resolution: float = 0.1, **kwargs: Any) -> Scene:
-    """A generated maze of corridors (see ``floorplans.maze``)."""
-    plan = floorplans.maze(seed, **kwargs)
-    return Scene.from_polygons(plan.outline, plan.obstacles, resolution=resolution)
-
-
-def clutter(seed: int | None = None, resolution: float = 0.1, **kwargs: Any) -> Scene:
-    """A generated open space cluttered with obstacles (see ``floorplans.clutter``)."""
-    plan = floorplans.clutter(seed, **kwargs)
-    return Scene.from_polygons(plan.outline, plan.obstacles, resolution=resolution)
-
-
 def _cells_of(tmap: TraversableMap, radius: float, label: int, ref: NDArray[np.float64], max_distance: float | None) -> NDArray[np.intp]:
     """Flat indices (row-major) of the cells of component ``label``, with centres within
     ``max_distance`` (m) of ``ref`` if given."""
@@ -498,3 +488,8 @@ def _cells_of(tmap: TraversableMap, radius: float, label: int, ref: NDArray[np.f
         return flat
     near = np.hypot(xy[:, 0] - ref[0], xy[:, 1] - ref[1]) <= max_distance
     return flat[near]
+
+
+# The generators name their scenes as datasets do (a module of their own, imported last:
+# they build Scenes).
+from pointnav_core.generated_scenes import clutter, maze, rooms

@@ -209,7 +209,7 @@ class TaskConfig:
         set_(self, "initial_pos", _check_position("initial_pos", self.initial_pos))
         set_(self, "initial_quat", _check_quat("initial_quat", self.initial_quat))
         set_(self, "goal_pos", _check_position("goal_pos", self.goal_pos))
-        set_(self, "goal_tolerance", _check_length("goal_tolerance", self.goal_tolerance))
+        set_(self, "goal_tolerance", validation.goal_tolerance("goal_tolerance", self.goal_tolerance))
         set_(self, "goal_in_polar", validation.boolean("goal_in_polar", self.goal_in_polar))
         set_(self, "path_range", _check_path_range(self.path_range))
         set_(self, "visualize_goal", validation.boolean("visualize_goal", self.visualize_goal))

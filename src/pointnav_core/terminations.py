@@ -249,7 +249,7 @@ class PointGoal(TerminationCondition):
 
     def __init__(self, goal_tolerance: float = 0.5) -> None:
         super().__init__()
-        self.goal_tolerance = _check_length("goal_tolerance", goal_tolerance)
+        self.goal_tolerance = validation.goal_tolerance("goal_tolerance", goal_tolerance)
 
     def step(self, task: Any, env: Any, action: Any) -> tuple[bool, bool]:
         x, y, _ = task.robot_xyz

@@ -32,7 +32,10 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-__all__ = ["MAX_CELLS", "boolean", "cell_budget", "integer", "is_real", "known_keys", "real", "vector"]
+__all__ = [
+    "MAX_CELLS", "boolean", "cell_budget", "goal_tolerance", "integer", "is_real", "is_real_array",
+    "known_keys", "real", "vector",
+]
 
 _REAL_KINDS = "biuf"  # numpy dtype kinds that hold real numbers (b: refused below)
 
@@ -47,6 +50,27 @@ def is_real(value: Any) -> bool:
     if isinstance(value, (bool, np.bool_)):
         return False
     return isinstance(value, (int, float, np.integer, np.floating))
+
+
+def is_real_array(value: Any) -> bool:
+    """Whether ``value`` holds real numbers only, whatever its shape: a numpy array of an
+    integer or floating dtype, a torch tensor of one (checked without importing torch), or
+    a list or tuple (nested or not) of real numbers (:func:`is_real`) and such arrays.
+    Booleans, complex numbers, strings and objects are not real numbers.
+
+    >>> is_real_array([[0.5, 1], [np.float32(0.2), -1]]), is_real_array(np.array([1.0, 0.0]))
+    (True, True)
+    >>> is_real_array([0.5, True]), is_real_array(np.array([1 + 1j, 0])), is_real_array("12")
+    (False, False, False)
+    """
+    if isinstance(value, (list, tuple)):
+        return all(is_real(v) or is_real_array(v) for v in value)
+    if isinstance(value, np.ndarray):
+        return value.dtype.kind in "iuf"
+    dtype = getattr(value, "dtype", None)
+    if type(value).__module__.split(".")[0] == "torch" and dtype is not None:
+        return not dtype.is_complex and str(dtype) != "torch.bool"
+    return False
 
 
 def _bound(minimum: float | None, strict: bool, maximum: float | None) -> str:
@@ -94,6 +118,20 @@ def real(
         suffix = f" ({unit})" if unit else ""
         raise ValueError(f"{name} must be {kind}{_bound(minimum, strict, maximum)}{suffix}, got {value!r}")
     return number
+
+
+def goal_tolerance(name: str, value: Any) -> float:
+    """A success radius (m) as a float: finite and > 0, or a ValueError naming ``name``.
+
+    Zero is refused: success is a distance *below* the radius, so at 0 m no episode could
+    ever succeed, and every one would silently run to its step limit.
+
+    >>> goal_tolerance("goal_tolerance", 0)
+    Traceback (most recent call last):
+    ...
+    ValueError: goal_tolerance must be a finite number > 0 (m), got 0
+    """
+    return real(name, value, minimum=0.0, strict=True, unit="m")
 
 
 def integer(name: str, value: Any, *, minimum: int | None = None) -> int:

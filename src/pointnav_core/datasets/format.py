@@ -251,6 +251,8 @@ def _episode_from_json(raw: Any, index: int, source: str, frame: str) -> PointNa
     radius = goals[0].get("radius")
     if radius is not None:
         radius = _number(where, goals[0], "radius", "goals[0].radius", minimum=0.0)
+        if radius == 0.0:  # success is a distance below the radius: none at 0 m
+            raise where.error("goals[0].radius", "a finite number > 0 or null", radius)
     info = raw.get("info")
     if not isinstance(info, Mapping):
         raise where.error("info", "an object with geodesic_distance, floor and robot_radius", info)

@@ -30,6 +30,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from pointnav_core import validation
 from pointnav_core.datasets.format import EpisodeDataset, PointNavEpisode
 from pointnav_core.datasets.scene_sets import SceneSet, load_scene
 from pointnav_core.errors import SamplingError
@@ -151,7 +152,7 @@ class GeneratorConfig:
         number("island_radius_limit", self.island_radius_limit, 0.0)
         number("robot_radius", self.robot_radius, 0.0)
         if self.goal_radius is not None:
-            number("goal_radius", self.goal_radius, 0.0)
+            validation.goal_tolerance("goal_radius", self.goal_radius)
         for name in ("retries_per_goal", "max_goals_per_episode"):
             value = getattr(self, name)
             if isinstance(value, bool) or not isinstance(value, int) or value < 1:

@@ -121,12 +121,19 @@ def episode_poses(
     Raises
     ------
     ValueError
-        Naming the episode and the field (``info.floor``, ``start_position``,
-        ``goals[0].position``) that does not suit the env.
+        Naming the episode and the field (``scene_id``: not the scene's own
+        :attr:`~pointnav_core.scenes.Scene.scene_id`, when it has one; ``info.floor``,
+        ``start_position``, ``goals[0].position``) that does not suit the env.
     """
     if not isinstance(episode, PointNavEpisode):
         raise ValueError(f"episode must be a PointNavEpisode, got {episode!r}")
     name = f"episode {episode.episode_id!r} (scene {episode.scene_id!r})"
+    here = getattr(scene, "scene_id", None)
+    if here is not None and episode.scene_id != here:  # another house: its geodesics mean nothing here
+        raise ValueError(
+            f"{name}: field 'scene_id' is {episode.scene_id!r}, but the env's scene is {here!r}; "
+            "play it on an env of its own scene (datasets.load_scene)"
+        )
     if episode.floor != floor:
         raise ValueError(
             f"{name}: field 'info.floor' is {episode.floor}, but robot {robot_idn}'s task navigates "
@@ -142,6 +149,8 @@ def episode_poses(
         ("start_position", episode.start_position),
         ("goals[0].position", episode.goal_position),
     ):
+        if not all(math.isfinite(v) for v in xyz):
+            raise ValueError(f"{name}: field '{field_name}' must be 3 finite numbers (m), got {list(xyz)}")
         if abs(xyz[2] - height) > _HEIGHT_TOL:
             raise ValueError(
                 f"{name}: field '{field_name}' has z = {xyz[2]} m, but floor {floor} is at {height} m"
@@ -152,6 +161,11 @@ def episode_poses(
                 f"(radius {radius} m) on floor {floor}: off the map, on an obstacle or void, or closer "
                 f"than the radius to one (the episode was made for radius {episode.robot_radius} m)"
             )
-    qx, qy, qz, qw = episode.start_rotation
-    norm = math.sqrt(qz * qz + qw * qw)
+    _, _, qz, qw = episode.start_rotation
+    norm = math.hypot(qz, qw)
+    if not (math.isfinite(norm) and norm > 0.0):  # a NaN yaw would reach every observation
+        raise ValueError(
+            f"{name}: field 'start_rotation' must be a finite yaw quaternion "
+            f"(0, 0, sin(yaw/2), cos(yaw/2)), got {list(episode.start_rotation)}"
+        )
     return episode.start_xy, (0.0, 0.0, qz / norm, qw / norm), episode.goal_xy

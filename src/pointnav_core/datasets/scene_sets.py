@@ -230,7 +230,13 @@ def load_scene(scene_id: str, root: str | os.PathLike[str] | None = None) -> Sce
         For a path that does not exist.
     """
     key = (scene_id, None if root is None else os.fspath(root))
-    return _CACHE.get_or_create(key, lambda: _build(scene_id, root))
+    return _CACHE.get_or_create(key, lambda: _named(_build(scene_id, root), scene_id))
+
+
+def _named(scene: Scene, scene_id: str) -> Scene:
+    # The envs check a dataset episode's scene_id against it (datasets.playback).
+    scene.scene_id = scene_id
+    return scene
 
 
 _FORMS = (

@@ -24,7 +24,7 @@ from pointnav_core.vector.contacts import advance
 from pointnav_core.vector.accounting import task_step
 from pointnav_core.vector.discrete import MOVED, DiscretePlan
 from pointnav_core.vector.drive import MAX_TURN, arc, body_command, sub_steps, substep_drive, travel
-from pointnav_core.vector.episodes import EpisodePool
+from pointnav_core.vector.episodes import EpisodePool, fixed_pose
 from pointnav_core.vector.falls import apply_falls
 from pointnav_core.vector.floors import FloorTables
 from pointnav_core.vector.local_map import VectorLocalMap, local_map_term
@@ -58,6 +58,14 @@ def _scene_list(scene: scenes.Scene | Sequence[scenes.Scene] | None) -> list[sce
     if not scene_list or not all(isinstance(s, scenes.Scene) for s in scene_list):
         raise ValueError(f"scene must be a Scene or a non-empty sequence of Scenes, got {scene!r}")
     return scene_list
+
+
+def check_real_actions(actions: Any) -> None:
+    """ValueError naming ``actions`` unless they are real numbers (both engines; the single
+    env's rule, :func:`pointnav_core.validation.is_real_array`: no bools, complex numbers or strings)."""
+    if not validation.is_real_array(actions):
+        kind = getattr(actions, "dtype", type(actions).__name__)
+        raise ValueError(f"actions must be real numbers in [-1, 1] (an integer or float array), got {kind}")
 
 
 class VectorPointNavEnv(PoolRefreshing, VectorEnv):
@@ -342,7 +350,9 @@ class VectorPointNavEnv(PoolRefreshing, VectorEnv):
     def reset(self, *, seed: int | None = None, options: dict[str, Any] | None = None) -> tuple[Any, dict[str, Any]]:
         """Reset every world. ``options={"episodes": [(start_xy, yaw, goal_xy), ...]}`` (one per
         world, yaw in rad) fixes each world's episode, at this reset and every autoreset, until a
-        reset without it; a new ``seed`` redraws the pools."""
+        reset without it; an entry may also be a dataset episode (``PointNavEpisode``), checked
+        as the single env checks it (its ``scene_id`` against the world's scene's, its floor,
+        start and goal). A new ``seed`` redraws the pools."""
         self._reset_pools(seed, options)
         a = self.arrays
         with np.errstate(invalid="ignore", divide="ignore"):
@@ -378,12 +388,8 @@ class VectorPointNavEnv(PoolRefreshing, VectorEnv):
 
     def _fixed_episode(self, i: int, episode: Any, s: int) -> tuple[Any, float, Any, int]:
         """World ``i``'s given episode on scene ``s``, checked; ValueError naming it."""
-        start, yaw, goal = episode
         env = self._samplers[s]
-        for name, xy in (("start", start), ("goal", goal)):
-            if not env.scene.is_usable(env.task.floor, xy, self.robot):
-                raise ValueError(f"options['episodes'][{i}]: {name} {list(xy)} is not usable by the robot")
-        return start, float(yaw), goal, s
+        return (*fixed_pose(f"options['episodes'][{i}]", episode, env.scene, env.task.floor, self.robot), s)
 
     def _reset_worlds(self, mask: Any) -> None:
         a, xp, st = self.arrays, self.arrays.xp, self._state
@@ -429,6 +435,7 @@ class VectorPointNavEnv(PoolRefreshing, VectorEnv):
             raise ValueError(
                 f"actions must have shape ({n}, {dim}) or ({n}, 1, {dim}) for a {self.robot.drive} drive, got {shape}"
             )
+        check_real_actions(actions)
         arr = a.asarray(actions).reshape(n, dim)
         if not bool(a.xp.isfinite(arr).all()):
             raise ValueError("actions must be finite (no NaN or infinity)")

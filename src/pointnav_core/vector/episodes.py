@@ -19,10 +19,52 @@ from typing import Any
 
 import numpy as np
 
+from pointnav_core import validation
 from pointnav_core.vector.fields import FieldTables
 from pointnav_core.vector.xp import Arrays
 
-__all__ = ["EpisodePool"]
+__all__ = ["EpisodePool", "fixed_pose"]
+
+
+def fixed_pose(where: str, episode: Any, scene: Any, floor: int, robot: Any) -> tuple[Any, float, Any]:
+    """One robot's fixed episode for the batched engines, checked as the single env checks it.
+
+    Parameters
+    ----------
+    where : str
+        Names the episode in errors (``options['episodes'][i]``).
+    episode : (start_xy, yaw, goal_xy) or PointNavEpisode
+        A start and goal (m) and a finite yaw (rad), or a dataset episode: then its
+        ``scene_id``, floor, heights, start and goal are checked against ``scene`` by
+        :func:`~pointnav_core.datasets.playback.episode_poses`, as the single env does.
+    scene, floor, robot
+        The world's scene, the task's floor and the robot (its radius).
+
+    Returns
+    -------
+    (start_xy, yaw, goal_xy)
+
+    Raises
+    ------
+    ValueError
+        Naming ``where`` (or the dataset episode) and what is wrong.
+    """
+    from pointnav_core.datasets.format import PointNavEpisode
+    from pointnav_core.datasets.playback import episode_poses
+
+    if isinstance(episode, PointNavEpisode):
+        start, quat, goal = episode_poses(episode, scene, floor, robot)
+        return start, 2.0 * math.atan2(quat[2], quat[3]), goal
+    try:
+        start, yaw, goal = episode
+    except (TypeError, ValueError):
+        raise ValueError(f"{where} must be a (start_xy, yaw, goal_xy) tuple or a PointNavEpisode, got {episode!r}") from None
+    yaw = validation.real(f"{where}: yaw", yaw, unit="rad")
+    for name, xy in (("start", start), ("goal", goal)):
+        point = validation.vector(f"{where}: {name}", xy, sizes=(2, 3))[:2]
+        if not scene.is_usable(floor, point, robot):
+            raise ValueError(f"{where}: {name} {list(xy)} is not usable by the robot")
+    return start, yaw, goal
 
 
 class EpisodePool:

@@ -32,7 +32,7 @@ from pointnav_core.vector.accounting import task_step
 from pointnav_core.vector.contacts_jit import advance_compiled
 from pointnav_core.vector.discrete import MOVED, DiscretePlan
 from pointnav_core.vector.drive import arc, body_command, sub_steps, substep_drive, travel
-from pointnav_core.vector.env import VectorPointNavEnv, _scene_list
+from pointnav_core.vector.env import VectorPointNavEnv, _scene_list, check_real_actions
 from pointnav_core.vector.falls import apply_falls
 from pointnav_core.vector.fleet_pool import FleetPool, check_fixed_episode
 from pointnav_core.vector.floors import FloorTables
@@ -199,6 +199,7 @@ class VectorFleetEnv(VectorPointNavEnv):
         want = (self.num_envs, self.n_robots, self.robot.action_dim)
         if shape != want:
             raise ValueError(f"actions must have shape {want} for a {self.robot.drive} drive, got {shape}")
+        check_real_actions(actions)
         arr = self.arrays.asarray(actions)
         if not bool(self.arrays.xp.isfinite(arr).all()):
             raise ValueError("actions must be finite (no NaN or infinity)")

@@ -21,6 +21,7 @@ from typing import Any
 
 import numpy as np
 
+from pointnav_core.vector.episodes import fixed_pose
 from pointnav_core.vector.fields import FieldTables
 from pointnav_core.vector.xp import Arrays
 
@@ -38,18 +39,13 @@ def check_fixed_episode(sampler: Any, episode: Sequence[FleetEpisode], where: st
     """
     n = len(sampler.tasks)
     try:
-        robots = [(start, float(yaw), goal) for start, yaw, goal in episode]
-    except (TypeError, ValueError):
-        raise ValueError(f"{where} must hold {n} (start_xy, yaw, goal_xy) tuples, got {episode!r}") from None
-    if len(robots) != n:
-        raise ValueError(f"{where} must hold one (start_xy, yaw, goal_xy) per robot ({n}), got {len(robots)}")
+        entries = list(episode)
+    except TypeError:
+        raise ValueError(f"{where} must hold {n} (start_xy, yaw, goal_xy) tuples or PointNavEpisodes, got {episode!r}") from None
+    if len(entries) != n:
+        raise ValueError(f"{where} must hold one (start_xy, yaw, goal_xy) per robot ({n}), got {len(entries)}")
     scene, floor, specs = sampler.scene, sampler.tasks[0].floor, sampler.robots
-    for r, (start, yaw, goal) in enumerate(robots):
-        if not math.isfinite(yaw):
-            raise ValueError(f"{where}[{r}]: yaw must be finite, got {yaw}")
-        for name, xy in (("start", start), ("goal", goal)):
-            if not scene.is_usable(floor, xy, specs[r]):
-                raise ValueError(f"{where}[{r}]: {name} {list(xy)} is not usable by the robot")
+    robots = [fixed_pose(f"{where}[{r}]", entry, scene, floor, specs[r]) for r, entry in enumerate(entries)]
     sep = sampler._separation
     for i in range(n):
         for j in range(i + 1, n):

@@ -9,30 +9,38 @@ it in at the start of a step once it is ready, with :func:`join_pools`: the new 
 come first, so autoresets draw from them only, and the old ones after, so that the worlds
 still in an old episode keep its goal field (their field index shifted by the new pool's
 length). When no world is left in an old episode, the env keeps the new pool alone.
+
+The worker (:mod:`~pointnav_core.vector.refresh_worker`) may fail: its build raises, or it
+is killed while building or idle. The env then warns once (:class:`PoolRefreshWarning`,
+with the cause), keeps its pool, and starts a new worker at the next refresh if the old one
+died. Copies and pickles of the env leave the worker, and a pending refresh, behind.
 """
 
 from __future__ import annotations
 
 import copy
 import functools
-import multiprocessing
+import warnings
 from collections.abc import Sequence
-from concurrent.futures import Executor, ProcessPoolExecutor
-from concurrent.futures.process import BrokenProcessPool
 from typing import Any
 
 from pointnav_core.vector.fields import FieldTables
+from pointnav_core.vector.refresh_worker import RefreshWorker
 from pointnav_core.vector.xp import Arrays, make_arrays
 
-__all__ = ["PoolRefresh", "PoolRefreshing", "build_pool", "join_pools", "pool_to", "refresh_executor"]
+__all__ = ["PoolRefresh", "PoolRefreshWarning", "PoolRefreshing", "build_pool", "join_pools", "pool_to"]
 
 # The per-episode arrays of both pool kinds (FleetPool's have a robot axis).
 _EPISODE_ARRAYS = ("sx", "sy", "syaw", "gx", "gy", "d0", "scene")
 
 
-def refresh_executor() -> Executor:
-    """One worker process, started fresh (``spawn``: safe beside torch and CUDA)."""
-    return ProcessPoolExecutor(max_workers=1, mp_context=multiprocessing.get_context("spawn"))
+class PoolRefreshWarning(RuntimeWarning):
+    """A background pool refresh failed (its build raised, or its worker died): the worlds
+    go on with the episodes they have, and the next ``refresh_pool`` tries again."""
+
+
+class RefreshFailed(Exception):
+    """Why a background build gave no pool (internal: the env turns it into a warning)."""
 
 
 def build_pool(kind: type, samplers: Sequence[Any], pool_size: int, seeds: Sequence[int]) -> Any:
@@ -41,12 +49,12 @@ def build_pool(kind: type, samplers: Sequence[Any], pool_size: int, seeds: Seque
 
 
 class PoolRefresh:
-    """A pool of ``kind`` being built by ``executor`` from ``samplers`` and ``seeds``.
+    """A pool of ``kind`` being built by ``worker`` from ``samplers`` and ``seeds``.
 
     Parameters
     ----------
-    executor : Executor
-        Runs :func:`build_pool` (a process pool from :func:`refresh_executor`).
+    worker : RefreshWorker
+        Runs :func:`build_pool`.
     kind : type
         The pool class, called as ``kind(samplers, pool_size, seeds, arrays)``.
     samplers, pool_size, seeds
@@ -55,27 +63,40 @@ class PoolRefresh:
         The env's device, where :meth:`result` puts the pool.
     """
 
-    def __init__(self, executor: Executor, kind: type, samplers: Sequence[Any], pool_size: int,
+    def __init__(self, worker: RefreshWorker, kind: type, samplers: Sequence[Any], pool_size: int,
                  seeds: Sequence[int], arrays: Arrays) -> None:
-        self._future = executor.submit(build_pool, kind, list(samplers), pool_size, list(map(int, seeds)))
+        worker.submit(build_pool, kind, list(samplers), pool_size, list(map(int, seeds)))
+        self.worker = worker
         self._arrays = arrays
+        self._outcome: tuple[str, Any] | None = None
 
     def done(self) -> bool:
-        """Whether the build has finished (successfully or not)."""
-        return self._future.done()
+        """Whether the build has finished (successfully or not), or its worker died."""
+        if self._outcome is None:
+            self._outcome = self.worker.answer(0.0)
+        return self._outcome is not None
+
+    def wait(self, timeout: float | None = None) -> bool:
+        """Wait until :meth:`done`, at most ``timeout`` s (None: no limit); whether it is."""
+        if self._outcome is None:
+            self._outcome = self.worker.answer(timeout)
+        return self._outcome is not None
 
     def result(self) -> Any:
-        """The new pool on the env's device, waiting for the build if needed; re-raises
-        the build's error."""
-        try:
-            pool = self._future.result()
-        except BrokenProcessPool as error:
-            raise RuntimeError(
-                "the pool refresh's worker process died; a script that starts one must guard its "
-                "entry point with `if __name__ == '__main__':` (the worker is spawned and imports "
-                "it), as for any spawned process, or call refresh_pool(wait=True)"
-            ) from error
-        return pool_to(pool, self._arrays)
+        """The new pool on the env's device, waiting for the build if needed.
+
+        Raises
+        ------
+        RefreshFailed
+            With the cause, if the build raised or the worker died.
+        """
+        self.wait()
+        kind, value = self._outcome
+        if kind == "done":
+            return pool_to(value, self._arrays)
+        if kind == "failed":
+            raise RefreshFailed(f"the pool refresh's build failed in its worker process: {value}")
+        raise RefreshFailed(value)
 
 
 def pool_to(pool: Any, arrays: Arrays) -> Any:
@@ -122,7 +143,7 @@ class PoolRefreshing:
     # The pending build and its worker, the new pool while older episodes are still run,
     # and the field index from which they start.
     _refresh: PoolRefresh | None = None
-    _executor: Executor | None = None
+    _worker: RefreshWorker | None = None
     _fresh: Any = None
     _old_from: int | None = None
 
@@ -136,6 +157,11 @@ class PoolRefreshing:
         built here and swapped in before returning: between batches, and reproducibly (the
         seeds come from the env's generator either way, and give the same pool, but in the
         background the step of the swap depends on the machine).
+
+        A background refresh that fails (its build raises, or its worker process dies,
+        while building or idle) is reported once, by a :class:`PoolRefreshWarning` naming
+        the cause, at the step, reset or refresh that finds it; the worlds go on with the
+        episodes they have, and the next refresh starts a new worker if the old one died.
 
         Raises
         ------
@@ -153,9 +179,11 @@ class PoolRefreshing:
         if wait:
             self._swap_pool(self._pool_kind()(self._samplers, self.pool_size, seeds, self.arrays))
             return
-        if self._executor is None:
-            self._executor = refresh_executor()
-        self._refresh = PoolRefresh(self._executor, self._pool_kind(), self._samplers, self.pool_size, seeds, self.arrays)
+        if self._worker is not None and not self._worker.alive():  # died while idle
+            self._report(self._worker.death("while idle") + "; a new one is started")
+        if self._worker is None:
+            self._worker = RefreshWorker()
+        self._refresh = PoolRefresh(self._worker, self._pool_kind(), self._samplers, self.pool_size, seeds, self.arrays)
 
     def _pool_kind(self) -> Any:
         # The pool class with this env's starts per goal (a partial pickles for the worker);
@@ -171,7 +199,25 @@ class PoolRefreshing:
     def _finish_refresh(self) -> None:
         """Swap in a pending refresh, waiting for its build."""
         if self._refresh is not None:
-            self._swap_pool(self._refresh.result())
+            self._take_refresh()
+
+    def _take_refresh(self) -> None:
+        """Swap in the pending refresh's pool, or report why there is none and go on."""
+        refresh, self._refresh = self._refresh, None
+        try:
+            new = refresh.result()
+        except RefreshFailed as failure:
+            if not refresh.worker.alive():
+                self._report(f"{failure}; the next refresh_pool() starts a new worker")
+            else:
+                warnings.warn(f"{failure}; the worlds go on with their current episodes", PoolRefreshWarning, stacklevel=4)
+            return
+        self._swap_pool(new)
+
+    def _report(self, cause: str) -> None:
+        """Warn of a dead worker, once, and let it go (the next refresh starts another)."""
+        self._stop_worker()
+        warnings.warn(f"{cause}; the worlds go on with their current episodes", PoolRefreshWarning, stacklevel=4)
 
     def _swap_pool(self, new: Any) -> None:
         self._refresh = None
@@ -184,16 +230,27 @@ class PoolRefreshing:
     def _poll_pool(self) -> None:
         """At a step's start: swap in a finished refresh; drop old episodes no world is in."""
         if self._refresh is not None and self._refresh.done():
-            self._swap_pool(self._refresh.result())
+            self._take_refresh()
         if self._old_from is not None and not bool((self._field >= self._old_from).any()):
             self.pool, self._fresh, self._old_from = self._fresh, None, None
 
+    def _stop_worker(self) -> None:
+        worker, self._worker, self._refresh = self._worker, None, None
+        if worker is not None:
+            worker.close()
+
     def close_extras(self, **kwargs: Any) -> None:
         """Stop the refresh worker process, if one was started (a pending build is dropped)."""
-        self._refresh = None
-        if self._executor is not None:
-            self._executor.shutdown(wait=True, cancel_futures=True)
-            self._executor = None
+        self._stop_worker()
+
+    def __getstate__(self) -> dict[str, Any]:
+        """The env's state for a copy or a pickle, without the refresh worker: the copy
+        starts its own at its first refresh, and a refresh pending here is the original's
+        alone (the copy goes on with the episodes it has)."""
+        state = self.__dict__.copy()
+        state.pop("_worker", None)
+        state.pop("_refresh", None)
+        return state
 
     @property
     def refresh_active(self) -> bool:
