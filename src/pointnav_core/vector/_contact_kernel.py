@@ -193,19 +193,20 @@ def _resolve(n, px, py, mx, my, left, nwall, wall, pair, ev_k, ev_j, ev_m, rad, 
 
 
 @_jit
-def advance_worlds(x, y, mx, my, slow, scene, radius, meta, table, x_out, y_out, contact):  # pragma: no cover
+def advance_worlds(x, y, mx, my, slow, scene, radius, meta, edge, dr, dc, ok, x_out, y_out, contact):  # pragma: no cover
     """Move the ``slow`` robots of every world by their chords with contacts (the backend's advance).
 
     ``x, y, mx, my`` (W, R) float64 start positions and chords (m); ``slow`` (W, R) the
     robots resolved here (the others neither move nor block: they are out of reach);
     ``radius`` (W, R) float64 each robot's radius (m; two robots touch at the sum);
     ``scene`` (W, R) int64; ``meta`` (S, 7) per scene: flat offset, rows, width, ox, oy,
-    cell size, 1 / cell size; ``table`` the floors' wall table (cells, K) for the longest
-    chord. Writes the slow robots' end positions to ``x_out, y_out`` and their contact flags
+    cell size, 1 / cell size; ``edge`` (all cells) bool the edge obstacle flags;
+    ``dr, dc, ok`` (S, P) per scene the row-major cell stencil of the longest chord
+    (``FloorTables.stencil``). Writes the slow robots' end positions to ``x_out, y_out`` and their contact flags
     to ``contact``.
     """
     n_worlds, n_robots = x.shape
-    n_table = table.shape[1]
+    n_table = dr.shape[1]
     ids = np.empty(n_robots, np.int64)
     rad = np.empty(n_robots)
     px = np.empty(n_robots)
@@ -259,14 +260,14 @@ def advance_worlds(x, y, mx, my, slow, scene, radius, meta, table, x_out, y_out,
             if not (0 <= col < width and 0 <= row < rows):
                 continue
             reach = rad[k] + span[k] + 4.0 * _ACTIVE
-            cell = off + int(row) * width + int(col)
             for j in range(n_table):
-                wid = table[cell, j]
-                if wid < 0:
+                if not ok[s, j]:
                     break
-                local = wid - off
-                wr = local // width
-                wx0 = ox + (local - wr * width) * res
+                wr = int(row) + dr[s, j]
+                wc = int(col) + dc[s, j]
+                if not (0 <= wr < rows and 0 <= wc < width) or not edge[off + wr * width + wc]:
+                    continue
+                wx0 = ox + wc * res
                 wy0 = oy + wr * res
                 if square_distance(px[k], py[k], wx0, wy0, wx0 + res, wy0 + res)[0] <= reach:
                     m = nwall[k]

@@ -60,7 +60,7 @@ def advance_compiled(
         Every robot's radius (m), one for all or each robot's own (two robots touch at the
         sum of their radii).
     max_travel : float
-        The longest chord any step may have (m): the wall table is built for it.
+        The longest chord any step may have (m): the walls are gathered within it.
 
     Returns
     -------
@@ -75,14 +75,15 @@ def advance_compiled(
     x, y = np.ascontiguousarray(view(x), np.float64), np.ascontiguousarray(view(y), np.float64)
     radius = view(radius) if a.is_torch and not isinstance(radius, (int, float)) else radius
     rad = np.ascontiguousarray(np.broadcast_to(np.asarray(radius, np.float64), x.shape))
-    # One wall table for the largest robot: each robot keeps the walls within its own reach.
-    table = floors.wall_table((float(rad.max()) if rad.size else 0.0) + max_travel + _WALL_MARGIN)
+    # One stencil for the largest robot: each robot keeps the walls within its own reach.
+    reach = (float(rad.max()) if rad.size else 0.0) + max_travel + _WALL_MARGIN
+    dr, dc, ok = (np.ascontiguousarray(floors.arrays.numpy(v)) for v in floors.stencil(reach))
     x_out, y_out = x.copy(), y.copy()
     contact = np.zeros(x.shape, np.bool_)
     advance_worlds(
         x, y, np.ascontiguousarray(view(mx), np.float64), np.ascontiguousarray(view(my), np.float64),
         np.ascontiguousarray(view(slow), np.bool_), np.ascontiguousarray(view(scene), np.int64), rad,
-        floors.host_meta, np.ascontiguousarray(view(table), np.int64), x_out, y_out, contact,
+        floors.host_meta, floors.host_edge, dr, dc, ok, x_out, y_out, contact,
     )
     return x_out, y_out, contact
 

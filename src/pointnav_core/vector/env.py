@@ -23,7 +23,7 @@ from pointnav_core.vector import contacts_jit
 from pointnav_core.vector.contacts import advance
 from pointnav_core.vector.accounting import task_step
 from pointnav_core.vector.discrete import MOVED, DiscretePlan
-from pointnav_core.vector.drive import MAX_TURN, arc, body_command, sub_steps, substep_drive, travel
+from pointnav_core.vector.drive import arc, body_command, sub_steps, substep_drive, travel
 from pointnav_core.vector.episodes import EpisodePool
 from pointnav_core.vector.falls import apply_falls
 from pointnav_core.vector.floors import FloorTables
@@ -294,8 +294,8 @@ class VectorPointNavEnv(PoolRefreshing, VectorEnv):
         self.local_map = None if map_term is None else VectorLocalMap(map_term, self.floors)
 
     def _read_task(self, t: Any, action_frequency: float) -> None:
-        """The task's settings the batched step reads (both engines), with the control
-        rate's check: ValueError if one control step needs the backend's sub-steps."""
+        """The task's settings the batched step reads (both engines). Any control rate: a
+        step near something is cut into the backend's sub-steps (:func:`~pointnav_core.vector.drive.sub_steps`)."""
         self.action_frequency = action_frequency
         self.dt = 1.0 / action_frequency
         self.task = t
@@ -306,15 +306,6 @@ class VectorPointNavEnv(PoolRefreshing, VectorEnv):
         self.geodesic_reward = t.reward_type == "geodesic"
         self.goal_in_polar = bool(t.goal_in_polar)
         spec = self.robot
-        # Top speed on one axis: a holonomic robot's diagonal step may travel sqrt(2) times
-        # that, which the backend splits into sub-steps near walls, and so does vector.drive.
-        if spec.max_angular_velocity * self.dt > MAX_TURN or spec.max_linear_velocity * self.dt > 0.5 * min(
-            float(s.floors[t.floor].resolution) for s in self.scenes
-        ):
-            raise ValueError(
-                f"action_frequency {self.action_frequency} Hz is too low for the batched engine: one control "
-                "step may turn at most 0.25 rad and drive at most half a cell (the kinematic backend's sub-step)"
-            )
         self.holonomic = spec.drive == "holonomic"
         # A chord is never longer than its arc (a holonomic one: the diagonal of its two
         # top speeds); the margin covers rounding.
