@@ -276,6 +276,7 @@ class VectorPointNavEnv(PoolRefreshing, VectorEnv):
         """The state arrays of ``shape`` (one entry per world, or per robot), the per-world
         flags and the sensors (both engines)."""
         a = self.arrays
+        contacts_jit.prepare(self.floors)  # not in the first step that meets a wall
         self._fixed: Any = None
         # "fs": the fall speed (m/s), 0 while the robot stands (vector.falls).
         keys = ("x", "y", "yaw", "z", "vx", "vy", "vz", "w", "fs", "gx", "gy", "d0", "pot", "path", "dist")
