@@ -100,15 +100,19 @@ class FieldTables:
             kind_of, label_of = field.settle(None if whole else near[near >= 0])
             kind = np.where(near >= 0, kind_of[np.maximum(near, 0)], 0).astype(np.int64)
             label = np.where(kind == 2, label_of[np.maximum(near, 0)], 0).astype(np.int64)
+            # Only the labels the window's cells name: a search labels every arc node of the
+            # floor's graph (millions on a large map), a window's cells name a few thousand.
+            used = np.unique(label[kind == 2])
+            label = np.where(kind == 2, np.searchsorted(used, label), 0)
             s = field.labels
-            node = np.asarray(s.node, dtype=np.int64)
-            side = np.asarray(s.side, dtype=np.float64)
-            pos = np.asarray(s.pos, dtype=np.float64)
+            node = np.asarray(s.node, dtype=np.int64)[used]
+            side = np.asarray(s.side, dtype=np.float64)[used]
+            pos = np.asarray(s.pos, dtype=np.float64)[used]
             n_lab = len(node)
             ccw = np.where(side > 0, pos, p.span[node] - pos) if n_lab else pos
             ang = p.phi0[node] + ccw if n_lab else pos
             lab_arrays.append(np.stack([
-                np.asarray(s.cost, dtype=np.float64), p.cx[node], p.cy[node], side, p.phi0[node],
+                np.asarray(s.cost, dtype=np.float64)[used], p.cx[node], p.cy[node], side, p.phi0[node],
                 p.span[node], pos, p.cx[node] + p.radius * np.cos(ang), p.cy[node] + p.radius * np.sin(ang),
             ], 1).reshape(n_lab, 9))
             kinds.append(kind)
