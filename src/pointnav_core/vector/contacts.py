@@ -38,6 +38,8 @@ def window(floors: FloorTables, scene: Any, x: Any, y: Any, reach: float) -> tup
     masked out); a robot off the map has none. The squares are those of the cell's
     stencil (:meth:`FloorTables.stencil`), gathered here for the robots that need them.
     """
+    if floors.has_polygons:  # FloorTables lets them in only where the compiled contacts run
+        raise ValueError("the array contacts collide with grid cells only, and a floor has obstacle polygons")
     a = floors.arrays
     xp = a.xp
     dr, dc, ok = floors.stencil(reach)

@@ -95,7 +95,8 @@ def advance_compiled(
     advance_worlds(
         x, y, np.ascontiguousarray(view(mx), np.float64), np.ascontiguousarray(view(my), np.float64),
         np.ascontiguousarray(view(slow), np.bool_), np.ascontiguousarray(view(scene), np.int64), rad,
-        floors.host_meta, floors.host_edge, dr, dc, ok, x_out, y_out, contact,
+        floors.host_meta, floors.host_edge, dr, dc, ok, floors.host_segments, floors.segment_offsets,
+        x_out, y_out, contact,
     )
     return x_out, y_out, contact
 

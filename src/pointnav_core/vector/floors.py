@@ -30,7 +30,9 @@ class FloorTables:
     Parameters
     ----------
     scenes : sequence of Scene
-        Their floor ``floor`` is used; it must have no obstacle polygons (grid cells only).
+        Their floor ``floor`` is used: its cells and the edges of its obstacle polygons
+        (the backend's ``FloorGeometry.edges``), which only the compiled contacts take
+        (on the CPU, with numba).
     floor : int
         The task's floor.
     radius : float
@@ -41,7 +43,8 @@ class FloorTables:
     Raises
     ------
     ValueError
-        Naming ``scene`` when a floor holds obstacle polygons.
+        Naming ``scene`` when a floor holds obstacle polygons and the compiled contacts
+        cannot run (on a GPU, or without numba).
     """
 
     def __init__(self, scenes: Sequence[Any], floor: int, radius: float, arrays: Arrays) -> None:
@@ -50,15 +53,22 @@ class FloorTables:
         codes, edge, meta = [], [], []
         offset = 0
         self.geometries = []
+        from pointnav_core.vector import contacts_jit
+
+        self.arrays = arrays
         self._stencils: dict[float, tuple[Any, Any, Any]] = {}
+        segments, seg_off = [], [0]
         for k, scene in enumerate(scenes):
             tmap = scene.floors[floor]
-            if len(tmap.collision.polygons):
+            if len(tmap.collision.polygons) and not contacts_jit.available(self):
                 raise ValueError(
-                    f"scene {k} has obstacle polygons on floor {floor}; the batched engine "
-                    "collides with grid cells only (build the scene with Scene.from_array)"
+                    f"scene {k} has obstacle polygons on floor {floor}; the batched engine collides with "
+                    "them on the CPU with numba (the fast extra) only: use device='numpy' or 'cpu' with "
+                    "numba installed, or build the scene from the floor's cells (Scene.from_array)"
                 )
             geom = FloorGeometry(tmap, float(scene.get_floor_height(floor)))
+            segments.extend(geom.edges.segments)
+            seg_off.append(len(segments))
             self.geometries.append(geom)
             grid = np.asarray(tmap.codes, dtype=np.uint8)
             codes.append(grid.ravel())
@@ -70,6 +80,12 @@ class FloorTables:
         self.codes = a.asarray(np.concatenate(codes), a.i64)
         #: Per cell of every floor, whether it is an edge obstacle cell (the backend's ``edge``).
         self.host_edge = np.concatenate(edge)
+        #: The polygon edges of every floor, ``(ax, ay, bx, by, ux, uy, length)`` (m), float64
+        #: ``(N, 7)``: scene ``s``'s at rows ``segment_offsets[s]:segment_offsets[s + 1]``.
+        self.host_segments = np.array(segments, dtype=np.float64).reshape(-1, 7)
+        self.segment_offsets = np.array(seg_off, dtype=np.int64)
+        #: Whether any floor has obstacle polygons (only the compiled contacts take them).
+        self.has_polygons = bool(len(segments))
         self.edge = a.asarray(self.host_edge, a.boolean)
         self.offset = a.asarray(m[:, 0], a.i64)
         self.rows = a.asarray(m[:, 1], a.i64)
@@ -154,3 +170,4 @@ def stencil_offsets(reach: float, res: float) -> np.ndarray:
     gap = np.hypot(np.maximum(np.abs(dr) - 1, 0), np.maximum(np.abs(dc) - 1, 0)) * res
     keep = gap <= reach
     return np.column_stack([dr[keep], dc[keep]])
+
