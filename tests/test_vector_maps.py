@@ -12,19 +12,27 @@ take as the backend's capsule walls.
 
 from __future__ import annotations
 
+import importlib.util
+
 import numpy as np
 import pytest
+import shapely
 from fleet_reference import compare_fleet, fleet_episodes
 from map_data import bookstore
-from vector_reference import OBS_TOL, REWARD_TOL, compare, random_actions, random_episodes
-
-import shapely
 from shapely import affinity
+from vector_reference import (
+    OBS_TOL,
+    REWARD_TOL,
+    compare,
+    random_actions,
+    random_episodes,
+)
 
 from pointnav_core import _compiled, scenes
 from pointnav_core.maps import OBSTACLE, VOID
 from pointnav_core.scenes import Scene
 
+ARRAY_DEVICE = "cpu" if importlib.util.find_spec("torch") else "numpy"
 TASK = {"reward_type": "geodesic", "termination_config": {"max_steps": 80, "max_collisions": 30}}
 
 
@@ -42,17 +50,18 @@ def fine_clutter() -> Scene:
     return Scene.from_array(grid, 0.03)
 
 
-@pytest.mark.parametrize("paths", ["compiled", "arrays"])
-@pytest.mark.parametrize("resolution", [0.05, 0.03])
-def test_native_resolution_matches_single_envs(resolution: float, paths: str) -> None:
+@pytest.mark.parametrize(("resolution", "paths", "device"), [
+    (0.05, "compiled", "numpy"), (0.05, "arrays", ARRAY_DEVICE), (0.03, "compiled", "numpy"), (0.03, "arrays", "numpy"),
+])
+def test_native_resolution_matches_single_envs(resolution: float, paths: str, device: str) -> None:
     # A crop of the bookstore (shelves, walls, unknown space as VOID) or the 0.03 m room.
     scene = bookstore(slice(40, 140), slice(44, 184)) if resolution == 0.05 else fine_clutter()
     rng = np.random.default_rng(11)
     episodes = random_episodes(scene, 6, rng)
-    actions = random_actions(rng, (160 if paths == "compiled" else 100, 6))
-    if paths == "arrays":
+    actions = random_actions(rng, (160 if paths == "compiled" else 80, 6))
+    if paths == "arrays":  # the array path, the one a GPU runs (on torch where it is installed)
         with _compiled.numpy_paths():
-            stats = compare(scene, episodes, actions, task=TASK)
+            stats = compare(scene, episodes, actions, task=TASK, device=device)
     else:
         stats = compare(scene, episodes, actions, task=TASK)
     assert stats["obs_diff"] <= OBS_TOL and stats["reward_diff"] <= REWARD_TOL

@@ -113,7 +113,7 @@ def segment_distance(px, py, ax, ay, ux, uy, length):  # pragma: no cover
     # The backend's segment_distance: distance (m) to the segment and the unit normal from
     # its nearest point towards p; on the segment itself, its left normal.
     s = (px - ax) * ux + (py - ay) * uy
-    s = 0.0 if s < 0.0 else length if s > length else s
+    s = 0.0 if s < 0.0 else min(s, length)
     vx = px - (ax + s * ux)
     vy = py - (ay + s * uy)
     dist = math.sqrt(vx * vx + vy * vy)
