@@ -78,8 +78,10 @@ class VectorPointNavEnv(PoolRefreshing, VectorEnv):
         default 500) and ``finished`` (``"park"``, the default, or ``"remove"``), as
         :func:`pointnav_core.parallel.parallel_env` does.
     scene : Scene or sequence of Scene, optional
-        World ``i`` runs on ``scene[i % len(scene)]``. Floors must be grid cells only (no
-        obstacle polygons). Default: the single env's default house as a grid.
+        World ``i`` runs on ``scene[i % len(scene)]``, at its own resolution. Floors with
+        obstacle polygons (floor plans, the generated houses) need the compiled contacts
+        (the CPU with numba) and no scan sensor. Default: the single env's default house
+        as a grid.
     robot : RobotSpec or dict, optional
         As for the single env: a differential drive (actions ``(v, w)``) or a holonomic one
         (actions ``(vx, vy, w)`` in the robot frame, +x ahead, +y to the left), scaled and
