@@ -50,11 +50,11 @@ class FloorTables:
     def __init__(self, scenes: Sequence[Any], floor: int, radius: float, arrays: Arrays) -> None:
         from pointnav_kinematic.geometry import FloorGeometry
 
+        from pointnav_core.vector import contacts_jit  # it imports this module
+
         codes, edge, meta = [], [], []
         offset = 0
         self.geometries = []
-        from pointnav_core.vector import contacts_jit
-
         self.arrays = arrays
         self._stencils: dict[float, tuple[Any, Any, Any]] = {}
         segments, seg_off = [], [0]
