@@ -80,3 +80,26 @@ def test_the_engines_reach_is_steps_times_the_longest_chord() -> None:
     fleet = VectorPointNavEnv(2, n_robots=2, scene=scene, seed=0, pool_size=1, max_cycles=10,
                               task={"termination_config": {"max_steps": 40}})
     assert fleet._reach == pytest.approx(10 * 0.05, rel=1e-8)  # max_cycles comes first
+
+
+def test_tables_keep_only_the_labels_their_window_names() -> None:
+    # A goal's search labels every arc node of the floor's graph; a window of 13 x 13 cells
+    # names a few of them, and its tables keep those (plus the one spare row).
+    field = long_hall().goal_field(0, (1.0, 1.0), robot=RobotSpec()).field
+    tables = FieldTables([field], make_arrays("numpy"), [np.array([[1.0, 1.0]])], 0.5)
+    kind, label = tables.kind, tables.label
+    named = len(set(label[kind == 2].tolist()))
+    assert tables.cost.shape[0] == named + 1 < len(field.labels.node)
+
+
+def test_field_tables_fit_their_byte_budget(monkeypatch: pytest.MonkeyPatch) -> None:
+    # The window of (1, 1) m within 0.5 m is 13 x 13 cells (test_reach_window_by_hand): 16
+    # bytes each is 2,704 bytes. One byte less is refused before any settling.
+    from pointnav_core.vector import fields
+
+    field = long_hall().goal_field(0, (1.0, 1.0), robot=RobotSpec()).field
+    monkeypatch.setattr(fields, "FIELD_TABLE_BYTES", 13 * 13 * 16)
+    FieldTables([field], make_arrays("numpy"), [np.array([[1.0, 1.0]])], 0.5)
+    monkeypatch.setattr(fields, "FIELD_TABLE_BYTES", 13 * 13 * 16 - 1)
+    with pytest.raises(ValueError, match=r"169 cells .* FIELD_TABLE_BYTES .* lower pool_size or max_episode_steps"):
+        FieldTables([field], make_arrays("numpy"), [np.array([[1.0, 1.0]])], 0.5)

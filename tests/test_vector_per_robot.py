@@ -107,7 +107,6 @@ def two_floors() -> Scene:
     ({"robot": [{}]}, r"^robot must be one value for all robots or a list .*got a list of 1"),
     ({"robot": [{}, "fast"]}, r"^robot\[1\] must be a RobotSpec"),
     ({"robot": [{}, {"drive": "holonomic"}]}, r"^robot: every robot must have the same drive .*\['differential', 'holonomic'\]"),
-    ({"robot": [{}, {"max_linear_velocity": 0.8}]}, r"^action_frequency"),
 ])
 def test_bad_lists_are_named(kwargs: dict, words: str) -> None:
     with pytest.raises(ValueError, match=words):

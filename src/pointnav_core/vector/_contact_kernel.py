@@ -109,6 +109,49 @@ def _hit(radius):  # pragma: no cover
 
 
 @_jit
+def segment_distance(px, py, ax, ay, ux, uy, length):  # pragma: no cover
+    # The backend's segment_distance: distance (m) to the segment and the unit normal from
+    # its nearest point towards p; on the segment itself, its left normal.
+    s = (px - ax) * ux + (py - ay) * uy
+    s = 0.0 if s < 0.0 else min(s, length)
+    vx = px - (ax + s * ux)
+    vy = py - (ay + s * uy)
+    dist = math.sqrt(vx * vx + vy * vy)
+    if dist > 0.0:
+        return dist, vx / dist, vy / dist
+    return 0.0, -uy, ux
+
+
+@_jit
+def enter_capsule(px, py, dx, dy, ax, ay, bx, by, ux, uy, length, radius):  # pragma: no cover
+    # The backend's enter_capsule: the rectangle part in the segment's frame, then its ends.
+    rx = px - ax
+    ry = py - ay
+    t = enter_box(rx * ux + ry * uy, ry * ux - rx * uy, dx * ux + dy * uy, dy * ux - dx * uy, 0.0, -radius, length, radius)
+    if t > 0.0 and radius > 0.0:
+        t = min(t, enter_disc(px, py, dx, dy, ax, ay, radius))
+        t = min(t, enter_disc(px, py, dx, dy, bx, by, radius))
+    return t
+
+
+@_jit
+def _wall_distance(wall, k, j, px, py):  # pragma: no cover
+    # Robot k's wall j: a cell square (column 7 is 0) or a polygon edge (1), as the backend's wall_distance.
+    if wall[k, j, 7] == 0.0:
+        return square_distance(px, py, wall[k, j, 0], wall[k, j, 1], wall[k, j, 2], wall[k, j, 3])
+    return segment_distance(px, py, wall[k, j, 0], wall[k, j, 1], wall[k, j, 4], wall[k, j, 5], wall[k, j, 6])
+
+
+@_jit
+def _enter_wall(wall, k, j, px, py, dx, dy, radius):  # pragma: no cover
+    # The backend's enter_wall on robot k's wall j.
+    if wall[k, j, 7] == 0.0:
+        return enter_rounded_square(px, py, dx, dy, wall[k, j, 0], wall[k, j, 1], wall[k, j, 2], wall[k, j, 3], radius)
+    return enter_capsule(px, py, dx, dy, wall[k, j, 0], wall[k, j, 1], wall[k, j, 2], wall[k, j, 3],
+                         wall[k, j, 4], wall[k, j, 5], wall[k, j, 6], radius)
+
+
+@_jit
 def _blocks(k, c, tx, ty, left, px, py, rad, cnx, cny, ckind, cforced, wall):  # pragma: no cover
     # Whether motion (tx, ty) of robot k, for ``left`` of the step, goes into its contact c
     # (the backend's _blocks): towards it, and forced or deeper than _HIT before ``left``.
@@ -118,8 +161,7 @@ def _blocks(k, c, tx, ty, left, px, py, rad, cnx, cny, ckind, cforced, wall):  #
         return True
     j = ckind[c]
     if j >= 0:
-        t = enter_rounded_square(px[k], py[k], tx, ty, wall[k, j, 0], wall[k, j, 1], wall[k, j, 2], wall[k, j, 3],
-                                 _hit(rad[k]))
+        t = _enter_wall(wall, k, j, px[k], py[k], tx, ty, _hit(rad[k]))
     else:
         m = -j - 1
         t = enter_disc(px[k], py[k], tx, ty, px[m], py[m], _hit(rad[k] + rad[m]))
@@ -139,7 +181,7 @@ def _resolve(n, px, py, mx, my, left, nwall, wall, pair, ev_k, ev_j, ev_m, rad, 
             continue
         nc = 0
         for j in range(nwall[k]):
-            d, nx, ny = square_distance(px[k], py[k], wall[k, j, 0], wall[k, j, 1], wall[k, j, 2], wall[k, j, 3])
+            d, nx, ny = _wall_distance(wall, k, j, px[k], py[k])
             if d <= rad[k] + _ACTIVE:
                 cnx[nc] = nx
                 cny[nc] = ny
@@ -193,19 +235,21 @@ def _resolve(n, px, py, mx, my, left, nwall, wall, pair, ev_k, ev_j, ev_m, rad, 
 
 
 @_jit
-def advance_worlds(x, y, mx, my, slow, scene, radius, meta, table, x_out, y_out, contact):  # pragma: no cover
+def advance_worlds(x, y, mx, my, slow, scene, radius, meta, edge, dr, dc, ok, seg, seg_off, x_out, y_out, contact):  # pragma: no cover
     """Move the ``slow`` robots of every world by their chords with contacts (the backend's advance).
 
     ``x, y, mx, my`` (W, R) float64 start positions and chords (m); ``slow`` (W, R) the
     robots resolved here (the others neither move nor block: they are out of reach);
     ``radius`` (W, R) float64 each robot's radius (m; two robots touch at the sum);
     ``scene`` (W, R) int64; ``meta`` (S, 7) per scene: flat offset, rows, width, ox, oy,
-    cell size, 1 / cell size; ``table`` the floors' wall table (cells, K) for the longest
-    chord. Writes the slow robots' end positions to ``x_out, y_out`` and their contact flags
+    cell size, 1 / cell size; ``edge`` (all cells) bool the edge obstacle flags;
+    ``dr, dc, ok`` (S, P) per scene the row-major cell stencil of the longest chord
+    (``FloorTables.stencil``); ``seg`` (N, 7) the floors' polygon edges ``(ax, ay, bx, by,
+    ux, uy, length)``, scene ``s``'s at rows ``seg_off[s]:seg_off[s + 1]``. Writes the slow robots' end positions to ``x_out, y_out`` and their contact flags
     to ``contact``.
     """
     n_worlds, n_robots = x.shape
-    n_table = table.shape[1]
+    n_table = dr.shape[1]
     ids = np.empty(n_robots, np.int64)
     rad = np.empty(n_robots)
     px = np.empty(n_robots)
@@ -217,9 +261,14 @@ def advance_worlds(x, y, mx, my, slow, scene, radius, meta, table, x_out, y_out,
     span = np.empty(n_robots)
     flag = np.zeros(n_robots, np.bool_)
     nwall = np.zeros(n_robots, np.int64)
-    wall = np.empty((n_robots, max(n_table, 1), 4))
+    most_seg = 0
+    for q in range(seg_off.shape[0] - 1):
+        most_seg = max(most_seg, seg_off[q + 1] - seg_off[q])
+    # Per wall: a square's corners (0-3), or an edge's ends, direction and length (0-6);
+    # column 7 says which (0 square, 1 edge).
+    wall = np.empty((n_robots, max(n_table, 1) + most_seg, 8))
     pair = np.zeros((n_robots, n_robots), np.bool_)
-    n_contacts = max(n_table, 1) + n_robots
+    n_contacts = max(n_table, 1) + most_seg + n_robots
     cnx = np.empty(n_contacts)
     cny = np.empty(n_contacts)
     ckind = np.empty(n_contacts, np.int64)
@@ -256,17 +305,16 @@ def advance_worlds(x, y, mx, my, slow, scene, radius, meta, table, x_out, y_out,
             inv = meta[s, 6]
             col = math.floor((px[k] - ox) * inv)
             row = math.floor((py[k] - oy) * inv)
-            if not (0 <= col < width and 0 <= row < rows):
-                continue
             reach = rad[k] + span[k] + 4.0 * _ACTIVE
-            cell = off + int(row) * width + int(col)
-            for j in range(n_table):
-                wid = table[cell, j]
-                if wid < 0:
+            # Off the map: no squares (its edge polygons, if any, still count).
+            for j in range(n_table if 0 <= col < width and 0 <= row < rows else 0):
+                if not ok[s, j]:
                     break
-                local = wid - off
-                wr = local // width
-                wx0 = ox + (local - wr * width) * res
+                wr = int(row) + dr[s, j]
+                wc = int(col) + dc[s, j]
+                if not (0 <= wr < rows and 0 <= wc < width) or not edge[off + wr * width + wc]:
+                    continue
+                wx0 = ox + wc * res
                 wy0 = oy + wr * res
                 if square_distance(px[k], py[k], wx0, wy0, wx0 + res, wy0 + res)[0] <= reach:
                     m = nwall[k]
@@ -274,6 +322,15 @@ def advance_worlds(x, y, mx, my, slow, scene, radius, meta, table, x_out, y_out,
                     wall[k, m, 1] = wy0
                     wall[k, m, 2] = wx0 + res
                     wall[k, m, 3] = wy0 + res
+                    wall[k, m, 7] = 0.0
+                    nwall[k] = m + 1
+            # Then the polygon edges within reach, in their order (the backend's walls()).
+            for q in range(seg_off[s], seg_off[s + 1]):
+                if segment_distance(px[k], py[k], seg[q, 0], seg[q, 1], seg[q, 4], seg[q, 5], seg[q, 6])[0] <= reach:
+                    m = nwall[k]
+                    for c in range(7):
+                        wall[k, m, c] = seg[q, c]
+                    wall[k, m, 7] = 1.0
                     nwall[k] = m + 1
         if n_moving == 0:
             for k in range(n):
@@ -305,11 +362,10 @@ def advance_worlds(x, y, mx, my, slow, scene, radius, meta, table, x_out, y_out,
                 speed = math.sqrt(vx[k] * vx[k] + vy[k] * vy[k])
                 hit_w = _hit(rad[k])
                 for j in range(nwall[k]):
-                    d, nx, ny = square_distance(px[k], py[k], wall[k, j, 0], wall[k, j, 1], wall[k, j, 2], wall[k, j, 3])
+                    d, nx, ny = _wall_distance(wall, k, j, px[k], py[k])
                     if vx[k] * nx + vy[k] * ny >= 0.0 or d - hit_w > speed * left:
                         continue
-                    t = enter_rounded_square(px[k], py[k], vx[k], vy[k], wall[k, j, 0], wall[k, j, 1],
-                                             wall[k, j, 2], wall[k, j, 3], hit_w)
+                    t = _enter_wall(wall, k, j, px[k], py[k], vx[k], vy[k], hit_w)
                     if t < t_first:
                         t_first = t
                         ev_k = k
@@ -340,8 +396,7 @@ def advance_worlds(x, y, mx, my, slow, scene, radius, meta, table, x_out, y_out,
             k = ev_k
             if ev_m < 0:
                 j = ev_j
-                place = enter_rounded_square(px[k], py[k], vx[k], vy[k], wall[k, j, 0], wall[k, j, 1],
-                                             wall[k, j, 2], wall[k, j, 3], rad[k] + _PLACE)
+                place = _enter_wall(wall, k, j, px[k], py[k], vx[k], vy[k], rad[k] + _PLACE)
             else:
                 m = ev_m
                 place = enter_disc(px[k], py[k], vx[k] - vx[m], vy[k] - vy[m], px[m], py[m], rad[k] + rad[m] + _PLACE)
@@ -358,9 +413,8 @@ def advance_worlds(x, y, mx, my, slow, scene, radius, meta, table, x_out, y_out,
                 depth_end = -_INF
                 depth_start = -_INF
                 for j in range(nwall[k]):
-                    w0, w1, w2, w3 = wall[k, j, 0], wall[k, j, 1], wall[k, j, 2], wall[k, j, 3]
-                    depth_end = max(depth_end, rad[k] - square_distance(px[k], py[k], w0, w1, w2, w3)[0])
-                    depth_start = max(depth_start, rad[k] - square_distance(sx[k], sy[k], w0, w1, w2, w3)[0])
+                    depth_end = max(depth_end, rad[k] - _wall_distance(wall, k, j, px[k], py[k])[0])
+                    depth_start = max(depth_start, rad[k] - _wall_distance(wall, k, j, sx[k], sy[k])[0])
                 if depth_end > _HIT and depth_end > depth_start:
                     px[k] = sx[k]
                     py[k] = sy[k]

@@ -7,7 +7,7 @@ tangent of a contact that goes into no other contact, and goes on with what is
 left of the motion. The backend resolves up to 8 contacts per robot and sub-step; here
 every robot runs :data:`EVENTS` rounds at once (a robot done early just idles), so the
 rule is the same. The walls are the edge obstacle squares within reach of each robot's
-cell (:meth:`FloorTables.wall_table`, one gather), in row-major order, as the backend
+cell (:meth:`FloorTables.stencil`, gathered per robot), in row-major order, as the backend
 lists them; only the :data:`CONTACTS` nearest take part in sliding (a disc touches at
 most four squares).
 """
@@ -32,28 +32,28 @@ CONTACTS = 6
 
 
 def window(floors: FloorTables, scene: Any, x: Any, y: Any, reach: float) -> tuple[Any, Any, Any, Any, Any]:
-    """The edge obstacle squares within ``reach`` (m) of each robot's cell: corners and mask, (M, K).
+    """The edge obstacle squares within ``reach`` (m) of each robot's cell: corners and mask, (M, P).
 
-    In row-major order, as the backend lists them; a robot off the map has none.
+    In row-major order, as the backend lists them (slots that hold no wall in between,
+    masked out); a robot off the map has none. The squares are those of the cell's
+    stencil (:meth:`FloorTables.stencil`), gathered here for the robots that need them.
     """
+    if floors.has_polygons:  # FloorTables lets them in only where the compiled contacts run
+        raise ValueError("the array contacts collide with grid cells only, and a floor has obstacle polygons")
     a = floors.arrays
     xp = a.xp
-    table = floors.wall_table(reach)
+    dr, dc, ok = floors.stencil(reach)
     row0, col0, inside = floors.cells(scene, x, y)
-    ids = table[floors.flat_index(scene, row0, col0, inside)]
-    valid = (ids >= 0) & inside[:, None]
     sc = scene.reshape(-1, 1)
-    row, col = _divmod(xp, xp.where(valid, ids - floors.offset[sc], 0), floors.width[sc])
+    row, col = row0[:, None] + dr[scene], col0[:, None] + dc[scene]
+    on_map = ok[scene] & inside[:, None] & (row >= 0) & (row < floors.rows[sc]) & (col >= 0) & (col < floors.width[sc])
+    ids = xp.where(on_map, floors.offset[sc] + row * floors.width[sc] + col, xp.zeros_like(row))
+    valid = on_map & floors.edge[ids]
     res = floors.res[sc]
     # Slots that hold no wall move far away, so that no distance test lands inside one.
     x0 = xp.where(valid, floors.ox[sc] + col * res, 1e9)
     y0 = floors.oy[sc] + row * res
     return x0, y0, x0 + res, y0 + res, valid
-
-
-def _divmod(xp: Any, a: Any, b: Any) -> tuple[Any, Any]:
-    q = xp.div(a, b, rounding_mode="floor") if hasattr(xp, "Tensor") else a // b
-    return q, a - q * b
 
 
 def _nearest(xp: Any, dist: Any, k: int) -> Any:
@@ -84,7 +84,7 @@ def advance(
     radius : float or float array (M,)
         Robot radius (m): one for all, or each robot's own.
     max_travel : float
-        The longest chord any step may have (m): the wall table is built for it.
+        The longest chord any step may have (m): the walls are gathered within it.
     """
     a = floors.arrays
     xp = a.xp

@@ -24,7 +24,7 @@ import numpy as np
 from pointnav_core import _compiled
 from pointnav_core.vector.floors import FloorTables
 
-__all__ = ["advance_compiled", "advance_one", "available"]
+__all__ = ["advance_compiled", "advance_one", "available", "prepare"]
 
 # The walls a robot may meet are within this (m) of its chord, beyond its radius
 # (4 x the backend's _ACTIVE, as vector.contacts.window is called).
@@ -35,6 +35,16 @@ def available(floors: FloorTables) -> bool:
     """Whether the compiled path can run for these floors' arrays (CPU, numba importable)."""
     a = floors.arrays
     return (not a.is_torch or a.device == "cpu") and _kernel() is not None
+
+
+def prepare(floors: FloorTables) -> None:
+    """Load the kernel now (numba compiles it on a machine's first use, then reads its
+    cache): called when an engine is built, so that the first step with a contact costs
+    what any other does. Nothing happens where the compiled path cannot run."""
+    if available(floors):
+        a = floors.arrays
+        empty = a.zeros((0, 1))
+        advance_compiled(floors, a.zeros((0, 1), a.i64), empty, empty, empty, empty, a.zeros((0, 1), a.boolean), 0.0, 0.0)
 
 
 def _kernel() -> Any:
@@ -60,7 +70,7 @@ def advance_compiled(
         Every robot's radius (m), one for all or each robot's own (two robots touch at the
         sum of their radii).
     max_travel : float
-        The longest chord any step may have (m): the wall table is built for it.
+        The longest chord any step may have (m): the walls are gathered within it.
 
     Returns
     -------
@@ -74,15 +84,19 @@ def advance_compiled(
     view = (lambda v: v.numpy()) if a.is_torch else (lambda v: v)
     x, y = np.ascontiguousarray(view(x), np.float64), np.ascontiguousarray(view(y), np.float64)
     radius = view(radius) if a.is_torch and not isinstance(radius, (int, float)) else radius
-    rad = np.ascontiguousarray(np.broadcast_to(np.asarray(radius, np.float64), x.shape))
-    # One wall table for the largest robot: each robot keeps the walls within its own reach.
-    table = floors.wall_table((float(rad.max()) if rad.size else 0.0) + max_travel + _WALL_MARGIN)
+    # A writable copy always: numba compiles a read-only argument (a broadcast that is
+    # already contiguous, as an empty one is) as another specialisation.
+    rad = np.array(np.broadcast_to(np.asarray(radius, np.float64), x.shape), order="C")
+    # One stencil for the largest robot: each robot keeps the walls within its own reach.
+    reach = (float(rad.max()) if rad.size else 0.0) + max_travel + _WALL_MARGIN
+    dr, dc, ok = (np.ascontiguousarray(floors.arrays.numpy(v)) for v in floors.stencil(reach))
     x_out, y_out = x.copy(), y.copy()
     contact = np.zeros(x.shape, np.bool_)
     advance_worlds(
         x, y, np.ascontiguousarray(view(mx), np.float64), np.ascontiguousarray(view(my), np.float64),
         np.ascontiguousarray(view(slow), np.bool_), np.ascontiguousarray(view(scene), np.int64), rad,
-        floors.host_meta, np.ascontiguousarray(view(table), np.int64), x_out, y_out, contact,
+        floors.host_meta, floors.host_edge, dr, dc, ok, floors.host_segments, floors.segment_offsets,
+        x_out, y_out, contact,
     )
     return x_out, y_out, contact
 

@@ -23,7 +23,7 @@ from pointnav_core.vector import contacts_jit
 from pointnav_core.vector.contacts import advance
 from pointnav_core.vector.accounting import task_step
 from pointnav_core.vector.discrete import MOVED, DiscretePlan
-from pointnav_core.vector.drive import MAX_TURN, arc, body_command, sub_steps, substep_drive, travel
+from pointnav_core.vector.drive import arc, body_command, sub_steps, substep_drive, travel
 from pointnav_core.vector.episodes import EpisodePool, fixed_pose
 from pointnav_core.vector.falls import apply_falls
 from pointnav_core.vector.floors import FloorTables
@@ -86,8 +86,10 @@ class VectorPointNavEnv(PoolRefreshing, VectorEnv):
         default 500) and ``finished`` (``"park"``, the default, or ``"remove"``), as
         :func:`pointnav_core.parallel.parallel_env` does.
     scene : Scene or sequence of Scene, optional
-        World ``i`` runs on ``scene[i % len(scene)]``. Floors must be grid cells only (no
-        obstacle polygons). Default: the single env's default house as a grid.
+        World ``i`` runs on ``scene[i % len(scene)]``, at its own resolution. Floors with
+        obstacle polygons (floor plans, the generated houses) need the compiled contacts
+        (the CPU with numba) and no scan sensor. Default: the single env's default house
+        as a grid.
     robot : RobotSpec or dict, optional
         As for the single env: a differential drive (actions ``(v, w)``) or a holonomic one
         (actions ``(vx, vy, w)`` in the robot frame, +x ahead, +y to the left), scaled and
@@ -284,6 +286,7 @@ class VectorPointNavEnv(PoolRefreshing, VectorEnv):
         """The state arrays of ``shape`` (one entry per world, or per robot), the per-world
         flags and the sensors (both engines)."""
         a = self.arrays
+        contacts_jit.prepare(self.floors)  # not in the first step that meets a wall
         self._fixed: Any = None
         # "fs": the fall speed (m/s), 0 while the robot stands (vector.falls).
         keys = ("x", "y", "yaw", "z", "vx", "vy", "vz", "w", "fs", "gx", "gy", "d0", "pot", "path", "dist")
@@ -302,8 +305,8 @@ class VectorPointNavEnv(PoolRefreshing, VectorEnv):
         self.local_map = None if map_term is None else VectorLocalMap(map_term, self.floors)
 
     def _read_task(self, t: Any, action_frequency: float) -> None:
-        """The task's settings the batched step reads (both engines), with the control
-        rate's check: ValueError if one control step needs the backend's sub-steps."""
+        """The task's settings the batched step reads (both engines). Any control rate: a
+        step near something is cut into the backend's sub-steps (:func:`~pointnav_core.vector.drive.sub_steps`)."""
         self.action_frequency = action_frequency
         self.dt = 1.0 / action_frequency
         self.task = t
@@ -314,15 +317,6 @@ class VectorPointNavEnv(PoolRefreshing, VectorEnv):
         self.geodesic_reward = t.reward_type == "geodesic"
         self.goal_in_polar = bool(t.goal_in_polar)
         spec = self.robot
-        # Top speed on one axis: a holonomic robot's diagonal step may travel sqrt(2) times
-        # that, which the backend splits into sub-steps near walls, and so does vector.drive.
-        if spec.max_angular_velocity * self.dt > MAX_TURN or spec.max_linear_velocity * self.dt > 0.5 * min(
-            float(s.floors[t.floor].resolution) for s in self.scenes
-        ):
-            raise ValueError(
-                f"action_frequency {self.action_frequency} Hz is too low for the batched engine: one control "
-                "step may turn at most 0.25 rad and drive at most half a cell (the kinematic backend's sub-step)"
-            )
         self.holonomic = spec.drive == "holonomic"
         # A chord is never longer than its arc (a holonomic one: the diagonal of its two
         # top speeds); the margin covers rounding.

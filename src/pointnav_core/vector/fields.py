@@ -30,7 +30,13 @@ from pointnav_core.geodesic import GoalField
 from pointnav_core.geodesic.tangents import ANG_TOL, TWO_PI
 from pointnav_core.vector.xp import Arrays
 
-__all__ = ["FieldTables", "reach_window"]
+__all__ = ["FIELD_TABLE_BYTES", "FieldTables", "reach_window"]
+
+#: Byte budget of one set of goal-field tables (a pool's): the cells of the fields' windows
+#: at 16 bytes each (kind and label). Building tables past it raises ``ValueError`` before
+#: any field is settled. Change it by assigning ``pointnav_core.vector.fields.FIELD_TABLE_BYTES``.
+FIELD_TABLE_BYTES = 2 * 2**30
+_CELL_BYTES = 16
 
 # Per Dijkstra label, in the order of the label table's columns.
 _PER_LABEL = ("cost", "cx", "cy", "side", "phi0", "span", "pos", "qx", "qy")
@@ -90,25 +96,32 @@ class FieldTables:
     ) -> None:
         kinds, labels, goal, geo, lab_arrays = [], [], [], [], []
         cell_off = lab_off = 0
+        windows = [(0, f.planner.geo.shape[0], 0, f.planner.geo.shape[1]) if starts is None
+                   else reach_window(f, starts[i], reach) for i, f in enumerate(fields)]
+        _check_budget(windows)
         for f, field in enumerate(fields):
             p = field.planner
             h, w = p.geo.shape
-            r0, r1, c0, c1 = (0, h, 0, w) if starts is None else reach_window(field, starts[f], reach)
+            r0, r1, c0, c1 = windows[f]
             near = np.asarray(p.near_usable, dtype=np.int64).reshape(h, w)[r0:r1, c0:c1].ravel()
             whole = (r0, r1, c0, c1) == (0, h, 0, w)
             # Only the cells the window's cells look up are settled (every one for the whole grid).
             kind_of, label_of = field.settle(None if whole else near[near >= 0])
             kind = np.where(near >= 0, kind_of[np.maximum(near, 0)], 0).astype(np.int64)
             label = np.where(kind == 2, label_of[np.maximum(near, 0)], 0).astype(np.int64)
+            # Only the labels the window's cells name: a search labels every arc node of the
+            # floor's graph (millions on a large map), a window's cells name a few thousand.
+            used = np.unique(label[kind == 2])
+            label = np.where(kind == 2, np.searchsorted(used, label), 0)
             s = field.labels
-            node = np.asarray(s.node, dtype=np.int64)
-            side = np.asarray(s.side, dtype=np.float64)
-            pos = np.asarray(s.pos, dtype=np.float64)
+            node = np.asarray(s.node, dtype=np.int64)[used]
+            side = np.asarray(s.side, dtype=np.float64)[used]
+            pos = np.asarray(s.pos, dtype=np.float64)[used]
             n_lab = len(node)
             ccw = np.where(side > 0, pos, p.span[node] - pos) if n_lab else pos
             ang = p.phi0[node] + ccw if n_lab else pos
             lab_arrays.append(np.stack([
-                np.asarray(s.cost, dtype=np.float64), p.cx[node], p.cy[node], side, p.phi0[node],
+                np.asarray(s.cost, dtype=np.float64)[used], p.cx[node], p.cy[node], side, p.phi0[node],
                 p.span[node], pos, p.cx[node] + p.radius * np.cos(ang), p.cy[node] + p.radius * np.sin(ang),
             ], 1).reshape(n_lab, 9))
             kinds.append(kind)
@@ -208,3 +221,16 @@ class FieldTables:
         point = self.cost[lab] + xp.where(outside & (turn > seen), wrap, straight)
         via = xp.where(tangent_ok, tangent, point)
         return xp.where(kind == 1, direct, xp.where(kind == 2, via, math.inf))
+
+
+def _check_budget(windows: Sequence[tuple[int, int, int, int]]) -> None:
+    """ValueError when the windows' cells would take more than :data:`FIELD_TABLE_BYTES`."""
+    cells = sum((r1 - r0) * (c1 - c0) for r0, r1, c0, c1 in windows)
+    if cells * _CELL_BYTES > FIELD_TABLE_BYTES:
+        raise ValueError(
+            f"the goal fields of {len(windows)} pool goals would take {cells * _CELL_BYTES / 2**20:.0f} MiB "
+            f"({cells} cells within the episodes' reach), over FIELD_TABLE_BYTES = "
+            f"{FIELD_TABLE_BYTES / 2**20:.0f} MiB: lower pool_size or max_episode_steps (the reach), "
+            "or raise pointnav_core.vector.fields.FIELD_TABLE_BYTES"
+        )
+

@@ -18,7 +18,7 @@ import numpy as np
 from pointnav_core.maps import VOID
 from pointnav_core.vector.xp import Arrays
 
-__all__ = ["FloorTables"]
+__all__ = ["FloorTables", "stencil_offsets"]
 
 
 class FloorTables:
@@ -30,7 +30,9 @@ class FloorTables:
     Parameters
     ----------
     scenes : sequence of Scene
-        Their floor ``floor`` is used; it must have no obstacle polygons (grid cells only).
+        Their floor ``floor`` is used: its cells and the edges of its obstacle polygons
+        (the backend's ``FloorGeometry.edges``), which only the compiled contacts take
+        (on the CPU, with numba).
     floor : int
         The task's floor.
     radius : float
@@ -41,36 +43,50 @@ class FloorTables:
     Raises
     ------
     ValueError
-        Naming ``scene`` when a floor holds obstacle polygons.
+        Naming ``scene`` when a floor holds obstacle polygons and the compiled contacts
+        cannot run (on a GPU, or without numba).
     """
 
     def __init__(self, scenes: Sequence[Any], floor: int, radius: float, arrays: Arrays) -> None:
         from pointnav_kinematic.geometry import FloorGeometry
 
+        from pointnav_core.vector import contacts_jit  # it imports this module
+
         codes, edge, meta = [], [], []
         offset = 0
         self.geometries = []
-        self._edges: list[np.ndarray] = []
-        self._walls: dict[float, Any] = {}
+        self.arrays = arrays
+        self._stencils: dict[float, tuple[Any, Any, Any]] = {}
+        segments, seg_off = [], [0]
         for k, scene in enumerate(scenes):
             tmap = scene.floors[floor]
-            if len(tmap.collision.polygons):
+            if len(tmap.collision.polygons) and not contacts_jit.available(self):
                 raise ValueError(
-                    f"scene {k} has obstacle polygons on floor {floor}; the batched engine "
-                    "collides with grid cells only (build the scene with Scene.from_array)"
+                    f"scene {k} has obstacle polygons on floor {floor}; the batched engine collides with "
+                    "them on the CPU with numba (the fast extra) only: use device='numpy' or 'cpu' with "
+                    "numba installed, or build the scene from the floor's cells (Scene.from_array)"
                 )
             geom = FloorGeometry(tmap, float(scene.get_floor_height(floor)))
+            segments.extend(geom.edges.segments)
+            seg_off.append(len(segments))
             self.geometries.append(geom)
             grid = np.asarray(tmap.codes, dtype=np.uint8)
             codes.append(grid.ravel())
             edge.append(np.frombuffer(geom.edge, dtype=np.uint8).astype(bool))
             meta.append((offset, geom.rows, geom.width, geom.ox, geom.oy, geom.res, geom.height))
-            self._edges.append(np.frombuffer(geom.edge, dtype=np.uint8).astype(bool).reshape(grid.shape))
             offset += grid.size
         m = np.array(meta, dtype=np.float64)
         a = arrays
         self.codes = a.asarray(np.concatenate(codes), a.i64)
-        self.edge = a.asarray(np.concatenate(edge), a.boolean)
+        #: Per cell of every floor, whether it is an edge obstacle cell (the backend's ``edge``).
+        self.host_edge = np.concatenate(edge)
+        #: The polygon edges of every floor, ``(ax, ay, bx, by, ux, uy, length)`` (m), float64
+        #: ``(N, 7)``: scene ``s``'s at rows ``segment_offsets[s]:segment_offsets[s + 1]``.
+        self.host_segments = np.array(segments, dtype=np.float64).reshape(-1, 7)
+        self.segment_offsets = np.array(seg_off, dtype=np.int64)
+        #: Whether any floor has obstacle polygons (only the compiled contacts take them).
+        self.has_polygons = bool(len(segments))
+        self.edge = a.asarray(self.host_edge, a.boolean)
         self.offset = a.asarray(m[:, 0], a.i64)
         self.rows = a.asarray(m[:, 1], a.i64)
         self.width = a.asarray(m[:, 2], a.i64)
@@ -96,40 +112,31 @@ class FloorTables:
             self._fast[radius] = table
         return table
 
-    def wall_table(self, reach: float) -> Any:
-        """Per cell, the flat indices of the edge obstacle cells whose squares come within
-        ``reach`` (m) of some point of the cell, in row-major order, padded with -1:
-        an int array ``(all cells, K)``, K the most any cell has. Cached per ``reach``."""
-        table = self._walls.get(reach)
-        if table is not None:
-            return table
-        blocks, offset = [], 0
-        for edge, res in zip(self._edges, self.arrays.numpy(self.res)):
-            rows, cols = edge.shape
-            k = math.ceil(reach / res) + 1
-            r, c = np.divmod(np.arange(rows * cols), cols)
-            found = []
-            for dr in range(-k, k + 1):
-                for dc in range(-k, k + 1):
-                    # The nearest points of two cell squares dr, dc apart are this far apart.
-                    if math.hypot(max(abs(dr) - 1, 0), max(abs(dc) - 1, 0)) * res > reach:
-                        continue
-                    rr, cc = r + dr, c + dc
-                    ok = (rr >= 0) & (rr < rows) & (cc >= 0) & (cc < cols)
-                    ok[ok] = edge[rr[ok], cc[ok]]
-                    found.append(np.where(ok, offset + rr * cols + cc, -1))
-            ids = np.stack(found, 1)
-            # Walls first, each row keeping its row-major order.
-            order = np.argsort(ids < 0, axis=1, kind="stable")
-            blocks.append(np.take_along_axis(ids, order, 1))
-            offset += rows * cols
-        width = max(int((b >= 0).sum(1).max()) if b.size else 0 for b in blocks)
-        width = max(width, 1)
-        table = np.concatenate([b[:, :width] if b.shape[1] >= width else
-                                np.pad(b, ((0, 0), (0, width - b.shape[1])), constant_values=-1) for b in blocks])
-        table = self.arrays.asarray(table, self.arrays.i64)
-        self._walls[reach] = table
-        return table
+    def stencil(self, reach: float) -> tuple[Any, Any, Any]:
+        """The cell offsets whose squares come within ``reach`` (m) of some point of a cell.
+
+        Per scene, the row and column offsets ``(dr, dc)`` of every cell square whose nearest
+        point is within ``reach`` of the centre cell's square, in row-major order (as the
+        backend lists walls), padded with ``valid`` False to the longest scene's count: int
+        arrays ``dr``, ``dc`` and bool ``valid``, ``(scenes, P)``. The edge obstacle cells of
+        a robot's window are those of its cell's stencil (:func:`~pointnav_core.vector.contacts.window`),
+        found when a robot needs them, so no table per cell is ever built (a 1024 x 1024
+        floor at 0.05 m would need hundreds of MB). Cached per ``reach``.
+        """
+        out = self._stencils.get(reach)
+        if out is not None:
+            return out
+        per_scene = [stencil_offsets(reach, float(res)) for res in self.host_meta[:, 5]]
+        width = max(len(d) for d in per_scene)
+        dr = np.zeros((len(per_scene), width), np.int64)
+        dc = np.zeros_like(dr)
+        valid = np.zeros(dr.shape, bool)
+        for s, d in enumerate(per_scene):
+            dr[s, :len(d)], dc[s, :len(d)], valid[s, :len(d)] = d[:, 0], d[:, 1], True
+        a = self.arrays
+        out = (a.asarray(dr, a.i64), a.asarray(dc, a.i64), a.asarray(valid, a.boolean))
+        self._stencils[reach] = out
+        return out
 
     def cells(self, scene: Any, x: Any, y: Any) -> tuple[Any, Any, Any]:
         """Row, column (int arrays) and on-map mask of the points ``(x, y)`` of worlds on ``scene`` (index array)."""
@@ -151,3 +158,16 @@ class FloorTables:
         row, col, inside = self.cells(scene, x, y)
         code = self.codes[self.flat_index(scene, row, col, inside)]
         return ~inside | (code == VOID)
+
+
+def stencil_offsets(reach: float, res: float) -> np.ndarray:
+    """The ``(dr, dc)`` offsets (int ``(P, 2)``, row-major) of the cell squares within
+    ``reach`` (m) of some point of a cell of side ``res`` (m): two squares ``dr, dc`` apart
+    have nearest points ``hypot(max(|dr| - 1, 0), max(|dc| - 1, 0)) * res`` apart."""
+    k = math.ceil(reach / res) + 1
+    d = np.arange(-k, k + 1)
+    dr, dc = (v.ravel() for v in np.meshgrid(d, d, indexing="ij"))
+    gap = np.hypot(np.maximum(np.abs(dr) - 1, 0), np.maximum(np.abs(dc) - 1, 0)) * res
+    keep = gap <= reach
+    return np.column_stack([dr[keep], dc[keep]])
+

@@ -1,0 +1,33 @@
+"""Real maps committed as test data, read with their format's rules written out here."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+from PIL import Image
+
+from pointnav_core.maps import FREE, OBSTACLE, VOID
+from pointnav_core.scenes import Scene
+
+DATA = Path(__file__).parent / "data"
+
+
+def bookstore_codes() -> np.ndarray:
+    """The bookstore map's cell codes (``tests/data/bookstore``), row 0 at the bottom:
+    map_server's trinary rule (occupancy ``(255 - p) / 255``; free below 0.196, occupied
+    above 0.65, unknown as VOID)."""
+    img = np.asarray(Image.open(DATA / "bookstore" / "map.pgm")).astype(np.float64)
+    occ = (255.0 - img) / 255.0
+    codes = np.full(img.shape, VOID, np.uint8)
+    codes[occ > 0.65] = OBSTACLE
+    codes[occ < 0.196] = FREE
+    return np.ascontiguousarray(codes[::-1])  # image row 0 is the top
+
+
+def bookstore(rows: slice = slice(None), cols: slice = slice(None)) -> Scene:
+    """The bookstore map at 0.05 m, origin (-10, -10), or the crop ``[rows, cols]`` of it
+    (cells, row 0 at the bottom) with the origin of its first cell."""
+    codes = bookstore_codes()
+    r0, c0 = rows.start or 0, cols.start or 0
+    return Scene.from_array(codes[rows, cols], 0.05, origin=(-10.0 + 0.05 * c0, -10.0 + 0.05 * r0))
