@@ -20,6 +20,7 @@ the same intervals.
 from __future__ import annotations
 
 import csv
+import itertools
 import json
 import math
 import os
@@ -301,7 +302,7 @@ def plot_results(
         (spl, (30, 70, 200), 2),
     ):
         points = []
-        for lo, hi in zip(edges[:-1], edges[1:]):
+        for lo, hi in itertools.pairwise(edges):
             sel = (geo >= lo) & (geo < hi)
             if sel.any():
                 points.append(px((lo + hi) / 2, float(values[sel].mean())))
