@@ -334,6 +334,16 @@ def test_bootstrap_interval_matches_a_plain_python_loop():
     np.testing.assert_allclose(alone, expected[:, 1], rtol=0, atol=1e-12)
 
 
+def test_bootstrap_interval_of_many_episodes_draws_the_documented_resamples():
+    """2,000 episodes: the library draws its index matrix in blocks of rows, which must be
+    the resamples drawn one by one."""
+    outcomes = (np.arange(2000) % 7 < 5).astype(float)
+    rng = np.random.default_rng(3)
+    means = [outcomes[rng.integers(0, 2000, size=2000)].sum() / 2000 for _ in range(1200)]
+    got = bootstrap_interval(outcomes, resamples=1200, seed=3)
+    np.testing.assert_allclose(got, np.quantile(means, [0.025, 0.975]), rtol=0, atol=1e-12)
+
+
 @pytest.mark.parametrize(
     "kwargs, match",
     [
