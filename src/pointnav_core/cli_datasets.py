@@ -5,9 +5,13 @@ episode dataset (:mod:`pointnav_core.datasets`); the same arguments give the sam
 
 ``pointnav eval --dataset FILE --policy oracle|MODULE:CALLABLE|MODEL.zip`` (a ``.zip`` with
 ``--trust-policy-file``: loading one runs the code pickled in it) plays every
-episode once (:mod:`pointnav_core.evaluation`), prints success, SPL, SoftSPL, the mean
-distance to the goal and collisions, and writes per-episode results (JSON lines, or CSV for
-a ``.csv`` path) and a PNG of SPL and success against geodesic distance.
+episode once (:mod:`pointnav_core.evaluation`), or every ``--stride``-th and then the first
+``--limit`` of those; prints success, SPL and SoftSPL with 95 % bootstrap confidence
+intervals, the mean distance to the goal and collisions; and writes per-episode results
+(JSON lines between a run record and a summary record, or CSV for a ``.csv`` path with
+those records beside it: :mod:`pointnav_core.evaluation_report`) and a PNG of SPL and
+success against geodesic distance. The run record names the library version, the
+dataset's SHA-256 and every setting that decides the results.
 
 Faults (see :mod:`pointnav_core.evaluation_log`): every output path is checked before the
 first episode; each finished episode is on disk (``RESULTS.partial``) as it ends; Ctrl-C or
@@ -62,6 +66,66 @@ def _default_output(dataset: str, suffix: str) -> str:
     return f"{name}.eval{suffix}"
 
 
+def _count(name: str, text: str | None) -> int | None:
+    """``--limit``/``--stride``'s text as an integer >= 1 (None stays None)."""
+    if text is None:
+        return None
+    try:
+        value = int(text)
+    except ValueError:
+        value = 0
+    if value < 1:
+        raise ValueError(f"{name} must be an integer >= 1, got {text!r}")
+    return value
+
+
+def _run_settings(args: argparse.Namespace, scenes_dir: str) -> dict[str, Any]:
+    """What decides a run's results (recorded in its log and its results file)."""
+    import hashlib
+
+    from pointnav_core import __version__
+
+    with open(args.dataset, "rb") as fh:
+        digest = hashlib.file_digest(fh, "sha256").hexdigest()
+    return {
+        "version": __version__,
+        "dataset": os.path.abspath(args.dataset), "dataset_sha256": digest,
+        "policy": args.policy, "sb3_algo": args.sb3_algo, "backend": args.backend,
+        "drive": args.drive, "max_steps": args.max_steps, "scenes_dir": os.path.abspath(scenes_dir),
+        "limit": args.limit, "stride": args.stride,
+    }
+
+
+def _print_summary(args: argparse.Namespace, summary: dict[str, Any], of: int) -> None:
+    """The summary as the table ``pointnav eval`` prints, with 95 % intervals."""
+    ci = summary["intervals"]
+
+    def with_ci(key: str) -> str:
+        lo, hi = ci[key]
+        return f"{summary[key]:.4f}  [{lo:.4f}, {hi:.4f}]"
+
+    rows = [
+        ("episodes", f"{summary['episodes']}" + (f" of {of}" if summary["episodes"] != of else "")),
+        ("success", with_ci("success")),
+        ("SPL", with_ci("spl")),
+        ("SoftSPL", with_ci("soft_spl")),
+        ("distance to goal", f"{summary['distance_to_goal']:.3f} m (mean, at the end)"),
+        ("collisions", f"{summary['collisions']:.3f} per episode"),
+        ("path length", f"{summary['path_length']:.2f} m (mean)"),
+    ]
+    width = max(len(name) for name, _ in rows)
+    subset = (f", --stride {args.stride}" if args.stride > 1 else "") + (
+        f", --limit {args.limit}" if args.limit is not None else ""
+    )
+    print(f"{args.policy} on {args.dataset}, {args.backend} backend{subset}")
+    for name, value in rows:
+        print(f"  {name:<{width}}  {value}")
+    print(
+        f"  [lo, hi]: {ci['confidence']:.0%} confidence interval "
+        f"({ci['method']}, {ci['resamples']} resamples, seed {ci['seed']})"
+    )
+
+
 def _eval(args: argparse.Namespace) -> int:
     from pointnav_core.datasets import EpisodeDataset
     from pointnav_core.errors import PointNavError
@@ -70,34 +134,34 @@ def _eval(args: argparse.Namespace) -> int:
         evaluate,
         make_policy,
         plot_results,
-        summarize,
+        select_episodes,
     )
     from pointnav_core.evaluation_log import ResultsLog
+    from pointnav_core.evaluation_report import summary_path
     from pointnav_core.outputs import check_output
 
     if os.getcwd() not in sys.path:  # MODULE:CALLABLE from here, as `python -m` would find it
         sys.path.insert(0, os.getcwd())
+    args.limit, args.stride = _count("--limit", args.limit), _count("--stride", args.stride)
     inputs = [args.dataset] + ([args.policy] if args.policy.endswith(".zip") else [])
     results_path = check_output("--results", args.results or _default_output(args.dataset, ".jsonl"), inputs)
     plot_path = check_output("--plot", args.plot or _default_output(args.dataset, ".png"), [*inputs, results_path])
+    if results_path.endswith(".csv"):
+        check_output("--results (its summary)", summary_path(results_path), [*inputs, plot_path])
     scenes_dir = args.scenes_dir if args.scenes_dir is not None else "."
     if not os.path.isdir(scenes_dir):
         raise ValueError(f"--scenes-dir {scenes_dir!r} is not a folder")
     make_policy(args.policy, args.sb3_algo, args.trust_policy_file)
     dataset = EpisodeDataset.load(args.dataset)
-    check_scene_ids(dataset.episodes, scenes_dir)
-    settings = {
-        "dataset": os.path.abspath(args.dataset), "policy": args.policy, "sb3_algo": args.sb3_algo,
-        "backend": args.backend, "drive": args.drive, "max_steps": args.max_steps,
-        "scenes_dir": os.path.abspath(scenes_dir),
-    }
-    log = ResultsLog(results_path, settings)
+    episodes = select_episodes(dataset, args.limit, args.stride)
+    check_scene_ids(episodes, scenes_dir)
+    log = ResultsLog(results_path, _run_settings(args, scenes_dir))
     check_output("--results (its log)", log.path, inputs)
-    done = log.start(args.resume, dataset.episodes)
+    done = log.start(args.resume, episodes)
     failed: list[str] = []
     try:
         evaluate(
-            [ep for ep in dataset if ep.episode_id not in done],
+            [ep for ep in episodes if ep.episode_id not in done],
             args.policy,
             backend=args.backend,
             workers=args.workers,
@@ -111,10 +175,10 @@ def _eval(args: argparse.Namespace) -> int:
             on_result=log.append,
             on_failure=_Signals.failure(failed),
         )
-        results = log.finish(dataset.episodes)
+        results, summary = log.finish(episodes)
     except (KeyboardInterrupt, PointNavError, ValueError) as err:
         log.close()
-        kept = f"{len(log.done)} of {len(dataset)} episodes finished, kept in {log.path}; rerun with --resume to finish"
+        kept = f"{len(log.done)} of {len(episodes)} episodes finished, kept in {log.path}; rerun with --resume to finish"
         if isinstance(err, KeyboardInterrupt) or _Signals.arrived:
             print(f"pointnav eval: {_Signals.name}: {kept}", file=sys.stderr)
             return 130
@@ -124,25 +188,15 @@ def _eval(args: argparse.Namespace) -> int:
         return 1
     for message in failed:
         print(f"pointnav eval: skipped: {message}", file=sys.stderr)
-    if not results:
+    if summary is None:
         print("pointnav eval: error: no episode finished", file=sys.stderr)
         return 1
     plot_results(results, plot_path)
-    summary = summarize(results)
-    rows = [
-        ("episodes", f"{int(summary['episodes'])}"),
-        ("success", f"{summary['success']:.4f}"),
-        ("SPL", f"{summary['spl']:.4f}"),
-        ("SoftSPL", f"{summary['soft_spl']:.4f}"),
-        ("distance to goal", f"{summary['distance_to_goal']:.3f} m (mean, at the end)"),
-        ("collisions", f"{summary['collisions']:.3f} per episode"),
-        ("path length", f"{summary['path_length']:.2f} m (mean)"),
-    ]
-    width = max(len(name) for name, _ in rows)
-    print(f"{args.policy} on {args.dataset}, {args.backend} backend")
-    for name, value in rows:
-        print(f"  {name:<{width}}  {value}")
-    print(f"wrote {results_path} and {plot_path}")
+    _print_summary(args, summary, len(dataset))
+    written = [results_path, plot_path]
+    if results_path.endswith(".csv"):
+        written.insert(1, summary_path(results_path))
+    print(f"wrote {', '.join(written[:-1])} and {written[-1]}")
     return 1 if failed else 0
 
 
@@ -264,6 +318,12 @@ def add_commands(sub: Any, positive_int: Callable[[str], int]) -> None:
     ev.add_argument("--drive", choices=("differential", "holonomic"), default="differential")
     ev.add_argument("--workers", type=positive_int, default=1, metavar="N")
     ev.add_argument("--max-steps", type=positive_int, default=1000, metavar="N")
+    ev.add_argument(
+        "--limit", default=None, metavar="N", help="play only the first N episodes (after --stride)"
+    )
+    ev.add_argument(
+        "--stride", default="1", metavar="K", help="play every K-th episode, from the first (default 1)"
+    )
     ev.add_argument(
         "--scenes-dir",
         default=None,

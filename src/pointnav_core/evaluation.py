@@ -17,6 +17,10 @@ Policies (``policy`` argument, or ``pointnav eval --policy``):
 - a path to a Stable-Baselines3 ``.zip``: the model (``sb3_algo``, PPO by default) acts
   deterministically; it gets the flat observation when its observation space is a ``Box``.
 
+``limit`` and ``stride`` (``--limit N``, ``--stride K``) play a subset: every ``K``-th
+episode of the dataset from the first, then the first ``N`` of those
+(:func:`select_episodes`).
+
 An SB3 ``.zip`` holds pickled Python objects that run code when they are loaded: it is
 loaded only with ``trust_policy_file=True`` (``--trust-policy-file``).
 
@@ -42,23 +46,32 @@ from pointnav_core.datasets.scene_sets import load_scene, locate_scene
 from pointnav_core.errors import EpisodeError
 from pointnav_core.evaluation_report import (
     EpisodeResult,
+    bootstrap_interval,
     plot_results,
     read_results,
+    read_run,
     result_line,
     summarize,
+    summary_record,
     write_results,
 )
+from pointnav_core.validation import integer
 from pointnav_core.workers import WorkerError, WorkerPool, usable_cores
 
 __all__ = [
+    "POLICY_FORMS",
     "EpisodeResult",
+    "bootstrap_interval",
     "check_scene_ids",
     "evaluate",
     "make_policy",
     "plot_results",
     "read_results",
+    "read_run",
     "result_line",
+    "select_episodes",
     "summarize",
+    "summary_record",
     "write_results",
 ]
 
@@ -66,6 +79,11 @@ __all__ = [
 DEFAULT_MAX_STEPS = 1000
 #: What ``on_error`` may say when an episode's policy raises.
 ON_ERROR = ("stop", "skip")
+#: The accepted forms of a policy spec, for messages.
+POLICY_FORMS = (
+    "'oracle', MODULE:CALLABLE (a function env -> (observation -> action)) or the path to "
+    "a Stable-Baselines3 .zip"
+)
 
 Policy = Callable[[Any], Any]
 PolicyFactory = Callable[[Any], Policy]
@@ -130,9 +148,7 @@ def make_policy(spec: str, sb3_algo: str = "PPO", trust_policy_file: bool = Fals
         ``.zip`` that does not exist or is not trusted.
     """
     if not isinstance(spec, str) or not spec:
-        raise ValueError(
-            f"policy must be 'oracle', MODULE:CALLABLE or a path to an SB3 .zip, got {spec!r}"
-        )
+        raise ValueError(f"policy must be {POLICY_FORMS}, got {spec!r}")
     if spec == "oracle":
         return _oracle
     if spec.endswith(".zip"):
@@ -147,9 +163,7 @@ def make_policy(spec: str, sb3_algo: str = "PPO", trust_policy_file: bool = Fals
         return _SB3Policy(spec, sb3_algo)
     module_name, sep, attr = spec.partition(":")
     if not sep or not module_name or not attr:
-        raise ValueError(
-            f"policy must be 'oracle', MODULE:CALLABLE or a path to an SB3 .zip, got {spec!r}"
-        )
+        raise ValueError(f"unknown policy {spec!r}: expected {POLICY_FORMS}")
     try:
         target: Any = importlib.import_module(module_name)
     except ImportError as err:
@@ -282,6 +296,25 @@ def check_scene_ids(episodes: Sequence[PointNavEpisode], scenes_root: str | None
                 raise ValueError(f"episode {ep.episode_id!r}: field 'scene_id': {err}") from None
 
 
+def select_episodes(
+    episodes: EpisodeDataset | Sequence[PointNavEpisode],
+    limit: int | None = None,
+    stride: int = 1,
+) -> list[PointNavEpisode]:
+    """Every ``stride``-th episode from the first, then the first ``limit`` of those (all
+    with None): ``list(episodes)[::stride][:limit]``.
+
+    Raises
+    ------
+    ValueError
+        For a ``limit`` or ``stride`` that is not an integer >= 1.
+    """
+    integer("stride", stride, minimum=1)
+    if limit is not None:
+        integer("limit", limit, minimum=1)
+    return list(episodes)[::stride][:limit]
+
+
 def evaluate(
     episodes: EpisodeDataset | Sequence[PointNavEpisode],
     policy: str | PolicyFactory = "oracle",
@@ -297,8 +330,11 @@ def evaluate(
     on_error: str = "stop",
     on_result: Callable[[EpisodeResult], None] | None = None,
     on_failure: Callable[[PointNavEpisode, str], None] | None = None,
+    limit: int | None = None,
+    stride: int = 1,
 ) -> list[EpisodeResult]:
-    """Play every episode once; the results in the episodes' order.
+    """Play every episode once (or the subset ``limit`` and ``stride`` select); the
+    results in the episodes' order.
 
     Parameters
     ----------
@@ -332,6 +368,9 @@ def evaluate(
     on_failure : callable, optional
         With ``on_error="skip"``: called with each failed episode and the message naming
         it (by default a ``RuntimeWarning``).
+    limit, stride : int, optional
+        Play only :func:`select_episodes` ``(episodes, limit, stride)``: every
+        ``stride``-th episode, then the first ``limit`` of those.
 
     Raises
     ------
@@ -344,7 +383,7 @@ def evaluate(
     KeyboardInterrupt
         Passed on, after every worker process has ended.
     """
-    episodes = list(episodes)
+    episodes = select_episodes(episodes, limit, stride)
     for name, value in (("workers", workers), ("max_steps", max_steps)):
         if isinstance(value, bool) or not isinstance(value, int) or value < 1:
             raise ValueError(f"{name} must be an integer >= 1, got {value!r}")

@@ -2,7 +2,8 @@
 
 Next to the results file ``R`` a run keeps ``R.partial``: a first line naming the run's
 settings (``{"pointnav_eval": {...}}``), then one line per finished episode, exactly the
-line it will have in ``R`` (:func:`~pointnav_core.evaluation_report.result_line`). Each
+line it will have in ``R`` (:func:`~pointnav_core.evaluation_report.result_line`); ``R``
+starts with the same first line and ends with the summary. Each
 line goes to disk in one ``write`` as its episode ends, and is taken back if the write
 fails (a full disk), so the log is valid JSON lines whatever stops the run. ``R`` itself is
 written once, at the end, in the dataset's order, whole or not at all; the log is then
@@ -19,7 +20,13 @@ from typing import Any
 
 from pointnav_core.datasets.format import PointNavEpisode
 from pointnav_core.errors import PointNavError
-from pointnav_core.evaluation_report import EpisodeResult, result_line, write_results
+from pointnav_core.evaluation_report import (
+    EpisodeResult,
+    result_line,
+    run_line,
+    summary_record,
+    write_results,
+)
 
 __all__ = ["ResultsLog", "ResultsWriteError"]
 
@@ -36,14 +43,16 @@ class ResultsLog:
     results : str
         The results file the run ends with.
     settings : mapping
-        What decides the results (dataset, policy, backend, ...): a resumed run must have
-        the same.
+        What decides the results (library version, dataset and its hash, policy, backend,
+        episode selection, ...): a resumed run must have the same. The results file
+        records them.
     """
 
     def __init__(self, results: str, settings: Mapping[str, Any]) -> None:
         self.results = results
         self.path = results + ".partial"
-        self.header = json.dumps({"pointnav_eval": dict(settings)}, sort_keys=True) + "\n"
+        self.settings = dict(settings)
+        self.header = run_line(self.settings)
         self.done: dict[str, EpisodeResult] = {}
         self._fd: int | None = None
         self._size = 0
@@ -83,8 +92,9 @@ class ResultsLog:
             lines = fh.read().split(b"\n")
         if not lines[0] or lines[0] + b"\n" != self.header.encode():
             raise ValueError(
-                f"{self.path} was written by a run with other arguments (dataset, policy, "
-                "backend, drive, max steps or scenes folder): rerun with those, or delete it"
+                f"{self.path} was written by a run with other arguments or inputs (dataset or "
+                "its contents, policy, backend, drive, max steps, scenes folder, --limit, "
+                "--stride or library version): rerun with those, or delete it"
             )
         size = len(lines[0]) + 1
         for number, line in enumerate(lines[1:], start=2):
@@ -124,17 +134,21 @@ class ResultsLog:
         self._write(result_line(result).encode())
         self.done.setdefault(result.episode_id, result)
 
-    def finish(self, episodes: Sequence[PointNavEpisode]) -> list[EpisodeResult]:
-        """Write the results file (the finished episodes in the dataset's order), then
-        remove the log. Returns those results."""
+    def finish(
+        self, episodes: Sequence[PointNavEpisode]
+    ) -> tuple[list[EpisodeResult], dict[str, Any] | None]:
+        """Write the results file (the settings, the finished episodes in the dataset's
+        order, their summary), then remove the log. Returns those results and the summary
+        (:func:`~pointnav_core.evaluation_report.summary_record`; None without results)."""
         ordered = [self.done[ep.episode_id] for ep in episodes if ep.episode_id in self.done]
+        summary = summary_record(ordered) if ordered else None
         try:
-            write_results(ordered, self.results)
+            write_results(ordered, self.results, run=self.settings, summary=summary)
         except OSError as err:
             raise ResultsWriteError(f"cannot write {self.results}: {err.strerror or err}") from None
         self.close()
         os.unlink(self.path)
-        return ordered
+        return ordered, summary
 
     def close(self) -> None:
         """Close the log, keeping it on disk."""
