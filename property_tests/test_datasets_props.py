@@ -31,7 +31,7 @@ def episodes(draw: st.DrawFn, episode_id: str) -> PointNavEpisode:
         start_position=(draw(coords), draw(coords), z),
         start_rotation=(0.0, 0.0, math.sin(yaw / 2), math.cos(yaw / 2)),
         goal_position=(draw(coords), draw(coords), z),
-        goal_radius=draw(st.none() | st.floats(0.0, 5.0)),
+        goal_radius=draw(st.none() | st.floats(1e-6, 5.0)),  # a radius of 0 is refused
         geodesic_distance=draw(st.floats(0.0, 1e4)),
         robot_radius=draw(st.floats(0.0, 1.0)),
     )
