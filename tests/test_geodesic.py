@@ -5,7 +5,7 @@ import math
 import numpy as np
 import pytest
 
-from pointnav_core.geodesic import planner as tangent_graph
+from pointnav_core.geodesic import Planner
 from pointnav_core.paths import path_length, resample_path
 from pointnav_core.geodesic.planner import planner_for
 from pointnav_core.maps import OBSTACLE, VOID, TraversableMap
@@ -87,7 +87,7 @@ def test_goal_field_cache_is_bounded_in_bytes(monkeypatch):
     planner = scene.planner(0)
     one = scene.goal_field(0, (0.5, 0.5)).field
     one.distance(1.5, 1.5)  # builds its per-step table
-    monkeypatch.setattr(tangent_graph, "FIELD_CACHE_BYTES", 3 * one.nbytes)
+    monkeypatch.setattr(Planner, "field_cache_bytes", 3 * one.nbytes)
     for i in range(20):
         scene.goal_field(0, (0.5 + 0.01 * i, 0.5)).distance(1.5, 1.5)
     assert sum(f.nbytes for f in planner._fields.values()) <= 3 * one.nbytes

@@ -7,7 +7,8 @@ The API (the model, its accuracy and cost: ``docs/geodesic.md``):
 - :class:`GoalField`: exact distances and paths from any point to one goal, and the
   per-step lookup (:meth:`GoalField.distance`) within :data:`LOOKUP_BOUND`;
 - :data:`MIN_RADIUS`, :data:`FIELD_CACHE_BYTES`, :data:`BLOCK`: the planner's smallest
-  radius, the goal-field cache's byte budget, the lookup table's block side.
+  radius, the goal-field cache's default byte budget (set ``Planner.field_cache_bytes``
+  to change it), the lookup table's block side.
 
 Inside, one module per step: ``tangents`` (the shared constructions and tolerances),
 ``sight`` (strict sight bounds), ``edges`` (common tangents), ``arcs`` (drawing arcs),

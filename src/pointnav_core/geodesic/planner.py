@@ -94,7 +94,16 @@ class Planner(ThawOnUnpickle):
         The floor's blocked set (every non-FREE cell, off the map, and its polygons).
     radius : float
         Robot radius in metres, >= 0.
+
+    Attributes
+    ----------
+    field_cache_bytes : int
+        Byte budget of the goal fields a planner keeps (default :data:`FIELD_CACHE_BYTES`,
+        256 MiB); set it on the class for every planner (``Planner.field_cache_bytes =
+        64 * 2**20``) or on one planner.
     """
+
+    field_cache_bytes: int = FIELD_CACHE_BYTES
 
     def __init__(self, collision: FloorCollision, radius: float) -> None:
         self.geo = collision
@@ -389,7 +398,7 @@ class Planner(ThawOnUnpickle):
     def goal_field(self, goal: ArrayLike) -> GoalField:
         """Return the cached :class:`GoalField` rooted at world point ``goal``.
 
-        The cache is bounded by :data:`FIELD_CACHE_BYTES`; the least recently used fields
+        The cache is bounded by :attr:`field_cache_bytes`; the least recently used fields
         are dropped beyond it.
         """
         g = np.asarray(goal, dtype=np.float64).reshape(-1)[:2]
@@ -403,7 +412,7 @@ class Planner(ThawOnUnpickle):
 
     def _trim_fields(self) -> None:
         total = sum(f.nbytes for f in self._fields.values())
-        while total > FIELD_CACHE_BYTES and len(self._fields) > 1:
+        while total > self.field_cache_bytes and len(self._fields) > 1:
             key = next(iter(self._fields))
             total -= self._fields.pop(key).nbytes
 
