@@ -52,6 +52,10 @@ _WINDOW = 16
 #: proven chord the robot may be for it to stay proven (a straight drive strays ~1e-7 m).
 _SHORT = 0.01
 _ON_CHORD = 1e-5
+#: Metres off its first leg the robot may be for the plan's candidates near a turn to be a
+#: fresh plan's (a straight drive strays ~1e-7 m; a fresh tangent from 0.1 mm off moves
+#: the turn by less).
+_ON_LEG = 1e-4
 
 
 def _wrap(angle: float) -> float:
@@ -111,13 +115,15 @@ class _Plan:
     """The beginning of a shortest path, kept while the robot follows it.
 
     ``points`` (N, 2) m is the drawn path (clear at ``radius`` m, its arcs circumscribed)
-    up to its first vertex ``lookahead`` or more along; ``leg`` is the leg the robot was
+    up to its first vertex ``2 * lookahead + _SHORT`` or more along; ``leg`` is the leg the robot was
     last found on (it only moves forward); ``goal`` is the ``(x, y, floor)`` it leads to.
     """
 
     points: NDArray[np.float64]
     radius: float
     goal: tuple[float, float, int]
+    #: Whether ``points`` reach the goal (else they stop at a vertex on the way).
+    whole: bool = False
     leg: int = 0
     #: ``(start, leg)``: the chord from ``start`` to the end of ``leg`` (less _SHORT) was
     #: found clear for a disc _ON_CHORD wider than ``radius``.
@@ -126,17 +132,29 @@ class _Plan:
     def locate(self, xy: NDArray[np.float64]) -> tuple[int, float] | None:
         """``(leg, distance)``: the nearest of the next :data:`_WINDOW` legs to ``xy`` and
         its distance (m); None when that is over :data:`_LEAVE` (the robot left the path)."""
-        stop = min(self.leg + _WINDOW, len(self.points) - 1)
-        a, b = self.points[self.leg : stop], self.points[self.leg + 1 : stop + 1]
-        d = b - a
-        length2 = np.einsum("ij,ij->i", d, d)
-        t = np.clip(np.einsum("ij,ij->i", xy - a, d) / np.maximum(length2, 1e-300), 0.0, 1.0)
-        off = np.hypot(*(a + t[:, None] * d - xy).T)
-        i = int(np.argmin(off))
-        if off[i] > _LEAVE:
+        x, y = float(xy[0]), float(xy[1])
+        pts = self.points
+        best, where = math.inf, self.leg
+        # A few legs at most: plain floats are several times quicker than numpy here.
+        for i in range(self.leg, min(self.leg + _WINDOW, len(pts) - 1)):
+            ax, ay = float(pts[i, 0]), float(pts[i, 1])
+            dx, dy = float(pts[i + 1, 0]) - ax, float(pts[i + 1, 1]) - ay
+            length2 = dx * dx + dy * dy
+            t = min(max(((x - ax) * dx + (y - ay) * dy) / length2, 0.0), 1.0) if length2 > 0.0 else 0.0
+            off = math.hypot(ax + t * dx - x, ay + t * dy - y)
+            if off < best:
+                best, where = off, i
+        if best > _LEAVE:
             return None
-        self.leg += i
-        return self.leg, float(off[i])
+        self.leg = where
+        return where, best
+
+    def ahead(self, xy: NDArray[np.float64]) -> float:
+        """Metres of the plan left from ``xy`` on its first leg (``inf`` if it reaches the goal)."""
+        if self.whole:
+            return math.inf
+        rest = np.hypot(*np.diff(self.points[1:], axis=0).T).sum() if len(self.points) > 2 else 0.0
+        return math.dist(xy, self.points[1]) + float(rest)
 
 
 class ShortestPathFollower:
@@ -227,10 +245,15 @@ class ShortestPathFollower:
             return None
         # Mid-leg, the shortest way from a point near the path heads for the leg's end, as
         # a fresh plan from there would; round a turn only a fresh plan knows the tangent.
-        leg, _ = at
+        leg, off = at
         turn = plan.points[leg + 1]
         span = math.dist(xy, turn)
         if span < self.lookahead + _SHORT:
+            # Still on the plan's first leg, straight towards the turn, a fresh plan from
+            # here wraps the same arc: the plan's own candidates, tested, decide.
+            if leg == 0 and off <= _ON_LEG and span > _SAME and plan.ahead(xy) >= self.lookahead:
+                tmap = self.env.scene.floors[self.task.floor]
+                return self._pick(xy, np.vstack([xy, plan.points[1:]]), plan.radius, tmap, fallback=False)
             return None
         ahead = xy + (turn - xy) * (self.lookahead / span)
         if plan.chord is None or plan.chord[1] != leg or _off_segment(xy, plan.chord[0], turn) > _ON_CHORD:
@@ -263,7 +286,9 @@ class ShortestPathFollower:
             if aim is None:
                 continue
             field = env.scene.goal_field(task.floor, aim, robot=radius)
-            path, _ = field.path(xy, max_length=self.lookahead)
+            # Twice the lookahead: the plan still covers a lookahead from where the robot
+            # will be as it nears the turn.
+            path, _ = field.path(xy, max_length=2.0 * self.lookahead + _SHORT)
             if path is not None:
                 break
             if radius > spec.radius:
@@ -279,7 +304,8 @@ class ShortestPathFollower:
             if path is None:
                 return None
             return centre
-        self._plan = _Plan(path, radius, (float(goal[0]), float(goal[1]), task.floor))
+        whole = math.dist(path[-1], aim) == 0.0
+        self._plan = _Plan(path, radius, (float(goal[0]), float(goal[1]), task.floor), whole)
         return self._pick(xy, path, radius, tmap, fallback=True)
 
     def _pick(
