@@ -144,3 +144,11 @@ def test_scene_build_refuses_bad_input_in_one_line(folder, monkeypatch, capsys, 
     assert main(argv) == 2
     err = capsys.readouterr().err
     assert message in err and "Traceback" not in err and len(err.strip().splitlines()) == 1
+
+
+def test_scene_build_in_worker_processes_names_a_bad_scene(folder, capsys):
+    from pointnav_core.cli import main
+
+    assert main(["scene", "build", "maze:3", "nope.map", "--workers", "2", "--quiet"]) == 2
+    err = capsys.readouterr().err
+    assert "scene 'nope.map'" in err and "no such file" in err and len(err.strip().splitlines()) == 1

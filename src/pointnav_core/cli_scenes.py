@@ -20,14 +20,22 @@ import argparse
 import os
 import time
 from collections.abc import Sequence
-from concurrent.futures import ProcessPoolExecutor, as_completed
-from multiprocessing import get_context
 from typing import Any
+
+from pointnav_core.workers import WorkerError, WorkerPool, usable_cores
 
 __all__ = ["add_commands", "build_scenes"]
 
 #: Extra width (m) the oracle (``ShortestPathFollower``'s default ``margin``) plans with.
 _ORACLE_MARGIN = 0.02
+
+
+def _no_state() -> None:
+    return None
+
+
+def _build_job(_state: None, job: tuple[str, str | None, float]) -> tuple[str, float, int, int, float]:
+    return _build_one(*job)
 
 
 def _build_one(scene_id: str, root: str | None, radius: float) -> tuple[str, float, int, int, float]:
@@ -69,11 +77,15 @@ def build_scenes(
                 done[i] = _build_one(*job)
                 bar.update(1)
         else:
-            with ProcessPoolExecutor(min(workers, len(jobs)), mp_context=get_context("spawn")) as pool:
-                futures = {pool.submit(_build_one, *job): i for i, job in enumerate(jobs)}
-                for future in as_completed(futures):
-                    done[futures[future]] = future.result()
-                    bar.update(1)
+            # Workers that end with this process, even when it is killed (pointnav_core.workers).
+            with WorkerPool(min(workers, len(jobs), usable_cores()), _no_state, (), _build_job) as pool:
+                try:
+                    for i, row in pool.imap_unordered(enumerate(jobs)):
+                        done[i] = row  # type: ignore[index]
+                        bar.update(1)
+                except WorkerError as err:
+                    where = "" if err.key is None else f"scene {jobs[err.key][0]!r}: "  # type: ignore[index]
+                    raise ValueError(f"{where}{err.cause}") from None
     return [done[i] for i in range(len(jobs))]
 
 
