@@ -152,8 +152,8 @@ def test_every_engine_builds_the_same_spaces_and_first_observation(config):
     multi = parallel_env(scene=scene, n_robots=2, config=config)
     vector = VectorPointNavEnv(2, scene=scene, config=config, seed=0, pool_size=1)
     fleet = VectorPointNavEnv(1, n_robots=2, scene=scene, config=config, seed=0, pool_size=1)
-    for env in (made, multi, vector, fleet):
-        assert env.unwrapped.config is config if hasattr(env, "unwrapped") else env.config is config
+    for env in (single, made, multi, vector, fleet):
+        assert env.unwrapped.config is config
     obs_space, act_space = single.observation_space, single.action_space
     n_sensor = 16 if config is SCAN else 64
     assert obs_space.shape == (8 + n_sensor,) and made.observation_space == obs_space
@@ -174,9 +174,9 @@ def test_every_engine_builds_the_same_spaces_and_first_observation(config):
 
 def test_arguments_the_config_sets_are_refused_beside_it():
     scene = room()
-    with pytest.raises(ValueError, match="robot given beside config, which sets them"):
+    with pytest.raises(ValueError, match=r"robot given beside config, which sets it: change the config instead \(dataclasses.replace"):
         PointNavEnv(scene=scene, robot={"radius": 0.2}, config=SCAN)
-    with pytest.raises(ValueError, match="sensors, action_space given beside config"):
+    with pytest.raises(ValueError, match="sensors, action_space given beside config, which sets them"):
         parallel_env(scene=scene, sensors=None, action_space="continuous", config=SCAN)
     with pytest.raises(ValueError, match="max_episode_steps given beside config"):
         VectorPointNavEnv(1, scene=scene, max_episode_steps=10, config=SCAN)

@@ -301,8 +301,9 @@ def takes_config(adapt: _Adapt | None = None, extra: tuple[str, ...] = ()) -> Ca
             clash = [k for k in (*supplied, *extra) if k in given]
             if clash:
                 raise ValueError(
-                    f"{', '.join(clash)} given beside config, which sets them: change the config "
-                    f"instead (dataclasses.replace(config, ...))"
+                    f"{', '.join(clash)} given beside config, which sets "
+                    f"{'it' if len(clash) == 1 else 'them'}: change the config instead "
+                    f"(dataclasses.replace(config, ...))"
                 )
             given.pop("self")
             return init(self, **{**given, **supplied})
