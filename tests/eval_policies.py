@@ -26,3 +26,17 @@ def raise_on_episode(env):
         return broken
     follower = ShortestPathFollower(env)
     return lambda obs: follower.act()
+
+
+def scan16_forward(env):
+    """MOVE_FORWARD always, after checking that the env is the one the 16-ray scan config
+    of ``tests/test_eval_env_config.py`` builds: flat observations of the 8 ``low_dim``
+    values and 16 ranges, 3 discrete actions (no STOP), 12 actions per episode."""
+    assert env.observation_space.shape == (24,) and env.action_space.n == 3
+    assert env.task.max_steps == 12 and env.task.goal_in_polar
+
+    def act(obs):
+        assert obs.shape == (24,)
+        return 0
+
+    return act

@@ -24,6 +24,7 @@ __all__ = [
     "OBSTACLE",
     "VOID",
     "BackendError",
+    "EnvConfig",
     "PointNavEnv",
     "PointNavError",
     "PointNavigationTask",
@@ -38,8 +39,13 @@ __all__ = [
     "spl",
 ]
 
-#: Exports that load Gymnasium or PettingZoo, imported on first access.
-_LAZY = {"PointNavEnv": "pointnav_core.env", "MultiPointNavEnv": "pointnav_core.parallel"}
+#: Exports that load Gymnasium or PettingZoo (EnvConfig checks its fields with the envs' own
+#: code), imported on first access.
+_LAZY = {
+    "PointNavEnv": "pointnav_core.env",
+    "MultiPointNavEnv": "pointnav_core.parallel",
+    "EnvConfig": "pointnav_core.env_config",
+}
 
 
 def __getattr__(name: str) -> Any:

@@ -93,7 +93,30 @@ def _run_settings(args: argparse.Namespace, scenes_dir: str) -> dict[str, Any]:
         "policy": args.policy, "sb3_algo": args.sb3_algo, "backend": args.backend,
         "drive": args.drive, "max_steps": args.max_steps, "scenes_dir": os.path.abspath(scenes_dir),
         "limit": args.limit, "stride": args.stride,
+        "env_config": None if args.config is None else args.config.to_dict(),
     }
+
+
+#: ``pointnav eval``'s flags that an env config sets, and their defaults without one.
+_CONFIG_FLAGS = {"backend": "kinematic", "drive": "differential", "max_steps": 1000}
+
+
+def _env_config(args: argparse.Namespace) -> None:
+    """Read ``--env-config`` into ``args.config`` (None without it), and settle
+    ``--backend``, ``--drive`` and ``--max-steps``: the config's values, or the defaults
+    without one. One of those flags beside ``--env-config`` is refused, naming it."""
+    from pointnav_core.env_config import EnvConfig
+
+    args.config = None if args.env_config is None else EnvConfig.load(args.env_config)
+    for name, default in _CONFIG_FLAGS.items():
+        if args.config is None:
+            value = default if getattr(args, name) is None else getattr(args, name)
+        elif getattr(args, name) is not None:
+            flag = "--" + name.replace("_", "-")
+            raise ValueError(f"{flag} given beside --env-config, which sets it: edit the config file instead")
+        else:
+            value = args.config.robot.drive if name == "drive" else getattr(args.config, name)
+        setattr(args, name, value)
 
 
 def _print_summary(args: argparse.Namespace, summary: dict[str, Any], of: int) -> None:
@@ -130,6 +153,7 @@ def _eval(args: argparse.Namespace) -> int:
     from pointnav_core.datasets import EpisodeDataset
     from pointnav_core.errors import PointNavError
     from pointnav_core.evaluation import (
+        check_robot_radius,
         check_scene_ids,
         evaluate,
         make_policy,
@@ -143,7 +167,9 @@ def _eval(args: argparse.Namespace) -> int:
     if os.getcwd() not in sys.path:  # MODULE:CALLABLE from here, as `python -m` would find it
         sys.path.insert(0, os.getcwd())
     args.limit, args.stride = _count("--limit", args.limit), _count("--stride", args.stride)
+    _env_config(args)
     inputs = [args.dataset] + ([args.policy] if args.policy.endswith(".zip") else [])
+    inputs += [args.env_config] if args.env_config is not None else []
     results_path = check_output("--results", args.results or _default_output(args.dataset, ".jsonl"), inputs)
     plot_path = check_output("--plot", args.plot or _default_output(args.dataset, ".png"), [*inputs, results_path])
     if results_path.endswith(".csv"):
@@ -155,19 +181,22 @@ def _eval(args: argparse.Namespace) -> int:
     dataset = EpisodeDataset.load(args.dataset)
     episodes = select_episodes(dataset, args.limit, args.stride)
     check_scene_ids(episodes, scenes_dir)
+    if args.config is not None:
+        check_robot_radius(args.config, episodes)
     log = ResultsLog(results_path, _run_settings(args, scenes_dir))
     check_output("--results (its log)", log.path, inputs)
     done = log.start(args.resume, episodes)
     failed: list[str] = []
+    # With an env config, evaluate takes these from it (args holds the config's values).
+    settings = {} if args.config is not None else {k: getattr(args, k) for k in _CONFIG_FLAGS}
     try:
         evaluate(
             [ep for ep in episodes if ep.episode_id not in done],
             args.policy,
-            backend=args.backend,
+            **settings,
             workers=args.workers,
-            max_steps=args.max_steps,
-            drive=args.drive,
             scenes_root=scenes_dir,
+            env_config=args.config,
             sb3_algo=args.sb3_algo,
             progress=not args.quiet,
             trust_policy_file=args.trust_policy_file,
@@ -314,10 +343,17 @@ def add_commands(sub: Any, positive_int: Callable[[str], int]) -> None:
     ev.add_argument(
         "--sb3-algo", default="PPO", help="algorithm class of an SB3 .zip (default PPO)"
     )
-    ev.add_argument("--backend", default="kinematic")
-    ev.add_argument("--drive", choices=("differential", "holonomic"), default="differential")
+    ev.add_argument(
+        "--env-config",
+        default=None,
+        metavar="FILE",
+        help="the env config (.yaml or .json) the policy was trained with: sensors, actions, robot, "
+        "backend, task settings, max steps",
+    )
+    ev.add_argument("--backend", default=None, help="default kinematic (or the env config's)")
+    ev.add_argument("--drive", choices=("differential", "holonomic"), default=None, help="default differential")
     ev.add_argument("--workers", type=positive_int, default=1, metavar="N")
-    ev.add_argument("--max-steps", type=positive_int, default=1000, metavar="N")
+    ev.add_argument("--max-steps", type=positive_int, default=None, metavar="N", help="default 1000")
     ev.add_argument(
         "--limit", default=None, metavar="N", help="play only the first N episodes (after --stride)"
     )

@@ -12,6 +12,7 @@ from numpy.typing import NDArray
 from pointnav_core import _envcommon, scenes
 from pointnav_core.actions import check_discrete_action, make_discrete_actions
 from pointnav_core.backend import Backend, RobotSpec, make_backend
+from pointnav_core.env_config import EnvConfig, takes_config
 from pointnav_core.maps import BoundedCache
 from pointnav_core.task import PointNavigationTask
 
@@ -174,6 +175,14 @@ class PointNavEnv(gym.Env[Any, np.ndarray]):
     | `sensors`          | **dict** or `None`           | `None`            | `scan`, `local_map`  |
     | `action_space`     | **str**                      | `"continuous"`    | or `"discrete"`      |
     | `discrete_actions` | **dict** or `None`           | `None`            | step, angle, STOP    |
+    | `config`           | **EnvConfig** or `None`      | `None`            | all of the above but |
+    |                    |                              |                   | scene, render_mode   |
+
+    `config` (:class:`~pointnav_core.env_config.EnvConfig`, read from YAML or JSON with
+    `EnvConfig.load`) gives `robot`, `task` (with its `max_steps`), `backend`,
+    `flatten_obs`, `action_frequency`, `sensors`, `action_space` and `discrete_actions`;
+    giving one of those beside it is a `ValueError` naming it. The batched engine and the
+    multi-robot env take the same config and give the same spaces.
 
     ```python
     >>> env = PointNavEnv(sensors={"scan": {"n_rays": 32}}, action_space="discrete")
@@ -194,6 +203,7 @@ class PointNavEnv(gym.Env[Any, np.ndarray]):
 
     metadata = {"render_modes": ["rgb_array"], "render_fps": 10}
 
+    @takes_config()
     def __init__(
         self,
         scene: scenes.Scene | None = None,
@@ -207,7 +217,10 @@ class PointNavEnv(gym.Env[Any, np.ndarray]):
         sensors: Mapping[str, Any] | None = None,
         action_space: str = "continuous",
         discrete_actions: Mapping[str, Any] | None = None,
+        config: EnvConfig | None = None,
     ) -> None:
+        #: The :class:`~pointnav_core.env_config.EnvConfig` this env was built from, or None.
+        self.config = config
         if render_mode is not None and render_mode not in self.metadata["render_modes"]:
             raise ValueError(
                 f"render_mode must be None or one of {self.metadata['render_modes']}, "
@@ -349,6 +362,12 @@ class TaskStepLimit(gym.Wrapper[Any, np.ndarray, Any, np.ndarray], gym.utils.Rec
         inner: Any = env
         while isinstance(inner, gym.Wrapper):
             if isinstance(inner, gym.wrappers.TimeLimit):
-                env.unwrapped.max_episode_steps = inner._max_episode_steps
+                limit, config = inner._max_episode_steps, getattr(env.unwrapped, "config", None)
+                if config is not None and limit != config.max_steps:
+                    raise ValueError(
+                        f"max_episode_steps={limit} given beside config, which sets "
+                        f"max_steps={config.max_steps}: change the config instead"
+                    )
+                env.unwrapped.max_episode_steps = limit
                 break
             inner = inner.env

@@ -43,7 +43,14 @@ from pointnav_core import metrics
 from pointnav_core.datasets.format import EpisodeDataset, PointNavEpisode
 from pointnav_core.datasets.playback import episode_seed
 from pointnav_core.datasets.scene_sets import load_scene, locate_scene
+from pointnav_core.env_config import EnvConfig
 from pointnav_core.errors import EpisodeError
+from pointnav_core.evaluation_config import (
+    check_beside_config,
+    check_robot_radius,
+    check_spaces,
+    episode_config,
+)
 from pointnav_core.evaluation_report import (
     EpisodeResult,
     bootstrap_interval,
@@ -62,7 +69,10 @@ __all__ = [
     "POLICY_FORMS",
     "EpisodeResult",
     "bootstrap_interval",
+    "check_robot_radius",
     "check_scene_ids",
+    "check_spaces",
+    "episode_config",
     "evaluate",
     "make_policy",
     "plot_results",
@@ -130,9 +140,15 @@ class _SB3Policy:
 
         return isinstance(self.model.observation_space, spaces.Box)
 
+    def check_env(self, env: Any) -> None:
+        """ValueError unless ``env``'s observation and action spaces have the shapes the
+        model was trained on (their bounds may differ: they follow the scene's size)."""
+        check_spaces(f"policy {self.path!r}", self.model, env)
+
     def __call__(self, env: Any) -> Policy:
         model = self.model
         return lambda obs: model.predict(obs, deterministic=True)[0]
+
 
 
 def make_policy(spec: str, sb3_algo: str = "PPO", trust_policy_file: bool = False) -> PolicyFactory:
@@ -190,12 +206,14 @@ class _Runner:
         scenes_root: str | None,
         sb3_algo: str,
         trust_policy_file: bool = False,
+        env_config: EnvConfig | None = None,
     ) -> None:
         self.factory = (
             make_policy(policy, sb3_algo, trust_policy_file) if isinstance(policy, str) else policy
         )
         self.backend, self.max_steps, self.drive = backend, max_steps, drive
         self.scenes_root, self.envs = scenes_root, {}
+        self.env_config = env_config
 
     def env_for(self, ep: PointNavEpisode) -> Any:
         from pointnav_core.env import PointNavEnv
@@ -213,6 +231,9 @@ class _Runner:
                     f"episode {ep.episode_id!r}: field 'info.floor' is {ep.floor}, but scene "
                     f"{ep.scene_id!r} has {scene.n_floors} floor(s)"
                 )
+            if self.env_config is not None:
+                self.envs[key] = PointNavEnv(scene=scene, config=episode_config(self.env_config, ep))
+                return self.envs[key]
             task: dict[str, Any] = {
                 "floor": ep.floor,
                 "termination_config": {"max_steps": self.max_steps},
@@ -236,6 +257,9 @@ class _Runner:
         try:
             try:
                 env = self.env_for(ep)
+                check = getattr(self.factory, "check_env", None)
+                if check is not None:  # a model that cannot read this env is bad input
+                    check(env)
                 obs, info = env.reset(seed=episode_seed(ep), options={"episode": ep})
             except (ValueError, FileNotFoundError) as err:
                 return "input", str(err)
@@ -332,6 +356,7 @@ def evaluate(
     on_failure: Callable[[PointNavEpisode, str], None] | None = None,
     limit: int | None = None,
     stride: int = 1,
+    env_config: EnvConfig | None = None,
 ) -> list[EpisodeResult]:
     """Play every episode once (or the subset ``limit`` and ``stride`` select); the
     results in the episodes' order.
@@ -371,6 +396,11 @@ def evaluate(
     limit, stride : int, optional
         Play only :func:`select_episodes` ``(episodes, limit, stride)``: every
         ``stride``-th episode, then the first ``limit`` of those.
+    env_config : EnvConfig, optional
+        Build every episode's env from this config (sensors, actions, robot, backend, task
+        settings, ``max_steps``; :mod:`pointnav_core.env_config`), with the episode's scene,
+        floor, start, goal and goal radius; ``backend``, ``max_steps`` and ``drive`` must
+        then keep their defaults, and every episode's robot radius must be the config's.
 
     Raises
     ------
@@ -391,8 +421,11 @@ def evaluate(
         raise ValueError(f"on_error must be one of {list(ON_ERROR)}, got {on_error!r}")
     if isinstance(policy, str):
         make_policy(policy, sb3_algo, trust_policy_file)  # a bad spec is refused here, once
+    if env_config is not None:
+        check_beside_config(env_config, backend=backend, max_steps=max_steps, drive=drive)
+        check_robot_radius(env_config, episodes)
     check_scene_ids(episodes, scenes_root)
-    args = (policy, backend, max_steps, drive, scenes_root, sb3_algo, trust_policy_file)
+    args = (policy, backend, max_steps, drive, scenes_root, sb3_algo, trust_policy_file, env_config)
     results: list[EpisodeResult | None] = [None] * len(episodes)
     from tqdm import tqdm
 

@@ -36,7 +36,10 @@ Arguments
 ---------
 ``parallel_env(scene=None, n_robots=2, robot=None, task=None, backend="kinematic",
 backend_kwargs=None, max_cycles=500, render_mode=None, flatten_obs=True, finished="park",
-action_frequency=10.0, sensors=None, action_space="continuous", discrete_actions=None)``
+action_frequency=10.0, sensors=None, action_space="continuous", discrete_actions=None,
+config=None)``; ``config`` (an :class:`~pointnav_core.env_config.EnvConfig`) sets every
+argument below but ``scene``, ``n_robots``, ``max_cycles`` (default: its ``max_steps``),
+``render_mode`` and ``finished``.
 
 | Argument           | Type                        | Default           | Description            |
 |--------------------|-----------------------------|-------------------|------------------------|
@@ -186,6 +189,7 @@ from pointnav_core._parallel_actions import check_actions, named_action_error, n
 from pointnav_core._parallel_state import STATE_FIELDS, global_state, state_space
 from pointnav_core.actions import make_discrete_actions
 from pointnav_core.backend import Backend, RobotSpec, make_backend
+from pointnav_core.env_config import EnvConfig, multi_robot_arguments, takes_config
 from pointnav_core.fleet import (
     FINISHED_MODES,
     check_finished,
@@ -247,6 +251,11 @@ class MultiPointNavEnv(ParallelEnv[str, Any, np.ndarray]):
         A finished robot stays as an obstacle, or leaves the world.
     action_frequency : float
         Control rate (Hz), from 0.1 to 10,000.
+    config : EnvConfig, optional
+        :class:`~pointnav_core.env_config.EnvConfig`: every robot's ``robot`` and ``task``
+        (with its ``max_steps``), ``backend``, ``flatten_obs``, ``action_frequency``,
+        ``sensors``, ``action_space`` and ``discrete_actions``, which may then not be given
+        (a ValueError names them); ``max_cycles`` defaults to its ``max_steps``.
 
     Raises
     ------
@@ -256,6 +265,7 @@ class MultiPointNavEnv(ParallelEnv[str, Any, np.ndarray]):
 
     metadata = {"render_modes": ["rgb_array"], "name": "MultiPointNav-v0", "render_fps": 10}
 
+    @takes_config(multi_robot_arguments)
     def __init__(
         self,
         scene: scenes.Scene | None = None,
@@ -273,7 +283,10 @@ class MultiPointNavEnv(ParallelEnv[str, Any, np.ndarray]):
         sensors: Mapping[str, Any] | None = None,
         action_space: str = "continuous",
         discrete_actions: Mapping[str, Any] | None = None,
+        config: EnvConfig | None = None,
     ) -> None:
+        #: The :class:`~pointnav_core.env_config.EnvConfig` this env was built from, or None.
+        self.config = config
         if render_mode is not None and render_mode not in (*self.metadata["render_modes"], "human"):
             raise ValueError(
                 f"render_mode must be None or one of {self.metadata['render_modes']}, "

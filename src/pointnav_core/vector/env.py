@@ -19,6 +19,7 @@ import numpy as np
 from gymnasium.vector import AutoresetMode, VectorEnv
 
 from pointnav_core import _envcommon, scenes, validation
+from pointnav_core.env_config import EnvConfig, takes_config, vector_arguments
 from pointnav_core.vector import contacts_jit
 from pointnav_core.vector.contacts import advance
 from pointnav_core.vector.accounting import task_step
@@ -135,6 +136,12 @@ class VectorPointNavEnv(PoolRefreshing, VectorEnv):
     max_episode_steps : int, optional
         The task's ``max_steps``, as ``gymnasium.make(..., max_episode_steps=N)`` sets it for
         the single env (the derived ``path_range`` follows).
+    config : EnvConfig, optional
+        :class:`~pointnav_core.env_config.EnvConfig`: ``robot``, ``task``, ``max_steps``,
+        ``sensors``, ``action_frequency``, ``action_space`` and ``discrete_actions``, which
+        may then not be given (nor ``max_episode_steps``); its ``backend`` must be
+        ``"kinematic"`` and its ``flatten_obs`` True. A single env built from the same
+        config has the same spaces (:mod:`pointnav_core.env_config`).
 
     Notes
     -----
@@ -224,6 +231,7 @@ class VectorPointNavEnv(PoolRefreshing, VectorEnv):
                     raise ValueError(f"{name} applies to several robots per world (n_robots > 1), got n_robots={n_robots!r}")
         return super().__new__(cls)
 
+    @takes_config(vector_arguments, extra=("max_episode_steps",))
     def __init__(
         self,
         num_envs: int = 1,
@@ -240,8 +248,12 @@ class VectorPointNavEnv(PoolRefreshing, VectorEnv):
         action_space: str = "continuous",
         discrete_actions: Mapping[str, Any] | None = None,
         starts_per_goal: int = 1,
+        config: EnvConfig | None = None,
     ) -> None:
         from pointnav_core.env import PointNavEnv
+
+        #: The :class:`~pointnav_core.env_config.EnvConfig` these worlds were built from, or None.
+        self.config = config
 
         self.num_envs = validation.integer("num_envs", num_envs, minimum=1)
         if validation.integer("n_robots", n_robots, minimum=1) != 1:  # several: built by __new__

@@ -25,6 +25,7 @@ import gymnasium as gym
 import numpy as np
 
 from pointnav_core import scenes, validation
+from pointnav_core.env_config import EnvConfig, takes_config, vector_fleet_arguments
 from pointnav_core.fleet import FINISHED_MODES, check_finished
 from pointnav_core.vector import contacts_jit
 from pointnav_core.vector.contacts import advance
@@ -79,6 +80,7 @@ class VectorFleetEnv(VectorPointNavEnv):
 
     _pool_class = FleetPool
 
+    @takes_config(vector_fleet_arguments, extra=("max_episode_steps",))
     def __init__(
         self,
         num_envs: int = 1,
@@ -97,8 +99,11 @@ class VectorFleetEnv(VectorPointNavEnv):
         action_space: str = "continuous",
         discrete_actions: Mapping[str, Any] | None = None,
         starts_per_goal: int = 1,
+        config: EnvConfig | None = None,
     ) -> None:
         from pointnav_core.parallel import parallel_env
+
+        self.config = config  # applied by takes_config; max_cycles defaults to its max_steps
 
         self.num_envs = validation.integer("num_envs", num_envs, minimum=1)
         self.n_robots = validation.integer("n_robots", n_robots, minimum=2)
