@@ -28,6 +28,7 @@ from pointnav_core.vector.episodes import EpisodePool, fixed_pose
 from pointnav_core.vector.falls import apply_falls
 from pointnav_core.vector.floors import FloorTables
 from pointnav_core.vector.local_map import VectorLocalMap, local_map_term
+from pointnav_core.vector.pool_build import build_parts, pool_options
 from pointnav_core.vector.refresh import PoolRefreshing
 from pointnav_core.vector.scan import ScanTables, VectorScan, requested_scan
 from pointnav_core.vector.xp import make_arrays
@@ -240,6 +241,8 @@ class VectorPointNavEnv(PoolRefreshing, VectorEnv):
         action_space: str = "continuous",
         discrete_actions: Mapping[str, Any] | None = None,
         starts_per_goal: int = 1,
+        workers: int | None = None,
+        progress: bool | None = None,
     ) -> None:
         from pointnav_core.env import PointNavEnv
 
@@ -253,6 +256,7 @@ class VectorPointNavEnv(PoolRefreshing, VectorEnv):
         self.arrays = make_arrays(device)
         self.device = device
         self.scenes = scene_list = _scene_list(scene)
+        self._pool_workers, self._pool_progress = pool_options(workers, progress, len(scene_list))
         self.robot = _envcommon.make_robot(robot)  # either drive (vector.drive)
         self._samplers = [
             PointNavEnv(scene=s, robot=self.robot, task=dict(task), sensors=sensors, flatten_obs=True,
@@ -338,7 +342,11 @@ class VectorPointNavEnv(PoolRefreshing, VectorEnv):
     def _build_pool(self, fixed: Sequence[tuple[Any, float, Any, int]]) -> None:
         size = 0 if fixed else self.pool_size
         seeds = self._rng.integers(2**31, size=size * len(self.scenes))
-        self.pool = self._pool_class(self._samplers, size, seeds, self.arrays, fixed, self.starts_per_goal, self._reach)
+        # Each scene's part, in worker processes with workers > 1 (the same arrays).
+        parts = None if fixed else build_parts(self._pool_class, self._samplers, size, seeds, self.starts_per_goal,
+                                               self._reach, self._pool_workers, self._pool_progress)
+        self.pool = self._pool_class(self._samplers, size, seeds, self.arrays, fixed, self.starts_per_goal, self._reach,
+                                     parts=parts)
 
     # ------------------------------------------------------------------ Gymnasium API
     def reset(self, *, seed: int | None = None, options: dict[str, Any] | None = None) -> tuple[Any, dict[str, Any]]:

@@ -36,6 +36,7 @@ from pointnav_core.vector.env import VectorPointNavEnv, _scene_list, check_real_
 from pointnav_core.vector.falls import apply_falls
 from pointnav_core.vector.fleet_pool import FleetPool, check_fixed_episode
 from pointnav_core.vector.floors import FloorTables
+from pointnav_core.vector.pool_build import pool_options
 from pointnav_core.vector.per_robot import (
     envelope,
     read_tasks,
@@ -97,6 +98,8 @@ class VectorFleetEnv(VectorPointNavEnv):
         action_space: str = "continuous",
         discrete_actions: Mapping[str, Any] | None = None,
         starts_per_goal: int = 1,
+        workers: int | None = None,
+        progress: bool | None = None,
     ) -> None:
         from pointnav_core.parallel import parallel_env
 
@@ -113,6 +116,7 @@ class VectorFleetEnv(VectorPointNavEnv):
         self.arrays = a = make_arrays(device)
         self.device = device
         self.scenes = scene_list = _scene_list(scene)
+        self._pool_workers, self._pool_progress = pool_options(workers, progress, len(scene_list))
         #: One spec per robot; ``robot`` is their envelope (largest radius, highest speeds).
         self.robots = robot_specs(robot, self.n_robots)
         self.robot = spec = envelope(self.robots)
