@@ -136,6 +136,14 @@ class VectorPointNavEnv(PoolRefreshing, VectorEnv):
     max_episode_steps : int, optional
         The task's ``max_steps``, as ``gymnasium.make(..., max_episode_steps=N)`` sets it for
         the single env (the derived ``path_range`` follows).
+    workers : int, optional
+        Processes that build a pool over several scenes, each scene's episodes and goal
+        fields in one (:mod:`pointnav_core.vector.pool_build`); the pool is the same, byte
+        for byte, for any number. Default: the usable cores, at most one per scene, from
+        4 scenes on; 1 builds in this process. A script that uses more than one must guard
+        its entry point (``if __name__ == "__main__":``), as for any spawned process.
+    progress : bool, optional
+        A tqdm bar over the pool's scenes on stderr; default: from 4 scenes on, on a terminal.
 
     Notes
     -----

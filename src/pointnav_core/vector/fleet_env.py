@@ -76,6 +76,9 @@ class VectorFleetEnv(VectorPointNavEnv):
     starts_per_goal : int
         Sets of starts per pool episode, >= 1: the extra sets share its goals and their
         settled fields (:class:`~pointnav_core.vector.fleet_pool.FleetPool`).
+    workers, progress
+        As for :class:`~pointnav_core.vector.env.VectorPointNavEnv`: a pool's scenes built
+        in worker processes (the same pool), with a progress bar over them.
     """
 
     _pool_class = FleetPool

@@ -14,6 +14,7 @@ when another process built it before, rather than building it again.
 from __future__ import annotations
 
 import math
+import warnings
 from collections.abc import Sequence
 from typing import Any
 
@@ -78,8 +79,8 @@ def build_parts(kind: Any, samplers: Sequence[Any], pool_size: int, seeds: Seque
     workers : int
         Processes (1: here, scene after scene).
     progress : bool, optional
-        A tqdm bar over the scenes; None: from :data:`PROGRESS_SCENES` scenes on (and only
-        on a terminal).
+        A tqdm bar over the scenes (on stderr); None: from :data:`PROGRESS_SCENES` scenes
+        on, on a terminal.
 
     Raises
     ------
@@ -87,32 +88,54 @@ def build_parts(kind: Any, samplers: Sequence[Any], pool_size: int, seeds: Seque
         A scene's error, of its own type, naming the scene (``scene 3: ...``); a worker
         that dies raises :class:`~pointnav_core.workers.WorkerError` naming its scene.
         The byte budget (:data:`~pointnav_core.vector.fields.FIELD_TABLE_BYTES`) is
-        checked as the parts come in, before any further one is kept.
+        checked as the parts come in, before any further one is kept. Workers that cannot
+        start (a script without the ``__main__`` guard) give a ``RuntimeWarning``, and the
+        pool is built here.
     """
     from tqdm.auto import tqdm
 
     n = len(samplers)
-    show = n >= PROGRESS_SCENES if progress is None else bool(progress)
+    # None: tqdm's own choice (a terminal only) from PROGRESS_SCENES scenes on; True: shown.
+    disable = (None if n >= PROGRESS_SCENES else True) if progress is None else not progress
+    with tqdm(total=n, desc="pool scenes", unit="scene", disable=disable) as bar:
+        if workers > 1 and n > 1:
+            try:
+                return _in_workers(kind, samplers, pool_size, seeds, starts, reach, workers, bar)
+            except WorkerError as error:
+                if error.key is not None:
+                    raise
+                # No worker started: most often a script without the __main__ guard.
+                warnings.warn(
+                    f"the pool's worker processes could not start ({error.cause}): a script that starts "
+                    "them must guard its entry point with `if __name__ == '__main__':`; building the pool "
+                    "in this process (workers=1 does so without trying)", RuntimeWarning, stacklevel=4,
+                )
+        parts: list[ScenePart] = []
+        cells = goals = 0
+        for s, env in enumerate(samplers):
+            part = kind.scene_part(env, s, pool_size, seeds[s * pool_size:(s + 1) * pool_size], starts, reach, cells, goals)
+            cells, goals = cells + part.cells, goals + len(part.fields)
+            parts.append(part)
+            bar.update(1)
+        return parts
+
+
+def _in_workers(kind: Any, samplers: Sequence[Any], pool_size: int, seeds: Sequence[int], starts: int, reach: float,
+                workers: int, bar: Any) -> list[ScenePart]:
+    """:func:`build_parts` with ``workers`` processes; the budget is checked as parts come in."""
+    n = len(samplers)
     parts: list[ScenePart | None] = [None] * n
     cells = goals = 0
-    with tqdm(total=n, desc="pool scenes", unit="scene", disable=not show or None) as bar:
-        if workers <= 1 or n <= 1:
-            for s, env in enumerate(samplers):
-                parts[s] = kind.scene_part(env, s, pool_size, seeds[s * pool_size:(s + 1) * pool_size], starts, reach,
-                                           cells, goals)
-                cells, goals = cells + parts[s].cells, goals + len(parts[s].fields)
-                bar.update(1)
-            return parts  # type: ignore[return-value]
-        items = ((f"scene {s}", (s, env, [int(v) for v in seeds[s * pool_size:(s + 1) * pool_size]]))
-                 for s, env in enumerate(samplers))
-        with WorkerPool(min(workers, n), _init, (kind, pool_size, starts, reach), _scene_task) as pool:
-            for _, (s, status, value) in pool.imap_unordered(items):
-                if status == "raised":
-                    raise _scene_error(s, value)
-                check_budget([], cells + value.cells, goals + len(value.fields))
-                cells, goals = cells + value.cells, goals + len(value.fields)
-                parts[s] = value
-                bar.update(1)
+    items = ((f"scene {s}", (s, env, [int(v) for v in seeds[s * pool_size:(s + 1) * pool_size]]))
+             for s, env in enumerate(samplers))
+    with WorkerPool(min(workers, n), _init, (kind, pool_size, starts, reach), _scene_task) as pool:
+        for _, (s, status, value) in pool.imap_unordered(items):
+            if status == "raised":
+                raise _scene_error(s, value)
+            check_budget([], cells + value.cells, goals + len(value.fields))
+            cells, goals = cells + value.cells, goals + len(value.fields)
+            parts[s] = value
+            bar.update(1)
     return parts  # type: ignore[return-value]
 
 
