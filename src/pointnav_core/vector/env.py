@@ -279,7 +279,8 @@ class VectorPointNavEnv(PoolRefreshing, VectorEnv):
         t, spec, a = self.task, self.robot, self.arrays
         acts = first.discrete_actions
         self._discrete = None if acts is None else DiscretePlan(acts, spec, self.action_frequency, a)
-        self.floors = FloorTables(scene_list, t.floor, spec.radius, a)
+        shared = [env.backend.floor_geometry(t.floor) for env in self._samplers]  # built by their backends
+        self.floors = FloorTables(scene_list, t.floor, spec.radius, a, shared)
         bounds = [env.task.observation_bounds for env in self._samplers]
         self._low = a.asarray(np.stack([b[0] for b in bounds]).astype(np.float64))
         self._high = a.asarray(np.stack([b[1] for b in bounds]).astype(np.float64))

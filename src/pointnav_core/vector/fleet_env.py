@@ -138,7 +138,8 @@ class VectorFleetEnv(VectorPointNavEnv):
         acts = first.discrete_actions
         # Each robot's own commands and control steps (its speed limits), as the multi-robot env plans them.
         self._discrete = None if acts is None else DiscretePlan(acts, list(self.robots), self.action_frequency, a)
-        self.floors = FloorTables(scene_list, t.floor, spec.radius, a)
+        shared = [env.backend.floor_geometry(t.floor) for env in self._samplers]  # built by their backends
+        self.floors = FloorTables(scene_list, t.floor, spec.radius, a, shared)
         # Each robot's clearance table, of its own radius: (R, all cells).
         self._fast = a.xp.stack([self.floors.fast_for(s.radius) for s in self.robots])
         bounds = [[t.observation_bounds for t in env.tasks] for env in self._samplers]  # (scene, robot)
