@@ -26,7 +26,13 @@ from typing import Any
 import numpy as np
 
 from pointnav_core import validation
-from pointnav_core.vector.fields import FieldPart, FieldTables, check_budget, field_part, reach_window
+from pointnav_core.vector.fields import (
+    FieldPart,
+    FieldTables,
+    check_budget,
+    field_part,
+    reach_window,
+)
 from pointnav_core.vector.xp import Arrays
 
 __all__ = ["EpisodePool", "ScenePart", "assemble_parts", "fixed_pose", "settle_part"]

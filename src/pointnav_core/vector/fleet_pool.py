@@ -21,7 +21,13 @@ from typing import Any
 
 import numpy as np
 
-from pointnav_core.vector.episodes import ScenePart, assemble_parts, build_in_process, fixed_pose, settle_part
+from pointnav_core.vector.episodes import (
+    ScenePart,
+    assemble_parts,
+    build_in_process,
+    fixed_pose,
+    settle_part,
+)
 from pointnav_core.vector.xp import Arrays
 
 __all__ = ["FleetEpisode", "FleetPool", "check_fixed_episode"]
