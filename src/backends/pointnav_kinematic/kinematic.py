@@ -128,6 +128,11 @@ class KinematicBackend(RobotStateBackend):
         self._robots = [_Robot(spec, self._floors[0]) for spec in specs]
         self._dt = dt
 
+    def floor_geometry(self, floor: int) -> FloorGeometry:
+        """The loaded world's floor ``floor`` as this backend collides with it (read only:
+        the batched engine shares it rather than building it again)."""
+        return self._floors[floor]
+
     # ------------------------------------------------------------------ poses
     def _pose(self, rb: _Robot) -> tuple[float, float, float]:
         return rb.x, rb.y, rb.yaw

@@ -29,6 +29,7 @@ from pointnav_core.vector.episodes import EpisodePool, fixed_pose
 from pointnav_core.vector.falls import apply_falls
 from pointnav_core.vector.floors import FloorTables
 from pointnav_core.vector.local_map import VectorLocalMap, local_map_term
+from pointnav_core.vector.pool_build import build_parts, pool_options
 from pointnav_core.vector.refresh import PoolRefreshing
 from pointnav_core.vector.scan import ScanTables, VectorScan, requested_scan
 from pointnav_core.vector.xp import make_arrays
@@ -142,6 +143,14 @@ class VectorPointNavEnv(PoolRefreshing, VectorEnv):
         may then not be given (nor ``max_episode_steps``); its ``backend`` must be
         ``"kinematic"`` and its ``flatten_obs`` True. A single env built from the same
         config has the same spaces (:mod:`pointnav_core.env_config`).
+    workers : int, optional
+        Processes that build a pool over several scenes, each scene's episodes and goal
+        fields in one (:mod:`pointnav_core.vector.pool_build`); the pool is the same, byte
+        for byte, for any number. Default: the usable cores, at most one per scene, from
+        4 scenes on; 1 builds in this process. A script that uses more than one must guard
+        its entry point (``if __name__ == "__main__":``), as for any spawned process.
+    progress : bool, optional
+        A tqdm bar over the pool's scenes on stderr; default: from 4 scenes on, on a terminal.
 
     Notes
     -----
@@ -249,6 +258,8 @@ class VectorPointNavEnv(PoolRefreshing, VectorEnv):
         discrete_actions: Mapping[str, Any] | None = None,
         starts_per_goal: int = 1,
         config: EnvConfig | None = None,
+        workers: int | None = None,
+        progress: bool | None = None,
     ) -> None:
         from pointnav_core.env import PointNavEnv
 
@@ -265,6 +276,7 @@ class VectorPointNavEnv(PoolRefreshing, VectorEnv):
         self.arrays = make_arrays(device)
         self.device = device
         self.scenes = scene_list = _scene_list(scene)
+        self._pool_workers, self._pool_progress = pool_options(workers, progress, len(scene_list))
         self.robot = _envcommon.make_robot(robot)  # either drive (vector.drive)
         self._samplers = [
             PointNavEnv(scene=s, robot=self.robot, task=dict(task), sensors=sensors, flatten_obs=True,
@@ -279,7 +291,8 @@ class VectorPointNavEnv(PoolRefreshing, VectorEnv):
         t, spec, a = self.task, self.robot, self.arrays
         acts = first.discrete_actions
         self._discrete = None if acts is None else DiscretePlan(acts, spec, self.action_frequency, a)
-        self.floors = FloorTables(scene_list, t.floor, spec.radius, a)
+        shared = [env.backend.floor_geometry(t.floor) for env in self._samplers]  # built by their backends
+        self.floors = FloorTables(scene_list, t.floor, spec.radius, a, shared)
         bounds = [env.task.observation_bounds for env in self._samplers]
         self._low = a.asarray(np.stack([b[0] for b in bounds]).astype(np.float64))
         self._high = a.asarray(np.stack([b[1] for b in bounds]).astype(np.float64))
@@ -350,7 +363,11 @@ class VectorPointNavEnv(PoolRefreshing, VectorEnv):
     def _build_pool(self, fixed: Sequence[tuple[Any, float, Any, int]]) -> None:
         size = 0 if fixed else self.pool_size
         seeds = self._rng.integers(2**31, size=size * len(self.scenes))
-        self.pool = self._pool_class(self._samplers, size, seeds, self.arrays, fixed, self.starts_per_goal, self._reach)
+        # Each scene's part, in worker processes with workers > 1 (the same arrays).
+        parts = None if fixed else build_parts(self._pool_class, self._samplers, size, seeds, self.starts_per_goal,
+                                               self._reach, self._pool_workers, self._pool_progress)
+        self.pool = self._pool_class(self._samplers, size, seeds, self.arrays, fixed, self.starts_per_goal, self._reach,
+                                     parts=parts)
 
     # ------------------------------------------------------------------ Gymnasium API
     def reset(self, *, seed: int | None = None, options: dict[str, Any] | None = None) -> tuple[Any, dict[str, Any]]:

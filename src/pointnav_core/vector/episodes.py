@@ -9,21 +9,33 @@ Settling a goal field costs seconds; a start costs next to nothing once its goal
 settled. With ``starts > 1`` each sampled goal gets ``starts - 1`` more starts, drawn by
 the single env's sampler with that goal fixed (``sampling.sample_episode``: a usable start
 within reach, a random heading, the geodesic in ``path_range``), all sharing its field.
+
+A pool is built scene by scene: each scene's :class:`ScenePart` (its episodes and its goal
+fields settled, as plain arrays) depends only on that scene's sampler and seeds, so the
+parts can be built in worker processes (:mod:`pointnav_core.vector.pool_build`) and
+assembled here into the same arrays as a build in this process.
 """
 
 from __future__ import annotations
 
 import math
 from collections.abc import Sequence
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 
 from pointnav_core import validation
-from pointnav_core.vector.fields import FieldTables
+from pointnav_core.vector.fields import (
+    FieldPart,
+    FieldTables,
+    check_budget,
+    field_part,
+    reach_window,
+)
 from pointnav_core.vector.xp import Arrays
 
-__all__ = ["EpisodePool", "fixed_pose"]
+__all__ = ["EpisodePool", "ScenePart", "assemble_parts", "fixed_pose", "settle_part"]
 
 
 def fixed_pose(where: str, episode: Any, scene: Any, floor: int, robot: Any) -> tuple[Any, float, Any]:
@@ -67,6 +79,55 @@ def fixed_pose(where: str, episode: Any, scene: Any, floor: int, robot: Any) -> 
     return start, yaw, goal
 
 
+@dataclass(frozen=True)
+class ScenePart:
+    """One scene's share of a pool, as plain numpy arrays (it pickles from a worker process).
+
+    Attributes
+    ----------
+    table : ndarray (n, ...)
+        Its episodes' rows, in the pool class's columns.
+    field_of : ndarray of int64 (n, ...)
+        Each episode's (each robot's) goal field, an index into :attr:`fields`.
+    fields : list of FieldPart
+        The goal fields, settled over their windows.
+    cells : int
+        The cells the fields keep (for the pool's byte budget).
+    """
+
+    table: np.ndarray
+    field_of: np.ndarray
+    fields: list[FieldPart]
+    cells: int
+
+
+def settle_part(table: np.ndarray, field_of: np.ndarray, fields: Sequence[Any], reach: float,
+                cells_before: int = 0, goals_before: int = 0) -> ScenePart:
+    """Settle ``fields`` (GoalFields) over the cells within ``reach`` (m) of their episodes'
+    starts (the first two columns of ``table``'s rows).
+
+    Raises
+    ------
+    ValueError
+        Before any field is settled, when the windows after ``cells_before`` cells of
+        ``goals_before`` goals (the parts built before) pass the byte budget
+        (:func:`~pointnav_core.vector.fields.check_budget`).
+    """
+    windows = [reach_window(f, table[field_of == i][:, :2], reach) for i, f in enumerate(fields)]
+    check_budget(windows, cells_before, goals_before)
+    parts = [field_part(f, w) for f, w in zip(fields, windows)]
+    return ScenePart(table, field_of, parts, sum((r1 - r0) * (c1 - c0) for r0, r1, c0, c1 in windows))
+
+
+def assemble_parts(parts: Sequence[ScenePart], arrays: Arrays) -> tuple[np.ndarray, np.ndarray, FieldTables]:
+    """The parts end to end: their rows, each row's field (a global index) and the tables."""
+    offsets = np.cumsum([0, *(len(p.fields) for p in parts)])
+    table = np.concatenate([p.table for p in parts])
+    field_of = np.concatenate([p.field_of + off for p, off in zip(parts, offsets)]).astype(np.int64)
+    check_budget([], sum(p.cells for p in parts), int(offsets[-1]))
+    return table, field_of, FieldTables.from_parts([f for p in parts for f in p.fields], arrays)
+
+
 class EpisodePool:
     """Episodes as arrays: start ``(sx, sy, syaw)``, goal ``(gx, gy)``, ``d0`` (m), scene and field.
 
@@ -74,20 +135,21 @@ class EpisodePool:
     ----------
     samplers : sequence of PointNavEnv
         One per scene, with the task to sample.
-    scene_ids : sequence of int
-        For each sampler, its scene index.
     pool_size : int
         Goals per scene.
     seeds : sequence of int
         ``pool_size * len(samplers)`` reset seeds, sampler by sampler.
+    arrays : Arrays
     fixed : sequence of (start_xy, yaw, goal_xy, scene index), optional
         Given episodes, added after the sampled ones.
-    arrays : Arrays
     starts : int
         Episodes per sampled goal (>= 1), sharing its goal field.
     reach : float
         How far (m) a robot gets from its start in one episode: each field keeps the cells
         within it of its episodes' starts (:class:`~pointnav_core.vector.fields.FieldTables`).
+    parts : sequence of ScenePart, optional
+        The scenes' parts, built already (by :meth:`scene_part`, in worker processes);
+        default: built here, scene by scene.
 
     Attributes
     ----------
@@ -106,49 +168,78 @@ class EpisodePool:
         fixed: Sequence[tuple[Any, float, Any, int]] = (),
         starts: int = 1,
         reach: float = math.inf,
+        parts: Sequence[ScenePart] | None = None,
     ) -> None:
-        from pointnav_core.sampling import sample_episode
-
-        rows, fields, field_of = [], [], []
-        k = 0
-        for s, env in enumerate(samplers):
-            for _ in range(pool_size):
-                env.reset(seed=int(seeds[k]))
-                k += 1
-                task = env.task
-                x, y, yaw = env.backend._pose(env.backend._robots[task.robot_idn])
-                gx, gy = task.goal_xy
-                rows.append((x, y, yaw, gx, gy, task.geodesic_dist, s))
-                field_of.append(len(fields))
-                cfg = task._config
-                for _ in range(starts - 1):
-                    ep = sample_episode(
-                        env, robot_idn=cfg.robot_idn, floor=cfg.floor, spec=env.robot,
-                        floor_height=task._floor_height, initial_pos=None, initial_quat=None,
-                        goal_pos=(gx, gy), goal_tolerance=cfg.goal_tolerance, path_range=cfg.path_range,
-                        max_trials=task.max_trials,
-                    )
-                    qz, qw = ep.start_quat[2], ep.start_quat[3]
-                    rows.append((ep.start_xy[0], ep.start_xy[1], 2.0 * np.arctan2(qz, qw), gx, gy, ep.geodesic, s))
-                    field_of.append(len(fields))
-                fields.append(task._goal_field.field)
-        for start, yaw, goal, s in fixed:
-            env = samplers[s]
-            ffield = env.scene.goal_field(env.task.floor, goal, robot=env.robot)
-            d0 = ffield.exact_distance(start)
-            rows.append((float(start[0]), float(start[1]), float(yaw), float(goal[0]), float(goal[1]), d0, s))
-            field_of.append(len(fields))
-            fields.append(ffield.field)
-        table = np.array(rows, dtype=np.float64).reshape(-1, 7)
+        if parts is None:
+            parts = build_in_process(type(self), samplers, pool_size, seeds, starts, reach)
+        parts = list(parts)
+        if fixed:
+            parts.append(_fixed_part(samplers, fixed, reach, parts))
+        table, field_of, self.fields = assemble_parts(parts, arrays)
         a = arrays
         self.sx, self.sy, self.syaw, self.gx, self.gy, self.d0 = (a.asarray(table[:, i]) for i in range(6))
         self.scene = a.asarray(table[:, 6], a.i64)
         self.field = a.asarray(field_of, a.i64)
-        field_index = np.asarray(field_of, dtype=np.int64)
-        per_field = [table[field_index == f, :2] for f in range(len(fields))]
-        self.fields = FieldTables(fields, arrays, per_field, reach)
         self.pool_size = pool_size * starts
         self.n_sampled = self.pool_size * len(samplers)
 
+    @staticmethod
+    def scene_part(env: Any, s: int, pool_size: int, seeds: Sequence[int], starts: int = 1, reach: float = math.inf,
+                   cells_before: int = 0, goals_before: int = 0) -> ScenePart:
+        """Scene ``s``'s part: ``pool_size`` episodes drawn by its sampler ``env`` from
+        ``seeds`` (one per goal), each goal with ``starts`` starts, its fields settled."""
+        from pointnav_core.sampling import sample_episode
+
+        rows, fields, field_of = [], [], []
+        for seed in seeds:
+            env.reset(seed=int(seed))
+            task = env.task
+            x, y, yaw = env.backend._pose(env.backend._robots[task.robot_idn])
+            gx, gy = task.goal_xy
+            rows.append((x, y, yaw, gx, gy, task.geodesic_dist, s))
+            field_of.append(len(fields))
+            cfg = task._config
+            for _ in range(starts - 1):
+                ep = sample_episode(
+                    env, robot_idn=cfg.robot_idn, floor=cfg.floor, spec=env.robot,
+                    floor_height=task._floor_height, initial_pos=None, initial_quat=None,
+                    goal_pos=(gx, gy), goal_tolerance=cfg.goal_tolerance, path_range=cfg.path_range,
+                    max_trials=task.max_trials,
+                )
+                qz, qw = ep.start_quat[2], ep.start_quat[3]
+                rows.append((ep.start_xy[0], ep.start_xy[1], 2.0 * np.arctan2(qz, qw), gx, gy, ep.geodesic, s))
+                field_of.append(len(fields))
+            fields.append(task._goal_field.field)
+        table = np.array(rows, dtype=np.float64).reshape(-1, 7)
+        return settle_part(table, np.asarray(field_of, dtype=np.int64), fields, reach, cells_before, goals_before)
+
     def __len__(self) -> int:
         return int(self.sx.shape[0])
+
+
+def build_in_process(kind: Any, samplers: Sequence[Any], pool_size: int, seeds: Sequence[int], starts: int,
+                     reach: float) -> list[ScenePart]:
+    """Every scene's part of a pool of ``kind`` (a class with ``scene_part``), here, in
+    order; the byte budget is checked before each scene's fields are settled."""
+    parts: list[ScenePart] = []
+    cells = goals = 0
+    for s, env in enumerate(samplers):
+        part = kind.scene_part(env, s, pool_size, seeds[s * pool_size:(s + 1) * pool_size], starts, reach, cells, goals)
+        cells, goals = cells + part.cells, goals + len(part.fields)
+        parts.append(part)
+    return parts
+
+
+def _fixed_part(samplers: Sequence[Any], fixed: Sequence[tuple[Any, float, Any, int]], reach: float,
+                before: Sequence[ScenePart]) -> ScenePart:
+    """The given episodes' part: each with the goal field of its scene's sampler."""
+    rows, fields = [], []
+    for start, yaw, goal, s in fixed:
+        env = samplers[s]
+        ffield = env.scene.goal_field(env.task.floor, goal, robot=env.robot)
+        d0 = ffield.exact_distance(start)
+        rows.append((float(start[0]), float(start[1]), float(yaw), float(goal[0]), float(goal[1]), d0, s))
+        fields.append(ffield.field)
+    table = np.array(rows, dtype=np.float64).reshape(-1, 7)
+    cells, goals = sum(p.cells for p in before), sum(len(p.fields) for p in before)
+    return settle_part(table, np.arange(len(rows), dtype=np.int64), fields, reach, cells, goals)

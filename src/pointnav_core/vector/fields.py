@@ -21,6 +21,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
@@ -30,7 +31,7 @@ from pointnav_core.geodesic import GoalField
 from pointnav_core.geodesic.tangents import ANG_TOL, TWO_PI
 from pointnav_core.vector.xp import Arrays
 
-__all__ = ["FIELD_TABLE_BYTES", "FieldTables", "reach_window"]
+__all__ = ["FIELD_TABLE_BYTES", "FieldPart", "FieldTables", "check_budget", "field_part", "reach_window", "window_cells"]
 
 #: Byte budget of one set of goal-field tables (a pool's): the cells of the fields' windows
 #: at 16 bytes each (kind and label). Building tables past it raises ``ValueError`` before
@@ -59,6 +60,67 @@ def reach_window(field: GoalField, starts: ArrayLike, reach: float) -> tuple[int
     c0, r0 = (int(min(max(v, 0), n)) for v, n in zip(lo, (w, h)))
     c1, r1 = (int(min(max(v, 0), n)) for v, n in zip(hi, (w, h)))
     return r0, max(r1, r0), c0, max(c1, c0)
+
+
+@dataclass(frozen=True)
+class FieldPart:
+    """One settled goal field's share of :class:`FieldTables`, as plain numpy arrays (it
+    pickles from a worker process).
+
+    Attributes
+    ----------
+    window : (row0, row1, col0, col1)
+        The cells kept, half-open, of the field's grid.
+    kind, label : ndarray of int64
+        Per kept cell, row by row: 0 unreachable, 1 straight to the goal, 2 by its label
+        (an index into :attr:`labels`).
+    labels : ndarray (n_labels, 9)
+        Per label used, the columns of ``_PER_LABEL`` (cost and node in m, angles in rad).
+    goal : (float, float)
+        The goal (m).
+    grid : (ox, oy, res, radius)
+        The grid's origin and cell size and the robot radius (m).
+    """
+
+    window: tuple[int, int, int, int]
+    kind: np.ndarray
+    label: np.ndarray
+    labels: np.ndarray
+    goal: tuple[float, float]
+    grid: tuple[float, float, float, float]
+
+
+def field_part(field: GoalField, window: tuple[int, int, int, int]) -> FieldPart:
+    """Settle ``field`` over ``window`` (:func:`reach_window`) and take its share of the tables.
+
+    Only the cells the window's cells look up are settled (every one for the whole grid),
+    and only the labels the window's cells name are kept: a search labels every arc node of
+    the floor's graph (millions on a large map), a window's cells name a few thousand.
+    """
+    p = field.planner
+    h, w = p.geo.shape
+    r0, r1, c0, c1 = window
+    near = np.asarray(p.near_usable, dtype=np.int64).reshape(h, w)[r0:r1, c0:c1].ravel()
+    whole = (r0, r1, c0, c1) == (0, h, 0, w)
+    kind_of, label_of = field.settle(None if whole else near[near >= 0])
+    kind = np.where(near >= 0, kind_of[np.maximum(near, 0)], 0).astype(np.int64)
+    label = np.where(kind == 2, label_of[np.maximum(near, 0)], 0).astype(np.int64)
+    used = np.unique(label[kind == 2])
+    label = np.where(kind == 2, np.searchsorted(used, label), 0).astype(np.int64)
+    s = field.labels
+    node = np.asarray(s.node, dtype=np.int64)[used]
+    side = np.asarray(s.side, dtype=np.float64)[used]
+    pos = np.asarray(s.pos, dtype=np.float64)[used]
+    n_lab = len(node)
+    ccw = np.where(side > 0, pos, p.span[node] - pos) if n_lab else pos
+    ang = p.phi0[node] + ccw if n_lab else pos
+    labels = np.stack([
+        np.asarray(s.cost, dtype=np.float64)[used], p.cx[node], p.cy[node], side, p.phi0[node],
+        p.span[node], pos, p.cx[node] + p.radius * np.cos(ang), p.cy[node] + p.radius * np.sin(ang),
+    ], 1).reshape(n_lab, 9)
+    goal = (float(field.goal[0]), float(field.goal[1]))
+    grid = (float(p.geo.origin[0]), float(p.geo.origin[1]), float(p.geo.resolution), float(p.radius))
+    return FieldPart(window, kind, label, labels, goal, grid)
 
 
 class FieldTables:
@@ -94,42 +156,31 @@ class FieldTables:
         self, fields: Sequence[GoalField], arrays: Arrays, starts: Sequence[ArrayLike] | None = None,
         reach: float = math.inf,
     ) -> None:
-        kinds, labels, goal, geo, lab_arrays = [], [], [], [], []
-        cell_off = lab_off = 0
         windows = [(0, f.planner.geo.shape[0], 0, f.planner.geo.shape[1]) if starts is None
                    else reach_window(f, starts[i], reach) for i, f in enumerate(fields)]
-        _check_budget(windows)
-        for f, field in enumerate(fields):
-            p = field.planner
-            h, w = p.geo.shape
-            r0, r1, c0, c1 = windows[f]
-            near = np.asarray(p.near_usable, dtype=np.int64).reshape(h, w)[r0:r1, c0:c1].ravel()
-            whole = (r0, r1, c0, c1) == (0, h, 0, w)
-            # Only the cells the window's cells look up are settled (every one for the whole grid).
-            kind_of, label_of = field.settle(None if whole else near[near >= 0])
-            kind = np.where(near >= 0, kind_of[np.maximum(near, 0)], 0).astype(np.int64)
-            label = np.where(kind == 2, label_of[np.maximum(near, 0)], 0).astype(np.int64)
-            # Only the labels the window's cells name: a search labels every arc node of the
-            # floor's graph (millions on a large map), a window's cells name a few thousand.
-            used = np.unique(label[kind == 2])
-            label = np.where(kind == 2, np.searchsorted(used, label), 0)
-            s = field.labels
-            node = np.asarray(s.node, dtype=np.int64)[used]
-            side = np.asarray(s.side, dtype=np.float64)[used]
-            pos = np.asarray(s.pos, dtype=np.float64)[used]
-            n_lab = len(node)
-            ccw = np.where(side > 0, pos, p.span[node] - pos) if n_lab else pos
-            ang = p.phi0[node] + ccw if n_lab else pos
-            lab_arrays.append(np.stack([
-                np.asarray(s.cost, dtype=np.float64)[used], p.cx[node], p.cy[node], side, p.phi0[node],
-                p.span[node], pos, p.cx[node] + p.radius * np.cos(ang), p.cy[node] + p.radius * np.sin(ang),
-            ], 1).reshape(n_lab, 9))
-            kinds.append(kind)
-            labels.append(label + lab_off)
-            goal.append((float(field.goal[0]), float(field.goal[1])))
-            geo.append((cell_off, r1 - r0, c1 - c0, p.geo.origin[0], p.geo.origin[1], p.geo.resolution, p.radius, r0, c0))
+        check_budget(windows)
+        self._assemble([field_part(f, w) for f, w in zip(fields, windows)], arrays)
+
+    @classmethod
+    def from_parts(cls, parts: Sequence[FieldPart], arrays: Arrays) -> FieldTables:
+        """The tables of fields settled apart (:func:`field_part`, in worker processes, say),
+        in order: the same arrays as the tables of those fields built here."""
+        tables = cls.__new__(cls)
+        tables._assemble(parts, arrays)
+        return tables
+
+    def _assemble(self, parts: Sequence[FieldPart], arrays: Arrays) -> None:
+        kinds, labels, lab_arrays, goal, geo = [], [], [], [], []
+        cell_off = lab_off = 0
+        for part in parts:
+            r0, r1, c0, c1 = part.window
+            kinds.append(part.kind)
+            labels.append(part.label + lab_off)
+            lab_arrays.append(part.labels)
+            goal.append(part.goal)
+            geo.append((cell_off, r1 - r0, c1 - c0, *part.grid, r0, c0))
             cell_off += (r1 - r0) * (c1 - c0)
-            lab_off += n_lab
+            lab_off += len(part.labels)
         a = arrays
         g = np.array(geo, dtype=np.float64).reshape(-1, 9)
         self.kind = a.asarray(np.concatenate(kinds), a.i64)
@@ -223,12 +274,18 @@ class FieldTables:
         return xp.where(kind == 1, direct, xp.where(kind == 2, via, math.inf))
 
 
-def _check_budget(windows: Sequence[tuple[int, int, int, int]]) -> None:
-    """ValueError when the windows' cells would take more than :data:`FIELD_TABLE_BYTES`."""
-    cells = sum((r1 - r0) * (c1 - c0) for r0, r1, c0, c1 in windows)
+def window_cells(windows: Sequence[tuple[int, int, int, int]]) -> int:
+    """The cells of ``windows`` ``(row0, row1, col0, col1)`` (half-open), all together."""
+    return sum((r1 - r0) * (c1 - c0) for r0, r1, c0, c1 in windows)
+
+
+def check_budget(windows: Sequence[tuple[int, int, int, int]], cells_before: int = 0, goals_before: int = 0) -> None:
+    """ValueError when the windows' cells, after ``cells_before`` of ``goals_before`` goals
+    already kept (the scenes built before), would take more than :data:`FIELD_TABLE_BYTES`."""
+    cells = cells_before + window_cells(windows)
     if cells * _CELL_BYTES > FIELD_TABLE_BYTES:
         raise ValueError(
-            f"the goal fields of {len(windows)} pool goals would take {cells * _CELL_BYTES / 2**20:.0f} MiB "
+            f"the goal fields of {goals_before + len(windows)} pool goals would take {cells * _CELL_BYTES / 2**20:.0f} MiB "
             f"({cells} cells within the episodes' reach), over FIELD_TABLE_BYTES = "
             f"{FIELD_TABLE_BYTES / 2**20:.0f} MiB: lower pool_size or max_episode_steps (the reach), "
             "or raise pointnav_core.vector.fields.FIELD_TABLE_BYTES"

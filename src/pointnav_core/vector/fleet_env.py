@@ -37,6 +37,7 @@ from pointnav_core.vector.env import VectorPointNavEnv, _scene_list, check_real_
 from pointnav_core.vector.falls import apply_falls
 from pointnav_core.vector.fleet_pool import FleetPool, check_fixed_episode
 from pointnav_core.vector.floors import FloorTables
+from pointnav_core.vector.pool_build import pool_options
 from pointnav_core.vector.per_robot import (
     envelope,
     read_tasks,
@@ -76,6 +77,9 @@ class VectorFleetEnv(VectorPointNavEnv):
     starts_per_goal : int
         Sets of starts per pool episode, >= 1: the extra sets share its goals and their
         settled fields (:class:`~pointnav_core.vector.fleet_pool.FleetPool`).
+    workers, progress
+        As for :class:`~pointnav_core.vector.env.VectorPointNavEnv`: a pool's scenes built
+        in worker processes (the same pool), with a progress bar over them.
     """
 
     _pool_class = FleetPool
@@ -100,6 +104,8 @@ class VectorFleetEnv(VectorPointNavEnv):
         discrete_actions: Mapping[str, Any] | None = None,
         starts_per_goal: int = 1,
         config: EnvConfig | None = None,
+        workers: int | None = None,
+        progress: bool | None = None,
     ) -> None:
         from pointnav_core.parallel import parallel_env
 
@@ -118,6 +124,7 @@ class VectorFleetEnv(VectorPointNavEnv):
         self.arrays = a = make_arrays(device)
         self.device = device
         self.scenes = scene_list = _scene_list(scene)
+        self._pool_workers, self._pool_progress = pool_options(workers, progress, len(scene_list))
         #: One spec per robot; ``robot`` is their envelope (largest radius, highest speeds).
         self.robots = robot_specs(robot, self.n_robots)
         self.robot = spec = envelope(self.robots)
@@ -136,7 +143,8 @@ class VectorFleetEnv(VectorPointNavEnv):
         acts = first.discrete_actions
         # Each robot's own commands and control steps (its speed limits), as the multi-robot env plans them.
         self._discrete = None if acts is None else DiscretePlan(acts, list(self.robots), self.action_frequency, a)
-        self.floors = FloorTables(scene_list, t.floor, spec.radius, a)
+        shared = [env.backend.floor_geometry(t.floor) for env in self._samplers]  # built by their backends
+        self.floors = FloorTables(scene_list, t.floor, spec.radius, a, shared)
         # Each robot's clearance table, of its own radius: (R, all cells).
         self._fast = a.xp.stack([self.floors.fast_for(s.radius) for s in self.robots])
         bounds = [[t.observation_bounds for t in env.tasks] for env in self._samplers]  # (scene, robot)

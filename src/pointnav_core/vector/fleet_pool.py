@@ -21,8 +21,13 @@ from typing import Any
 
 import numpy as np
 
-from pointnav_core.vector.episodes import fixed_pose
-from pointnav_core.vector.fields import FieldTables
+from pointnav_core.vector.episodes import (
+    ScenePart,
+    assemble_parts,
+    build_in_process,
+    fixed_pose,
+    settle_part,
+)
 from pointnav_core.vector.xp import Arrays
 
 __all__ = ["FleetEpisode", "FleetPool", "check_fixed_episode"]
@@ -97,46 +102,47 @@ class FleetPool:
         fixed: Sequence[tuple[Sequence[tuple[Any, float, Any]], int]] = (),
         starts: int = 1,
         reach: float = math.inf,
+        parts: Sequence[ScenePart] | None = None,
     ) -> None:
-        rows: list[list[tuple[float, ...]]] = []
-        fields = []
-        field_of: list[list[int]] = []
-        k = 0
-        for env in samplers:
-            backend = env.backend
-            for _ in range(pool_size):
-                env.reset(seed=int(seeds[k]))
-                k += 1
-                episode = []
-                field_of.extend([[len(fields) + i for i in range(len(env.tasks))]] * starts)
-                for i, task in enumerate(env.tasks):
-                    x, y, yaw = backend._pose(backend._robots[i])
-                    gx, gy = task.goal_xy
-                    episode.append((x, y, yaw, gx, gy, task.geodesic_dist))
-                    fields.append(task._goal_field.field)
-                rows.append(episode)
-                rows.extend(_more_starts(env, [row[3:5] for row in episode]) for _ in range(starts - 1))
-        for robots, s in fixed:
-            env = samplers[s]
-            episode = []
-            field_of.append([len(fields) + i for i in range(len(robots))])
-            for i, (start, yaw, goal) in enumerate(robots):
-                # The field of the robot's own radius, as its task reads it.
-                field = env.scene.goal_field(env.tasks[0].floor, goal, robot=env.robots[i])
-                episode.append((float(start[0]), float(start[1]), yaw, float(goal[0]), float(goal[1]), field.exact_distance(start)))
-                fields.append(field.field)
-            rows.append(episode)
         n_robots = len(samplers[0].tasks)
-        table = np.array(rows, dtype=np.float64).reshape(-1, n_robots, 6)
+        if parts is None:
+            parts = build_in_process(type(self), samplers, pool_size, seeds, starts, reach)
+        parts = list(parts)
+        if fixed:
+            parts.append(_fixed_part(samplers, fixed, reach, parts))
+        table, field_index, self.fields = assemble_parts(parts, arrays)
+        table = table.reshape(-1, n_robots, 6)
         a = arrays
         self.sx, self.sy, self.syaw, self.gx, self.gy, self.d0 = (a.asarray(table[..., i]) for i in range(6))
-        field_index = np.array(field_of, dtype=np.int64).reshape(-1, n_robots)
-        per_field = [table[field_index == f][:, :2] for f in range(len(fields))]
-        self.fields = FieldTables(fields, arrays, per_field, reach)
-        self.field = a.asarray(field_index, a.i64)
+        self.field = a.asarray(field_index.reshape(-1, n_robots), a.i64)
         self.pool_size = pool_size * starts
         self.n_sampled = self.pool_size * len(samplers)
         self.n_robots = n_robots
+
+    @staticmethod
+    def scene_part(env: Any, s: int, pool_size: int, seeds: Sequence[int], starts: int = 1, reach: float = math.inf,
+                   cells_before: int = 0, goals_before: int = 0) -> ScenePart:
+        """Scene ``s``'s part: ``pool_size`` episodes drawn by its multi-robot env ``env``
+        from ``seeds``, each with ``starts`` sets of starts, every robot's field settled."""
+        rows: list[list[tuple[float, ...]]] = []
+        fields = []
+        field_of: list[list[int]] = []
+        backend = env.backend
+        for seed in seeds:
+            env.reset(seed=int(seed))
+            episode = []
+            field_of.extend([[len(fields) + i for i in range(len(env.tasks))]] * starts)
+            for i, task in enumerate(env.tasks):
+                x, y, yaw = backend._pose(backend._robots[i])
+                gx, gy = task.goal_xy
+                episode.append((x, y, yaw, gx, gy, task.geodesic_dist))
+                fields.append(task._goal_field.field)
+            rows.append(episode)
+            rows.extend(_more_starts(env, [row[3:5] for row in episode]) for _ in range(starts - 1))
+        n_robots = len(env.tasks)
+        table = np.array(rows, dtype=np.float64).reshape(-1, n_robots, 6)
+        index = np.array(field_of, dtype=np.int64).reshape(-1, n_robots)
+        return settle_part(table, index, fields, reach, cells_before, goals_before)
 
     def __len__(self) -> int:
         return int(self.sx.shape[0])
@@ -161,3 +167,22 @@ def _more_starts(env: Any, goals: Sequence[tuple[float, float]]) -> list[tuple[f
         yaw = 2.0 * math.atan2(ep.start_quat[2], ep.start_quat[3])
         rows[i] = (float(ep.start_xy[0]), float(ep.start_xy[1]), yaw, gx, gy, ep.geodesic)
     return [rows[i] for i in range(len(env.tasks))]
+
+
+def _fixed_part(samplers: Sequence[Any], fixed: Sequence[tuple[Sequence[tuple[Any, float, Any]], int]], reach: float,
+                before: Sequence[ScenePart]) -> ScenePart:
+    """The given episodes' part: each robot with the goal field of its own radius, as its task reads it."""
+    rows, fields = [], []
+    for robots, s in fixed:
+        env = samplers[s]
+        episode = []
+        for i, (start, yaw, goal) in enumerate(robots):
+            field = env.scene.goal_field(env.tasks[0].floor, goal, robot=env.robots[i])
+            episode.append((float(start[0]), float(start[1]), yaw, float(goal[0]), float(goal[1]), field.exact_distance(start)))
+            fields.append(field.field)
+        rows.append(episode)
+    n_robots = len(samplers[0].tasks)
+    table = np.array(rows, dtype=np.float64).reshape(-1, n_robots, 6)
+    index = np.arange(len(fields), dtype=np.int64).reshape(-1, n_robots)
+    cells, goals = sum(p.cells for p in before), sum(len(p.fields) for p in before)
+    return settle_part(table, index, fields, reach, cells, goals)

@@ -39,6 +39,9 @@ class FloorTables:
         Robot radius (m), for the clearance table ``fast``.
     arrays : Arrays
         Namespace and device.
+    geometries : sequence of FloorGeometry, optional
+        Each scene's floor as the kinematic backend built it already (the samplers'
+        backends, ``KinematicBackend.floor_geometry``): shared, not built again.
 
     Raises
     ------
@@ -47,7 +50,8 @@ class FloorTables:
         cannot run (on a GPU, or without numba).
     """
 
-    def __init__(self, scenes: Sequence[Any], floor: int, radius: float, arrays: Arrays) -> None:
+    def __init__(self, scenes: Sequence[Any], floor: int, radius: float, arrays: Arrays,
+                 geometries: Sequence[Any] | None = None) -> None:
         from pointnav_kinematic.geometry import FloorGeometry
 
         from pointnav_core.vector import contacts_jit  # it imports this module
@@ -66,7 +70,7 @@ class FloorTables:
                     "them on the CPU with numba (the fast extra) only: use device='numpy' or 'cpu' with "
                     "numba installed, or build the scene from the floor's cells (Scene.from_array)"
                 )
-            geom = FloorGeometry(tmap, float(scene.get_floor_height(floor)))
+            geom = geometries[k] if geometries is not None else FloorGeometry(tmap, float(scene.get_floor_height(floor)))
             segments.extend(geom.edges.segments)
             seg_off.append(len(segments))
             self.geometries.append(geom)
