@@ -332,6 +332,7 @@ def evaluate(
     on_failure: Callable[[PointNavEpisode, str], None] | None = None,
     limit: int | None = None,
     stride: int = 1,
+    isolate: bool = False,
 ) -> list[EpisodeResult]:
     """Play every episode once (or the subset ``limit`` and ``stride`` select); the
     results in the episodes' order.
@@ -371,6 +372,10 @@ def evaluate(
     limit, stride : int, optional
         Play only :func:`select_episodes` ``(episodes, limit, stride)``: every
         ``stride``-th episode, then the first ``limit`` of those.
+    isolate : bool
+        Play in worker processes even with one worker, so that a signal handler that
+        raises in this process never lands inside the policy's or the compiler's code
+        (``pointnav eval`` does: see :mod:`pointnav_core.cli_datasets`).
 
     Raises
     ------
@@ -413,11 +418,11 @@ def evaluate(
 
     try:
         n_workers = min(workers, len(episodes), usable_cores())
-        if n_workers <= 1:
+        if n_workers <= 1 and not isolate:
             runner = _Runner(*args)
             for i, ep in enumerate(episodes):
                 record(i, *runner.outcome(ep))
-        else:
+        elif episodes:
             with WorkerPool(n_workers, _Runner, args, _play) as pool:
                 try:
                     for i, (kind, payload) in pool.imap_unordered(enumerate(episodes)):
