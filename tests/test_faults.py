@@ -151,18 +151,19 @@ def test_signals_at_random_moments_lose_nothing(work, tmp_path):
                     r["killed"] = time.monotonic()
             assert time.monotonic() - start < 60, "a run never started"
             time.sleep(0.02)
-        for r in runs:
-            rc = r["proc"].wait(timeout=20)
-            died = time.monotonic()
-            assert died - r["killed"] < 10, "the run went on after the signal"  # (waits are in turn)
-            if r["proc"].stderr is not None:
-                with r["proc"].stderr as pipe:
-                    err = pipe.read()
+        for r in runs:  # every death first: the checks below take seconds each
+            r["rc"], r["died"] = r["proc"].wait(timeout=20), time.monotonic()
             left = seen[id(r)]
-            while left and time.monotonic() - died < 5.0:
+            while left and time.monotonic() - r["died"] < 5.0:
                 left = left & set(_parents())
                 time.sleep(0.05)
             assert not left, f"{r['sig'].name}: processes {left} outlived their parent by 5 s"
+        for r in runs:
+            rc, died = r["rc"], r["died"]
+            assert died - r["killed"] < 10, "the run went on after the signal"
+            if r["proc"].stderr is not None:
+                with r["proc"].stderr as pipe:
+                    err = pipe.read()
             if "old" in r:  # dataset generate: the old file, or the whole new one
                 assert rc in (0, 130, -9), r["ready"].read_text()
                 EpisodeDataset.load(r["old"])
