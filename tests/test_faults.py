@@ -9,6 +9,7 @@ on one small MovingAI map, so the whole module takes a few tens of seconds.
 from __future__ import annotations
 
 import base64
+import contextlib
 import json
 import os
 import random
@@ -114,67 +115,77 @@ def test_signals_at_random_moments_lose_nothing(work, tmp_path):
     folder, dataset, reference = work
     rng = random.Random(29)
     runs = []
-    for sig in (signal.SIGINT, signal.SIGTERM, signal.SIGKILL):
-        for workers in (1, 2):
-            results = tmp_path / f"{sig.name}-{workers}.jsonl"
-            args = _eval_args(folder, results, "--workers", str(workers))
-            proc = subprocess.Popen(
-                _cli(*args), env=_env(), start_new_session=True,
-                stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True,
-            )
-            ready = Path(str(results) + ".partial")
-            runs.append({"proc": proc, "sig": sig, "results": results, "ready": ready, "delay": rng.uniform(0.0, 1.0)})
-        old = tmp_path / f"old-{sig.name}.json.gz"
-        old.write_bytes(dataset.read_bytes())
-        gen = ["dataset", "generate", "--scenes", str(folder), "--split", "train", "--seed", "1",
-               "--episodes", "20", "--out", str(old)]
-        progress = tmp_path / f"progress-{sig.name}.txt"  # the progress bar: it has started
-        with open(progress, "w") as bar:
-            proc = subprocess.Popen(_cli(*gen), env=_env(), start_new_session=True,
-                                    stdout=subprocess.DEVNULL, stderr=bar, text=True)
-        runs.append({"proc": proc, "sig": sig, "old": old, "ready": progress, "delay": rng.uniform(0.0, 1.5)})
-    start, seen = time.monotonic(), {id(r): set() for r in runs}
-    while any("killed" not in r for r in runs):
+    try:
+        for sig in (signal.SIGINT, signal.SIGTERM, signal.SIGKILL):
+            for workers in (1, 2):
+                results = tmp_path / f"{sig.name}-{workers}.jsonl"
+                args = _eval_args(folder, results, "--workers", str(workers))
+                proc = subprocess.Popen(
+                    _cli(*args), env=_env(), start_new_session=True,
+                    stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True,
+                )
+                ready = Path(str(results) + ".partial")
+                runs.append({"proc": proc, "sig": sig, "results": results, "ready": ready, "delay": rng.uniform(0.0, 1.0)})
+            old = tmp_path / f"old-{sig.name}.json.gz"
+            old.write_bytes(dataset.read_bytes())
+            gen = ["dataset", "generate", "--scenes", str(folder), "--split", "train", "--seed", "1",
+                   "--episodes", "20", "--out", str(old)]
+            progress = tmp_path / f"progress-{sig.name}.txt"  # the progress bar: it has started
+            with open(progress, "w") as bar:
+                proc = subprocess.Popen(_cli(*gen), env=_env(), start_new_session=True,
+                                        stdout=subprocess.DEVNULL, stderr=bar, text=True)
+            runs.append({"proc": proc, "sig": sig, "old": old, "ready": progress, "delay": rng.uniform(0.0, 1.5)})
+        start, seen = time.monotonic(), {id(r): set() for r in runs}
+        while any("killed" not in r for r in runs):
+            for r in runs:
+                if "killed" in r:
+                    continue
+                seen[id(r)] |= _descendants(r["proc"].pid)
+                if "since" not in r and r["ready"].exists() and r["ready"].stat().st_size > 0:
+                    r["since"] = time.monotonic()
+                if "since" in r and time.monotonic() - r["since"] >= r["delay"]:
+                    if r["sig"] == signal.SIGINT:  # Ctrl-C reaches the whole foreground group
+                        os.killpg(r["proc"].pid, signal.SIGINT)
+                    else:
+                        r["proc"].send_signal(r["sig"])
+                    r["killed"] = time.monotonic()
+            assert time.monotonic() - start < 60, "a run never started"
+            time.sleep(0.02)
+        for r in runs:  # every death first: the checks below take seconds each
+            r["rc"], r["died"] = r["proc"].wait(timeout=20), time.monotonic()
+            left = seen[id(r)]
+            while left and time.monotonic() - r["died"] < 5.0:
+                left = left & set(_parents())
+                time.sleep(0.05)
+            assert not left, f"{r['sig'].name}: processes {left} outlived their parent by 5 s"
         for r in runs:
-            if "killed" in r:
+            rc, died = r["rc"], r["died"]
+            assert died - r["killed"] < 10, "the run went on after the signal"
+            if r["proc"].stderr is not None:
+                with r["proc"].stderr as pipe:
+                    err = pipe.read()
+            if "old" in r:  # dataset generate: the old file, or the whole new one
+                assert rc in (0, 130, -9), r["ready"].read_text()
+                EpisodeDataset.load(r["old"])
+                if rc != 0:
+                    assert r["old"].read_bytes() == dataset.read_bytes()
                 continue
-            seen[id(r)] |= _descendants(r["proc"].pid)
-            if "since" not in r and r["ready"].exists() and r["ready"].stat().st_size > 0:
-                r["since"] = time.monotonic()
-            if "since" in r and time.monotonic() - r["since"] >= r["delay"]:
-                if r["sig"] == signal.SIGINT:  # Ctrl-C reaches the whole foreground group
-                    os.killpg(r["proc"].pid, signal.SIGINT)
-                else:
-                    r["proc"].send_signal(r["sig"])
-                r["killed"] = time.monotonic()
-        assert time.monotonic() - start < 60, "a run never started"
-        time.sleep(0.02)
-    for r in runs:
-        rc = r["proc"].wait(timeout=20)
-        died = time.monotonic()
-        assert died - r["killed"] < 10, "the run went on after the signal"  # (waits are in turn)
-        if r["proc"].stderr is not None:
-            with r["proc"].stderr as pipe:
-                err = pipe.read()
-        left = seen[id(r)]
-        while left and time.monotonic() - died < 5.0:
-            left = left & set(_parents())
-            time.sleep(0.05)
-        assert not left, f"{r['sig'].name}: processes {left} outlived their parent by 5 s"
-        if "old" in r:  # dataset generate: the old file, or the whole new one
-            assert rc in (0, 130, -9), r["ready"].read_text()
-            EpisodeDataset.load(r["old"])
-            if rc != 0:
-                assert r["old"].read_bytes() == dataset.read_bytes()
-            continue
-        assert rc in ((-9,) if r["sig"] == signal.SIGKILL else (130,)) or rc == 0, err
-        if rc == 130 and r["ready"].exists():  # else the signal came after the results were written
-            assert err.count("\n") == 1 and f"interrupted by {r['sig'].name}" in err and "--resume" in err
-        if r["ready"].exists():
-            _valid_log(r["ready"])
-        assert main(_eval_args(folder, r["results"], "--resume")) == 0
-        assert r["results"].read_bytes() == reference
-        assert not r["ready"].exists()
+            assert rc in ((-9,) if r["sig"] == signal.SIGKILL else (130,)) or rc == 0, err
+            if rc == 130 and r["ready"].exists():  # else the signal came after the results were written
+                assert err.count("\n") == 1 and f"interrupted by {r['sig'].name}" in err and "--resume" in err
+            if r["ready"].exists():
+                _valid_log(r["ready"])
+            assert main(_eval_args(folder, r["results"], "--resume")) == 0
+            assert r["results"].read_bytes() == reference
+            assert not r["ready"].exists()
+    finally:  # a failed check leaves no run behind (nor its pipe) to trouble later tests
+        for r in runs:
+            if r["proc"].poll() is None:
+                with contextlib.suppress(ProcessLookupError):
+                    os.killpg(r["proc"].pid, signal.SIGKILL)
+            r["proc"].wait()
+            if r["proc"].stderr is not None:
+                r["proc"].stderr.close()
 
 
 def _limit_file_size(limit: int):

@@ -18,6 +18,7 @@ the GIF (which then still plays in real time).
 from __future__ import annotations
 
 import argparse
+import os
 import sys
 import time
 from collections.abc import Sequence
@@ -238,4 +239,13 @@ def main(argv: Sequence[str] | None = None) -> int:
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    status = main()
+    if status == 130:
+        # CPython (3.11 to 3.13) ends `python -m` by killing itself with SIGINT when a
+        # KeyboardInterrupt ever passed through code that exec or eval ran from a string
+        # (numba and the standard library build code so), even one that was caught: an
+        # interrupted run that said so, and kept its results, must still exit with 130.
+        sys.stdout.flush()
+        sys.stderr.flush()
+        os._exit(130)
+    sys.exit(status)

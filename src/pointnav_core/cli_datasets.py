@@ -201,8 +201,9 @@ def _eval(args: argparse.Namespace) -> int:
             progress=not args.quiet,
             trust_policy_file=args.trust_policy_file,
             on_error=args.on_error,
-            on_result=log.append,
+            on_result=_Signals.result(log.append),
             on_failure=_Signals.failure(failed),
+            isolate=True,
         )
         results, summary = log.finish(episodes)
     except (KeyboardInterrupt, PointNavError, ValueError) as err:
@@ -232,9 +233,10 @@ def _eval(args: argparse.Namespace) -> int:
 class _Signals:
     """SIGTERM raises KeyboardInterrupt as Ctrl-C does; ``name`` says which arrived.
 
-    ``arrived`` stays set once one has: a KeyboardInterrupt raised inside an import (the
-    policy's first step imports numba) comes out as an ImportError, or as an episode's
-    error, and must still end the run as an interruption.
+    ``arrived`` stays set once one has: a KeyboardInterrupt raised inside an import comes
+    out as an ImportError, or as an episode's error, and must still end the run as an
+    interruption. Only the first signal raises: a second Ctrl-C while the run is being
+    wound up (workers ended, the log closed) must not cut that short.
     """
 
     name = "interrupted"
@@ -242,6 +244,8 @@ class _Signals:
 
     @classmethod
     def handler(cls, signum: int, _frame: Any) -> None:
+        if cls.arrived:
+            return
         cls.name, cls.arrived = f"interrupted by {signal.Signals(signum).name}", True
         raise KeyboardInterrupt
 
@@ -249,6 +253,18 @@ class _Signals:
     def install(cls) -> list[Any]:
         cls.name, cls.arrived = "interrupted", False
         return [signal.signal(s, cls.handler) for s in (signal.SIGINT, signal.SIGTERM)]
+
+    @classmethod
+    def result(cls, keep: Callable[[Any], None]) -> Callable[[Any], None]:
+        """An ``on_result`` that keeps each result, then stops the run if a signal came
+        whose KeyboardInterrupt something swallowed (a ``__del__`` prints and drops one)."""
+
+        def note(result: Any) -> None:
+            keep(result)
+            if cls.arrived:
+                raise KeyboardInterrupt
+
+        return note
 
     @classmethod
     def failure(cls, failed: list[str]) -> Callable[[Any, str], None]:

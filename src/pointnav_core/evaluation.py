@@ -357,6 +357,7 @@ def evaluate(
     limit: int | None = None,
     stride: int = 1,
     env_config: EnvConfig | None = None,
+    isolate: bool = False,
 ) -> list[EpisodeResult]:
     """Play every episode once (or the subset ``limit`` and ``stride`` select); the
     results in the episodes' order.
@@ -401,6 +402,10 @@ def evaluate(
         settings, ``max_steps``; :mod:`pointnav_core.env_config`), with the episode's scene,
         floor, start, goal and goal radius; ``backend``, ``max_steps`` and ``drive`` must
         then keep their defaults, and every episode's robot radius must be the config's.
+    isolate : bool
+        Play in worker processes even with one worker, so that a signal handler that
+        raises in this process never lands inside the policy's or the compiler's code
+        (``pointnav eval`` does: see :mod:`pointnav_core.cli_datasets`).
 
     Raises
     ------
@@ -446,11 +451,11 @@ def evaluate(
 
     try:
         n_workers = min(workers, len(episodes), usable_cores())
-        if n_workers <= 1:
+        if n_workers <= 1 and not isolate:
             runner = _Runner(*args)
             for i, ep in enumerate(episodes):
                 record(i, *runner.outcome(ep))
-        else:
+        elif episodes:
             with WorkerPool(n_workers, _Runner, args, _play) as pool:
                 try:
                     for i, (kind, payload) in pool.imap_unordered(enumerate(episodes)):

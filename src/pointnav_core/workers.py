@@ -20,6 +20,7 @@ import signal
 import threading
 import time
 from collections.abc import Callable, Hashable, Iterable, Iterator
+from contextlib import contextmanager
 from multiprocessing import connection, get_context
 from typing import Any
 
@@ -81,6 +82,33 @@ def _worker_main(conn: Any, parent: int, init: Callable[..., Any], initargs: tup
             conn.send(("raised", key, _describe(error)))
 
 
+@contextmanager
+def _signals_held() -> Iterator[None]:
+    """Hold SIGINT and SIGTERM back from this process's Python handlers for the block, then
+    deliver the first that came.
+
+    A handler that raises (Ctrl-C's KeyboardInterrupt) between the spawn of a worker and
+    the write of its start-up data would leave the worker reading a closed pipe, and
+    printing that traceback on the shared stderr. Only the main thread can set handlers:
+    elsewhere the block runs as it is.
+    """
+    held: list[int] = []
+    wanted = [signal.SIGINT, signal.SIGTERM]
+    previous = {s: signal.getsignal(s) for s in wanted}
+    if threading.current_thread() is not threading.main_thread() or None in previous.values():
+        yield
+        return
+    for signum in wanted:
+        signal.signal(signum, lambda signum, _frame: held.append(signum))
+    try:
+        yield
+    finally:
+        for signum, handler in previous.items():
+            signal.signal(signum, handler)
+        if held:
+            signal.raise_signal(held[0])
+
+
 class WorkerPool:
     """``workers`` processes running ``task(init(*initargs), item)`` (see the module notes).
 
@@ -89,11 +117,20 @@ class WorkerPool:
     """
 
     def __init__(self, workers: int, init: Callable[..., Any], initargs: tuple, task: Callable[[Any, Any], Any]) -> None:
-        context = get_context("spawn")
         self._procs, self._conns = [], []
+        try:
+            with _signals_held():
+                self._start(workers, init, initargs, task)
+        except BaseException:  # a signal held while starting is raised here: end what started
+            self.close()
+            raise
+
+    def _start(self, workers: int, init: Callable[..., Any], initargs: tuple, task: Callable[[Any, Any], Any]) -> None:
+        context = get_context("spawn")
         # A worker is born with SIGINT blocked (the mask survives fork and exec), so that a
-        # Ctrl-C while it is still starting does not kill it with a traceback; here a Ctrl-C
-        # waits until the workers are started.
+        # Ctrl-C to the process group while it is still starting does not kill it with a
+        # traceback. (In this process the mask does not hold SIGINT back: another thread,
+        # e.g. a BLAS one, takes it; _signals_held does.)
         blocking = hasattr(signal, "pthread_sigmask")
         if blocking:  # it would unblock SIGINT if it started in the middle (it blocks its own)
             from multiprocessing import resource_tracker
@@ -110,9 +147,6 @@ class WorkerPool:
                 theirs.close()
                 self._procs.append(proc)
                 self._conns.append(ours)
-        except BaseException:
-            self.close()
-            raise
         finally:
             if blocking:
                 signal.pthread_sigmask(signal.SIG_SETMASK, mask)
