@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import os
+
 import pytest
 
 from pointnav_core.cli import main
@@ -37,9 +39,16 @@ def data(tmp_path_factory):
     folder = tmp_path_factory.mktemp("room")
     (folder / "room.map").write_text(MAP)
     out = folder / "val.json.gz"
-    args = ["dataset", "generate", "--scenes", str(folder), "--split", "train", "--episodes", "3",
+    # From inside the folder: the scene ids ("movingai:./room.map"), and with them the
+    # episodes drawn, do not depend on where the temporary folder is.
+    args = ["dataset", "generate", "--scenes", ".", "--split", "train", "--episodes", "3",
             "--max-geodesic", "4", "--out", str(out), "--quiet"]
-    assert main(args) == 0
+    here = os.getcwd()
+    os.chdir(folder)
+    try:
+        assert main(args) == 0
+    finally:
+        os.chdir(here)
     SCAN.save(folder / "scan.yaml")
     return folder
 
@@ -51,13 +60,13 @@ def _eval(folder, tmp_path, *extra):
 
 def test_module_policy_gets_the_configs_env(data):
     episodes = list(EpisodeDataset.load(data / "val.json.gz"))
-    results = evaluate(episodes, "eval_policies:scan16_forward", env_config=SCAN)
+    results = evaluate(episodes, "eval_policies:scan16_forward", env_config=SCAN, scenes_root=str(data))
     assert len(results) == 3
     # max_steps counts discrete actions: a forward-only robot either arrives or runs 12 of them.
     assert all(r.steps <= 12 and (r.success or r.steps == 12) for r in results)
     assert any(r.path_length > 0.25 * 5 for r in results)  # moved forward_step per action, several times
     with pytest.raises(ValueError, match="max_steps given beside env_config"):
-        evaluate(episodes, "oracle", env_config=SCAN, max_steps=50)
+        evaluate(episodes, "oracle", env_config=SCAN, max_steps=50, scenes_root=str(data))
 
 
 def test_sb3_model_trained_on_a_scan_env_evaluates_with_its_config(data, tmp_path, capsys):
