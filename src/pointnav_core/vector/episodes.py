@@ -19,7 +19,7 @@ assembled here into the same arrays as a build in this process.
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from typing import Any
 
@@ -170,11 +170,7 @@ class EpisodePool:
         reach: float = math.inf,
         parts: Sequence[ScenePart] | None = None,
     ) -> None:
-        if parts is None:
-            parts = build_in_process(type(self), samplers, pool_size, seeds, starts, reach)
-        parts = list(parts)
-        if fixed:
-            parts.append(_fixed_part(samplers, fixed, reach, parts))
+        parts = pool_parts(type(self), samplers, pool_size, seeds, starts, reach, fixed, parts)
         table, field_of, self.fields = assemble_parts(parts, arrays)
         a = arrays
         self.sx, self.sy, self.syaw, self.gx, self.gy, self.d0 = (a.asarray(table[:, i]) for i in range(6))
@@ -218,15 +214,30 @@ class EpisodePool:
 
 
 def build_in_process(kind: Any, samplers: Sequence[Any], pool_size: int, seeds: Sequence[int], starts: int,
-                     reach: float) -> list[ScenePart]:
+                     reach: float, done: Callable[[int], Any] | None = None) -> list[ScenePart]:
     """Every scene's part of a pool of ``kind`` (a class with ``scene_part``), here, in
-    order; the byte budget is checked before each scene's fields are settled."""
+    order; the byte budget is checked before each scene's fields are settled. ``done(1)``
+    is called after each scene (a progress bar's ``update``)."""
     parts: list[ScenePart] = []
     cells = goals = 0
     for s, env in enumerate(samplers):
         part = kind.scene_part(env, s, pool_size, seeds[s * pool_size:(s + 1) * pool_size], starts, reach, cells, goals)
         cells, goals = cells + part.cells, goals + len(part.fields)
         parts.append(part)
+        if done is not None:
+            done(1)
+    return parts
+
+
+def pool_parts(kind: Any, samplers: Sequence[Any], pool_size: int, seeds: Sequence[int], starts: int, reach: float,
+               fixed: Sequence[Any], parts: Sequence[ScenePart] | None,
+               fixed_part: Callable[..., ScenePart] | None = None) -> list[ScenePart]:
+    """A pool's parts: ``parts`` (built ahead, e.g. in workers) or every scene's built here,
+    then the part of the ``fixed`` episodes, if any, made by ``fixed_part`` (default: one
+    robot's; both pool kinds share this)."""
+    parts = list(parts) if parts is not None else build_in_process(kind, samplers, pool_size, seeds, starts, reach)
+    if fixed:
+        parts.append((fixed_part or _fixed_part)(samplers, fixed, reach, parts))
     return parts
 
 

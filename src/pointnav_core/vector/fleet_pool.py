@@ -24,8 +24,8 @@ import numpy as np
 from pointnav_core.vector.episodes import (
     ScenePart,
     assemble_parts,
-    build_in_process,
     fixed_pose,
+    pool_parts,
     settle_part,
 )
 from pointnav_core.vector.xp import Arrays
@@ -105,11 +105,7 @@ class FleetPool:
         parts: Sequence[ScenePart] | None = None,
     ) -> None:
         n_robots = len(samplers[0].tasks)
-        if parts is None:
-            parts = build_in_process(type(self), samplers, pool_size, seeds, starts, reach)
-        parts = list(parts)
-        if fixed:
-            parts.append(_fixed_part(samplers, fixed, reach, parts))
+        parts = pool_parts(type(self), samplers, pool_size, seeds, starts, reach, fixed, parts, _fixed_part)
         table, field_index, self.fields = assemble_parts(parts, arrays)
         table = table.reshape(-1, n_robots, 6)
         a = arrays

@@ -21,7 +21,7 @@ from typing import Any
 import numpy as np
 
 from pointnav_core import validation
-from pointnav_core.vector.episodes import ScenePart
+from pointnav_core.vector.episodes import ScenePart, build_in_process
 from pointnav_core.vector.fields import check_budget
 from pointnav_core.workers import WorkerError, WorkerPool, usable_cores
 
@@ -110,14 +110,7 @@ def build_parts(kind: Any, samplers: Sequence[Any], pool_size: int, seeds: Seque
                     "them must guard its entry point with `if __name__ == '__main__':`; building the pool "
                     "in this process (workers=1 does so without trying)", RuntimeWarning, stacklevel=4,
                 )
-        parts: list[ScenePart] = []
-        cells = goals = 0
-        for s, env in enumerate(samplers):
-            part = kind.scene_part(env, s, pool_size, seeds[s * pool_size:(s + 1) * pool_size], starts, reach, cells, goals)
-            cells, goals = cells + part.cells, goals + len(part.fields)
-            parts.append(part)
-            bar.update(1)
-        return parts
+        return build_in_process(kind, samplers, pool_size, seeds, starts, reach, bar.update)
 
 
 def _in_workers(kind: Any, samplers: Sequence[Any], pool_size: int, seeds: Sequence[int], starts: int, reach: float,
