@@ -140,7 +140,7 @@ def main() -> None:
     args = parser.parse_args()
     import torch
 
-    from pointnav_core.vector.env import _default_scene
+    from pointnav_core.vector.arguments import default_scene
 
     torch.set_num_threads(1)
     try:  # the compiled scan: one thread as well (it does not use more today)
@@ -153,7 +153,7 @@ def main() -> None:
     print(f"machine: {platform.machine()}, {platform.processor() or 'cpu'}, {os.cpu_count()} cores; torch "
           f"{torch.__version__}; one torch thread; OMP_NUM_THREADS={threads}")
     # One scene object for every engine: the goal fields it caches are settled once.
-    scene = _default_scene()
+    scene = default_scene()
     _table(scene, 1024, 4, "cpu", args.steps, args.rounds, args.pool_size)
     if torch.cuda.is_available():
         for worlds in (8192, 32768, 131072):

@@ -214,10 +214,6 @@ __all__ = [
 ]
 
 
-def _check_int(name: str, value: Any, minimum: int) -> int:
-    return validation.integer(name, value, minimum=minimum)
-
-
 class MultiPointNavEnv(ParallelEnv[str, Any, np.ndarray]):
     """Many robots, one scene, one :class:`PointNavigationTask` each: a PettingZoo ParallelEnv.
 
@@ -292,8 +288,8 @@ class MultiPointNavEnv(ParallelEnv[str, Any, np.ndarray]):
                 f"render_mode must be None or one of {self.metadata['render_modes']}, "
                 f"got {render_mode!r}"
             )
-        n = _check_int("n_robots", n_robots, 1)
-        self.max_cycles = _check_int("max_cycles", max_cycles, 1)
+        n = validation.integer("n_robots", n_robots, minimum=1)
+        self.max_cycles = validation.integer("max_cycles", max_cycles, minimum=1)
         check_finished(finished)
         scene, frequency = _envcommon.check_world_args(
             scene, flatten_obs, action_frequency, backend_kwargs

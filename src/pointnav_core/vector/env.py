@@ -23,6 +23,7 @@ from pointnav_core.env_config import EnvConfig, takes_config, vector_arguments
 from pointnav_core.vector import contacts_jit
 from pointnav_core.vector.contacts import advance
 from pointnav_core.vector.accounting import task_step
+from pointnav_core.vector.arguments import as_scene_list, check_real_actions, task_arguments
 from pointnav_core.vector.discrete import MOVED, DiscretePlan
 from pointnav_core.vector.drive import arc, body_command, sub_steps, substep_drive, travel
 from pointnav_core.vector.episodes import EpisodePool, fixed_pose
@@ -35,39 +36,6 @@ from pointnav_core.vector.scan import ScanTables, VectorScan, requested_scan
 from pointnav_core.vector.xp import make_arrays
 
 __all__ = ["VectorPointNavEnv"]
-
-
-def _default_scene() -> scenes.Scene:
-    # The single env's default house, its floor as grid cells only (see docs/decisions.md).
-    house = scenes.rooms(seed=0)
-    floor = house.floors[0]
-    return scenes.Scene.from_array(np.asarray(floor.codes), floor.resolution, origin=tuple(floor.origin))
-
-
-def _task_arguments(task: Mapping[str, Any] | None) -> dict[str, Any]:
-    """A copy of the ``task`` arguments; ValueError for a non-dict or a custom term."""
-    if task is not None and not isinstance(task, Mapping):
-        raise ValueError(f"task must be None or a dict of PointNavigationTask arguments, got {task!r}")
-    for key in ("termination_conditions", "reward_functions", "observation_terms"):
-        if task is not None and task.get(key) is not None:
-            raise ValueError(f"task: {key} is not supported by the batched engine")
-    return dict(task or {})
-
-
-def _scene_list(scene: scenes.Scene | Sequence[scenes.Scene] | None) -> list[scenes.Scene]:
-    """The worlds' scenes (default: the default house as a grid); ValueError if not Scenes."""
-    scene_list = [scene] if isinstance(scene, scenes.Scene) else list(scene) if scene is not None else [_default_scene()]
-    if not scene_list or not all(isinstance(s, scenes.Scene) for s in scene_list):
-        raise ValueError(f"scene must be a Scene or a non-empty sequence of Scenes, got {scene!r}")
-    return scene_list
-
-
-def check_real_actions(actions: Any) -> None:
-    """ValueError naming ``actions`` unless they are real numbers (both engines; the single
-    env's rule, :func:`pointnav_core.validation.is_real_array`: no bools, complex numbers or strings)."""
-    if not validation.is_real_array(actions):
-        kind = getattr(actions, "dtype", type(actions).__name__)
-        raise ValueError(f"actions must be real numbers in [-1, 1] (an integer or float array), got {kind}")
 
 
 class VectorPointNavEnv(PoolRefreshing, VectorEnv):
@@ -270,12 +238,12 @@ class VectorPointNavEnv(PoolRefreshing, VectorEnv):
         if validation.integer("n_robots", n_robots, minimum=1) != 1:  # several: built by __new__
             raise ValueError(f"n_robots must be 1 here, got {n_robots}: VectorPointNavEnv builds the multi-robot engine")
         scan_term = requested_scan(sensors)
-        task = _task_arguments(task)
+        task = task_arguments(task)
         self.pool_size = validation.integer("pool_size", pool_size, minimum=1)
         self.starts_per_goal = validation.integer("starts_per_goal", starts_per_goal, minimum=1)
         self.arrays = make_arrays(device)
         self.device = device
-        self.scenes = scene_list = _scene_list(scene)
+        self.scenes = scene_list = as_scene_list(scene)
         self._pool_workers, self._pool_progress = pool_options(workers, progress, len(scene_list))
         self.robot = _envcommon.make_robot(robot)  # either drive (vector.drive)
         self._samplers = [

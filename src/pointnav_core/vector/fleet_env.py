@@ -33,7 +33,8 @@ from pointnav_core.vector.accounting import task_step
 from pointnav_core.vector.contacts_jit import advance_compiled
 from pointnav_core.vector.discrete import MOVED, DiscretePlan
 from pointnav_core.vector.drive import arc, body_command, sub_steps, substep_drive, travel
-from pointnav_core.vector.env import VectorPointNavEnv, _scene_list, check_real_actions
+from pointnav_core.vector.arguments import as_scene_list, check_real_actions
+from pointnav_core.vector.env import VectorPointNavEnv
 from pointnav_core.vector.falls import apply_falls
 from pointnav_core.vector.fleet_pool import FleetPool, check_fixed_episode
 from pointnav_core.vector.floors import FloorTables
@@ -123,7 +124,7 @@ class VectorFleetEnv(VectorPointNavEnv):
         self.starts_per_goal = validation.integer("starts_per_goal", starts_per_goal, minimum=1)
         self.arrays = a = make_arrays(device)
         self.device = device
-        self.scenes = scene_list = _scene_list(scene)
+        self.scenes = scene_list = as_scene_list(scene)
         self._pool_workers, self._pool_progress = pool_options(workers, progress, len(scene_list))
         #: One spec per robot; ``robot`` is their envelope (largest radius, highest speeds).
         self.robots = robot_specs(robot, self.n_robots)

@@ -1,0 +1,46 @@
+"""The batched engines' arguments, read and checked once for both (one robot a world, and
+:mod:`pointnav_core.vector.fleet_env`'s several): scenes, task arguments and actions."""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+from typing import Any
+
+import numpy as np
+
+from pointnav_core import scenes, validation
+
+__all__ = ["as_scene_list", "check_real_actions", "default_scene", "task_arguments"]
+
+
+def default_scene() -> scenes.Scene:
+    # The single env's default house, its floor as grid cells only (see docs/decisions.md).
+    house = scenes.rooms(seed=0)
+    floor = house.floors[0]
+    return scenes.Scene.from_array(np.asarray(floor.codes), floor.resolution, origin=tuple(floor.origin))
+
+
+def task_arguments(task: Mapping[str, Any] | None) -> dict[str, Any]:
+    """A copy of the ``task`` arguments; ValueError for a non-dict or a custom term."""
+    if task is not None and not isinstance(task, Mapping):
+        raise ValueError(f"task must be None or a dict of PointNavigationTask arguments, got {task!r}")
+    for key in ("termination_conditions", "reward_functions", "observation_terms"):
+        if task is not None and task.get(key) is not None:
+            raise ValueError(f"task: {key} is not supported by the batched engine")
+    return dict(task or {})
+
+
+def as_scene_list(scene: scenes.Scene | Sequence[scenes.Scene] | None) -> list[scenes.Scene]:
+    """The worlds' scenes (default: the default house as a grid); ValueError if not Scenes."""
+    scene_list = [scene] if isinstance(scene, scenes.Scene) else list(scene) if scene is not None else [default_scene()]
+    if not scene_list or not all(isinstance(s, scenes.Scene) for s in scene_list):
+        raise ValueError(f"scene must be a Scene or a non-empty sequence of Scenes, got {scene!r}")
+    return scene_list
+
+
+def check_real_actions(actions: Any) -> None:
+    """ValueError naming ``actions`` unless they are real numbers (both engines; the single
+    env's rule, :func:`pointnav_core.validation.is_real_array`: no bools, complex numbers or strings)."""
+    if not validation.is_real_array(actions):
+        kind = getattr(actions, "dtype", type(actions).__name__)
+        raise ValueError(f"actions must be real numbers in [-1, 1] (an integer or float array), got {kind}")
