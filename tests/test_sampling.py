@@ -82,3 +82,20 @@ def test_a_multi_robot_reset_that_cannot_separate_goals_tries_max_trials_pairs_a
     # Two draws (start, goal) per trial; robots before the failing one took one trial or more.
     n_trials = env.tasks[0].max_trials
     assert len(drawn) <= 5 * 2 * n_trials
+
+
+@pytest.mark.parametrize("resolution", [0.1, 0.05, 0.3])
+def test_points_within_max_distance_are_exactly_those_math_hypot_keeps(resolution):
+    # Cell centres at exact distances (3-4-5 triangles on the grid) sit on the bound: the
+    # fast squared test must keep exactly the cells that math.hypot keeps.
+    scene = Scene.from_array(np.zeros((41, 41), np.uint8), resolution=resolution)
+    tmap = scene.floors[0]
+    ref = tmap.cell_to_world(np.array([20, 20]))
+    label = int(tmap.component_at(ref, 0.0))
+    flat, xy = tmap.component_cells(0.0, label)
+    for cells in (5, 10, 12.5, 15):
+        bound = cells * resolution
+        want = [i for i, (x, y) in zip(flat.tolist(), xy.tolist()) if math.hypot(x - ref[0], y - ref[1]) <= bound]
+        from pointnav_core.scenes import _cells_of
+
+        assert _cells_of(tmap, 0.0, label, ref, bound).tolist() == want

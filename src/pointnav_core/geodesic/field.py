@@ -72,7 +72,7 @@ class GoalField(ThawOnUnpickle):
     @property
     def nbytes(self) -> int:
         """Approximate memory held by this field, in bytes."""
-        if self._nbytes is None:  # counted once: the planner's cache sums it on every insert
+        if self._nbytes is None:  # counted once, again after the root table is made
             table = 0 if self._table is None else sum(v.nbytes for v in self._table.values() if isinstance(v, np.ndarray))
             self._nbytes = self._search.nbytes + table
         return self._nbytes
@@ -261,10 +261,11 @@ class GoalField(ThawOnUnpickle):
             "gx": float(self.goal[0]),
             "gy": float(self.goal[1]),
         }
+        before = self.nbytes
         self._table = table
         self._nbytes = None
         # The table made this field bigger: keep the planner's cache within its budget.
-        self.planner._trim_fields()
+        self.planner.field_resized(self, before)
         return table
 
 

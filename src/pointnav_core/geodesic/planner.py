@@ -134,6 +134,8 @@ class Planner(ThawOnUnpickle):
         self._usable: NDArray[np.bool_] | None = None
         self._near: NDArray[np.int32] | None = None
         self._fields: dict[tuple[float, float], GoalField] = {}
+        # The cached fields' bytes, kept as they enter, grow and leave (a sum over the
+        # cache on every insert cost a tenth of a reset).
         self._field_bytes = 0
 
     # ------------------------------------------------------------------ nodes
@@ -406,15 +408,22 @@ class Planner(ThawOnUnpickle):
         field = self._fields.pop(key, None)
         if field is None:
             field = GoalField(self, g)
+            self._field_bytes += field.nbytes
         self._fields[key] = field  # most recently used last
         self._trim_fields()
         return field
 
+    def field_resized(self, field: GoalField, before: int) -> None:
+        """Count a cached ``field`` whose size changed from ``before`` bytes (its root table
+        was made), and keep the cache within :attr:`field_cache_bytes`."""
+        if self._fields.get((float(field.goal[0]), float(field.goal[1]))) is field:
+            self._field_bytes += field.nbytes - before
+            self._trim_fields()
+
     def _trim_fields(self) -> None:
-        total = sum(f.nbytes for f in self._fields.values())
-        while total > self.field_cache_bytes and len(self._fields) > 1:
+        while self._field_bytes > self.field_cache_bytes and len(self._fields) > 1:
             key = next(iter(self._fields))
-            total -= self._fields.pop(key).nbytes
+            self._field_bytes -= self._fields.pop(key).nbytes
 
     def shortest_path(
         self, source: ArrayLike, target: ArrayLike
