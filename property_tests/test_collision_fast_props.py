@@ -4,7 +4,7 @@ For random grids (random blocked cells, outside blocked or not), radii (0 includ
 segments of every kind (points, axis-aligned, on grid lines, crossing the map's edge, far
 off it), :meth:`pointnav_core.collision.FloorCollision.segments_clear` answers the same
 with its numba kernel as with its numpy arrays (the ``fast`` extra's path and the path
-without it). The numpy path itself is checked against shapely in
+without it). So does the one-segment call, :meth:`FloorCollision.segment_clear`. The numpy path itself is checked against shapely in
 ``property_tests/test_geometry_agreement.py`` and ``tests/test_collision.py``.
 """
 
@@ -55,3 +55,10 @@ def test_compiled_cell_test_equals_the_numpy_path(
         want = geo.segments_clear(a, b, radius)
     np.testing.assert_array_equal(got, want)
     assert kernel("pointnav_core._collision_kernel", "cells_hit") is not None
+    # The one-segment call (planners' and worlds' point tests), compiled and not.
+    pairs = list(zip(a.tolist(), b.tolist()))
+    one = np.array([geo.segment_clear(*p, *q, radius) for p, q in pairs])
+    with numpy_paths():
+        plain = np.array([geo.segment_clear(*p, *q, radius) for p, q in pairs])
+    np.testing.assert_array_equal(one, want)
+    np.testing.assert_array_equal(plain, want)

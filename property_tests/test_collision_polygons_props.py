@@ -57,3 +57,6 @@ def test_compiled_polygon_test_equals_shapely(polys, seed, radius) -> None:
     dist = shapely.distance(shapely.union_all(polys), lines)
     sure = np.abs(dist - reach) > 1e-9
     np.testing.assert_array_equal(got[sure], want[sure])
+    # The one-segment call (planners' and worlds' point tests) answers as the array call.
+    one = np.array([geo.segment_clear(*p, *q, radius) for p, q in zip(a.tolist(), b.tolist())])
+    np.testing.assert_array_equal(one, got)

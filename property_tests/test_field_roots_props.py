@@ -6,6 +6,11 @@ round mirrored corners tie), robot radii 0 and above, and random goals,
 ``GoalField.settle`` gives every cell of the map (its blocks in a random order, some twice)
 exactly the kind and label that the one-point exact query (``GoalField._best``) picks at
 the cell's centre; with numba's kernels and on their numpy paths alike.
+
+The floor's cell links (:class:`pointnav_core.geodesic.cell_links.CellLinks`: every usable
+cell centre's clear links, found once per floor) give, through ``roots.table_roots``, exactly
+the kinds, labels and distances of ``roots.compiled_roots``, which tests each candidate
+link's segment itself; each cell's links are those the one-point query finds.
 """
 
 from __future__ import annotations
@@ -13,10 +18,13 @@ from __future__ import annotations
 import contextlib
 
 import numpy as np
+import pytest
 from hypothesis import HealthCheck, given, note, settings
 from hypothesis import strategies as st
 
 from pointnav_core import _compiled
+from pointnav_core.geodesic import roots
+from pointnav_core.geodesic.cell_links import CellLinks, cell_centres
 from pointnav_core.maps import FREE, OBSTACLE
 from pointnav_core.scenes import Scene
 from pointnav_core.testing.strategies import cluttered_rooms, nav_scenes
@@ -115,3 +123,28 @@ def test_batched_settle_equals_the_one_point_query(field, data, numpy_paths: boo
         got = field.distance(float(xs[i]), float(ys[i]))
         assert abs(got - field.point_distance((xs[i], ys[i]))) <= 1e-9
     note(f"kinds {np.bincount(want_kind, minlength=3).tolist()}")
+
+
+@settings(max_examples=40, deadline=None, suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large])
+@given(field=fields())
+def test_roots_from_cell_links_equal_the_roots_found_link_by_link(field) -> None:
+    pytest.importorskip("numba")
+    p = field.planner
+    if not p.n_nodes or not field.goal_usable:
+        return
+    links = CellLinks.build(p)
+    cells = np.flatnonzero(p.usable.ravel())
+    xs, ys = cell_centres(p, cells)
+    tables = field.arc_tables()
+    got = roots.table_roots(field, tables, links, cells, xs, ys)
+    want = roots.compiled_roots(field, tables, xs, ys)
+    for a, b in zip(got, want):
+        np.testing.assert_array_equal(a, b)
+    # Every link is clear and lands on its node's arc: the same links the one-point query
+    # finds (Planner.point_links), in a cell's order.
+    for i in cells[:: max(1, len(cells) // 25)].tolist():
+        x, y = cell_centres(p, np.array([i]))
+        lo, n = links.first[i], links.count[i]
+        mine = sorted(zip(links.node[lo : lo + n].tolist(), (1 - 2 * links.side[lo : lo + n]).tolist()))
+        theirs = sorted((c, s) for c, s, _, _ in p.point_links(float(x[0]), float(y[0])))
+        assert mine == theirs

@@ -111,6 +111,52 @@ def test_the_cache_can_be_turned_off_and_follows_the_platform(monkeypatch, tmp_p
         assert cache.cache_dir() == tmp_path / "pointnav-core"
 
 
+# ---------------------------------------------------------------- cell links
+def test_cell_links_are_kept_and_read_back_whole(folder) -> None:
+    first = _built(_geo())
+    links = first.cell_links()
+    assert links is not None and len(links.node)
+    second = Planner(_geo(), 0.18)
+    again = second.cell_links(build=False)  # read from the file: nothing to build
+    assert again is not None
+    for name, array in links.arrays().items():
+        np.testing.assert_array_equal(again.arrays()[name], array)
+
+
+@pytest.mark.parametrize("damage", ["node", "first", "side", "missing"])
+def test_damaged_cell_links_are_never_read_and_are_built_again(folder, damage: str) -> None:
+    want = _built(_geo()).cell_links().arrays()
+    (path,) = folder.glob("*.npz")
+    with np.load(path) as z:
+        arrays = {k: z[k] for k in z.files}
+    if damage == "node":
+        arrays["link_node"][0] = 10**6  # a node the floor does not have
+    elif damage == "first":
+        arrays["link_first"][-1] = len(arrays["link_node"]) + 5
+        arrays["link_count"][-1] = 1
+    elif damage == "side":
+        arrays["link_side"][0] = 7
+    else:
+        del arrays["link_pos"]
+    np.savez(path.with_suffix(""), **arrays)
+    p = Planner(_geo(), 0.18)
+    assert p.cell_links(build=False) is None
+    for name, array in p.cell_links().arrays().items():
+        np.testing.assert_array_equal(array, want[name])
+
+
+def test_cell_links_are_built_once_the_roots_without_them_cost_as_much(folder, monkeypatch) -> None:
+    from pointnav_core.geodesic import cell_links
+
+    monkeypatch.setattr(cell_links, "BUILD_SECONDS_PER_PAIR", 1.0)  # never worth it
+    p = Planner(_geo(), 0.18)
+    p.goal_field((4.55, 2.05)).settle()
+    assert p.cell_links(build=False) is None
+    monkeypatch.setattr(cell_links, "BUILD_SECONDS_PER_PAIR", 0.0)  # at once
+    p.goal_field((0.55, 3.55)).settle()
+    assert p.cell_links(build=False) is not None
+
+
 # ---------------------------------------------------------------- pointnav scene build
 def test_scene_build_keeps_every_floor_for_later_processes(folder, capsys):
     from pointnav_core import scenes
@@ -124,6 +170,7 @@ def test_scene_build_keeps_every_floor_for_later_processes(folder, capsys):
     # that was not built misses.
     tmap = scenes.maze(seed=3).floors[0]
     assert planner_for(tmap, 0.1).cached and planner_for(tmap, 0.15).cached
+    assert planner_for(tmap, 0.1).cell_links(build=False) is not None  # kept with the rest
     assert not planner_for(tmap, 0.12).cached
 
 

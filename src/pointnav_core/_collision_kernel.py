@@ -12,7 +12,7 @@ import math
 
 import numba
 
-__all__ = ["cells_hit"]
+__all__ = ["cells_hit", "segment_hits"]
 
 _jit = numba.njit(cache=True, nogil=True, error_model="numpy")
 
@@ -175,3 +175,15 @@ def polygons_hit(ax, ay, bx, by, reach, boxes, first, last, x0, y0, x1, y1, out)
     """``out[i]``: :func:`segment_hits_polygons` of segment ``i``."""
     for i in range(ax.shape[0]):
         out[i] = segment_hits_polygons(ax[i], ay[i], bx[i], by[i], reach, boxes, first, last, x0, y0, x1, y1)
+
+
+@_jit
+def segment_hits(ax, ay, bx, by, ox, oy, inv, rho, rowcum, outside_blocked, reach, boxes, first, last, ex0, ey0, ex1,
+                 ey1, use_polygons):  # pragma: no cover
+    """``FloorCollision.segments_clear``'s test, negated, for one segment in world metres
+    (``inv`` = 1 / resolution; ``rho`` and ``reach`` as :meth:`FloorCollision._cells_hit` and
+    :meth:`FloorCollision._polygons_hit` derive them from the radius)."""
+    if segment_hits_cells((ax - ox) * inv, (ay - oy) * inv, (bx - ox) * inv, (by - oy) * inv, rho, rowcum,
+                          outside_blocked):
+        return True
+    return use_polygons and segment_hits_polygons(ax, ay, bx, by, reach, boxes, first, last, ex0, ey0, ex1, ey1)

@@ -50,6 +50,7 @@ def _build_one(scene_id: str, root: str | None, radius: float) -> tuple[str, flo
     for tmap in scene.floors:
         planner = planner_for(tmap, radius)
         planner.build_all_edges()
+        planner.cell_links()  # every cell's clear links, where the floor is small enough
         kept += planner.cached
     return scene_id, radius, scene.n_floors, kept, time.perf_counter() - started
 

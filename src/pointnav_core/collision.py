@@ -27,6 +27,7 @@ tested with shapely's exact ``dwithin``.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Sequence
 from typing import Any
 
@@ -141,6 +142,23 @@ class FloorCollision:
         return (np.zeros((0, 4)), np.zeros(0, np.int64), np.zeros(0, np.int64), *(np.zeros(0),) * 4)
 
     # ------------------------------------------------------------------ queries
+    def segment_clear(self, ax: float, ay: float, bx: float, by: float, radius: float) -> bool:
+        """:meth:`segments_clear` for one segment from ``(ax, ay)`` to ``(bx, by)`` (m), without
+        its array set-up: the compiled test called on the numbers where numba is installed
+        (a tenth of the cost for one point; a property test holds the two equal)."""
+        kernel = _compiled.kernel("pointnav_core._collision_kernel", "segment_hits")
+        if kernel is None or not self.compiled_polygons:
+            return bool(self.segments_clear(np.array([ax, ay]), np.array([bx, by]), radius))
+        if not (math.isfinite(ax) and math.isfinite(ay) and math.isfinite(bx) and math.isfinite(by)):
+            return False
+        radius = float(radius)
+        ox, oy, res, rowcum, outside, *poly, use_polygons = self.kernel_geometry()
+        inv = 1.0 / res
+        rho = max(radius - TOUCH_TOL, TOUCH_TOL) * inv  # as _cells_hit and _polygons_hit derive them
+        reach = max(radius - 2 * TOUCH_TOL, TOUCH_TOL / 2)
+        return not kernel(float(ax), float(ay), float(bx), float(by), ox, oy, inv, rho, rowcum, outside, reach,
+                          *poly, use_polygons)
+
     def points_clear(self, points: ArrayLike, radius: float) -> NDArray[np.bool_]:
         """Whether discs of ``radius`` metres centred at world ``points`` miss the blocked set.
 

@@ -486,14 +486,18 @@ def _cells_of(tmap: TraversableMap, radius: float, label: int, ref: NDArray[np.f
     flat, xy = tmap.component_cells(radius, label)
     if max_distance is None or not math.isfinite(max_distance):
         return flat
-    dx, dy = xy[:, 0] - ref[0], xy[:, 1] - ref[1]
-    d2 = dx * dx + dy * dy
+    rx, ry = float(ref[0]), float(ref[1])
+    d2 = xy[:, 0] - rx
+    d2 *= d2
+    dy = xy[:, 1] - ry
+    dy *= dy
+    d2 += dy
     # The squared test decides all but a thin shell around the bound, where it could round
     # the other way; there ``hypot`` decides, so the cells are exactly those with
     # ``hypot <= max_distance`` (at a fifth of its cost).
     near = d2 <= (max_distance * (1 - 1e-9)) ** 2
-    shell = np.flatnonzero(~near & (d2 <= (max_distance * (1 + 1e-9)) ** 2))
-    near[shell] = np.hypot(dx[shell], dy[shell]) <= max_distance
+    shell = np.flatnonzero((d2 <= (max_distance * (1 + 1e-9)) ** 2) != near)
+    near[shell] = np.hypot(xy[shell, 0] - rx, xy[shell, 1] - ry) <= max_distance
     return flat[near]
 
 

@@ -100,7 +100,7 @@ class FloorGrid:
         :data:`~pointnav_core.collision.TOUCH_TOL` is fine. A subclass may answer the
         common case faster, but must give the same answer.
         """
-        return bool(self.collision.points_clear((x, y), r))
+        return self.collision.segment_clear(x, y, x, y, r)
 
 
 def robots_overlap(

@@ -19,9 +19,9 @@ import math
 
 import numba
 
-from pointnav_core._collision_kernel import segment_hits_cells, segment_hits_polygons
+from pointnav_core._collision_kernel import segment_hits as _hits
 
-__all__ = ["best_links", "point_links"]
+__all__ = ["best_links", "cell_links", "point_links", "table_roots"]
 
 _jit = numba.njit(cache=True, nogil=True, error_model="numpy")
 
@@ -42,6 +42,40 @@ def _arc_free(blocked, has_blocked, span, node, s, p1, p2, tol):  # pragma: no c
         if lo + tol < b and b < hi - tol:
             return False
     return True
+
+
+@_jit
+def _link_value(c, s, dep, length, r, ang_tol, span, lab_start, graph_end, labels, lab_pos, lab_cost, blocked,
+                has_blocked):  # pragma: no cover
+    """The best total (m; inf: none) and label of a link of winding ``s`` to node ``c``, its
+    reverse path leaving the arc at ``dep`` (rad) after a tangent of ``length`` (m)."""
+    # The link's best label on the arc its reverse path leaves along (winding -s). Along the
+    # arc, Dijkstra's costs grow by at most r per radian from vertex to vertex, so of the
+    # graph's vertices the last at or before the departure is the best (a blocked piece of
+    # arc between it and the departure blocks every earlier one too); the field's own
+    # arrivals are looked at one by one.
+    g = 2 * c + (1 if s > 0 else 0)
+    value = math.inf
+    lab = -1
+    lo_j = lab_start[g]
+    hi_j = graph_end[g]
+    while lo_j < hi_j:
+        mid = (lo_j + hi_j) // 2
+        if lab_pos[labels[mid]] <= dep + ang_tol:
+            lo_j = mid + 1
+        else:
+            hi_j = mid
+    for j in range(max(lo_j - 1, lab_start[g]), lab_start[g + 1]):
+        if j < graph_end[g] and j != lo_j - 1:
+            continue
+        lb = labels[j]
+        lp = lab_pos[lb]
+        if lp <= dep + ang_tol and _arc_free(blocked, has_blocked, span, c, -s, lp, dep, ang_tol):
+            v = lab_cost[lb] + r * max(dep - lp, 0.0) + length
+            if v < value:
+                value = v
+                lab = lb
+    return value, lab
 
 
 @_jit
@@ -133,34 +167,9 @@ def best_links(  # pragma: no cover
                 if not ok:
                     continue
                 pos = ccw if s > 0 else span[c] - ccw
-                dep = span[c] - pos
                 order = side_rank * n_nodes + c
-                # The link's best label on the arc its reverse path leaves along (winding -s).
-                # Along the arc, Dijkstra's costs grow by at most r per radian from vertex to
-                # vertex, so of the graph's vertices the last at or before the departure is
-                # the best (a blocked piece of arc between it and the departure blocks every
-                # earlier one too); the field's own arrivals are looked at one by one.
-                g = 2 * c + (1 if s > 0 else 0)
-                value = math.inf
-                lab = -1
-                lo_j = lab_start[g]
-                hi_j = graph_end[g]
-                while lo_j < hi_j:
-                    mid = (lo_j + hi_j) // 2
-                    if lab_pos[labels[mid]] <= dep + ang_tol:
-                        lo_j = mid + 1
-                    else:
-                        hi_j = mid
-                for j in range(max(lo_j - 1, lab_start[g]), lab_start[g + 1]):
-                    if j < graph_end[g] and j != lo_j - 1:
-                        continue
-                    lb = labels[j]
-                    lp = lab_pos[lb]
-                    if lp <= dep + ang_tol and _arc_free(blocked, has_blocked, span, c, -s, lp, dep, ang_tol):
-                        v = lab_cost[lb] + r * max(dep - lp, 0.0) + length
-                        if v < value:
-                            value = v
-                            lab = lb
+                value, lab = _link_value(c, s, span[c] - pos, length, r, ang_tol, span, lab_start, graph_end, labels,
+                                         lab_pos, lab_cost, blocked, has_blocked)
                 if lab < 0:
                     continue
                 if not (value < best or (value == best and order < best_order)):
@@ -175,15 +184,6 @@ def best_links(  # pragma: no cover
                 winner = c
         hint = winner
         best_value[i] = best
-
-
-@_jit
-def _hits(ax, ay, bx, by, ox, oy, inv, rho, rowcum, outside_blocked, reach, boxes, first, last, ex0, ey0, ex1, ey1,
-          use_polygons):  # pragma: no cover
-    # FloorCollision.segments_clear's test, negated, for one segment in world metres.
-    if segment_hits_cells((ax - ox) * inv, (ay - oy) * inv, (bx - ox) * inv, (by - oy) * inv, rho, rowcum, outside_blocked):
-        return True
-    return use_polygons and segment_hits_polygons(ax, ay, bx, by, reach, boxes, first, last, ex0, ey0, ex1, ey1)
 
 
 @_jit
@@ -215,3 +215,90 @@ def point_links(  # pragma: no cover
             length_out[n] = length
             n += 1
     return n
+
+
+@_jit
+def cell_links(  # pragma: no cover
+    x, y, cand, cand_lo, cand_hi, cx, cy, phi0, span, r, ang_tol, touch_tol, ball, profile,
+    ox, oy, res, rowcum, outside_blocked, boxes, first, last, ex0, ey0, ex1, ey1, use_polygons,
+    node_out, side_out, pos_out, length_out, count,
+):
+    """Every visible link of each point ``(x[i], y[i])`` over the candidate nodes
+    ``cand[cand_lo[i]:cand_hi[i]]``: the tangents that land on a node's arc, within its sight
+    ball (radius ``ball``), and are clear, as :func:`best_links` tests them. Writes them point
+    after point into the ``*_out`` arrays (``side_out`` 0 for winding +1, 1 for -1; ``pos_out``
+    as :func:`best_links` computes it) and each point's number into ``count``; returns the
+    total, or -1 when the ``*_out`` arrays are too short."""
+    inv = 1.0 / res
+    rho = max(r - touch_tol, touch_tol) * inv
+    reach = max(r - 2 * touch_tol, touch_tol / 2)
+    n = 0
+    cap = node_out.shape[0]
+    for i in range(x.shape[0]):
+        px = x[i]
+        py = y[i]
+        count[i] = 0
+        for step in range(cand_lo[i], cand_hi[i]):
+            c = cand[step]
+            dx = cx[c] - px
+            dy = cy[c] - py
+            if dx * dx + dy * dy > ball[c] * ball[c]:
+                continue
+            for side_rank in range(2):
+                s = 1.0 if side_rank == 0 else -1.0
+                ok, ccw, length, qx, qy = _link(px, py, c, s, cx, cy, phi0, span, r, ang_tol, touch_tol, profile)
+                if not ok:
+                    continue
+                if _hits(px, py, qx, qy, ox, oy, inv, rho, rowcum, outside_blocked, reach, boxes, first, last, ex0, ey0,
+                         ex1, ey1, use_polygons):
+                    continue
+                if n == cap:
+                    return -1
+                node_out[n] = c
+                side_out[n] = side_rank
+                pos_out[n] = ccw if s > 0 else span[c] - ccw
+                length_out[n] = length
+                n += 1
+                count[i] += 1
+    return n
+
+
+@_jit
+def table_roots(  # pragma: no cover
+    x, y, gx, gy, link_first, link_count, link_node, link_side, link_pos, link_length, n_nodes,
+    span, r, ang_tol, touch_tol, lab_start, graph_end, labels, lab_pos, lab_cost, blocked, has_blocked,
+    ox, oy, res, rowcum, outside_blocked, boxes, first, last, ex0, ey0, ex1, ey1, use_polygons,
+    kind, best_lab, best_value,
+):
+    """:func:`best_links`' decision for clear points whose visible links are known
+    (``link_*[link_first[i]:link_first[i] + link_count[i]]``, from :func:`cell_links`): the
+    direct segment to the goal (its one segment test), then the smallest ``(total, order)``
+    over the links, with no further segment test."""
+    inv = 1.0 / res
+    rho = max(r - touch_tol, touch_tol) * inv
+    reach = max(r - 2 * touch_tol, touch_tol / 2)
+    for i in range(x.shape[0]):
+        px = x[i]
+        py = y[i]
+        best = math.inf
+        if not _hits(px, py, gx, gy, ox, oy, inv, rho, rowcum, outside_blocked, reach, boxes, first, last, ex0, ey0,
+                     ex1, ey1, use_polygons):
+            best = math.hypot(gx - px, gy - py)
+        kind[i] = 1 if best < math.inf else 0
+        best_lab[i] = -1
+        best_order = -1
+        for j in range(link_first[i], link_first[i] + link_count[i]):
+            c = link_node[j]
+            side_rank = link_side[j]
+            s = 1.0 if side_rank == 0 else -1.0
+            value, lab = _link_value(c, s, span[c] - link_pos[j], link_length[j], r, ang_tol, span, lab_start,
+                                     graph_end, labels, lab_pos, lab_cost, blocked, has_blocked)
+            if lab < 0:
+                continue
+            order = side_rank * n_nodes + c
+            if value < best or (value == best and order < best_order):
+                best = value
+                best_order = order
+                best_lab[i] = lab
+                kind[i] = 2
+        best_value[i] = best

@@ -20,7 +20,8 @@ from numpy.typing import ArrayLike, NDArray
 
 from pointnav_core.frozen import ThawOnUnpickle
 from pointnav_core.geodesic.arc_graph import FieldLabels
-from pointnav_core.geodesic.roots import ArcTables, cell_roots, compiled, compiled_roots
+from pointnav_core.geodesic.cell_links import centre_cell
+from pointnav_core.geodesic.roots import ArcTables, cell_roots, compiled, compiled_roots, table_roots
 from pointnav_core.geodesic.tangents import ANG_TOL, TWO_PI
 
 if TYPE_CHECKING:
@@ -110,6 +111,11 @@ class GoalField(ThawOnUnpickle):
         if compiled(p, "best_links") is not None:
             if not self.goal_usable or not p.is_clear(x, y):
                 return math.inf
+            links = p.cell_links(build=False)
+            cell = -1 if links is None else centre_cell(p, x, y)
+            if cell >= 0:  # a cell centre (a sampled start): its links are known
+                one = np.array([cell])
+                return float(table_roots(self, self.arc_tables(), links, one, np.array([x]), np.array([y]))[2][0])
             return float(compiled_roots(self, self.arc_tables(), np.array([x]), np.array([y]))[2][0])
         return self._best(x, y)[0]
 

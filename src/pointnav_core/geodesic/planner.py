@@ -57,6 +57,7 @@ from pointnav_core.geodesic.tangents import ANG_TOL, COST_TOL, TWO_PI, ccw_pos, 
 from pointnav_core.geodesic.edges import build_edges
 from pointnav_core.geodesic.field import GoalField
 from pointnav_core.geodesic.roots import compiled
+from pointnav_core.geodesic.cell_links import CellLinks
 from pointnav_core.geodesic.sight import NodeBalls, node_sights
 
 if TYPE_CHECKING:
@@ -118,10 +119,16 @@ class Planner(ThawOnUnpickle):
         self._cache_key = cache.floor_key(collision, self.radius) if cache.cache_dir() is not None else None
         stored = cache.load(self._cache_key, self.n_nodes) if self._cache_key is not None else None
         self._in_cache = stored is not None
+        # Every cell's clear links (geodesic.cell_links): None until asked for, False where
+        # the floor gets none.
+        self._cell_links: CellLinks | None | bool = None
+        self._roots_seconds = 0.0
+        self._links_estimate: float | None = None
         if stored is not None:
             self.sights = stored["sights"].astype(np.float64)
             self.sight_profile = stored["sight_profile"].astype(np.float32)
             self._restore_edges(stored)
+            self._cell_links = CellLinks.stored(stored, collision.shape[0] * collision.shape[1], self.n_nodes)
         else:
             # Strict bounds (m) on every clear segment leaving a node's arc (geodesic.sight).
             # and per direction bin (geodesic.sight.blocked_by_profile).
@@ -299,7 +306,48 @@ class Planner(ThawOnUnpickle):
                 bar.update(min(_EDGE_BATCH, len(todo) - i))
         self._build_seconds += time.perf_counter() - started
         if self._cache_key is not None and self._build_seconds >= cache.MIN_SECONDS:
-            self._in_cache = cache.save(self._cache_key, self._stored_edges()) is not None
+            links = self._cell_links.arrays() if isinstance(self._cell_links, CellLinks) else {}
+            self._in_cache = cache.save(self._cache_key, {**self._stored_edges(), **links}) is not None
+
+    @property
+    def sight_reach(self) -> NDArray[np.float64]:
+        """Per node, the radius (m) of its sight ball: no point further from the node's centre
+        sees its arc by a clear tangent."""
+        return self._balls.reach
+
+    def cell_links(self, build: bool = True) -> CellLinks | None:
+        """Every usable cell centre's clear links (:class:`~pointnav_core.geodesic.cell_links.
+        CellLinks`), or None where the floor gets none (its roots are then settled link by
+        link, as fast for a few goals).
+
+        With ``build`` they are built now where the floor is small enough
+        (:meth:`CellLinks.fits`) and kept in the disk cache; without, they are returned only
+        when already built, loaded from the cache, or once the roots settled without them
+        have cost as much as building them would (:meth:`spent_on_roots`).
+        """
+        if self._cell_links is None and build:
+            self._cell_links = False
+            if CellLinks.fits(self):
+                self.build_all_edges()
+                started = time.perf_counter()
+                self._cell_links = CellLinks.build(self)
+                self._build_seconds += time.perf_counter() - started
+                if self._cache_key is not None and self._build_seconds >= cache.MIN_SECONDS:
+                    arrays = {**self._stored_edges(), **self._cell_links.arrays()}
+                    self._in_cache = cache.save(self._cache_key, arrays) is not None
+        return self._cell_links or None
+
+    def spent_on_roots(self, seconds: float) -> None:
+        """Count ``seconds`` of roots settled without the cell links; once they add up to the
+        links' estimated build (:data:`~pointnav_core.geodesic.cell_links.BUILD_SECONDS_PER_PAIR`
+        per candidate pair), build them: a floor that serves many goals pays at most twice
+        the cheaper of the two ways, and one that serves few never builds them."""
+        self._roots_seconds += seconds
+        if self._cell_links is None:
+            if self._links_estimate is None:
+                self._links_estimate = CellLinks.build_estimate(self)
+            if self._roots_seconds >= self._links_estimate:
+                self.cell_links()
 
     @property
     def cached(self) -> bool:
@@ -386,11 +434,13 @@ class Planner(ThawOnUnpickle):
     # ------------------------------------------------------------------ queries
     def is_clear(self, x: float, y: float) -> bool:
         """Whether the robot's disc fits at world point ``(x, y)``."""
-        return bool(self.geo.points_clear(np.array([x, y]), self.radius))
+        return self.geo.segment_clear(x, y, x, y, self.radius)
 
     def segment_clear(self, a: ArrayLike, b: ArrayLike) -> bool:
         """Whether the robot's disc can move straight from ``a`` to ``b``."""
-        return bool(self.geo.segments_clear(np.asarray(a, float), np.asarray(b, float), self.radius))
+        a = np.asarray(a, dtype=np.float64).reshape(-1)
+        b = np.asarray(b, dtype=np.float64).reshape(-1)
+        return self.geo.segment_clear(float(a[0]), float(a[1]), float(b[0]), float(b[1]), self.radius)
 
     def has_field(self, goal: ArrayLike) -> bool:
         """Whether the goal field of world point ``goal`` is cached."""

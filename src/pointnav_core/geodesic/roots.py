@@ -36,6 +36,7 @@ Everything is in world metres and radians.
 from __future__ import annotations
 
 import math
+import time
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
@@ -46,11 +47,12 @@ from pointnav_core.collision import TOUCH_TOL
 from pointnav_core.geodesic.tangents import ANG_TOL, ccw_pos, tangent_from_point
 
 if TYPE_CHECKING:
+    from pointnav_core.geodesic.cell_links import CellLinks
     from pointnav_core.geodesic.planner import Planner
     from pointnav_core.geodesic.arc_graph import FieldLabels
     from pointnav_core.geodesic.field import GoalField
 
-__all__ = ["CHUNK", "ArcTables", "cell_roots", "compiled", "compiled_roots"]
+__all__ = ["CHUNK", "ArcTables", "cell_roots", "compiled", "compiled_roots", "table_roots"]
 
 #: Most cells settled together: bounds the (cell, node) and (link, label) arrays of one pass.
 CHUNK = 256
@@ -145,11 +147,18 @@ def cell_roots(field: GoalField, cells: NDArray[np.int64]) -> tuple[NDArray[np.i
     clear = np.flatnonzero(geo.points_clear(np.stack([xs, ys], axis=1), p.radius))
     tables = field.arc_tables() if p.n_nodes else None
     if tables is not None and compiled(p, "best_links") is not None:
+        links = p.cell_links(build=False)
+        if links is not None:
+            # The floor's clear links are known: no segment test beyond the direct one.
+            kind[clear], label[clear], _ = table_roots(field, tables, links, cells[clear], xs[clear], ys[clear])
+            return kind, label
+        started = time.perf_counter()
         # In chunks: the candidate lists of a chunk are held at once.
         step = max(len(clear), 1) if p.n_nodes <= _BRUTE_NODES else max(16, _COMPILED_PAIRS // p.n_nodes)
         for i in range(0, len(clear), step):
             sub = clear[i : i + step]
             kind[sub], label[sub], _ = compiled_roots(field, tables, xs[sub], ys[sub])
+        p.spent_on_roots(time.perf_counter() - started)
         return kind, label
     # Fewer cells per chunk where many nodes could fall in a centre's ball.
     chunk = max(16, min(CHUNK, _CANDIDATES // max(p.n_nodes, 1)))
@@ -258,9 +267,35 @@ def compiled_roots(
     value = np.empty(len(x))
     best_links(
         x, y, float(field.goal[0]), float(field.goal[1]), cand, lo, hi, p.n_nodes <= _BRUTE_NODES, _SLACK,
-        p.cx, p.cy, p.phi0, p.span, p.radius, ANG_TOL, TOUCH_TOL, p._balls.reach,
+        p.cx, p.cy, p.phi0, p.span, p.radius, ANG_TOL, TOUCH_TOL, p.sight_reach,
         p.sight_profile, tables.cheapest, tables.start, tables.graph_end, tables.labels, search.pos, search.cost,
         blocked, has_blocked, *p.geo.kernel_geometry(), kind, label, value,
+    )
+    return kind, label.astype(np.int32), value
+
+
+def table_roots(
+    field: GoalField,
+    tables: ArcTables,
+    links: CellLinks,
+    cells: NDArray[np.int64],
+    x: NDArray[np.float64],
+    y: NDArray[np.float64],
+) -> tuple[NDArray[np.int8], NDArray[np.int32], NDArray[np.float64]]:
+    """:func:`compiled_roots`' decision for the clear centres ``(x, y)`` of ``cells``, read
+    from the floor's :class:`~pointnav_core.geodesic.cell_links.CellLinks`: kinds, labels and
+    exact distances (m). Needs numba."""
+    p = field.planner
+    search = field.labels
+    blocked, has_blocked = p.blocked_arcs()
+    kind = np.zeros(len(x), dtype=np.int8)
+    label = np.full(len(x), -1, dtype=np.int64)
+    value = np.empty(len(x))
+    compiled(p, "table_roots")(
+        x, y, float(field.goal[0]), float(field.goal[1]), links.first[cells], links.count[cells], links.node,
+        links.side, links.pos, links.length, p.n_nodes, p.span, p.radius, ANG_TOL, TOUCH_TOL,
+        tables.start, tables.graph_end, tables.labels, search.pos, search.cost, blocked, has_blocked,
+        *p.geo.kernel_geometry(), kind, label, value,
     )
     return kind, label.astype(np.int32), value
 
