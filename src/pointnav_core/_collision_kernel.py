@@ -12,7 +12,7 @@ import math
 
 import numba
 
-__all__ = ["cells_hit", "segment_hits"]
+__all__ = ["cells_hit", "segment_hits", "segments_clear"]
 
 _jit = numba.njit(cache=True, nogil=True, error_model="numpy")
 
@@ -187,3 +187,20 @@ def segment_hits(ax, ay, bx, by, ox, oy, inv, rho, rowcum, outside_blocked, reac
                           outside_blocked):
         return True
     return use_polygons and segment_hits_polygons(ax, ay, bx, by, reach, boxes, first, last, ex0, ey0, ex1, ey1)
+
+
+@_jit
+def segments_clear(a, b, ox, oy, inv, rho, rowcum, outside_blocked, reach, boxes, first, last, ex0, ey0, ex1, ey1,
+                   use_polygons, out):  # pragma: no cover
+    """``FloorCollision.segments_clear`` for the segments ``a[i]`` to ``b[i]`` (``(N, 2)``, m)
+    in one call: False where an end is not finite, else not :func:`segment_hits`."""
+    for i in range(a.shape[0]):
+        ax = a[i, 0]
+        ay = a[i, 1]
+        bx = b[i, 0]
+        by = b[i, 1]
+        if not (math.isfinite(ax) and math.isfinite(ay) and math.isfinite(bx) and math.isfinite(by)):
+            out[i] = False
+        else:
+            out[i] = not segment_hits(ax, ay, bx, by, ox, oy, inv, rho, rowcum, outside_blocked, reach, boxes, first,
+                                      last, ex0, ey0, ex1, ey1, use_polygons)

@@ -151,13 +151,17 @@ class FloorCollision:
             return bool(self.segments_clear(np.array([ax, ay]), np.array([bx, by]), radius))
         if not (math.isfinite(ax) and math.isfinite(ay) and math.isfinite(bx) and math.isfinite(by)):
             return False
-        radius = float(radius)
+        return not kernel(float(ax), float(ay), float(bx), float(by), *self._kernel_radius(float(radius)))
+
+    def _kernel_radius(self, radius: float) -> tuple[Any, ...]:
+        """:func:`~pointnav_core._collision_kernel.segment_hits`' arguments after the segment,
+        for a disc of ``radius`` m (``rho`` and ``reach`` as ``_cells_hit`` and
+        ``_polygons_hit`` derive them)."""
         ox, oy, res, rowcum, outside, *poly, use_polygons = self.kernel_geometry()
         inv = 1.0 / res
-        rho = max(radius - TOUCH_TOL, TOUCH_TOL) * inv  # as _cells_hit and _polygons_hit derive them
+        rho = max(radius - TOUCH_TOL, TOUCH_TOL) * inv
         reach = max(radius - 2 * TOUCH_TOL, TOUCH_TOL / 2)
-        return not kernel(float(ax), float(ay), float(bx), float(by), ox, oy, inv, rho, rowcum, outside, reach,
-                          *poly, use_polygons)
+        return (ox, oy, inv, rho, rowcum, outside, reach, *poly, use_polygons)
 
     def points_clear(self, points: ArrayLike, radius: float) -> NDArray[np.bool_]:
         """Whether discs of ``radius`` metres centred at world ``points`` miss the blocked set.
@@ -194,10 +198,18 @@ class FloorCollision:
         """
         a = np.asarray(a, dtype=np.float64)
         b = np.asarray(b, dtype=np.float64)
-        a, b = np.broadcast_arrays(a, b)
+        if a.shape != b.shape:
+            a, b = np.broadcast_arrays(a, b)
         shape = a.shape[:-1]
         a = a.reshape(-1, 2)
         b = b.reshape(-1, 2)
+        kernel = _compiled.kernel("pointnav_core._collision_kernel", "segments_clear")
+        if kernel is not None and self.compiled_polygons:
+            # Both tests in one compiled loop: the oracle asks about a few segments at a time,
+            # where the array set-up cost more than the tests.
+            out = np.empty(len(a), dtype=np.bool_)
+            kernel(np.ascontiguousarray(a), np.ascontiguousarray(b), *self._kernel_radius(float(radius)), out)
+            return out.reshape(shape)
         ok = np.isfinite(a).all(axis=1) & np.isfinite(b).all(axis=1)
         out = np.zeros(len(a), dtype=bool)
         idx = np.flatnonzero(ok)
