@@ -148,3 +148,25 @@ def test_roots_from_cell_links_equal_the_roots_found_link_by_link(field) -> None
         mine = sorted(zip(links.node[lo : lo + n].tolist(), (1 - 2 * links.side[lo : lo + n]).tolist()))
         theirs = sorted((c, s) for c, s, _, _ in p.point_links(float(x[0]), float(y[0])))
         assert mine == theirs
+
+
+@settings(max_examples=40, deadline=None, suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large])
+@given(field=fields(), seed=st.integers(0, 2**31 - 1))
+def test_compiled_way_equals_the_one_point_query(field, seed: int) -> None:
+    """``GoalField.path`` starts from ``_way``: compiled, it picks the one-point query's root
+    (the same label and departure) wherever two do not tie, and the same cost (1e-9 m)."""
+    pytest.importorskip("numba")
+    geo = field.planner.geo
+    h, w = geo.shape
+    rng = np.random.default_rng(seed)
+    points = geo.origin + rng.uniform(0.0, 1.0, (30, 2)) * (w * geo.resolution, h * geo.resolution)
+    for x, y in points.tolist():
+        cost, label, dep = field._way(x, y)
+        with _compiled.numpy_paths():
+            want = field._best(x, y)
+        assert (label == -2) == (want[1] == -2) and (label == -1) == (want[1] == -1)
+        if label == -2:
+            continue
+        assert abs(cost - want[0]) <= 1e-9
+        if label == want[1]:
+            assert abs(dep - want[2]) <= 1e-9

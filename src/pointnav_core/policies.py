@@ -420,22 +420,22 @@ class ShortestPathFollower:
         kappa = 2.0 * math.sin(bearing) / dist  # curvature (1/m) of the arc through both
         length = dist * bearing / math.sin(bearing)
         s = min(length, spec.max_linear_velocity * dt, spec.max_angular_velocity * dt / abs(kappa))
-        # The driven arc, as chords whose sagitta the clearance test adds to the radius.
-        u = np.linspace(0.0, s, _ARC_CHORDS + 1)
-        pts = np.stack(
-            [
-                xy[0] + (np.sin(yaw + kappa * u) - math.sin(yaw)) / kappa,
-                xy[1] - (np.cos(yaw + kappa * u) - math.cos(yaw)) / kappa,
-            ],
-            axis=1,
-        )
+        # The driven arc, as chords whose sagitta the clearance test adds to the radius (a few
+        # points: plain floats, not arrays).
+        x0, y0, step = float(xy[0]), float(xy[1]), s / _ARC_CHORDS
+        sin0, cos0 = math.sin(yaw), math.cos(yaw)
+        pts = [
+            (x0 + (math.sin(yaw + kappa * (k * step)) - sin0) / kappa, y0 - (math.cos(yaw + kappa * (k * step)) - cos0) / kappa)
+            for k in range(_ARC_CHORDS + 1)
+        ]
         sagitta = (s / _ARC_CHORDS) ** 2 * abs(kappa) / 8.0
         # Along a proven chord (see _follow) the arc and its chords bulge at most ``bulge``
         # off the chord to the carrot (the whole arc's sagitta), which left ``_room``.
         bulge = 0.5 * dist * math.tan(0.5 * abs(bearing))
         if self._room is None or bulge + sagitta + _HAIR > self._room:
-            tmap = self.env.scene.floors[self.task.floor]
-            if not tmap.collision.segments_clear(pts[:-1], pts[1:], spec.radius + _HAIR + sagitta).all():
+            geo = self.env.scene.floors[self.task.floor].collision
+            reach = spec.radius + _HAIR + sagitta
+            if not all(geo.segment_clear(*a, *b, reach) for a, b in zip(pts, pts[1:])):
                 return None
         v = s / (spec.max_linear_velocity * dt)
         w = kappa * s / (spec.max_angular_velocity * dt)

@@ -114,13 +114,13 @@ def best_links(  # pragma: no cover
     cx, cy, phi0, span, r, ang_tol, touch_tol, ball,
     profile, cheapest, lab_start, graph_end, labels, lab_pos, lab_cost, blocked, has_blocked,
     ox, oy, res, rowcum, outside_blocked, boxes, first, last, ex0, ey0, ex1, ey1, use_polygons,
-    kind, best_lab, best_value,
+    kind, best_lab, best_value, best_dep,
 ):
     """Per clear point ``(x[i], y[i])``, over the candidate nodes ``cand[cand_lo[i]:cand_hi[i]]``
     (those whose sight ball, radius ``ball``, holds the point count): the kind (0 none, 1 the
     goal ``(gx, gy)`` directly, 2 a label), label and total (m; inf: none) of the smallest
     visible ``(total, order)``, the direct segment first, written into ``kind``, ``best_lab``
-    and ``best_value``. With ``by_cheap`` the candidates are in ascending order of their
+    and ``best_value``, and the departure (rad) on the label's arc into ``best_dep``. With ``by_cheap`` the candidates are in ascending order of their
     arcs' cheapest label, and the scan stops where that alone passes the best."""
     inv = 1.0 / res
     rho = max(r - touch_tol, touch_tol) * inv
@@ -137,6 +137,7 @@ def best_links(  # pragma: no cover
             best = math.hypot(gx - px, gy - py)
         kind[i] = 1 if best < math.inf else 0
         best_lab[i] = -1
+        best_dep[i] = 0.0
         best_order = -1
         # The previous point's winner first (neighbours mostly share a root): its total bounds
         # the rest, which are skipped where their lower bound (the arcs' cheapest label plus
@@ -180,6 +181,7 @@ def best_links(  # pragma: no cover
                 best = value
                 best_order = order
                 best_lab[i] = lab
+                best_dep[i] = span[c] - pos
                 kind[i] = 2
                 winner = c
         hint = winner

@@ -101,6 +101,22 @@ class GoalField(ThawOnUnpickle):
                         best = (total, lab, dep)
         return best
 
+    def _way(self, x: float, y: float) -> tuple[float, int, float]:
+        """:meth:`_best`'s ``(cost, label, departure)``, in compiled code where numba is
+        installed: the same cost within rounding, and the same root wherever two do not tie
+        (a property test)."""
+        p = self.planner
+        if compiled(p, "best_links") is None:
+            return self._best(x, y)
+        if not self.goal_usable or not p.is_clear(x, y):
+            return math.inf, -2, 0.0
+        kind, label, value, dep = compiled_roots(self, self.arc_tables(), np.array([x]), np.array([y]), departures=True)
+        if kind[0] == 0:
+            return math.inf, -2, 0.0
+        if kind[0] == 1:
+            return float(value[0]), -1, 0.0
+        return float(value[0]), int(label[0]), float(dep[0])
+
     def point_distance(self, xy: ArrayLike) -> float:
         """Exact geodesic distance (m) from world point ``xy`` to the goal (inf if none).
 
@@ -130,7 +146,7 @@ class GoalField(ThawOnUnpickle):
         still the whole path's.
         """
         x, y = (float(v) for v in np.asarray(xy, dtype=np.float64).reshape(-1)[:2])
-        cost, label, dep = self._best(x, y)
+        cost, label, dep = self._way(x, y)
         if label == -2:
             return None, None
         pts = [np.array([x, y])]

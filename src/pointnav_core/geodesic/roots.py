@@ -246,10 +246,11 @@ def compiled(planner: Planner, name: str) -> Any:
 
 
 def compiled_roots(
-    field: GoalField, tables: ArcTables, x: NDArray[np.float64], y: NDArray[np.float64]
-) -> tuple[NDArray[np.int8], NDArray[np.int32], NDArray[np.float64]]:
+    field: GoalField, tables: ArcTables, x: NDArray[np.float64], y: NDArray[np.float64], departures: bool = False
+) -> tuple[NDArray[np.int8], NDArray[np.int32], NDArray[np.float64]] | tuple[NDArray, ...]:
     """:func:`_chunk_roots`' decision for clear points (cell centres or any), one at a time
-    in compiled code: kinds, labels and the exact distances (m). Needs numba."""
+    in compiled code: kinds, labels and the exact distances (m), and with ``departures``
+    where each path leaves its label's arc (rad, 0 for the direct segment). Needs numba."""
     p = field.planner
     search = field.labels
     best_links = compiled(p, "best_links")
@@ -265,12 +266,15 @@ def compiled_roots(
     kind = np.zeros(len(x), dtype=np.int8)
     label = np.full(len(x), -1, dtype=np.int64)
     value = np.empty(len(x))
+    dep = np.empty(len(x))
     best_links(
         x, y, float(field.goal[0]), float(field.goal[1]), cand, lo, hi, p.n_nodes <= _BRUTE_NODES, _SLACK,
         p.cx, p.cy, p.phi0, p.span, p.radius, ANG_TOL, TOUCH_TOL, p.sight_reach,
         p.sight_profile, tables.cheapest, tables.start, tables.graph_end, tables.labels, search.pos, search.cost,
-        blocked, has_blocked, *p.geo.kernel_geometry(), kind, label, value,
+        blocked, has_blocked, *p.geo.kernel_geometry(), kind, label, value, dep,
     )
+    if departures:
+        return kind, label.astype(np.int32), value, dep
     return kind, label.astype(np.int32), value
 
 
