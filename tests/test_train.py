@@ -117,3 +117,96 @@ def test_what_is_not_a_checkpoint_is_refused_naming_the_file(tmp_path) -> None:
     assert not marker.exists(), "loading a checkpoint ran code"
     with pytest.raises(ValueError, match="no such checkpoint file"):
         make_policy(str(tmp_path / "missing.pt"))
+
+
+# ---------------------------------------------------------------------- pointnav train -> eval
+def _train_config(out: str, env: EnvConfig, total_steps: int = 512, **extra) -> dict:
+    """A tiny run: 16 worlds, 16 steps each per update, a held-out evaluation every 256 steps."""
+    return {
+        "env": env.to_dict(), "scenes": "maps", "split": "train", "path_range": [0.5, 3.0],
+        "eval_dataset": "val.json.gz", "eval_every": 256, "out": out,
+        "ppo": {"total_steps": total_steps, "num_steps": 16, "minibatch": 64, "width": 16, "epochs": 2},
+        "engine": {"num_envs": 16, "pool_size": 2, "starts_per_goal": 4}, **extra,
+    }
+
+
+def _write(path, data: dict) -> str:
+    import yaml
+
+    with open(path, "w", encoding="utf-8") as fh:
+        yaml.safe_dump(data, fh)
+    return str(path)
+
+
+@pytest.fixture(scope="module")
+def room(tmp_path_factory):
+    """A folder with the room as a one-scene set (maps/), a 4-episode held-out dataset
+    (val.json.gz) and one of 3 episodes made for a robot of radius 0.25 m (wide.json.gz)."""
+    folder = tmp_path_factory.mktemp("train")
+    (folder / "maps").mkdir()
+    (folder / "maps" / "room.map").write_text(MAP)
+    here = os.getcwd()
+    os.chdir(folder)  # the scene ids ("movingai:maps/room.map") are relative to it
+    try:
+        for name, n, extra in (("val", 4, []), ("wide", 3, ["--robot-radius", "0.25"])):
+            assert main(["dataset", "generate", "--scenes", "maps", "--split", "train", "--episodes", str(n),
+                         "--max-geodesic", "3", "--out", f"{name}.json.gz", "--quiet", *extra]) == 0
+    finally:
+        os.chdir(here)
+    return folder
+
+
+@pytest.fixture(scope="module")
+def scan_run(room):
+    """``pointnav train`` of the scan with discrete actions: the run's folder."""
+    here = os.getcwd()
+    os.chdir(room)
+    try:
+        assert main(["train", "--config", _write(room / "scan.yaml", _train_config("scan_run", SCAN)), "--quiet"]) == 0
+    finally:
+        os.chdir(here)
+    return room / "scan_run"
+
+
+def _same_as_trainer(run, results_file) -> None:
+    """``pointnav eval``'s results are the trainer's held-out results of the same checkpoint."""
+    ckpt = load_checkpoint(run / "best.pt")
+    trainer = read_results(run / "heldout" / f"step_{ckpt.step:09d}.jsonl")
+    assert read_results(results_file) == trainer and len(trainer) == 4
+
+
+def test_train_then_eval_with_no_other_argument_scan_discrete(scan_run, room, monkeypatch, capsys) -> None:
+    from pointnav_core.evaluation import read_run
+    from pointnav_core.training.curve import read_curve
+
+    rows = read_curve(scan_run / "curve.csv")
+    assert [r["step"] for r in rows] == [256, 512] and all(r["heldout_episodes"] == 4 for r in rows)
+    assert (scan_run / "curve.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    assert load_checkpoint(scan_run / "latest.pt").step == 512
+    best = load_checkpoint(scan_run / "best.pt")
+    assert best.env_config.sensors == {"scan": {"n_rays": 8}} and best.training is None
+    monkeypatch.chdir(room)
+    capsys.readouterr()
+    assert main(["eval", "--policy", "scan_run/best.pt", "--dataset", "val.json.gz"]) == 0
+    _same_as_trainer(scan_run, room / "val.eval.jsonl")
+    assert read_run(room / "val.eval.jsonl")["pointnav_eval"]["env_config"] == best.env_config.to_dict()
+
+
+def test_train_then_eval_continuous_and_resume(room, monkeypatch) -> None:
+    from pointnav_core.training.curve import read_curve
+
+    monkeypatch.chdir(room)
+    env = EnvConfig(task={"goal_in_polar": True, "reward_type": "geodesic"}, max_steps=80)  # continuous, blind
+    config = _write(room / "cont.yaml", _train_config("cont_run", env, total_steps=256))
+    assert main(["train", "--config", config, "--quiet"]) == 0
+    assert main(["eval", "--policy", "cont_run/best.pt", "--dataset", "val.json.gz", "--results", "cont.jsonl",
+                 "--quiet"]) == 0
+    _same_as_trainer(room / "cont_run", room / "cont.jsonl")
+    first = read_curve(room / "cont_run" / "curve.csv")
+    assert main(["train", "--config", config, "--quiet"]) == 2  # a run is there: --resume, or another out
+    config = _write(room / "cont.yaml", _train_config("cont_run", env, total_steps=768))
+    assert main(["train", "--config", config, "--resume", "--quiet"]) == 0
+    rows = read_curve(room / "cont_run" / "curve.csv")
+    assert [r["step"] for r in rows] == [256, 512, 768] and rows[0] == first[0]
+    assert rows[1]["wall_s"] >= rows[0]["wall_s"]
+    assert load_checkpoint(room / "cont_run" / "latest.pt").step == 768
