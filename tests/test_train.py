@@ -168,11 +168,16 @@ def scan_run(room):
     return room / "scan_run"
 
 
-def _same_as_trainer(run, results_file) -> None:
-    """``pointnav eval``'s results are the trainer's held-out results of the same checkpoint."""
+def _same_as_trainer_results(run, results) -> None:
+    """``results`` are the trainer's held-out results of ``best.pt``, episode by episode."""
     ckpt = load_checkpoint(run / "best.pt")
     trainer = read_results(run / "heldout" / f"step_{ckpt.step:09d}.jsonl")
-    assert read_results(results_file) == trainer and len(trainer) == 4
+    assert list(results) == trainer and len(trainer) == 4
+
+
+def _same_as_trainer(run, results_file) -> None:
+    """``pointnav eval``'s results file holds the trainer's held-out results of ``best.pt``."""
+    _same_as_trainer_results(run, read_results(results_file))
 
 
 def test_train_then_eval_with_no_other_argument_scan_discrete(scan_run, room, monkeypatch, capsys) -> None:
@@ -210,3 +215,48 @@ def test_train_then_eval_continuous_and_resume(room, monkeypatch) -> None:
     assert [r["step"] for r in rows] == [256, 512, 768] and rows[0] == first[0]
     assert rows[1]["wall_s"] >= rows[0]["wall_s"]
     assert load_checkpoint(room / "cont_run" / "latest.pt").step == 768
+
+
+def test_bad_input_is_refused_naming_what_is_wrong(scan_run, room, monkeypatch, capsys) -> None:
+    monkeypatch.chdir(room)
+    capsys.readouterr()
+
+    def refused(*args: str) -> str:
+        assert main([*args, "--quiet"]) == 2
+        err = capsys.readouterr().err
+        assert err.count("\n") == 1, err  # one line, no traceback
+        return err
+
+    # A checkpoint made for a robot of another radius than the dataset's episodes.
+    err = refused("eval", "--policy", "scan_run/best.pt", "--dataset", "wide.json.gz")
+    assert "robot radius is 0.18 m" in err and "radius 0.25 m" in err
+    # An env config whose observation the network cannot read: the message names the config to use.
+    EnvConfig(sensors={"scan": {"n_rays": 16}}, action_space="discrete", discrete_actions={"stop": False},
+              task={"goal_in_polar": True}, max_steps=30).save(room / "scan16.yaml")
+    err = refused("eval", "--policy", "scan_run/best.pt", "--dataset", "val.json.gz", "--env-config", "scan16.yaml")
+    assert "takes observations of shape (16,)" in err and "gives (24,)" in err
+    assert "the env config it carries (sensors {'scan': {'n_rays': 8}}" in err
+    assert "unknown policy 'scan_run/best'" in refused("eval", "--policy", "scan_run/best", "--dataset", "val.json.gz")
+    assert "--limit must be an integer >= 1, got '0'" in refused(
+        "eval", "--policy", "scan_run/best.pt", "--dataset", "val.json.gz", "--limit", "0")
+    assert "--max-steps given beside the checkpoint" in refused(
+        "eval", "--policy", "scan_run/best.pt", "--dataset", "val.json.gz", "--max-steps", "50")
+    # Training refuses a held-out dataset made for another robot before it trains or writes anything.
+    config = _write(room / "wide.yaml", _train_config("wide_run", SCAN, eval_dataset="wide.json.gz"))
+    assert "radius 0.25 m" in refused("train", "--config", config)
+    assert not (room / "wide_run").exists()
+    config = _write(room / "typo.yaml", {**_train_config("typo_run", SCAN), "ppo": {"learning_rate": 0.1}})
+    assert "ppo has an unknown key 'learning_rate'" in refused("train", "--config", config)
+    assert "holds no latest.pt" in refused("train", "--config", _write(room / "none.yaml", _train_config("none", SCAN)),
+                                           "--resume")
+
+
+def test_evaluate_plays_a_checkpoint_with_its_own_config(scan_run, room) -> None:
+    from pointnav_core.datasets import EpisodeDataset
+
+    episodes = list(EpisodeDataset.load(room / "val.json.gz"))
+    best = str(scan_run / "best.pt")
+    results = evaluate(episodes, best, scenes_root=str(room))  # no env_config: the checkpoint's
+    _same_as_trainer_results(scan_run, results)
+    with pytest.raises(ValueError, match="max_steps given beside env_config"):
+        evaluate(episodes, best, scenes_root=str(room), max_steps=50)

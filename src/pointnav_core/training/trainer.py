@@ -59,7 +59,11 @@ def heldout_episodes(config: TrainConfig) -> list[Any]:
     """The held-out episodes (``eval_limit`` and ``eval_stride`` applied), checked before
     any training: their scenes exist, and their robot radius is the config's."""
     from pointnav_core.datasets import EpisodeDataset
-    from pointnav_core.evaluation import check_robot_radius, check_scene_ids, select_episodes
+    from pointnav_core.evaluation import (
+        check_robot_radius,
+        check_scene_ids,
+        select_episodes,
+    )
 
     episodes = select_episodes(EpisodeDataset.load(config.eval_dataset), config.eval_limit, config.eval_stride)
     check_robot_radius(config.policy_config(), episodes)
