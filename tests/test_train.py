@@ -260,3 +260,16 @@ def test_evaluate_plays_a_checkpoint_with_its_own_config(scan_run, room) -> None
     _same_as_trainer_results(scan_run, results)
     with pytest.raises(ValueError, match="max_steps given beside env_config"):
         evaluate(episodes, best, scenes_root=str(room), max_steps=50)
+
+
+def test_the_example_config_reads_and_fits_the_shipped_validation_set(monkeypatch) -> None:
+    from pathlib import Path
+
+    from pointnav_core.training.config import TrainConfig
+    from pointnav_core.training.trainer import heldout_episodes
+
+    root = Path(__file__).resolve().parents[1]
+    monkeypatch.chdir(root)  # its paths are relative to the repository's root
+    config = TrainConfig.load(root / "examples" / "train_scan.yaml")
+    assert config.policy_config().sensors == {"scan": {"n_rays": 64}} and config.path_range == (1.0, 30.0)
+    assert len(heldout_episodes(config)) == 60  # every 5th of the 300, the robot radius checked

@@ -235,7 +235,8 @@ def _loop(run: _Run, env: Any, bar: Any, echo: Callable[[str], None] | None) -> 
             obs, stats = ppo.update(env, obs)
             run.record(stats)
             bar.update(ppo.steps - before)
-            bar.set_postfix(train_success=f"{stats['success']:.2f}", refresh=False)
+            n = max(run.acc["n"], 1.0)  # the training episodes since the last evaluation
+            bar.set_postfix(train_success=f"{run.acc['success'] / n:.2f}", refresh=False)
             if refresh and ppo.steps // refresh > before // refresh:
                 env.refresh_pool()
             if ppo.steps // every > before // every or ppo.steps >= config.ppo.total_steps:
