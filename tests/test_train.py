@@ -9,6 +9,7 @@ episode.
 
 from __future__ import annotations
 
+import hashlib
 import os
 import pickle
 
@@ -194,7 +195,9 @@ def test_train_then_eval_with_no_other_argument_scan_discrete(scan_run, room, mo
     capsys.readouterr()
     assert main(["eval", "--policy", "scan_run/best.pt", "--dataset", "val.json.gz"]) == 0
     _same_as_trainer(scan_run, room / "val.eval.jsonl")
-    assert read_run(room / "val.eval.jsonl")["pointnav_eval"]["env_config"] == best.env_config.to_dict()
+    run = read_run(room / "val.eval.jsonl")["pointnav_eval"]
+    assert run["env_config"] == best.env_config.to_dict()
+    assert run["policy_sha256"] == hashlib.sha256((scan_run / "best.pt").read_bytes()).hexdigest()
 
 
 def test_train_then_eval_continuous_and_resume(room, monkeypatch) -> None:

@@ -80,22 +80,30 @@ def _count(name: str, text: str | None) -> int | None:
     return value
 
 
-def _run_settings(args: argparse.Namespace, scenes_dir: str) -> dict[str, Any]:
-    """What decides a run's results (recorded in its log and its results file)."""
+def _sha256(path: str) -> str:
+    """The SHA-256 of a file's bytes, as ``sha256sum`` prints it."""
     import hashlib
 
+    with open(path, "rb") as fh:
+        return hashlib.file_digest(fh, "sha256").hexdigest()
+
+
+def _run_settings(args: argparse.Namespace, scenes_dir: str) -> dict[str, Any]:
+    """What decides a run's results (recorded in its log and its results file); a policy
+    file (a checkpoint, an SB3 ``.zip``) is recorded with its SHA-256 too."""
     from pointnav_core import __version__
 
-    with open(args.dataset, "rb") as fh:
-        digest = hashlib.file_digest(fh, "sha256").hexdigest()
-    return {
+    settings = {
         "version": __version__,
-        "dataset": os.path.abspath(args.dataset), "dataset_sha256": digest,
+        "dataset": os.path.abspath(args.dataset), "dataset_sha256": _sha256(args.dataset),
         "policy": args.policy, "sb3_algo": args.sb3_algo, "backend": args.backend,
         "drive": args.drive, "max_steps": args.max_steps, "scenes_dir": os.path.abspath(scenes_dir),
         "limit": args.limit, "stride": args.stride,
         "env_config": None if args.config is None else args.config.to_dict(),
     }
+    if args.policy.endswith((".zip", ".pt")):
+        settings["policy_sha256"] = _sha256(args.policy)
+    return settings
 
 
 #: ``pointnav eval``'s flags that an env config sets, and their defaults without one.
