@@ -162,13 +162,15 @@ def make_policy(spec: str, sb3_algo: str = "PPO", trust_policy_file: bool = Fals
     """The policy factory named by ``spec`` (see the module notes).
 
     ``trust_policy_file`` must be True for an SB3 ``.zip``: loading one unpickles Python
-    objects stored in it, which can run any code (see the module notes).
+    objects stored in it, which can run any code (see the module notes). A checkpoint
+    ``.pt`` is plain data and needs no trust; it is read when first used.
 
     Raises
     ------
     ValueError
-        For a spec of no known form, a module or attribute that does not exist, or a
-        ``.zip`` that does not exist or is not trusted.
+        For a spec of no known form, a module or attribute that does not exist, a ``.zip``
+        that does not exist or is not trusted, or a ``.pt`` that does not exist (or without
+        torch).
     """
     if not isinstance(spec, str) or not spec:
         raise ValueError(f"policy must be {POLICY_FORMS}, got {spec!r}")
