@@ -191,6 +191,9 @@ def test_train_then_eval_with_no_other_argument_scan_discrete(scan_run, room, mo
     assert load_checkpoint(scan_run / "latest.pt").step == 512
     best = load_checkpoint(scan_run / "best.pt")
     assert best.env_config.sensors == {"scan": {"n_rays": 8}} and best.training is None
+    from pointnav_core.training.config import TrainConfig
+
+    assert TrainConfig.load(scan_run / "train_config.yaml") == TrainConfig.load(room / "scan.yaml")
     monkeypatch.chdir(room)
     capsys.readouterr()
     assert main(["eval", "--policy", "scan_run/best.pt", "--dataset", "val.json.gz"]) == 0

@@ -213,7 +213,9 @@ def run_training(
         else:
             import yaml
 
-            with open(run.paths["config"], "w", encoding="utf-8") as fh:
+            from pointnav_core.outputs import atomic_writer
+
+            with atomic_writer(run.paths["config"], "w", encoding="utf-8") as fh:
                 yaml.safe_dump(config.to_dict(), fh, sort_keys=False)
         _loop(run, env, tqdm(total=config.ppo.total_steps, initial=min(run.ppo.steps, config.ppo.total_steps),
                              disable=not progress, unit="step", desc="train"), echo)
