@@ -206,7 +206,7 @@ def test_train_then_eval_with_no_other_argument_scan_discrete(scan_run, room, mo
     assert run["policy_sha256"] == hashlib.sha256((scan_run / "best.pt").read_bytes()).hexdigest()
 
 
-def test_train_then_eval_continuous_and_resume(room, monkeypatch) -> None:
+def test_train_then_eval_continuous_and_resume(room, monkeypatch, capsys) -> None:
     from pointnav_core.training.curve import read_curve
 
     monkeypatch.chdir(room)
@@ -223,6 +223,11 @@ def test_train_then_eval_continuous_and_resume(room, monkeypatch) -> None:
     rows = read_curve(room / "cont_run" / "curve.csv")
     assert [r["step"] for r in rows] == [256, 512, 768] and rows[0] == first[0]
     assert rows[1]["wall_s"] >= rows[0]["wall_s"]
+    assert load_checkpoint(room / "cont_run" / "latest.pt").step == 768
+    other = _write(room / "other.yaml", _train_config("cont_run", SCAN, total_steps=1024))
+    capsys.readouterr()
+    assert main(["train", "--config", other, "--resume", "--quiet"]) == 2
+    assert "was trained with another env config" in capsys.readouterr().err
     assert load_checkpoint(room / "cont_run" / "latest.pt").step == 768
 
 

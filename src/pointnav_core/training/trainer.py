@@ -95,15 +95,9 @@ class _Run:
         self.wall0 = 0.0  # wall seconds of the earlier parts of a resumed run
         self.acc = {"n": 0.0, "return": 0.0, "success": 0.0, "spl": 0.0}
 
-    def resume(self) -> None:
-        """Take ``latest.pt``'s weights, statistics, optimiser and step, and the curve."""
-        ckpt = load_checkpoint(self.paths["latest"])
-        want = self.config.policy_config()
-        if ckpt.env_config != want:
-            raise ValueError(
-                f"--resume: {self.paths['latest']!r} was trained with another env config than the "
-                f"config file's env (and path_range); resume with the config it was started with"
-            )
+    def resume(self, ckpt: Any) -> None:
+        """Take the weights, statistics, optimiser and step of ``ckpt`` (``latest.pt``,
+        checked by :func:`_resumable`), and the curve up to its step."""
         if ckpt.network != self.ppo.agent.shape or ckpt.training is None:
             raise ValueError(f"--resume: {self.paths['latest']!r} holds another network or no training state")
         self.ppo.agent.load_state_dict(ckpt.agent.state_dict())
@@ -161,6 +155,19 @@ class _Run:
         return row
 
 
+def _resumable(config: TrainConfig) -> Any:
+    """``latest.pt`` of the run in ``config.out``; ValueError unless it was trained with
+    the config's env (checked before the engine's pools are built)."""
+    path = os.path.join(config.out, OUTPUTS["latest"])
+    ckpt = load_checkpoint(path)
+    if ckpt.env_config != config.policy_config():
+        raise ValueError(
+            f"--resume: {path!r} was trained with another env config than the config file's env "
+            f"(and path_range); resume with the config it was started with"
+        )
+    return ckpt
+
+
 def _check_out(config: TrainConfig, resume: bool) -> None:
     """Refuse to overwrite a run, or to resume none."""
     latest = os.path.join(config.out, OUTPUTS["latest"])
@@ -202,14 +209,15 @@ def run_training(
     from tqdm import tqdm
 
     _check_out(config, resume)
+    ckpt = _resumable(config) if resume else None
     episodes = heldout_episodes(config)
     torch.set_num_threads(config.engine.torch_threads)
     env = _engine(config, training_scenes(config))
     try:
         os.makedirs(config.out, exist_ok=True)
         run = _Run(config, PPO(env, config.ppo), episodes)
-        if resume:
-            run.resume()
+        if ckpt is not None:
+            run.resume(ckpt)
         else:
             import yaml
 
