@@ -6,7 +6,8 @@ kinematic backend, and prints success, SPL, SoftSPL, path length, collisions and
 
 ``pointnav demo --scene FILE`` drives on a scene file instead: a ROS map ``.yaml``, a ProcTHOR
 or HouseExpo ``.json``, a MovingAI ``.map`` or a traversability PNG (any ``scene_id``).
-``pointnav dataset generate`` and ``pointnav eval`` are in :mod:`pointnav_core.cli_datasets`.
+``pointnav dataset generate`` and ``pointnav eval`` are in :mod:`pointnav_core.cli_datasets`,
+``pointnav train`` in :mod:`pointnav_core.cli_train`.
 
 ``--gif FILE`` writes the first episode as an animated GIF and ``--png FILE`` its last frame
 (top-down, :func:`pointnav_core.recording.render_env`). When either is given, the demo's tasks
@@ -228,11 +229,12 @@ def main(argv: Sequence[str] | None = None) -> int:
         "a MovingAI .map, an OmniGibson floor_trav_<n>.png or a folder of them",
     )
     demo.add_argument("--quiet", action="store_true", help="no progress bar")
-    from pointnav_core import cli_datasets, cli_scenes
+    from pointnav_core import cli_datasets, cli_scenes, cli_train
 
     demo.set_defaults(func=cli_datasets.reporting("demo", _demo))
 
     cli_datasets.add_commands(sub, _positive_int)
+    cli_train.add_command(sub, cli_datasets.reporting)
     cli_scenes.add_commands(sub, _positive_int, cli_datasets.reporting)
     args = parser.parse_args(argv)
     return int(args.func(args))

@@ -3,8 +3,9 @@
 ``pointnav dataset generate --scenes SET --split val --episodes N --out FILE`` writes an
 episode dataset (:mod:`pointnav_core.datasets`); the same arguments give the same bytes.
 
-``pointnav eval --dataset FILE --policy oracle|MODULE:CALLABLE|MODEL.zip`` (a ``.zip`` with
-``--trust-policy-file``: loading one runs the code pickled in it) plays every
+``pointnav eval --dataset FILE --policy oracle|MODULE:CALLABLE|CHECKPOINT.pt|MODEL.zip`` (a
+``.zip`` with ``--trust-policy-file``: loading one runs the code pickled in it; a checkpoint
+of ``pointnav train`` plays with the env config it carries) plays every
 episode once (:mod:`pointnav_core.evaluation`), or every ``--stride``-th and then the first
 ``--limit`` of those; prints success, SPL and SoftSPL with 95 % bootstrap confidence
 intervals, the mean distance to the goal and collisions; and writes per-episode results
@@ -79,41 +80,59 @@ def _count(name: str, text: str | None) -> int | None:
     return value
 
 
-def _run_settings(args: argparse.Namespace, scenes_dir: str) -> dict[str, Any]:
-    """What decides a run's results (recorded in its log and its results file)."""
+def _sha256(path: str) -> str:
+    """The SHA-256 of a file's bytes, as ``sha256sum`` prints it."""
     import hashlib
 
+    with open(path, "rb") as fh:
+        return hashlib.file_digest(fh, "sha256").hexdigest()
+
+
+def _run_settings(args: argparse.Namespace, scenes_dir: str) -> dict[str, Any]:
+    """What decides a run's results (recorded in its log and its results file); a policy
+    file (a checkpoint, an SB3 ``.zip``) is recorded with its SHA-256 too."""
     from pointnav_core import __version__
 
-    with open(args.dataset, "rb") as fh:
-        digest = hashlib.file_digest(fh, "sha256").hexdigest()
-    return {
+    settings = {
         "version": __version__,
-        "dataset": os.path.abspath(args.dataset), "dataset_sha256": digest,
+        "dataset": os.path.abspath(args.dataset), "dataset_sha256": _sha256(args.dataset),
         "policy": args.policy, "sb3_algo": args.sb3_algo, "backend": args.backend,
         "drive": args.drive, "max_steps": args.max_steps, "scenes_dir": os.path.abspath(scenes_dir),
         "limit": args.limit, "stride": args.stride,
         "env_config": None if args.config is None else args.config.to_dict(),
     }
+    if args.policy.endswith((".zip", ".pt")):
+        settings["policy_sha256"] = _sha256(args.policy)
+    return settings
 
 
 #: ``pointnav eval``'s flags that an env config sets, and their defaults without one.
 _CONFIG_FLAGS = {"backend": "kinematic", "drive": "differential", "max_steps": 1000}
 
 
-def _env_config(args: argparse.Namespace) -> None:
-    """Read ``--env-config`` into ``args.config`` (None without it), and settle
-    ``--backend``, ``--drive`` and ``--max-steps``: the config's values, or the defaults
-    without one. One of those flags beside ``--env-config`` is refused, naming it."""
+def _env_config(args: argparse.Namespace, factory: Any) -> None:
+    """Read ``--env-config`` (or else the config a checkpoint ``factory`` carries) into
+    ``args.config`` (None without either), and settle ``--backend``, ``--drive`` and
+    ``--max-steps``: the config's values, or the defaults without one. One of those flags
+    beside a config is refused, naming it."""
     from pointnav_core.env_config import EnvConfig
 
-    args.config = None if args.env_config is None else EnvConfig.load(args.env_config)
+    source = "--env-config"
+    if args.env_config is not None:
+        args.config = EnvConfig.load(args.env_config)
+    else:
+        args.config = getattr(factory, "env_config", None)
+        source = f"the checkpoint {args.policy!r}"
     for name, default in _CONFIG_FLAGS.items():
         if args.config is None:
             value = default if getattr(args, name) is None else getattr(args, name)
         elif getattr(args, name) is not None:
             flag = "--" + name.replace("_", "-")
-            raise ValueError(f"{flag} given beside --env-config, which sets it: edit the config file instead")
+            raise ValueError(
+                f"{flag} given beside {source}, whose env config sets it: "
+                + ("edit the config file instead" if args.env_config is not None else
+                   "pass an edited copy of its config with --env-config")
+            )
         else:
             value = args.config.robot.drive if name == "drive" else getattr(args.config, name)
         setattr(args, name, value)
@@ -167,8 +186,9 @@ def _eval(args: argparse.Namespace) -> int:
     if os.getcwd() not in sys.path:  # MODULE:CALLABLE from here, as `python -m` would find it
         sys.path.insert(0, os.getcwd())
     args.limit, args.stride = _count("--limit", args.limit), _count("--stride", args.stride)
-    _env_config(args)
-    inputs = [args.dataset] + ([args.policy] if args.policy.endswith(".zip") else [])
+    factory = make_policy(args.policy, args.sb3_algo, args.trust_policy_file)
+    _env_config(args, factory)
+    inputs = [args.dataset] + ([args.policy] if args.policy.endswith((".zip", ".pt")) else [])
     inputs += [args.env_config] if args.env_config is not None else []
     results_path = check_output("--results", args.results or _default_output(args.dataset, ".jsonl"), inputs)
     plot_path = check_output("--plot", args.plot or _default_output(args.dataset, ".png"), [*inputs, results_path])
@@ -177,7 +197,6 @@ def _eval(args: argparse.Namespace) -> int:
     scenes_dir = args.scenes_dir if args.scenes_dir is not None else "."
     if not os.path.isdir(scenes_dir):
         raise ValueError(f"--scenes-dir {scenes_dir!r} is not a folder")
-    make_policy(args.policy, args.sb3_algo, args.trust_policy_file)
     dataset = EpisodeDataset.load(args.dataset)
     episodes = select_episodes(dataset, args.limit, args.stride)
     check_scene_ids(episodes, scenes_dir)
@@ -354,7 +373,9 @@ def add_commands(sub: Any, positive_int: Callable[[str], int]) -> None:
     ev = sub.add_parser("eval", help="evaluate a policy on an episode dataset")
     ev.add_argument("--dataset", required=True, metavar="FILE")
     ev.add_argument(
-        "--policy", default="oracle", help="oracle, MODULE:CALLABLE or a Stable-Baselines3 .zip"
+        "--policy", default="oracle",
+        help="oracle, MODULE:CALLABLE, a checkpoint .pt of pointnav train (played with its own env config) "
+        "or a Stable-Baselines3 .zip"
     )
     ev.add_argument(
         "--sb3-algo", default="PPO", help="algorithm class of an SB3 .zip (default PPO)"
@@ -364,7 +385,7 @@ def add_commands(sub: Any, positive_int: Callable[[str], int]) -> None:
         default=None,
         metavar="FILE",
         help="the env config (.yaml or .json) the policy was trained with: sensors, actions, robot, "
-        "backend, task settings, max steps",
+        "backend, task settings, max steps (default: a checkpoint's own)",
     )
     ev.add_argument("--backend", default=None, help="default kinematic (or the env config's)")
     ev.add_argument("--drive", choices=("differential", "holonomic"), default=None, help="default differential")

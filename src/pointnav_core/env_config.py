@@ -52,8 +52,8 @@ from pointnav_core import validation
 from pointnav_core.frozen import FrozenMapping
 from pointnav_core.robot_spec import RobotSpec
 
-__all__ = ["CONFIG_FORMATS", "EnvConfig", "multi_robot_arguments", "takes_config", "vector_arguments",
-           "vector_fleet_arguments"]
+__all__ = ["CONFIG_FORMATS", "EnvConfig", "multi_robot_arguments", "read_config_file", "takes_config",
+           "vector_arguments", "vector_fleet_arguments"]
 
 #: File suffixes :meth:`EnvConfig.load` and :meth:`EnvConfig.save` read and write.
 CONFIG_FORMATS = (".yaml", ".yml", ".json")
@@ -214,16 +214,7 @@ class EnvConfig:
             For a file that cannot be read.
         """
         path = os.fspath(path)
-        suffix = _suffix(path)
-        import yaml
-
-        with open(path, encoding="utf-8") as fh:
-            text = fh.read()
-        try:
-            data = json.loads(text) if suffix == ".json" else yaml.safe_load(text)
-        except (ValueError, yaml.YAMLError) as err:  # json.JSONDecodeError is a ValueError
-            kind = "JSON" if suffix == ".json" else "YAML"
-            raise ValueError(f"env config {path!r} is not valid {kind}: {err}") from None
+        data = read_config_file(path)
         try:
             return cls.from_dict(data)
         except ValueError as err:
@@ -265,11 +256,35 @@ class EnvConfig:
         }
 
 
-def _suffix(path: str) -> str:
+def _suffix(path: str, what: str = "env config") -> str:
     suffix = os.path.splitext(path)[1].lower()
     if suffix not in CONFIG_FORMATS:
-        raise ValueError(f"env config {path!r} must be a {', '.join(CONFIG_FORMATS)} file")
+        raise ValueError(f"{what} {path!r} must be a {', '.join(CONFIG_FORMATS)} file")
     return suffix
+
+
+def read_config_file(path: str | os.PathLike[str], what: str = "env config") -> Any:
+    """The data of a ``.yaml``/``.yml`` (``yaml.safe_load``) or ``.json`` file.
+
+    Raises
+    ------
+    ValueError
+        For another suffix or a file that is not valid YAML or JSON, naming ``what`` and
+        the file.
+    OSError
+        For a file that cannot be read.
+    """
+    path = os.fspath(path)
+    suffix = _suffix(path, what)
+    import yaml
+
+    with open(path, encoding="utf-8") as fh:
+        text = fh.read()
+    try:
+        return json.loads(text) if suffix == ".json" else yaml.safe_load(text)
+    except (ValueError, yaml.YAMLError) as err:  # json.JSONDecodeError is a ValueError
+        kind = "JSON" if suffix == ".json" else "YAML"
+        raise ValueError(f"{what} {path!r} is not valid {kind}: {err}") from None
 
 
 #: What each engine does with the config's fields: None if they become constructor

@@ -15,7 +15,11 @@ Policies (``policy`` argument, or ``pointnav eval --policy``):
 - ``"MODULE:CALLABLE"``: ``CALLABLE(env)`` is called after each reset and returns a
   function ``observation -> action``;
 - a path to a Stable-Baselines3 ``.zip``: the model (``sb3_algo``, PPO by default) acts
-  deterministically; it gets the flat observation when its observation space is a ``Box``.
+  deterministically; it gets the flat observation when its observation space is a ``Box``;
+- a path to a checkpoint ``.pt`` (``pointnav train``'s,
+  :mod:`pointnav_core.training.checkpoint`): its network acts deterministically (the most
+  likely action, or the mean), in envs built from the env config it carries, unless
+  ``env_config`` is given. Loading one runs no code, so it needs no trust flag.
 
 ``limit`` and ``stride`` (``--limit N``, ``--stride K``) play a subset: every ``K``-th
 episode of the dataset from the first, then the first ``N`` of those
@@ -91,9 +95,12 @@ DEFAULT_MAX_STEPS = 1000
 ON_ERROR = ("stop", "skip")
 #: The accepted forms of a policy spec, for messages.
 POLICY_FORMS = (
-    "'oracle', MODULE:CALLABLE (a function env -> (observation -> action)) or the path to "
-    "a Stable-Baselines3 .zip"
+    "'oracle', MODULE:CALLABLE (a function env -> (observation -> action)), the path to "
+    "a checkpoint .pt (pointnav train's) or the path to a Stable-Baselines3 .zip"
 )
+#: The suffix of a checkpoint (pointnav_core.training.checkpoint.CHECKPOINT_SUFFIX, which
+#: imports torch).
+CHECKPOINT_SUFFIX = ".pt"
 
 Policy = Callable[[Any], Any]
 PolicyFactory = Callable[[Any], Policy]
@@ -155,18 +162,28 @@ def make_policy(spec: str, sb3_algo: str = "PPO", trust_policy_file: bool = Fals
     """The policy factory named by ``spec`` (see the module notes).
 
     ``trust_policy_file`` must be True for an SB3 ``.zip``: loading one unpickles Python
-    objects stored in it, which can run any code (see the module notes).
+    objects stored in it, which can run any code (see the module notes). A checkpoint
+    ``.pt`` is plain data and needs no trust; it is read when first used.
 
     Raises
     ------
     ValueError
-        For a spec of no known form, a module or attribute that does not exist, or a
-        ``.zip`` that does not exist or is not trusted.
+        For a spec of no known form, a module or attribute that does not exist, a ``.zip``
+        that does not exist or is not trusted, or a ``.pt`` that does not exist (or without
+        torch).
     """
     if not isinstance(spec, str) or not spec:
         raise ValueError(f"policy must be {POLICY_FORMS}, got {spec!r}")
     if spec == "oracle":
         return _oracle
+    if spec.endswith(CHECKPOINT_SUFFIX):
+        if not os.path.isfile(spec):
+            raise ValueError(f"policy {spec!r}: no such checkpoint file")
+        try:
+            from pointnav_core.training.policy import CheckpointPolicy
+        except ImportError:
+            raise ValueError(f"policy {spec!r}: a checkpoint needs torch (pip install 'pointnav-core[vector]')") from None
+        return CheckpointPolicy(spec)
     if spec.endswith(".zip"):
         if not os.path.isfile(spec):
             raise ValueError(f"policy {spec!r}: no such SB3 .zip file")
@@ -366,8 +383,10 @@ def evaluate(
     ----------
     episodes : EpisodeDataset or sequence of PointNavEpisode
     policy : str or callable
-        ``"oracle"``, ``"MODULE:CALLABLE"``, a path to an SB3 ``.zip``, or a factory
-        ``env -> (observation -> action)`` (with ``workers > 1`` it must be picklable).
+        ``"oracle"``, ``"MODULE:CALLABLE"``, a path to a checkpoint ``.pt`` or to an SB3
+        ``.zip``, or a factory ``env -> (observation -> action)`` (with ``workers > 1`` it
+        must be picklable); a factory with an ``env_config`` attribute (a checkpoint's)
+        plays in envs built from it when ``env_config`` is None.
     backend : str
         Registered backend name.
     workers : int
@@ -424,8 +443,9 @@ def evaluate(
             raise ValueError(f"{name} must be an integer >= 1, got {value!r}")
     if on_error not in ON_ERROR:
         raise ValueError(f"on_error must be one of {list(ON_ERROR)}, got {on_error!r}")
-    if isinstance(policy, str):
-        make_policy(policy, sb3_algo, trust_policy_file)  # a bad spec is refused here, once
+    factory = make_policy(policy, sb3_algo, trust_policy_file) if isinstance(policy, str) else policy
+    if env_config is None:  # a checkpoint carries the config it was trained with
+        env_config = getattr(factory, "env_config", None)
     if env_config is not None:
         check_beside_config(env_config, backend=backend, max_steps=max_steps, drive=drive)
         check_robot_radius(env_config, episodes)

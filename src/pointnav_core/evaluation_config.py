@@ -59,18 +59,19 @@ def _shape_of(space: Any) -> Any:
     return tuple(getattr(space, "shape", ()) or ())
 
 
-def check_spaces(name: str, model: Any, env: Any) -> None:
+def check_spaces(name: str, model: Any, env: Any, advice: str | None = None) -> None:
     """ValueError unless the observation and action spaces of ``model`` (anything with
     ``observation_space`` and ``action_space``) have the shapes of ``env``'s; the message
-    names the env config to pass (``--env-config``, ``evaluate(env_config=...)``)."""
+    names the env config to pass (``--env-config``, ``evaluate(env_config=...)``), or
+    says ``advice`` instead."""
     for what in ("observation", "action"):
         want = _shape_of(getattr(model, f"{what}_space"))
         got = _shape_of(getattr(env, f"{what}_space"))
         if want != got:
             raise ValueError(
                 f"{name} takes {what}s of shape {want}, but the env built for it gives {got}: "
-                f"pass the env config the policy was trained with (pointnav eval --env-config "
-                f"FILE, evaluate(env_config=...); pointnav_core.env_config.EnvConfig)"
+                + (advice or "pass the env config the policy was trained with (pointnav eval "
+                   "--env-config FILE, evaluate(env_config=...); pointnav_core.env_config.EnvConfig)")
             )
 
 

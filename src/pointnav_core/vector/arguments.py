@@ -10,14 +10,19 @@ import numpy as np
 
 from pointnav_core import scenes, validation
 
-__all__ = ["as_scene_list", "check_real_actions", "default_scene", "task_arguments"]
+__all__ = ["as_scene_list", "check_real_actions", "default_scene", "grid_scene", "task_arguments"]
+
+
+def grid_scene(scene: scenes.Scene, floor: int = 0) -> scenes.Scene:
+    """Floor ``floor`` of ``scene`` as a one-floor scene of grid cells only: its obstacle
+    polygons as the cells they were rasterised to (what the batched scan sees)."""
+    tmap = scene.floors[floor]
+    return scenes.Scene.from_array(np.asarray(tmap.codes), tmap.resolution, origin=tuple(tmap.origin))
 
 
 def default_scene() -> scenes.Scene:
     # The single env's default house, its floor as grid cells only (see docs/decisions.md).
-    house = scenes.rooms(seed=0)
-    floor = house.floors[0]
-    return scenes.Scene.from_array(np.asarray(floor.codes), floor.resolution, origin=tuple(floor.origin))
+    return grid_scene(scenes.rooms(seed=0))
 
 
 def task_arguments(task: Mapping[str, Any] | None) -> dict[str, Any]:

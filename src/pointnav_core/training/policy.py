@@ -1,0 +1,95 @@
+"""A checkpoint as an evaluation policy: ``pointnav eval --policy CHECKPOINT.pt``.
+
+:class:`CheckpointPolicy` is the policy factory :func:`pointnav_core.evaluation.evaluate`
+plays a checkpoint with: its env config is the checkpoint's own (unless the caller gives
+one), and it acts deterministically (the most likely discrete action, or the Gaussian's
+mean). The file is read once per process; the factory itself pickles as its path, so
+worker processes load it themselves.
+"""
+
+from __future__ import annotations
+
+from types import SimpleNamespace
+from typing import Any
+
+import numpy as np
+
+from pointnav_core.env_config import EnvConfig
+
+__all__ = ["CheckpointPolicy"]
+
+
+class CheckpointPolicy:
+    """A picklable factory ``env -> (observation -> action)`` for a checkpoint file.
+
+    Parameters
+    ----------
+    path : str
+        A checkpoint written by :func:`~pointnav_core.training.checkpoint.save_checkpoint`.
+
+    Raises
+    ------
+    ValueError
+        (When first used) for a file that is not a checkpoint, naming it.
+    """
+
+    #: The checkpoint's networks read the flat observation.
+    flat = True
+
+    def __init__(self, path: str) -> None:
+        self.path = path
+        self._checkpoint: Any = None
+
+    def __getstate__(self) -> dict[str, Any]:
+        return {"path": self.path, "_checkpoint": None}
+
+    @property
+    def checkpoint(self) -> Any:
+        """The loaded :class:`~pointnav_core.training.checkpoint.Checkpoint`."""
+        if self._checkpoint is None:
+            from pointnav_core.training.checkpoint import load_checkpoint
+
+            self._checkpoint = load_checkpoint(self.path)
+        return self._checkpoint
+
+    @property
+    def env_config(self) -> EnvConfig:
+        """The env config the checkpoint was trained with."""
+        return self.checkpoint.env_config
+
+    def spaces(self) -> Any:
+        """The observation and action spaces the network was built for (their shapes)."""
+        from gymnasium import spaces
+
+        net = self.checkpoint.network
+        obs = spaces.Box(-np.inf, np.inf, (net["n_obs"],), np.float32)
+        if net["continuous"]:
+            action: Any = spaces.Box(-1.0, 1.0, (net["n_actions"],), np.float32)
+        else:
+            action = spaces.Discrete(net["n_actions"])
+        return SimpleNamespace(observation_space=obs, action_space=action)
+
+    def check_env(self, env: Any) -> None:
+        """ValueError unless ``env``'s spaces have the shapes the network was built for."""
+        from pointnav_core.evaluation_config import check_spaces
+
+        own = self.env_config.to_dict()
+        check_spaces(
+            f"checkpoint {self.path!r}", self.spaces(), env,
+            advice=f"play it with the env config it carries (sensors {own['sensors']}, action_space "
+            f"{own['action_space']!r}): leave out --env-config (evaluate(env_config=None))",
+        )
+
+    def __call__(self, env: Any) -> Any:
+        import torch
+
+        ckpt = self.checkpoint
+        agent, norm, continuous = ckpt.agent, ckpt.obs_norm, ckpt.network["continuous"]
+
+        def act(obs: Any) -> Any:
+            x = torch.as_tensor(np.asarray(obs, dtype=np.float32)).reshape(1, -1)
+            with torch.no_grad():
+                action = agent.greedy(norm.normalize(x))[0]
+            return action.numpy().astype(np.float32) if continuous else int(action)
+
+        return act
