@@ -30,8 +30,8 @@ if TYPE_CHECKING:
 __all__ = ["BLOCK", "GoalField", "LOOKUP_BOUND"]
 
 #: Side (cells) of the square blocks of the root table, each settled on its first lookup
-#: (8: a reset's first lookup settles 64 cells, about 0.6 ms on the default house).
-BLOCK = 8
+#: (4: a reset's first lookup settles 16 cells; a path of L cells settles about 4 L, against 8 L at 8).
+BLOCK = 4
 #: Table kind of a cell not settled yet.
 UNSETTLED = 4
 #: The lookup's documented bound: ``|distance(p) - point_distance(p)| <= LOOKUP_BOUND * |p - c|``,
