@@ -242,10 +242,18 @@ class GoalField(ThawOnUnpickle):
                 raise ValueError(f"cells must lie in [0, {h * w}), got {idx.min()} to {idx.max()}")
         b = BLOCK
         blocks = np.unique((idx // w) // b * t["blocks_w"] + (idx % w) // b)
-        todo = [_block_cells(int(k), t["blocks_w"], h, w) for k in blocks.tolist() if not t["done"][k]]
-        if todo:
-            t["done"][blocks] = True
-            self._settle_cells(np.concatenate(todo))
+        todo = blocks[~t["done"][blocks]]
+        if len(todo) > 16:
+            # Many blocks (a pool's window): their cells by one mask over the grid, not a
+            # list per block (the order does not change any root).
+            wanted = np.zeros(len(t["done"]), dtype=bool)
+            wanted[todo] = True
+            rows, cols = np.divmod(np.arange(h * w), w)
+            t["done"][todo] = True
+            self._settle_cells(np.flatnonzero(wanted[rows // b * t["blocks_w"] + cols // b]))
+        elif len(todo):
+            t["done"][todo] = True
+            self._settle_cells(np.concatenate([_block_cells(int(k), t["blocks_w"], h, w) for k in todo.tolist()]))
         kind, label = t["kind"].view(), t["label"].view()
         kind.flags.writeable = label.flags.writeable = False
         return kind, label
