@@ -5,6 +5,7 @@ import math
 import numpy as np
 import pytest
 
+from pointnav_core.collision import FloorCollision
 from pointnav_core.geodesic import Planner
 from pointnav_core.paths import path_length, resample_path
 from pointnav_core.geodesic.planner import planner_for
@@ -193,3 +194,28 @@ def test_a_drawn_arc_through_a_passage_exactly_as_wide_as_the_robot_keeps_clear_
     # Through the passage's midpoint, and as long as reported (arcs drawn outside the circle).
     assert min(math.dist(p, (0.85, 0.8)) for p in path) < 1e-6
     assert dist - 1e-9 <= path_length(path) <= dist * (1 + 1.1e-4) + 1e-9
+
+
+def test_a_floor_geometry_past_its_byte_budget_is_refused_naming_the_budget(monkeypatch):
+    from pointnav_core import scenes
+    from pointnav_core.geodesic import cache
+
+    monkeypatch.setenv(cache.ENV_VAR, "off")  # built here, so that tracemalloc sees it
+    scene = scenes.clutter(seed=1)
+    planner = Planner(FloorCollision.from_map(scene.floors[0]), 0.18)
+    monkeypatch.setattr(Planner, "geometry_bytes", 200_000)
+    with pytest.raises(ValueError, match=r"needs more than Planner.geometry_bytes = 0 MiB"):
+        planner.goal_field((5.05, 5.05))
+    monkeypatch.setattr(Planner, "geometry_bytes", 2**30)
+    planner = Planner(FloorCollision.from_map(scene.floors[0]), 0.18)
+    planner.build_all_edges()
+    # The estimate is of the right size: within a factor of 2 of what tracemalloc sees.
+    import tracemalloc
+
+    tracemalloc.start()
+    again = Planner(FloorCollision.from_map(scene.floors[0]), 0.18)
+    again.build_all_edges()
+    again.arc_graph()
+    used, _ = tracemalloc.get_traced_memory()
+    tracemalloc.stop()
+    assert 0.5 * used <= again.geometry_nbytes <= 2 * used

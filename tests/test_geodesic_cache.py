@@ -153,6 +153,7 @@ def test_cell_links_are_built_once_the_roots_without_them_cost_as_much(folder, m
     p.goal_field((4.55, 2.05)).settle()
     assert p.cell_links(build=False) is None
     monkeypatch.setattr(cell_links, "BUILD_SECONDS_PER_PAIR", 0.0)  # at once
+    p = Planner(_geo(), 0.18)
     p.goal_field((0.55, 3.55)).settle()
     assert p.cell_links(build=False) is not None
 

@@ -6,17 +6,21 @@ The API (the model, its accuracy and cost: ``docs/geodesic.md``):
   floor): exact shortest paths between two points, and the goal fields it caches;
 - :class:`GoalField`: exact distances and paths from any point to one goal, and the
   per-step lookup (:meth:`GoalField.distance`) within :data:`LOOKUP_BOUND`;
-- :data:`MIN_RADIUS`, :data:`FIELD_CACHE_BYTES`, :data:`BLOCK`: the planner's smallest
-  radius, the goal-field cache's default byte budget (set ``Planner.field_cache_bytes``
-  to change it), the lookup table's block side.
+- :data:`MIN_RADIUS`, :data:`FIELD_CACHE_BYTES`, :data:`GEOMETRY_BYTES`, :data:`BLOCK`: the
+  planner's smallest radius, the default byte budgets of the goal-field cache and of a
+  floor's geometry (set ``Planner.field_cache_bytes`` and ``Planner.geometry_bytes`` to
+  change them), the lookup table's block side.
 
 Inside, one module per step: ``tangents`` (the shared constructions and tolerances),
-``sight`` (strict sight bounds), ``edges`` (common tangents), ``arcs`` (drawing arcs),
+``sight`` (strict sight bounds), ``edges`` (common tangents), ``cell_links`` (each cell's
+clear links, once per floor), ``arcs`` (drawing arcs),
 ``arc_graph`` (the graph solved by Dijkstra), ``roots`` (exact cell roots), ``field`` and
 ``planner``.
 """
 
 from pointnav_core.geodesic.field import BLOCK, LOOKUP_BOUND, GoalField
-from pointnav_core.geodesic.planner import FIELD_CACHE_BYTES, MIN_RADIUS, Planner, planner_for
+from pointnav_core.geodesic.planner import FIELD_CACHE_BYTES, GEOMETRY_BYTES, MIN_RADIUS, Planner, planner_for
 
-__all__ = ["BLOCK", "FIELD_CACHE_BYTES", "LOOKUP_BOUND", "MIN_RADIUS", "GoalField", "Planner", "planner_for"]
+__all__ = [
+    "BLOCK", "FIELD_CACHE_BYTES", "GEOMETRY_BYTES", "LOOKUP_BOUND", "MIN_RADIUS", "GoalField", "Planner", "planner_for",
+]

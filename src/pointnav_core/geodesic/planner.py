@@ -78,6 +78,12 @@ _TILE = 32
 MIN_RADIUS = 1e-6
 #: Byte budget of the goal fields a planner keeps.
 FIELD_CACHE_BYTES = 256 * 2**20
+#: Byte budget of a floor's geometry for one radius (nodes, sight bounds, tangent edges,
+#: the arc graph and the cell links; the goal fields have their own).
+GEOMETRY_BYTES = 1 * 2**30
+#: Approximate bytes one tangent edge holds, in the planner's lists and the arc graph's arrays
+#: (440-450 measured with tracemalloc on ``scenes.clutter``).
+_EDGE_BYTES = 450
 
 
 def planner_for(tmap: TraversableMap, radius: float) -> Planner:
@@ -102,9 +108,14 @@ class Planner(ThawOnUnpickle):
         Byte budget of the goal fields a planner keeps (default :data:`FIELD_CACHE_BYTES`,
         256 MiB); set it on the class for every planner (``Planner.field_cache_bytes =
         64 * 2**20``) or on one planner.
+    geometry_bytes : int
+        Byte budget of the floor's geometry for this radius (default :data:`GEOMETRY_BYTES`,
+        1 GiB): building tangent edges past it raises ``ValueError``, and cell links that
+        would pass it are not kept. Set it as ``field_cache_bytes``.
     """
 
     field_cache_bytes: int = FIELD_CACHE_BYTES
+    geometry_bytes: int = GEOMETRY_BYTES
 
     def __init__(self, collision: FloorCollision, radius: float) -> None:
         self.geo = collision
@@ -128,6 +139,7 @@ class Planner(ThawOnUnpickle):
             self.sights = stored["sights"].astype(np.float64)
             self.sight_profile = stored["sight_profile"].astype(np.float32)
             self._restore_edges(stored)
+            self._check_geometry_bytes()
             self._cell_links = CellLinks.stored(stored, collision.shape[0] * collision.shape[1], self.n_nodes)
         else:
             # Strict bounds (m) on every clear segment leaving a node's arc (geodesic.sight).
@@ -304,10 +316,31 @@ class Planner(ThawOnUnpickle):
             for i in batches:
                 build_edges(self, todo[i : i + _EDGE_BATCH])
                 bar.update(min(_EDGE_BATCH, len(todo) - i))
+                self._check_geometry_bytes()
         self._build_seconds += time.perf_counter() - started
         if self._cache_key is not None and self._build_seconds >= cache.MIN_SECONDS:
             links = self._cell_links.arrays() if isinstance(self._cell_links, CellLinks) else {}
             self._in_cache = cache.save(self._cache_key, {**self._stored_edges(), **links}) is not None
+
+    @property
+    def geometry_nbytes(self) -> int:
+        """Approximate memory (bytes) of this floor's geometry for this radius: nodes, sight
+        bounds, tangent edges, arc graph and cell links (the goal fields not included)."""
+        arrays = sum(a.nbytes for a in (self.cx, self.cy, self.phi0, self.span, self.sights, self.sight_profile))
+        n_edges = sum(len(v[0]) for v in self._edges.values())
+        links = self._cell_links.nbytes if isinstance(self._cell_links, CellLinks) else 0
+        return int(arrays + n_edges * _EDGE_BYTES + links)
+
+    def _check_geometry_bytes(self) -> None:
+        used = self.geometry_nbytes
+        if used > self.geometry_bytes:
+            h, w = self.geo.shape
+            raise ValueError(
+                f"the geometry of this {h} x {w}-cell floor ({self.n_nodes} corners) for a robot of radius "
+                f"{self.radius} m needs more than Planner.geometry_bytes = {self.geometry_bytes / 2**20:.0f} MiB "
+                f"({used / 2**20:.0f} MiB so far); raise the budget (pointnav_core.geodesic.Planner.geometry_bytes "
+                f"= n_bytes) or use a coarser map"
+            )
 
     @property
     def sight_reach(self) -> NDArray[np.float64]:
@@ -332,6 +365,8 @@ class Planner(ThawOnUnpickle):
                 started = time.perf_counter()
                 self._cell_links = CellLinks.build(self)
                 self._build_seconds += time.perf_counter() - started
+                if self.geometry_nbytes > self.geometry_bytes:
+                    self._cell_links = False  # optional: not kept past the budget
                 if self._cache_key is not None and self._build_seconds >= cache.MIN_SECONDS:
                     arrays = {**self._stored_edges(), **self._cell_links.arrays()}
                     self._in_cache = cache.save(self._cache_key, arrays) is not None
