@@ -18,7 +18,7 @@ from __future__ import annotations
 import math
 from typing import Any
 
-from pointnav_core.metrics import _soft_spl, _spl
+from pointnav_core.metrics import soft_spl_values, spl_values
 
 __all__ = ["EpisodeState"]
 
@@ -145,8 +145,8 @@ class EpisodeState:
             "success": success,
             "done": done,
             "path_length": length,
-            "spl": _spl(success, d0, length),
-            "soft_spl": _soft_spl(d_t, d0, length),
+            "spl": spl_values(success, d0, length),
+            "soft_spl": soft_spl_values(d_t, d0, length),
             "geodesic_dist": d0,
             "distance_to_goal": d_t,
             "collisions": self.collisions,

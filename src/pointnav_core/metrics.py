@@ -2,8 +2,11 @@
 
 Both compare the path the robot drove, of length ``L``, with the shortest path from the
 start, of geodesic length ``d0`` (Anderson et al., 2018, "On Evaluation of Embodied
-Navigation Agents"; SoftSPL as in Habitat). They are pure functions of Python floats, cheap
-enough for every control step, and they are defined on the whole closed domain:
+Navigation Agents"; SoftSPL as in Habitat). :func:`spl_values` and :func:`soft_spl_values`
+are the one definition every engine calls, on Python floats (the single envs, every control
+step) or on numpy or torch arrays (the batched engine, with the array library's ``where``);
+:func:`spl` and :func:`soft_spl` check their arguments first. They are defined on the whole
+closed domain:
 
 - ``d0 = inf`` (the goal is not reachable from the start): both are 0.
 - ``d0 = 0`` (the start is the goal): the efficiency ``d0 / max(d0, L)`` is read as 1 when
@@ -17,8 +20,10 @@ Both lie in ``[0, 1]``.
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
+from typing import Any
 
-__all__ = ["spl", "soft_spl"]
+__all__ = ["soft_spl", "soft_spl_values", "spl", "spl_values"]
 
 
 def _check_distance(name: str, value: float, *, allow_inf: bool) -> float:
@@ -32,28 +37,41 @@ def _check_distance(name: str, value: float, *, allow_inf: bool) -> float:
     return d
 
 
-def _efficiency(d0: float, path_length: float) -> float:
+def _where(condition: bool, a: float, b: float) -> float:
+    """``numpy.where`` for one value: the scalar engines' ``where``."""
+    return a if condition else b
+
+
+# One definition for every engine: Python floats with the default ``where``, numpy or torch
+# arrays with the array library's (the batched engine passes ``xp.where``). Both branches of
+# a ``where`` are evaluated on arrays, so each division is guarded. Unchecked: the engines
+# call these on values they keep valid (the public functions below check).
+def spl_values(success: Any, d0: Any, path_length: Any, where: Callable[..., Any] = _where) -> Any:
+    """SPL of one episode or a batch: ``success * d0 / max(d0, L)``, 0 where ``d0`` is inf.
+
+    Parameters
+    ----------
+    success : bool or bool array
+    d0, path_length : float or float array
+        Geodesic from the start (m, ``inf`` unreachable) and path driven (m, finite).
+    where : callable
+        ``where(condition, a, b)``: the default for scalars, ``numpy.where`` or
+        ``torch.where`` for arrays.
+    """
+    return where(success & (d0 < math.inf), _efficiency(d0, path_length, where), 0.0)
+
+
+def soft_spl_values(d_t: Any, d0: Any, path_length: Any, where: Callable[..., Any] = _where) -> Any:
+    """SoftSPL of one episode or a batch: ``max(0, 1 - d_T / d0) * d0 / max(d0, L)`` with the
+    module's readings of ``d0 == 0`` and ``inf``; arguments as :func:`spl_values`."""
+    positive = d0 > 0.0
+    progress = where(positive, 1.0 - d_t / where(positive, d0, 1.0), where(d_t == 0.0, 1.0, 0.0))
+    return where((d0 < math.inf) & (progress > 0.0), progress * _efficiency(d0, path_length, where), 0.0)
+
+
+def _efficiency(d0: Any, path_length: Any, where: Callable[..., Any]) -> Any:
     # d0 / max(d0, L), with 0 / 0 read as 1 (see the module docstring).
-    return 1.0 if path_length <= d0 else d0 / path_length
-
-
-# Unchecked kernels: the task calls these on every step with values it keeps valid.
-def _spl(success: bool, d0: float, path_length: float) -> float:
-    if not success or d0 == math.inf:
-        return 0.0
-    return _efficiency(d0, path_length)
-
-
-def _soft_spl(d_t: float, d0: float, path_length: float) -> float:
-    if d0 == math.inf:
-        return 0.0
-    if d0 > 0.0:
-        progress = 1.0 - d_t / d0
-        if progress <= 0.0:
-            return 0.0
-    else:
-        progress = 1.0 if d_t == 0.0 else 0.0
-    return progress * _efficiency(d0, path_length)
+    return where(path_length <= d0, 1.0, d0 / where(path_length > 0.0, path_length, 1.0))
 
 
 def spl(success: bool, geodesic_dist: float, path_length: float) -> float:
@@ -103,7 +121,7 @@ def spl(success: bool, geodesic_dist: float, path_length: float) -> float:
     """
     d0 = _check_distance("geodesic_dist", geodesic_dist, allow_inf=True)
     length = _check_distance("path_length", path_length, allow_inf=False)
-    return _spl(bool(success), d0, length)
+    return float(spl_values(bool(success), d0, length))
 
 
 def soft_spl(distance_to_goal: float, geodesic_dist: float, path_length: float) -> float:
@@ -149,4 +167,4 @@ def soft_spl(distance_to_goal: float, geodesic_dist: float, path_length: float) 
     d_t = _check_distance("distance_to_goal", distance_to_goal, allow_inf=True)
     d0 = _check_distance("geodesic_dist", geodesic_dist, allow_inf=True)
     length = _check_distance("path_length", path_length, allow_inf=False)
-    return _soft_spl(d_t, d0, length)
+    return float(soft_spl_values(d_t, d0, length))

@@ -20,6 +20,7 @@ from gymnasium.vector import AutoresetMode, VectorEnv
 
 from pointnav_core import _envcommon, scenes, validation
 from pointnav_core.env_config import EnvConfig, takes_config, vector_arguments
+from pointnav_core.metrics import soft_spl_values, spl_values
 from pointnav_core.vector import contacts_jit
 from pointnav_core.vector.contacts import advance
 from pointnav_core.vector.accounting import task_step
@@ -562,11 +563,8 @@ class VectorPointNavEnv(PoolRefreshing, VectorEnv):
     def _info(self, success: Any, r_pot: Any, r_col: Any, r_goal: Any, contact: Any, resetting: Any) -> dict[str, Any]:
         xp, st = self.arrays.xp, self._state
         d0, length, d_t = st["d0"], st["path"], st["dist"]
-        finite = d0 < math.inf
-        eff = xp.where(length <= d0, 1.0, d0 / xp.where(length > 0.0, length, 1.0))
-        spl = xp.where(success & finite, eff, 0.0)
-        progress = xp.where(d0 > 0.0, 1.0 - d_t / xp.where(d0 > 0.0, d0, 1.0), xp.where(d_t == 0.0, 1.0, xp.zeros_like(d_t)))
-        soft = xp.where(finite & (progress > 0.0), progress * eff, 0.0)
+        spl = spl_values(success, d0, length, xp.where)  # the single env's definition
+        soft = soft_spl_values(d_t, d0, length, xp.where)
         info = {
             "success": success, "spl": spl, "soft_spl": soft, "path_length": length, "geodesic_dist": d0,
             "distance_to_goal": d_t, "collisions": self._collisions, "episode_length": self._steps,
