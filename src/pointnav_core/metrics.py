@@ -23,7 +23,7 @@ import math
 from collections.abc import Callable
 from typing import Any
 
-__all__ = ["soft_spl", "soft_spl_values", "spl", "spl_values"]
+__all__ = ["scalar_where", "soft_spl", "soft_spl_values", "spl", "spl_values"]
 
 
 def _check_distance(name: str, value: float, *, allow_inf: bool) -> float:
@@ -37,8 +37,9 @@ def _check_distance(name: str, value: float, *, allow_inf: bool) -> float:
     return d
 
 
-def _where(condition: bool, a: float, b: float) -> float:
-    """``numpy.where`` for one value: the scalar engines' ``where``."""
+def scalar_where(condition: bool, a: Any, b: Any) -> Any:
+    """``numpy.where`` for one value: what the single envs pass where the batched engine
+    passes ``xp.where`` (the terms defined once for both, here and in ``rewards``)."""
     return a if condition else b
 
 
@@ -46,7 +47,7 @@ def _where(condition: bool, a: float, b: float) -> float:
 # arrays with the array library's (the batched engine passes ``xp.where``). Both branches of
 # a ``where`` are evaluated on arrays, so each division is guarded. Unchecked: the engines
 # call these on values they keep valid (the public functions below check).
-def spl_values(success: Any, d0: Any, path_length: Any, where: Callable[..., Any] = _where) -> Any:
+def spl_values(success: Any, d0: Any, path_length: Any, where: Callable[..., Any] = scalar_where) -> Any:
     """SPL of one episode or a batch: ``success * d0 / max(d0, L)``, 0 where ``d0`` is inf.
 
     Parameters
@@ -61,7 +62,7 @@ def spl_values(success: Any, d0: Any, path_length: Any, where: Callable[..., Any
     return where(success & (d0 < math.inf), _efficiency(d0, path_length, where), 0.0)
 
 
-def soft_spl_values(d_t: Any, d0: Any, path_length: Any, where: Callable[..., Any] = _where) -> Any:
+def soft_spl_values(d_t: Any, d0: Any, path_length: Any, where: Callable[..., Any] = scalar_where) -> Any:
     """SoftSPL of one episode or a batch: ``max(0, 1 - d_T / d0) * d0 / max(d0, L)`` with the
     module's readings of ``d0 == 0`` and ``inf``; arguments as :func:`spl_values`."""
     positive = d0 > 0.0

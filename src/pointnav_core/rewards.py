@@ -39,8 +39,10 @@ Examples
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from typing import Any, ClassVar
 
+from pointnav_core.metrics import scalar_where
 from pointnav_core.terminations import _check_length
 
 __all__ = ["RewardFunction", "PotentialReward", "CollisionReward", "PointGoalReward"]
@@ -113,9 +115,15 @@ class PotentialReward(RewardFunction):
         super().reset(task, env)
         self.previous_potential = task.potential
 
+    @staticmethod
+    def value(r_potential: Any, previous: Any, current: Any) -> Any:
+        """The reward of one robot's step or of a batch's (the batched engine calls it):
+        ``r_potential * (previous - current)``, potentials in metres."""
+        return r_potential * (previous - current)
+
     def step(self, task: Any, env: Any, action: Any) -> float:
         current = task.potential
-        self.reward = reward = self.r_potential * (self.previous_potential - current)
+        self.reward = reward = self.value(self.r_potential, self.previous_potential, current)
         self.previous_potential = current
         return reward
 
@@ -142,8 +150,15 @@ class CollisionReward(RewardFunction):
         super().__init__()
         self.r_collision = _check_scale("r_collision", r_collision)
 
+    @staticmethod
+    def value(r_collision: Any, touched: Any, where: Callable[..., Any] = scalar_where, zero: Any = 0.0) -> Any:
+        """The penalty of one step or a batch's: ``-r_collision`` where ``touched``, else
+        ``zero`` (the batched engine passes its array library's ``where`` and a float64 zero
+        array)."""
+        return where(touched, -r_collision, zero)
+
     def step(self, task: Any, env: Any, action: Any) -> float:
-        self.reward = reward = -self.r_collision if task.in_contact else 0.0
+        self.reward = reward = self.value(self.r_collision, task.in_contact)
         return reward
 
     def __repr__(self) -> str:
@@ -188,10 +203,14 @@ class PointGoalReward(RewardFunction):
                 f"which the task does not have; its conditions are {names}"
             )
 
+    @staticmethod
+    def value(r_pointgoal: Any, success: Any, where: Callable[..., Any] = scalar_where, zero: Any = 0.0) -> Any:
+        """The reward of one step or a batch's: ``r_pointgoal`` where ``success``, else
+        ``zero`` (arguments as :meth:`CollisionReward.value`)."""
+        return where(success, r_pointgoal, zero)
+
     def step(self, task: Any, env: Any, action: Any) -> float:
-        self.reward = reward = (
-            self.r_pointgoal if task.termination_results[self.condition][1] else 0.0
-        )
+        self.reward = reward = self.value(self.r_pointgoal, task.termination_results[self.condition][1])
         return reward
 
     def __repr__(self) -> str:

@@ -166,8 +166,13 @@ class MaxCollision(TerminationCondition):
         super().__init__()
         self.max_collisions = _check_count("max_collisions", max_collisions, minimum=0)
 
+    @staticmethod
+    def value(collisions: Any, max_collisions: Any) -> Any:
+        """Whether one robot's episode ends, or a batch's (the batched engine calls it)."""
+        return collisions > max_collisions
+
     def step(self, task: Any, env: Any, action: Any) -> tuple[bool, bool]:
-        self.done = done = task.collisions > self.max_collisions
+        self.done = done = self.value(task.collisions, self.max_collisions)
         return done, False
 
     def __repr__(self) -> str:
@@ -196,8 +201,13 @@ class Timeout(TerminationCondition):
         super().__init__()
         self.max_steps = _check_count("max_steps", max_steps, minimum=1)
 
+    @staticmethod
+    def value(steps: Any, max_steps: Any) -> Any:
+        """Whether one robot's episode is truncated, or a batch's (the batched engine calls it)."""
+        return steps >= max_steps
+
     def step(self, task: Any, env: Any, action: Any) -> tuple[bool, bool]:
-        self.done = done = task.episode_length >= self.max_steps
+        self.done = done = self.value(task.episode_length, self.max_steps)
         return done, False
 
     def __repr__(self) -> str:
@@ -224,8 +234,13 @@ class Falling(TerminationCondition):
         super().__init__()
         self.fall_height = _check_length("fall_height", fall_height)
 
+    @staticmethod
+    def value(z: Any, floor_height: Any, fall_height: Any) -> Any:
+        """Whether one robot fell (heights in metres), or a batch's (the batched engine calls it)."""
+        return z < floor_height - fall_height
+
     def step(self, task: Any, env: Any, action: Any) -> tuple[bool, bool]:
-        self.done = done = task.robot_xyz[2] < task.floor_height - self.fall_height
+        self.done = done = self.value(task.robot_xyz[2], task.floor_height, self.fall_height)
         return done, False
 
     def __repr__(self) -> str:

@@ -2,9 +2,12 @@
 
 One function for both batched engines: the one-robot engine's ``(num_envs,)`` robots and
 the fleet's ``(num_envs, n_robots)`` robots, masked there by the robots still acting (an
-ended robot's path, steps, collisions and rewards stay as they were). The expressions and
-their order are the single task's (``rewards``, ``terminations``, ``metrics``), so the
-rewards are the same floats.
+ended robot's path, steps, collisions and rewards stay as they were). The reward terms and
+the collision, timeout and fall conditions are the single task's own definitions
+(``value`` of each term in ``rewards`` and ``terminations``), called on arrays, so the
+rewards are the same floats. The goal condition keeps its own form here: the single task
+measures the distance with ``math.hypot``, the engine with ``sqrt`` of the squares (the
+same within an ulp).
 """
 
 from __future__ import annotations
@@ -12,6 +15,9 @@ from __future__ import annotations
 import math
 from collections.abc import Mapping
 from typing import Any, NamedTuple
+
+from pointnav_core.rewards import CollisionReward, PointGoalReward, PotentialReward
+from pointnav_core.terminations import Falling, MaxCollision, Timeout
 
 __all__ = ["TaskStep", "task_step"]
 
@@ -71,25 +77,26 @@ def task_step(engine: Any, moved: Mapping[str, Any], contact: Any, stopped: Any,
         touched = contact & acting
         height = height[:, None]
     collisions = engine._collisions + a.to_int(touched)
+    # The task's terms, each the single task's own definition on arrays (rewards, terminations).
     dist = engine.pool.fields.distance(engine._field, x, y)
     gx, gy = st["gx"], st["gy"]
     l2 = xp.sqrt((gx - x) ** 2 + (gy - y) ** 2)
     pot = xp.where(engine._geo_metric, xp.where(dist < math.inf, dist, st["pot"]), l2)
     success = l2 < engine.goal_tolerance
-    fell = z < height - engine.fall_height
-    truncated = steps >= engine.max_steps
+    fell = Falling.value(z, height, engine.fall_height)
+    truncated = Timeout.value(steps, engine.max_steps)
     if acting is not None:
         success, fell, truncated = acting & success, acting & fell, acting & truncated
     if stopped is not None:  # with STOP, success needs STOP within the tolerance (StopAtGoal)
         success = success & stopped
-    terminated = (collisions > engine.max_collisions) | fell | success
+    terminated = MaxCollision.value(collisions, engine.max_collisions) | fell | success
     if stopped is not None:
         terminated = terminated | stopped
-    r_pot = engine.r_potential * (st["pot"] - pot)
+    r_pot = PotentialReward.value(engine.r_potential, st["pot"], pot)
     if acting is not None:
         terminated = acting & terminated
         r_pot = xp.where(acting, r_pot, zero)
-    r_col = xp.where(touched, -engine.r_collision, zero)
-    r_goal = xp.where(success, engine.r_pointgoal, zero)
+    r_col = CollisionReward.value(engine.r_collision, touched, xp.where, zero)
+    r_goal = PointGoalReward.value(engine.r_pointgoal, success, xp.where, zero)
     reward = ((0.0 + r_pot) + r_col) + r_goal
     return TaskStep(path, steps, collisions, dist, pot, success, fell, terminated, truncated, r_pot, r_col, r_goal, reward)
