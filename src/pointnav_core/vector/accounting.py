@@ -19,7 +19,27 @@ from typing import Any, NamedTuple
 from pointnav_core.rewards import CollisionReward, PointGoalReward, PotentialReward
 from pointnav_core.terminations import Falling, MaxCollision, Timeout
 
-__all__ = ["TaskStep", "task_step"]
+__all__ = ["BatchedTask", "TaskStep", "custom_rewards", "task_step"]
+
+#: The built-in reward terms' names (the engine computes them itself, from their ``value``).
+BUILT_IN_REWARDS = ("potential", "collision", "pointgoal")
+
+
+class BatchedTask(NamedTuple):
+    """What a custom reward term's ``batched(task)`` reads: the single task's per-step
+    snapshot (``pointnav_core.rewards``) for every robot at once, as arrays of the robots'
+    shape (numpy or torch, as the engine's ``device``)."""
+
+    xp: Any  #: the array module (numpy, or torch)
+    zero: Any  #: float64 zeros of the robots' shape (``torch.where`` of two numbers gives float32)
+    robot_xyz: tuple[Any, Any, Any]  #: the robots' positions after the step (m)
+    goal_xy: tuple[Any, Any]  #: the goals (m)
+    distance_to_goal: Any  #: geodesic distance now (m; inf where none)
+    potential: Any  #: the potential this step (m)
+    in_contact: Any  #: touched something this step
+    success: Any  #: the goal condition succeeded this step
+    episode_length: Any  #: steps taken in the episode
+    collisions: Any  #: steps with a contact so far
 
 
 class TaskStep(NamedTuple):
@@ -37,6 +57,7 @@ class TaskStep(NamedTuple):
     r_pot: Any  #: the potential reward
     r_col: Any  #: the collision penalty
     r_goal: Any  #: the goal reward
+    r_custom: dict[str, Any]  #: each custom reward term's values, by name
     reward: Any  #: their sum, as the task adds them
 
 
@@ -99,4 +120,19 @@ def task_step(engine: Any, moved: Mapping[str, Any], contact: Any, stopped: Any,
     r_col = CollisionReward.value(engine.r_collision, touched, xp.where, zero)
     r_goal = PointGoalReward.value(engine.r_pointgoal, success, xp.where, zero)
     reward = ((0.0 + r_pot) + r_col) + r_goal
-    return TaskStep(path, steps, collisions, dist, pot, success, fell, terminated, truncated, r_pot, r_col, r_goal, reward)
+    r_custom: dict[str, Any] = {}
+    if engine.custom_rewards:  # after the built-in ones, in order, as the task sums them
+        view = BatchedTask(xp, zero, (x, y, z), (gx, gy), dist, pot, touched, success, steps, collisions)
+        for name, term in engine.custom_rewards:
+            value = xp.zeros_like(x) + term.batched(view)  # float64 of the robots' shape
+            r_custom[name] = value if acting is None else xp.where(acting, value, zero)
+            reward = reward + r_custom[name]
+    return TaskStep(path, steps, collisions, dist, pot, success, fell, terminated, truncated, r_pot, r_col, r_goal,
+                    r_custom, reward)
+
+
+def custom_rewards(task: Any) -> list[tuple[str, Any]]:
+    """The task's reward terms other than the built-in ones, ``(name, term)`` in order; each
+    has a ``batched(task)`` method (:func:`~pointnav_core.vector.arguments.task_arguments`
+    refuses the others)."""
+    return [(name, term) for name, term in task.reward_functions.items() if name not in BUILT_IN_REWARDS]

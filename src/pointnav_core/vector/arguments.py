@@ -26,13 +26,33 @@ def default_scene() -> scenes.Scene:
 
 
 def task_arguments(task: Mapping[str, Any] | None) -> dict[str, Any]:
-    """A copy of the ``task`` arguments; ValueError for a non-dict or a custom term."""
+    """A copy of the ``task`` arguments; ValueError for a non-dict, a custom termination or
+    observation term, or a reward term the engine cannot run (see :func:`check_batched_rewards`)."""
     if task is not None and not isinstance(task, Mapping):
         raise ValueError(f"task must be None or a dict of PointNavigationTask arguments, got {task!r}")
-    for key in ("termination_conditions", "reward_functions", "observation_terms"):
+    for key in ("termination_conditions", "observation_terms"):
         if task is not None and task.get(key) is not None:
             raise ValueError(f"task: {key} is not supported by the batched engine")
+    if task is not None and task.get("reward_functions") is not None:
+        check_batched_rewards(task["reward_functions"])
     return dict(task or {})
+
+
+def check_batched_rewards(terms: Any) -> None:
+    """ValueError unless every reward term is a new one (not named like a built-in) with a
+    ``batched(task)`` method: the batched engine computes the built-in terms itself and calls
+    the others on every robot at once (``vector.accounting.BatchedTask``)."""
+    from pointnav_core.vector.accounting import BUILT_IN_REWARDS
+
+    for term in terms if isinstance(terms, (list, tuple)) else [terms]:
+        name = getattr(term, "name", None)
+        if name in BUILT_IN_REWARDS:
+            raise ValueError(f"task: reward_functions: the batched engine cannot replace the built-in {name!r} term")
+        if not callable(getattr(term, "batched", None)):
+            raise ValueError(
+                f"task: reward_functions: {term!r} has no batched(task) method; the batched engine runs a custom "
+                f"reward term on every robot at once through it (docs/extending.md)"
+            )
 
 
 def as_scene_list(scene: scenes.Scene | Sequence[scenes.Scene] | None) -> list[scenes.Scene]:

@@ -23,7 +23,7 @@ from pointnav_core.env_config import EnvConfig, takes_config, vector_arguments
 from pointnav_core.metrics import soft_spl_values, spl_values
 from pointnav_core.vector import contacts_jit
 from pointnav_core.vector.contacts import advance
-from pointnav_core.vector.accounting import task_step
+from pointnav_core.vector.accounting import custom_rewards, task_step
 from pointnav_core.vector.arguments import as_scene_list, check_real_actions, task_arguments
 from pointnav_core.vector.discrete import MOVED, DiscretePlan
 from pointnav_core.vector.drive import arc, body_command, sub_steps, substep_drive, travel
@@ -309,6 +309,7 @@ class VectorPointNavEnv(PoolRefreshing, VectorEnv):
         self.fall_height, self.goal_tolerance = float(cfg["fall_height"]), t.goal_tolerance
         self.r_potential, self.r_collision, self.r_pointgoal = (float(rcfg[k]) for k in ("r_potential", "r_collision", "r_pointgoal"))
         self.geodesic_reward = t.reward_type == "geodesic"
+        self.custom_rewards = custom_rewards(t)
         self.goal_in_polar = bool(t.goal_in_polar)
         spec = self.robot
         self.holonomic = spec.drive == "holonomic"
@@ -508,7 +509,7 @@ class VectorPointNavEnv(PoolRefreshing, VectorEnv):
         a, xp, st = self.arrays, self.arrays.xp, self._state
         t = task_step(self, moved, contact, stopped)  # PointNavigationTask.step's accounting
         reward, terminated, truncated, success = t.reward, t.terminated, t.truncated, t.success
-        r_pot, r_col, r_goal = t.r_pot, t.r_col, t.r_goal
+        r_pot, r_col, r_goal, r_custom = t.r_pot, t.r_col, t.r_goal, t.r_custom
         # Commit, then reset the worlds that ended on the previous step (next-step autoreset).
         st.update({key: moved[key] for key in MOVED}, path=t.path, dist=t.dist, pot=t.pot)
         self._steps, self._collisions = t.steps, t.collisions
@@ -519,8 +520,11 @@ class VectorPointNavEnv(PoolRefreshing, VectorEnv):
             reward = xp.where(keep, reward, 0.0)
             terminated, truncated, success, contact = terminated & keep, truncated & keep, success & keep, contact & keep
             r_pot, r_col, r_goal = (xp.where(keep, r, 0.0) for r in (r_pot, r_col, r_goal))
+            r_custom = {name: xp.where(keep, r, 0.0) for name, r in r_custom.items()}
         self._needs_reset = terminated | truncated
         info = self._info(success, r_pot, r_col, r_goal, contact, resetting)
+        for name, r in r_custom.items():  # fresh arrays, as _info's
+            info[f"reward_{name}"] = r.clone() if a.is_torch else r.copy()
         return self._observe(), reward, terminated, truncated, info
 
     # ------------------------------------------------------------------ observation and info
