@@ -24,7 +24,7 @@ from contextlib import contextmanager
 from multiprocessing import connection, get_context
 from typing import Any
 
-__all__ = ["WorkerError", "WorkerPool", "usable_cores"]
+__all__ = ["WorkerError", "WorkerPool", "in_worker", "mark_worker", "usable_cores"]
 
 #: How often (s) a worker checks that its parent is alive.
 _WATCH_PERIOD = 0.2
@@ -47,6 +47,21 @@ def usable_cores() -> int:
         return os.cpu_count() or 1
 
 
+_IN_WORKER = False
+
+
+def in_worker() -> bool:
+    """Whether this process is a worker of :class:`WorkerPool` (or another of the library's
+    worker processes): it then keeps to one core, its siblings having the others."""
+    return _IN_WORKER
+
+
+def mark_worker() -> None:
+    """Record that this process is one of the library's workers (see :func:`in_worker`)."""
+    global _IN_WORKER
+    _IN_WORKER = True
+
+
 def _watch_parent(parent: int) -> None:
     while os.getppid() == parent:
         time.sleep(_WATCH_PERIOD)
@@ -62,6 +77,7 @@ def _worker_main(conn: Any, parent: int, init: Callable[..., Any], initargs: tup
     if hasattr(signal, "pthread_sigmask"):  # blocked since birth (see WorkerPool): now ignored
         signal.pthread_sigmask(signal.SIG_UNBLOCK, {signal.SIGINT})
     threading.Thread(target=_watch_parent, args=(parent,), daemon=True).start()
+    mark_worker()
     try:
         state = init(*initargs)
     except Exception as error:

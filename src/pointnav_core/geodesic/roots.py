@@ -37,12 +37,13 @@ from __future__ import annotations
 
 import math
 import time
+from concurrent.futures import ThreadPoolExecutor
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from numpy.typing import NDArray
 
-from pointnav_core import _compiled
+from pointnav_core import _compiled, workers
 from pointnav_core.collision import TOUCH_TOL
 from pointnav_core.geodesic.tangents import ANG_TOL, ccw_pos, tangent_from_point
 
@@ -67,6 +68,8 @@ _COMPILED_PAIRS = 2**22
 _FIRST_BAND = 8
 #: Relative loosening of the candidate bounds (m per m), far above rounding error.
 _SLACK = 1e-9
+#: Cells per thread from which a settle (a pool's window) runs its kernel on several cores.
+THREAD_CELLS = 2048
 
 
 class ArcTables:
@@ -148,17 +151,25 @@ def cell_roots(field: GoalField, cells: NDArray[np.int64]) -> tuple[NDArray[np.i
     tables = field.arc_tables() if p.n_nodes else None
     if tables is not None and compiled(p, "best_links") is not None:
         links = p.cell_links(build=False)
+        started = time.perf_counter()
         if links is not None:
             # The floor's clear links are known: no segment test beyond the direct one.
-            kind[clear], label[clear], _ = table_roots(field, tables, links, cells[clear], xs[clear], ys[clear])
-            return kind, label
-        started = time.perf_counter()
-        # In chunks: the candidate lists of a chunk are held at once.
-        step = max(len(clear), 1) if p.n_nodes <= _BRUTE_NODES else max(16, _COMPILED_PAIRS // p.n_nodes)
-        for i in range(0, len(clear), step):
-            sub = clear[i : i + step]
-            kind[sub], label[sub], _ = compiled_roots(field, tables, xs[sub], ys[sub])
-        p.spent_on_roots(time.perf_counter() - started)
+            def run(sub: NDArray[np.int64]) -> tuple[NDArray, ...]:
+                return table_roots(field, tables, links, cells[sub], xs[sub], ys[sub])
+
+            step = max(len(clear), 1)
+        else:
+            def run(sub: NDArray[np.int64]) -> tuple[NDArray, ...]:
+                return compiled_roots(field, tables, xs[sub], ys[sub])
+
+            # In chunks: the candidate lists of a chunk are held at once.
+            step = max(len(clear), 1) if p.n_nodes <= _BRUTE_NODES else max(16, _COMPILED_PAIRS // p.n_nodes)
+        threads = _threads(len(clear))
+        pieces = np.array_split(clear, max(threads, -(-len(clear) // step)))
+        for sub, (k, lab, _) in zip(pieces, _map(run, pieces, threads)):
+            kind[sub], label[sub] = k, lab
+        if links is None:
+            p.spent_on_roots(time.perf_counter() - started)
         return kind, label
     # Fewer cells per chunk where many nodes could fall in a centre's ball.
     chunk = max(16, min(CHUNK, _CANDIDATES // max(p.n_nodes, 1)))
@@ -166,6 +177,23 @@ def cell_roots(field: GoalField, cells: NDArray[np.int64]) -> tuple[NDArray[np.i
         sub = clear[i : i + chunk]
         kind[sub], label[sub] = _chunk_roots(field, tables, xs[sub], ys[sub])
     return kind, label
+
+
+def _threads(n_cells: int) -> int:
+    """Threads for settling ``n_cells`` cells: the process's cores from :data:`THREAD_CELLS`
+    cells on, one in a worker process (its siblings use the other cores)."""
+    if n_cells < THREAD_CELLS or workers.in_worker():
+        return 1
+    return max(1, min(workers.usable_cores(), n_cells // THREAD_CELLS))
+
+
+def _map(run: Any, pieces: list[NDArray[np.int64]], threads: int) -> list[Any]:
+    """``run`` over ``pieces``, in ``threads`` threads (the compiled kernels release the GIL
+    and write only their own outputs), in order."""
+    if threads <= 1:
+        return [run(piece) for piece in pieces]
+    with ThreadPoolExecutor(threads) as pool:
+        return list(pool.map(run, pieces))
 
 
 def _chunk_roots(

@@ -21,6 +21,8 @@ from multiprocessing.connection import Connection, wait
 from multiprocessing.reduction import ForkingPickler
 from typing import Any
 
+from pointnav_core import workers
+
 __all__ = ["RefreshWorker"]
 
 # Seconds a closing worker gets to leave on its own before it is terminated.
@@ -55,6 +57,7 @@ def _serve(conn: Connection) -> None:
     # leaves when the env closes its pipe or exits (a traceback from here would only confuse).
     signal.signal(signal.SIGINT, signal.SIG_IGN)
     threading.Thread(target=_leave_with_parent, name="pointnav-pool-refresh-parent", daemon=True).start()
+    workers.mark_worker()  # one core: the env's process steps on the others
     try:
         conn.send(("ready", None))
         while True:
