@@ -15,6 +15,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 import shapely
+from fleet_reference import compare_fleet, fleet_episodes
 from scan_reference import assert_within, blocked_shapes, reference_ranges
 from shapely import affinity
 from vector_reference import compare, random_actions, random_episodes
@@ -43,6 +44,20 @@ def random_plan(seed: int) -> Scene:
         parts.append(affinity.rotate(box, rng.uniform(0.0, 180.0)))
     parts.append(shapely.Point(rng.uniform(1, 3), rng.uniform(1, 2)).buffer(0.2, quad_segs=5))
     return Scene.from_polygons(shapely.box(0.0, 0.0, 4.0, 3.0), parts, resolution=0.1)
+
+
+def inside_a_free_cell(scene: Scene) -> tuple[float, float]:
+    """A point inside an obstacle polygon whose cell is not OBSTACLE (only the polygon can
+    say it is inside: the single scan reads 0 there)."""
+    tmap = scene.floors[0]
+    codes, res, (ox, oy) = np.asarray(tmap.codes), tmap.resolution, tmap.origin
+    for poly in tmap.collision.polygons:
+        x0, y0, x1, y1 = poly.bounds
+        for x in np.linspace(x0, x1, 23)[1:-1]:
+            for y in np.linspace(y0, y1, 23)[1:-1]:
+                if poly.contains(shapely.Point(x, y)) and codes[int((y - oy) // res), int((x - ox) // res)] != 1:
+                    return float(x), float(y)
+    raise AssertionError("no polygon point in a free cell")
 
 
 @functools.cache
@@ -75,17 +90,19 @@ def test_cast_batch_equals_the_single_scan_on_polygon_floors(method: str, device
     w, r, angles, max_range = 6, 3, np.linspace(-np.pi, np.pi, 40, endpoint=False), 3.0
     scene = np.arange(w) % 2
     xy = np.array([[scenes[k].get_random_point(0, rng=rng)[1][:2] for _ in range(r)] for k in scene])
-    # Robot 0 of world 0 inside a wall of the house; robot 0 of world 1 inside a part.
+    # Robot 0 of world 0 inside a wall of the house; of world 1 inside a part of the plan
+    # where no OBSTACLE cell is (only the polygon says it is inside).
     xy[0, 0] = scenes[0].floors[0].collision.polygons[0].representative_point().coords[0]
-    xy[1, 0] = scenes[1].floors[0].collision.polygons[0].representative_point().coords[0]
+    xy[1, 0] = inside_a_free_cell(scenes[1])
     yaw = rng.uniform(-np.pi, np.pi, (w, r))
     present = np.ones((w, r), bool)
     present[2, 1] = False
     got = cast_batch(tables, a.asarray(scene, a.i64), a.asarray(xy[..., 0]), a.asarray(xy[..., 1]), a.asarray(yaw),
                      a.asarray(present, a.boolean), 0.18, a.asarray(angles), max_range, method=method)
     got = a.numpy(got) if a.is_torch else got
+    geos = [ScanGeometry(one.floors[0]) for one in scenes]
     for i in range(w):
-        geo = ScanGeometry(scenes[scene[i]].floors[0])
+        geo = geos[scene[i]]
         seen = np.flatnonzero(present[i])
         discs = np.column_stack([xy[i, seen], np.full(len(seen), 0.18)])
         own = np.full(r, -1)
@@ -117,3 +134,14 @@ def test_the_batched_scan_sees_thin_walls_as_shapely_does(method: str) -> None:
         grid_only = cast_rays(ScanGeometry(Scene.from_array(tmap.codes, 0.1).floors[0]), p[None], [yaw], angles, 3.0)
         polygon_rays += int((got < grid_only[0] - 1e-3).sum())
     assert polygon_rays >= 5  # rays stopped by polygon edges that no cell covers
+
+
+@compiled
+def test_robots_scan_polygon_edges_and_each_other_as_parallel_envs_do() -> None:
+    # Three robots a world: each scan sees the plan's edges and the other robots' discs.
+    scene = random_plan(7)
+    rng = np.random.default_rng(4)
+    task = {"reward_type": "geodesic", "goal_tolerance": 0.2, "termination_config": {"max_steps": 40}}
+    stats = compare_fleet(scene, fleet_episodes(scene, 2, 3, rng), random_actions(rng, (40, 2, 3)), task=task,
+                          sensors=SCAN)
+    assert stats["ends"] > 0, stats
