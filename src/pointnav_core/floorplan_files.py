@@ -9,7 +9,8 @@ as the floor's exact collision geometry.
   world ``(x, y)``, the same picture seen from above). Each wall (its two base points,
   ``y = 0``) becomes a ``wall_thickness`` slab centred on it, except ``empty`` walls (the
   open side between two rooms of one space), and each door's ``holePolygon`` (``x`` from
-  wall0's first base point along the wall) is cut out of the walls; windows are above the
+  wall0's first base point along the wall) is cut out of the walls, unless ``doors`` closes
+  it (ProcTHOR's ``openness``: 1 open, 0 closed); windows are above the
   floor and cut nothing. Objects carry no size in the house file, so they become obstacles only when
   ``object_sizes`` gives their footprint: ``assetId -> (size_x, size_z)`` metres, turned by
   their y rotation (degrees, clockwise seen from above, as Unity turns).
@@ -35,7 +36,11 @@ from shapely.geometry import LineString, Polygon, box
 from pointnav_core import validation
 from pointnav_core.floorplans import FloorPlan
 
-__all__ = ["read_houseexpo", "read_procthor", "sniff_plan_format"]
+__all__ = ["DOOR_MODES", "read_houseexpo", "read_procthor", "sniff_plan_format"]
+
+#: ``doors=`` of :func:`read_procthor`: every door open (a hole in its wall), each as the
+#: file stores it (closed where its ``openness`` is 0), or every door closed (no holes).
+DOOR_MODES = ("open", "as_stored", "closed")
 
 
 def _load(path: str | os.PathLike[str]) -> tuple[dict[str, Any], str]:
@@ -116,7 +121,23 @@ def _walls(doc: dict[str, Any], where: str, thickness: float) -> tuple[dict[str,
     return bases, shapely.unary_union(slabs)
 
 
-def _door_holes(doc: dict[str, Any], where: str, bases: Mapping[str, LineString], thickness: float) -> list[Polygon]:
+def _is_closed(door: dict[str, Any], field: str, mode: str) -> bool:
+    """Whether ``door`` fills its wall's hole under ``mode`` (one of :data:`DOOR_MODES`).
+
+    ProcTHOR writes ``openness`` 1 (open) or 0 (closed: its doors to the outside) on doors
+    with a leaf, and nothing on door frames (always open); THOR's openness is in [0, 1],
+    and only 0 closes the doorway (a leaf ajar leaves a gap).
+    """
+    if mode != "as_stored":
+        return mode == "closed"
+    openness = door.get("openness", 1)
+    if not (validation.is_real(openness) and 0.0 <= openness <= 1.0):
+        raise ValueError(f"{field}.openness must be a number in [0, 1], got {openness!r}")
+    return openness == 0
+
+
+def _door_holes(doc: dict[str, Any], where: str, bases: Mapping[str, LineString], thickness: float,
+                mode: str) -> list[Polygon]:
     doors = doc.get("doors", [])
     if not isinstance(doors, list):
         raise ValueError(f"{where}: doors must be a list, got {doors!r:.80}")
@@ -126,6 +147,8 @@ def _door_holes(doc: dict[str, Any], where: str, bases: Mapping[str, LineString]
         wall = door.get("wall0") if isinstance(door, dict) else None
         if wall not in bases:
             raise ValueError(f"{field}.wall0 must name a wall of walls, got {wall!r}")
+        if _is_closed(door, field, mode):  # its hole stays filled (the door's file is still checked)
+            continue
         span = [x for x, _ in _xz(door.get("holePolygon"), f"{field}.holePolygon")]
         if len(span) < 2:
             raise ValueError(f"{field}.holePolygon must have two corners")
@@ -160,6 +183,7 @@ def read_procthor(
     path: str | os.PathLike[str],
     wall_thickness: float = 0.1,
     object_sizes: Mapping[str, Sequence[float]] | None = None,
+    doors: str = "open",
 ) -> FloorPlan:
     """The floor plan of a ProcTHOR ``house.json`` (see the module notes).
 
@@ -171,7 +195,20 @@ def read_procthor(
     object_sizes : mapping, optional
         ``assetId -> (size_x, size_z)`` in metres; with it every top-level object is an
         obstacle (an object without an entry is an error). Without it objects are ignored.
+    doors : {"open", "as_stored", "closed"}
+        ``"open"`` (default): every door is a hole in its wall. ``"as_stored"``: a door
+        whose ``openness`` is 0 (ProcTHOR's doors to the outside) leaves its wall whole; a
+        door without ``openness`` (a door frame) is open. ``"closed"``: every wall is
+        whole, frames included.
+
+    Raises
+    ------
+    ValueError
+        Naming ``doors`` for another value, and the file and field for a door whose
+        ``openness`` is not a number in [0, 1] (with ``"as_stored"``).
     """
+    if not isinstance(doors, str) or doors not in DOOR_MODES:
+        raise ValueError(f"doors must be one of {', '.join(map(repr, DOOR_MODES))}, got {doors!r}")
     thickness = validation.real("wall_thickness", wall_thickness, minimum=0.0, strict=True)
     doc, where = _load(path)
     rooms = doc.get("rooms")
@@ -183,7 +220,7 @@ def read_procthor(
         floors.append(_polygon(_xz(room.get("floorPolygon") if isinstance(room, dict) else None, field), field))
     outline = _outline(floors, f"{where}: rooms")
     bases, walls = _walls(doc, where, thickness)
-    holes = _door_holes(doc, where, bases, thickness)
+    holes = _door_holes(doc, where, bases, thickness, doors)
     if holes:
         walls = walls.difference(shapely.unary_union(holes))
     obstacles = [p for p in shapely.get_parts(walls) if p.area > 0]

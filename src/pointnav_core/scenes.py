@@ -279,12 +279,14 @@ class Scene:
 
     @classmethod
     def from_procthor(cls, house_json: str | PathLike[str], resolution: float = 0.05, wall_thickness: float = 0.1,
-                      object_sizes: Any = None, **kwargs: Any) -> Scene:
+                      object_sizes: Any = None, doors: str = "open", **kwargs: Any) -> Scene:
         """Scene of a ProcTHOR ``house.json``: rooms as floor, walls with door holes as obstacles,
-        exact polygons (see :func:`pointnav_core.floorplan_files.read_procthor`)."""
+        exact polygons (see :func:`pointnav_core.floorplan_files.read_procthor`). ``doors``:
+        ``"open"`` (every door a hole), ``"as_stored"`` (closed where ``openness`` is 0) or
+        ``"closed"`` (no holes)."""
         from pointnav_core.floorplan_files import read_procthor
 
-        plan = read_procthor(house_json, wall_thickness=wall_thickness, object_sizes=object_sizes)
+        plan = read_procthor(house_json, wall_thickness=wall_thickness, object_sizes=object_sizes, doors=doors)
         return cls.from_polygons(plan.outline, plan.obstacles, resolution=resolution, **kwargs)
 
     @classmethod

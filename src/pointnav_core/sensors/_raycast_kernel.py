@@ -15,7 +15,7 @@ import numpy as np
 
 from pointnav_core.sensors.raycast import TOUCH_EPS
 
-__all__ = ["cast"]
+__all__ = ["cast", "polygon_range"]
 
 _jit = numba.njit(cache=True, nogil=True, error_model="numpy")
 _EPS = TOUCH_EPS
@@ -144,6 +144,96 @@ def pseudo_angle(y, x):  # pragma: no cover
     q = x / (abs(x) + abs(y))
     return 1.0 - q if y >= 0.0 else q - 1.0
 
+
+@_jit
+def polygon_range(px, py, c, s, phi, edges, max_range, out):  # pragma: no cover
+    # The rays of one origin (px, py) (m), of directions c, s (n_rays,), against the polygon
+    # edges (ScanGeometry.edge_table rows): out (n_rays,), each ray's range so far (m),
+    # becomes the nearer of it and the ray's first edge hit. phi (n_rays,) is scratch.
+    # The one definition of a polygon edge's hit for the compiled scans (the single env's
+    # cast and the batched engine's vector._scan_kernel.cast_worlds).
+    n_edges = edges.shape[0]
+    n_rays = c.shape[0]
+    far = 0.0
+    for r in range(n_rays):  # the rays' directions, as pseudo_angle gives the edges' ends
+        phi[r] = pseudo_angle(s[r], c[r])
+        far = max(far, out[r])
+    far += _CULL_MARGIN
+    order = np.argsort(phi)
+    sphi = phi[order]
+    # The polygon edges, each against the rays in its angular span only.
+    for j in range(n_edges):
+        if not (edges[j, 6] >= px - max_range and edges[j, 4] <= px + max_range
+                and edges[j, 7] >= py - max_range and edges[j, 5] <= py + max_range):
+            continue
+        fx = edges[j, 0] - px
+        fy = edges[j, 1] - py
+        ex = edges[j, 2]
+        ey = edges[j, 3]
+        num0 = ey * fx - ex * fy
+        if num0 > 0.0:  # seen from its back (the material's side)
+            continue
+        # The edge's nearest point beyond every ray's range so far: no ray reaches it.
+        ee = ex * ex + ey * ey
+        tt = min(max(-(fx * ex + fy * ey) / ee, 0.0), 1.0) if ee > 0.0 else 0.0
+        nx = fx + tt * ex
+        ny = fy + tt * ey
+        if nx * nx + ny * ny > far * far:
+            continue
+        full = True
+        lo = hi = 0.0
+        gx2 = fx + ex
+        gy2 = fy + ey
+        # (Squared distances: no square roots.)
+        if (num0 * num0 >= _SPAN_MIN_DIST2 * ee and fx * fx + fy * fy >= _SPAN_MIN_END2
+                and gx2 * gx2 + gy2 * gy2 >= _SPAN_MIN_END2):
+            # Far enough from the edge's line and ends: a ray more than _SPAN_MARGIN
+            # outside the directions of its ends misses it by far more than
+            # rounding and TOUCH_EPS, so only the rays between them are tested.
+            pa = pseudo_angle(fy, fx)
+            pb = pseudo_angle(gy2, gx2)
+            width = pb - pa
+            if width > 2.0:
+                width -= 4.0
+            elif width < -2.0:
+                width += 4.0
+            lo = min(pa, pa + width) - _SPAN_MARGIN
+            hi = max(pa, pa + width) + _SPAN_MARGIN
+            full = False
+        for wrap in range(3):  # the span, and its parts shifted by a full turn
+            if full:
+                if wrap != 1:
+                    continue
+                k0 = 0
+                k1 = n_rays
+            else:
+                a = lo + (wrap - 1) * 4.0
+                b = hi + (wrap - 1) * 4.0
+                if b < -2.0 or a > 2.0:
+                    continue
+                k0 = np.searchsorted(sphi, a)
+                k1 = np.searchsorted(sphi, b, side="right")
+            for k in range(k0, k1):
+                r = order[k]
+                best = out[r]
+                dx = c[r]
+                dy = s[r]
+                cross = dx * ey - dy * ex
+                num = fx * ey - fy * ex
+                # Without dividing: t = num / cross surely negative (opposite signs,
+                # num far from underflow) or surely beyond best changes nothing.
+                if abs(num) > 1e-250 and (num < 0.0) != (cross < 0.0) and cross != 0.0:
+                    continue
+                if abs(num) > best * abs(cross) * (1.0 + 1e-12):
+                    continue
+                den = 1.0 / cross
+                t = num * den
+                if t >= 0.0 and t < best:
+                    u = (fx * dy - fy * dx) * den
+                    if abs(u - 0.5) <= edges[j, 8]:
+                        out[r] = t
+
+
 @_jit
 def cast(p, cy, sy, ca, sa, params, lookup, clear, near_polygon, edges, discs, own, out):  # pragma: no cover
     res = params[0]
@@ -171,7 +261,7 @@ def cast(p, cy, sy, ca, sa, params, lookup, clear, near_polygon, edges, discs, o
         py = p[i, 1]
         gx = (px - ox) * inv + 1.0
         gy = (py - oy) * inv + 1.0
-        # An origin in a cell a polygon touches may be inside one (raycast._inside_polygon).
+        # An origin in a cell a polygon touches may be inside one (raycast.inside_polygon).
         col = int(min(max(math.floor((px - ox) * inv) + 1.0, 0.0), wp - 1))
         row = int(min(max(math.floor((py - oy) * inv) + 1.0, 0.0), hp - 1))
         if near_polygon[row * wp + col]:
@@ -198,84 +288,6 @@ def cast(p, cy, sy, ca, sa, params, lookup, clear, near_polygon, edges, discs, o
                     continue
                 best = min(best, disc_range(px - discs[m, 0], py - discs[m, 1], dx, dy, discs[m, 2] * discs[m, 2]))
             out[i, r] = best
-        if n_edges == 0:
-            continue
-        far = 0.0
-        for r in range(n_rays):  # the rays' directions, as pseudo_angle gives the edges' ends
-            phi[r] = pseudo_angle(s[r], c[r])
-            far = max(far, out[i, r])
-        far += _CULL_MARGIN
-        order = np.argsort(phi)
-        sphi = phi[order]
-        # The polygon edges, each against the rays in its angular span only.
-        for j in range(n_edges):
-            if not (edges[j, 6] >= px - max_range and edges[j, 4] <= px + max_range
-                    and edges[j, 7] >= py - max_range and edges[j, 5] <= py + max_range):
-                continue
-            fx = edges[j, 0] - px
-            fy = edges[j, 1] - py
-            ex = edges[j, 2]
-            ey = edges[j, 3]
-            num0 = ey * fx - ex * fy
-            if num0 > 0.0:  # seen from its back (the material's side)
-                continue
-            # The edge's nearest point beyond every ray's range so far: no ray reaches it.
-            ee = ex * ex + ey * ey
-            tt = min(max(-(fx * ex + fy * ey) / ee, 0.0), 1.0) if ee > 0.0 else 0.0
-            nx = fx + tt * ex
-            ny = fy + tt * ey
-            if nx * nx + ny * ny > far * far:
-                continue
-            full = True
-            lo = hi = 0.0
-            gx2 = fx + ex
-            gy2 = fy + ey
-            # (Squared distances: no square roots.)
-            if (num0 * num0 >= _SPAN_MIN_DIST2 * ee and fx * fx + fy * fy >= _SPAN_MIN_END2
-                    and gx2 * gx2 + gy2 * gy2 >= _SPAN_MIN_END2):
-                # Far enough from the edge's line and ends: a ray more than _SPAN_MARGIN
-                # outside the directions of its ends misses it by far more than
-                # rounding and TOUCH_EPS, so only the rays between them are tested.
-                pa = pseudo_angle(fy, fx)
-                pb = pseudo_angle(gy2, gx2)
-                width = pb - pa
-                if width > 2.0:
-                    width -= 4.0
-                elif width < -2.0:
-                    width += 4.0
-                lo = min(pa, pa + width) - _SPAN_MARGIN
-                hi = max(pa, pa + width) + _SPAN_MARGIN
-                full = False
-            for wrap in range(3):  # the span, and its parts shifted by a full turn
-                if full:
-                    if wrap != 1:
-                        continue
-                    k0 = 0
-                    k1 = n_rays
-                else:
-                    a = lo + (wrap - 1) * 4.0
-                    b = hi + (wrap - 1) * 4.0
-                    if b < -2.0 or a > 2.0:
-                        continue
-                    k0 = np.searchsorted(sphi, a)
-                    k1 = np.searchsorted(sphi, b, side="right")
-                for k in range(k0, k1):
-                    r = order[k]
-                    best = out[i, r]
-                    dx = c[r]
-                    dy = s[r]
-                    cross = dx * ey - dy * ex
-                    num = fx * ey - fy * ex
-                    # Without dividing: t = num / cross surely negative (opposite signs,
-                    # num far from underflow) or surely beyond best changes nothing.
-                    if abs(num) > 1e-250 and (num < 0.0) != (cross < 0.0) and cross != 0.0:
-                        continue
-                    if abs(num) > best * abs(cross) * (1.0 + 1e-12):
-                        continue
-                    den = 1.0 / cross
-                    t = num * den
-                    if t >= 0.0 and t < best:
-                        u = (fx * dy - fy * dx) * den
-                        if abs(u - 0.5) <= edges[j, 8]:
-                            out[i, r] = t
+        if n_edges:
+            polygon_range(px, py, c, s, phi, edges, max_range, out[i])
     return n_near

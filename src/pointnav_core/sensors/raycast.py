@@ -47,7 +47,7 @@ from pointnav_core.maps import OBSTACLE, TraversableMap
 from pointnav_core.sensors import raycast_jit
 from pointnav_core.sensors.clearance import quadrant_clearance
 
-__all__ = ["TOUCH_EPS", "ScanGeometry", "cast_pose_compiled", "cast_rays"]
+__all__ = ["TOUCH_EPS", "ScanGeometry", "cast_pose_compiled", "cast_rays", "inside_polygon", "polygon_hits"]
 
 #: Metres within which a ray counts as touching a blocked square's face or corner.
 TOUCH_EPS = 1e-9
@@ -168,6 +168,13 @@ class ScanGeometry:
             self._jit_params_of[max_range] = params
         return params
 
+    @property
+    def edge_table(self) -> NDArray[np.float64]:
+        """The obstacle polygons' edges as the compiled kernels read them, ``(E, 9)``
+        float64: per edge its start ``a``, ``b - a``, low corner, high corner (m) and the
+        ``|u - 1/2|`` slack (``sensors._raycast_kernel.polygon_range``)."""
+        return self._jit_edges
+
     def __getstate__(self) -> dict[str, Any]:
         state = self.__dict__.copy()
         state["_poly_tree"] = None  # rebuilt, not shipped
@@ -249,7 +256,7 @@ def cast_rays(
             geometry, np.ascontiguousarray(p), cy, sy, ca, sa, float(max_range), np.ascontiguousarray(d), own
         )
         if near:  # an origin in a cell a polygon touches: shapely decides if it is inside
-            best[_inside_polygon(geometry, p)] = 0.0
+            best[inside_polygon(geometry, p)] = 0.0
         return best
     if method == "numba":
         raise ValueError('method="numba" needs numba: pip install "pointnav-core[fast]"')
@@ -259,7 +266,7 @@ def cast_rays(
         _grid_hits(geometry, p, c, s, float(max_range)), float(max_range)
     )
     if len(geometry.edge_a):
-        np.minimum(best, _polygon_hits(geometry, p, c, s, float(max_range)), out=best)
+        np.minimum(best, polygon_hits(geometry, p, c, s, float(max_range)), out=best)
     if discs is not None:
         d = np.asarray(discs, dtype=np.float64).reshape(-1, 3)
         if len(d):
@@ -289,7 +296,7 @@ def cast_pose_compiled(
         geometry, origin, heading[:1], heading[1:], angles[0], angles[1], max_range, _NO_DISCS, _no_own(1)
     )
     if near:
-        best[_inside_polygon(geometry, origin)] = 0.0
+        best[inside_polygon(geometry, origin)] = 0.0
     return best[0]
 
 
@@ -367,10 +374,16 @@ def _grid_hits(
     return best * res
 
 
-def _polygon_hits(
+def polygon_hits(
     geo: ScanGeometry, p: NDArray[np.float64], c: NDArray[np.float64], s: NDArray[np.float64], max_range: float
 ) -> NDArray[np.float64]:
-    """Range (m) to the first obstacle-polygon edge along each ray (inf: none in range)."""
+    """Range (m) to the first obstacle-polygon edge along each ray (inf: none in range).
+
+    The array path's definition of a polygon hit, for the single env and the batched
+    engine alike (:mod:`pointnav_core.vector.scan`): origins ``p`` ``(N, 2)`` (m), ray
+    directions ``c``, ``s`` ``(N, R)``; ``(N, R)`` ranges, 0 for an origin inside (or on) a
+    polygon.
+    """
     n, r = c.shape
     best = np.full((n, r), np.inf)
     # Candidate edges: those whose bounding box is within max_range of the origin.
@@ -405,12 +418,13 @@ def _polygon_hits(
         else:  # per robot, the nearest over its candidate edges (pairs grouped by robot)
             starts = np.flatnonzero(np.r_[True, robot[1:] != robot[:-1]])
             best[robot[starts]] = np.minimum.reduceat(t, starts, axis=0)
-    best[_inside_polygon(geo, p)] = 0.0
+    best[inside_polygon(geo, p)] = 0.0
     return best
 
 
-def _inside_polygon(geo: ScanGeometry, p: NDArray[np.float64]) -> NDArray[np.intp]:
-    """Indices of the origins inside (or on) an obstacle polygon: they read 0."""
+def inside_polygon(geo: ScanGeometry, p: NDArray[np.float64]) -> NDArray[np.intp]:
+    """Indices of the origins ``p`` ``(N, 2)`` (m) inside (or on) an obstacle polygon:
+    they read 0."""
     # Only an origin in a cell a polygon touches can be inside one.
     hp, wp = geo.shape
     inv = 1.0 / geo.resolution

@@ -3,7 +3,8 @@
 Imported only when the compiled path runs, so the package imports without numba. One loop
 over worlds, robots and rays, inside the kernel; each ray is the single env's crossing walk
 (``sensors._raycast_kernel.grid_range``) on its world's grid, then the discs of the world's
-other present robots, with the same expressions as the array path.
+other present robots, with the same expressions as the array path, then its floor's
+obstacle-polygon edges by the single kernel's ``polygon_range``.
 """
 
 from __future__ import annotations
@@ -13,7 +14,7 @@ import math
 import numba
 import numpy as np
 
-from pointnav_core.sensors._raycast_kernel import disc_range, grid_range
+from pointnav_core.sensors._raycast_kernel import disc_range, grid_range, polygon_range
 from pointnav_core.sensors.raycast import TOUCH_EPS
 
 __all__ = ["cast_worlds"]
@@ -22,12 +23,13 @@ _jit = numba.njit(cache=True, nogil=True, error_model="numpy")
 
 
 @_jit
-def cast_worlds(scene, x, y, cyaw, syaw, ca, sa, present, radius, max_range, meta, lookup, clear, out):  # pragma: no cover
+def cast_worlds(scene, x, y, cyaw, syaw, ca, sa, present, radius, max_range, meta, lookup, clear, edges, out):  # pragma: no cover
     n_worlds, n_robots = x.shape
     n_rays = ca.shape[0]
     # radius (W, R): each robot's disc (m).
     c = np.empty(n_rays)
     s = np.empty(n_rays)
+    phi = np.empty(n_rays)
     near = np.empty(n_robots, np.int64)
     for w in range(n_worlds):
         k = scene[w]
@@ -38,6 +40,8 @@ def cast_worlds(scene, x, y, cyaw, syaw, ca, sa, present, radius, max_range, met
         res = meta[k, 4]
         ox = meta[k, 5]
         oy = meta[k, 6]
+        e0 = int(meta[k, 7])
+        own_edges = edges[e0 : e0 + int(meta[k, 8])]
         inv = 1.0 / res
         e = TOUCH_EPS * inv
         reach = max_range * inv
@@ -85,3 +89,5 @@ def cast_worlds(scene, x, y, cyaw, syaw, ca, sa, present, radius, max_range, met
                     m = near[j]
                     best = min(best, disc_range(px - x[w, m], py - y[w, m], dx, dy, radius[w, m] * radius[w, m]))
                 out[w, i, r] = best
+            if own_edges.shape[0]:  # the single scan's polygon edges (origins inside: the caller)
+                polygon_range(px, py, c, s, phi, own_edges, max_range, out[w, i])

@@ -59,7 +59,7 @@ class VectorPointNavEnv(PoolRefreshing, VectorEnv):
     scene : Scene or sequence of Scene, optional
         World ``i`` runs on ``scene[i % len(scene)]``, at its own resolution. Floors with
         obstacle polygons (floor plans, the generated houses) need the compiled contacts
-        (the CPU with numba) and no scan sensor. Default: the single env's default house
+        (the CPU with numba); the scan sees their polygons as the single env's does. Default: the single env's default house
         as a grid.
     robot : RobotSpec or dict, optional
         As for the single env: a differential drive (actions ``(v, w)``) or a holonomic one

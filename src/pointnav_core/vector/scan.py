@@ -1,10 +1,14 @@
 """The range scan of a batch of worlds: ``(W, R, n_rays)`` ranges in one call.
 
-Every world has its own grid floor and up to ``R`` robots; each present robot casts the
+Every world has its own floor and up to ``R`` robots; each present robot casts the
 rays of a :class:`~pointnav_core.sensors.RangeScan` from its centre and reads, per ray,
 the distance (m) to the first thing the single env's scan sees
 (:mod:`pointnav_core.sensors.raycast`): an OBSTACLE cell, the map's edge (one ring of
-blocked cells around the map) or the disc of another present robot of the same world.
+blocked cells around the map), an edge of the floor's obstacle polygons (floor plans; an
+origin inside a polygon reads 0) or the disc of another present robot of the same world.
+The polygon edges are the single scan's own definitions, called, not copied:
+``raycast.polygon_hits`` on the array path (on the host, for torch too) and
+``sensors._raycast_kernel.polygon_range`` compiled.
 VOID is not seen; touching counts (within :data:`~pointnav_core.sensors.TOUCH_EPS`); an
 origin touching a blocked cell reads 0. Absent robots neither see nor are seen; their rows
 read ``max_range``.
@@ -34,7 +38,12 @@ from typing import Any
 import numpy as np
 
 from pointnav_core.sensors.noise import episode_key, scan_noise, seed_entropy
-from pointnav_core.sensors.raycast import TOUCH_EPS, ScanGeometry
+from pointnav_core.sensors.raycast import (
+    TOUCH_EPS,
+    ScanGeometry,
+    inside_polygon,
+    polygon_hits,
+)
 from pointnav_core.sensors.scan import RangeScan
 from pointnav_core.vector.xp import Arrays
 
@@ -52,39 +61,41 @@ class ScanTables:
     Parameters
     ----------
     scenes : sequence of Scene
-        Their floor ``floor`` is used; grid cells only (obstacle polygons are refused).
+        Their floor ``floor`` is used: its cells and the edges of its obstacle polygons.
     floor : int
         The task's floor.
     arrays : Arrays
         Namespace and device of the array path.
-
-    Raises
-    ------
-    ValueError
-        Naming ``scene`` when a floor holds obstacle polygons.
     """
 
     def __init__(self, scenes: Sequence[Any], floor: int, arrays: Arrays) -> None:
-        lookups, clears, meta = [], [], []
-        lo = co = 0
-        for k, scene in enumerate(scenes):
-            tmap = scene.floors[floor]
-            if len(tmap.collision.polygons):
-                raise ValueError(f"scene {k} has obstacle polygons on floor {floor}; the batched scan sees grid cells only")
-            geo = ScanGeometry(tmap)
+        lookups, clears, edges, meta = [], [], [], []
+        lo = co = eo = 0
+        #: Per scene, the single scan's geometry of its floor (cells and polygon edges).
+        self.geometries = [ScanGeometry(scene.floors[floor]) for scene in scenes]
+        for geo in self.geometries:
             hp, wp = geo.shape
             lookups.append(geo._lookup)
             clears.append(geo._clearance)
-            # lookup offset, clearance offset, padded rows, padded columns, cell size, origin
-            meta.append((lo, co, hp, wp, geo.resolution, geo.origin[0], geo.origin[1]))
+            edges.append(geo.edge_table)
+            n_edges = len(geo.edge_table)
+            # lookup offset, clearance offset, padded rows, padded columns, cell size, origin,
+            # first polygon edge, number of edges
+            meta.append((lo, co, hp, wp, geo.resolution, geo.origin[0], geo.origin[1], eo, n_edges))
             lo += geo._lookup.size
             co += geo._clearance.size
-        #: Per scene: lookup offset, clearance offset, hp, wp, resolution, ox, oy (float64).
+            eo += n_edges
+        #: Per scene: lookup offset, clearance offset, hp, wp, resolution, ox, oy, first
+        #: edge, edges (float64).
         self.meta = np.ascontiguousarray(meta, dtype=np.float64)
         #: The three lookup planes of every padded grid, end to end (bool, numpy).
         self.lookup = np.ascontiguousarray(np.concatenate(lookups))
         #: Per padded cell and quadrant, the free square ahead (sensors.clearance, uint8).
         self.clearance = np.ascontiguousarray(np.concatenate(clears), dtype=np.uint8)
+        #: Every floor's polygon edges (ScanGeometry.edge_table rows), end to end.
+        self.edges = np.ascontiguousarray(np.concatenate(edges).reshape(-1, 9))
+        #: The scenes whose floor has obstacle polygons.
+        self.polygon_scenes = [k for k, geo in enumerate(self.geometries) if len(geo.polygons)]
         self.min_res = float(self.meta[:, 4].min())
         self.max_side = int(self.meta[:, 2:4].max())
         a = self.arrays = arrays
@@ -201,13 +212,51 @@ def cast_batch(
             np.ascontiguousarray(y, dtype=np.float64), np.cos(yaw), np.sin(yaw), np.cos(angles), np.sin(angles),
             np.ascontiguousarray(view(present), dtype=np.bool_), np.ascontiguousarray(view(radius), dtype=np.float64),
             float(max_range),
-            tables.meta, tables.lookup, tables.clearance, out,
+            tables.meta, tables.lookup, tables.clearance, tables.edges, out,
         )
+        _zero_inside(tables, view(scene), x, y, view(present), out)
         return a.asarray(out) if a.is_torch else out
     c, s = directions(a, yaw, angles)
     best = _grid_ranges(tables, scene, x, y, c, s, float(max_range))
     best = a.xp.minimum(best, _disc_ranges(a, x, y, c, s, present, radius))
+    best = _polygon_ranges(tables, scene, x, y, c, s, float(max_range), best)
     return a.xp.where(present[..., None], best, a.xp.full_like(best, float(max_range)))
+
+
+def _polygon_ranges(tables: ScanTables, scene: Any, x: Any, y: Any, c: Any, s: Any, max_range: float, best: Any) -> Any:
+    """``best`` (W, R, n) lowered to each ray's first obstacle-polygon edge, by the single
+    scan's own definition (``raycast.polygon_hits``, on the host: it culls edges per
+    origin); an origin inside a polygon reads 0."""
+    if not tables.polygon_scenes:
+        return best
+    a = tables.arrays
+    host = a.numpy if a.is_torch else np.asarray
+    scene_h = host(scene)
+    x_h, y_h, c_h, s_h = host(x), host(y), host(c), host(s)
+    n = c_h.shape[2]
+    for k in tables.polygon_scenes:
+        worlds = np.flatnonzero(scene_h == k)
+        if not len(worlds):
+            continue
+        p = np.stack([x_h[worlds].ravel(), y_h[worlds].ravel()], axis=1)
+        hits = polygon_hits(tables.geometries[k], p, c_h[worlds].reshape(-1, n), s_h[worlds].reshape(-1, n), max_range)
+        w = a.asarray(worlds, a.i64) if a.is_torch else worlds
+        best[w] = a.xp.minimum(best[w], a.asarray(hits.reshape(len(worlds), -1, n)))
+    return best
+
+
+def _zero_inside(tables: ScanTables, scene: Any, x: Any, y: Any, present: Any, out: Any) -> None:
+    """Set to 0 the rays (numpy ``out`` (W, R, n)) of present robots inside (or on) an
+    obstacle polygon (``raycast.inside_polygon``, as the single compiled scan does)."""
+    for k in tables.polygon_scenes:
+        worlds = np.flatnonzero(np.asarray(scene) == k)
+        if not len(worlds):
+            continue
+        p = np.stack([np.asarray(x)[worlds].ravel(), np.asarray(y)[worlds].ravel()], axis=1)
+        inside = inside_polygon(tables.geometries[k], p)
+        w, r = np.divmod(inside, x.shape[1])
+        keep = np.asarray(present)[worlds[w], r]
+        out[worlds[w[keep]], r[keep]] = 0.0
 
 
 def _grid_ranges(tables: ScanTables, scene: Any, x: Any, y: Any, c: Any, s: Any, max_range: float) -> Any:
