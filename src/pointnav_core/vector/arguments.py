@@ -9,6 +9,7 @@ from typing import Any
 import numpy as np
 
 from pointnav_core import scenes, validation
+from pointnav_core.errors import ArgumentError
 
 __all__ = ["as_scene_list", "check_real_actions", "default_scene", "grid_scene", "task_arguments"]
 
@@ -28,10 +29,10 @@ def default_scene() -> scenes.Scene:
 def task_arguments(task: Mapping[str, Any] | None) -> dict[str, Any]:
     """A copy of the ``task`` arguments; ValueError for a non-dict or a custom term."""
     if task is not None and not isinstance(task, Mapping):
-        raise ValueError(f"task must be None or a dict of PointNavigationTask arguments, got {task!r}")
+        raise ArgumentError(f"task must be None or a dict of PointNavigationTask arguments, got {task!r}")
     for key in ("termination_conditions", "reward_functions", "observation_terms"):
         if task is not None and task.get(key) is not None:
-            raise ValueError(f"task: {key} is not supported by the batched engine")
+            raise ArgumentError(f"task: {key} is not supported by the batched engine")
     return dict(task or {})
 
 
@@ -39,7 +40,7 @@ def as_scene_list(scene: scenes.Scene | Sequence[scenes.Scene] | None) -> list[s
     """The worlds' scenes (default: the default house as a grid); ValueError if not Scenes."""
     scene_list = [scene] if isinstance(scene, scenes.Scene) else list(scene) if scene is not None else [default_scene()]
     if not scene_list or not all(isinstance(s, scenes.Scene) for s in scene_list):
-        raise ValueError(f"scene must be a Scene or a non-empty sequence of Scenes, got {scene!r}")
+        raise ArgumentError(f"scene must be a Scene or a non-empty sequence of Scenes, got {scene!r}")
     return scene_list
 
 
@@ -48,4 +49,4 @@ def check_real_actions(actions: Any) -> None:
     env's rule, :func:`pointnav_core.validation.is_real_array`: no bools, complex numbers or strings)."""
     if not validation.is_real_array(actions):
         kind = getattr(actions, "dtype", type(actions).__name__)
-        raise ValueError(f"actions must be real numbers in [-1, 1] (an integer or float array), got {kind}")
+        raise ArgumentError(f"actions must be real numbers in [-1, 1] (an integer or float array), got {kind}")

@@ -21,6 +21,8 @@ from multiprocessing.connection import Connection, wait
 from multiprocessing.reduction import ForkingPickler
 from typing import Any
 
+from pointnav_core.errors import TaskStateError
+
 __all__ = ["RefreshWorker"]
 
 # Seconds a closing worker gets to leave on its own before it is terminated.
@@ -102,7 +104,7 @@ class RefreshWorker:
         few MB, more than the pipe holds.
         """
         if self._busy:
-            raise RuntimeError("the refresh worker is still busy with a job")
+            raise TaskStateError("the refresh worker is still busy with a job")
         payload = bytes(ForkingPickler.dumps((func, args)))
         self._sender = threading.Thread(target=self._send, args=(payload,), name="pointnav-pool-refresh-send", daemon=True)
         self._busy = True
