@@ -195,7 +195,7 @@ MIN_FREQUENCY, MAX_FREQUENCY = 0.1, 10_000.0
 
 def check_action_frequency(action_frequency: Any) -> float:
     """Return ``action_frequency`` (Hz) as a float in ``[MIN_FREQUENCY, MAX_FREQUENCY]``,
-    or raise ValueError naming it."""
+    or raise ArgumentError (a ValueError) naming it."""
     return validation.real(
         "action_frequency", action_frequency, minimum=MIN_FREQUENCY, maximum=MAX_FREQUENCY, unit="Hz"
     )
@@ -335,7 +335,7 @@ def observation_space(task: PointNavigationTask, flatten: bool) -> spaces.Space[
 def check_action(
     action: Any, shape: tuple[int], drive: str, name: str = "action", *, finite: bool = True
 ) -> np.ndarray:
-    """Return ``action`` as a float array of ``shape``, or raise ValueError naming ``name``.
+    """Return ``action`` as a float array of ``shape``, or raise ArgumentError (a ValueError) naming ``name``.
 
     A float ndarray of the right shape passes through as is (the per-step fast path);
     anything else is converted. Values outside ``[-1, 1]`` are kept (the backend clips

@@ -179,7 +179,7 @@ def make_discrete_actions(
 
 
 def check_discrete_action(action: Any, n: int, name: str = "action") -> int:
-    """Return ``action`` as an int in ``[0, n)``, or raise ValueError naming ``name``.
+    """Return ``action`` as an int in ``[0, n)``, or raise ArgumentError (a ValueError) naming ``name``.
 
     Takes a Python or numpy integer, or an integer array holding one value (as vectorised
     learners pass it); a bool, a float or anything else is an error.

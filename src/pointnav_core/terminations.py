@@ -54,7 +54,7 @@ __all__ = [
 
 
 def _check_count(name: str, value: Any, minimum: int) -> int:
-    """Return ``value`` as an int ``>= minimum``, or raise ValueError naming ``name``.
+    """Return ``value`` as an int ``>= minimum``, or raise ArgumentError (a ValueError) naming ``name``.
 
     Booleans and non-integral numbers are refused (``True`` is not a step count).
 
@@ -69,7 +69,7 @@ def _check_count(name: str, value: Any, minimum: int) -> int:
 
 
 def _check_length(name: str, value: Any, unit: str = "m") -> float:
-    """Return ``value`` as a finite float ``>= 0``, or raise ValueError naming ``name``.
+    """Return ``value`` as a finite float ``>= 0``, or raise ArgumentError (a ValueError) naming ``name``.
 
     Examples
     --------
