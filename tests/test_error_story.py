@@ -21,7 +21,12 @@ import pytest
 from pointnav_core import errors, scenes
 from pointnav_core.datasets.format import PointNavEpisode
 from pointnav_core.env import PointNavEnv
-from pointnav_core.errors import ArgumentError, ArgumentTypeError, PointNavError, TaskStateError
+from pointnav_core.errors import (
+    ArgumentError,
+    ArgumentTypeError,
+    PointNavError,
+    TaskStateError,
+)
 from pointnav_core.maps import OBSTACLE
 from pointnav_core.parallel import parallel_env
 from pointnav_core.vector import VectorPointNavEnv
