@@ -9,7 +9,13 @@ library as soon as both it and this package are imported (see ``registration``).
 
 from typing import Any
 
-from pointnav_core.errors import BackendError, PointNavError, SamplingError
+from pointnav_core.errors import (
+    ArgumentError,
+    ArgumentTypeError,
+    BackendError,
+    PointNavError,
+    SamplingError,
+)
 from pointnav_core.maps import FREE, OBSTACLE, VOID, TraversableMap
 from pointnav_core.metrics import soft_spl, spl
 from pointnav_core.registration import register_envs, register_when_imported
@@ -23,6 +29,8 @@ __all__ = [
     "MultiPointNavEnv",
     "OBSTACLE",
     "VOID",
+    "ArgumentError",
+    "ArgumentTypeError",
     "BackendError",
     "EnvConfig",
     "PointNavEnv",

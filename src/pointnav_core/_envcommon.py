@@ -24,6 +24,7 @@ from gymnasium import spaces
 
 from pointnav_core import scenes, validation
 from pointnav_core.backend import RobotSpec
+from pointnav_core.errors import ArgumentError
 from pointnav_core.task import PointNavigationTask
 
 __all__ = [
@@ -65,7 +66,7 @@ def make_robot(robot: RobotSpec | Mapping[str, Any] | None, name: str = "robot")
     >>> make_robot({"size": 1})  # doctest: +ELLIPSIS
     Traceback (most recent call last):
     ...
-    ValueError: robot has an unknown key 'size'; valid keys are ['radius', ...]
+    pointnav_core.errors.ArgumentError: robot has an unknown key 'size'; valid keys are ['radius', ...]
     """
     if robot is None:
         return RobotSpec()
@@ -74,7 +75,7 @@ def make_robot(robot: RobotSpec | Mapping[str, Any] | None, name: str = "robot")
     if isinstance(robot, Mapping):
         validation.known_keys(name, robot, ROBOT_KEYS)
         return RobotSpec(**robot)
-    raise ValueError(f"{name} must be a RobotSpec, a dict of its fields, or None, got {robot!r}")
+    raise ArgumentError(f"{name} must be a RobotSpec, a dict of its fields, or None, got {robot!r}")
 
 
 def make_task(
@@ -101,14 +102,14 @@ def make_task(
     >>> make_task({"robot_idn": 1}, name="task[0]", robot_idn=0)
     Traceback (most recent call last):
     ...
-    ValueError: task[0] sets robot_idn=1, but the environment sets robot_idn=0 for it
+    pointnav_core.errors.ArgumentError: task[0] sets robot_idn=1, but the environment sets robot_idn=0 for it
     """
     if task is None:
         return PointNavigationTask(**fixed)
     if isinstance(task, PointNavigationTask):
         for key, value in fixed.items():
             if getattr(task, key) != value:
-                raise ValueError(
+                raise ArgumentError(
                     f"{name} has {key}={getattr(task, key)!r}, but the environment needs "
                     f"{key}={value!r} for it"
                 )
@@ -117,7 +118,7 @@ def make_task(
         validation.known_keys(name, task, TASK_KEYS)
         for key, value in fixed.items():
             if key in task and task[key] != value:
-                raise ValueError(
+                raise ArgumentError(
                     f"{name} sets {key}={task[key]!r}, but the environment sets "
                     f"{key}={value!r} for it"
                 )
@@ -125,7 +126,7 @@ def make_task(
         # (a multi-robot env builds one task per robot from the same dict).
         args = {k: copy.deepcopy(v) if k in TERM_KEYS else v for k, v in task.items()}
         return PointNavigationTask(**{**args, **fixed})
-    raise ValueError(
+    raise ArgumentError(
         f"{name} must be a PointNavigationTask, a dict of its arguments, or None, got {task!r}"
     )
 
@@ -152,7 +153,7 @@ def add_sensors(task: Any, sensors: Mapping[str, Any] | None, name: str = "task"
     if task is None:
         task = {}
     if isinstance(task, PointNavigationTask):
-        raise ValueError(
+        raise ArgumentError(
             f"sensors cannot be added to a ready PointNavigationTask ({name}): pass the task "
             f"as a dict of its arguments, or put the sensor terms in its observation_terms"
         )
@@ -162,7 +163,7 @@ def add_sensors(task: Any, sensors: Mapping[str, Any] | None, name: str = "task"
     names = {getattr(term, "name", None) for term in given}
     for term in terms:
         if term.name in names:
-            raise ValueError(
+            raise ArgumentError(
                 f"sensors turns on {term.name!r}, which {name}['observation_terms'] already has"
             )
     return {**task, "observation_terms": [*terms, *given]}
@@ -176,14 +177,14 @@ def check_world_args(
     ``scene`` None means the default generated house (``scenes.rooms(seed=0)``).
     """
     if not isinstance(flatten_obs, (bool, np.bool_)):
-        raise ValueError(f"flatten_obs must be True or False, got {flatten_obs!r}")
+        raise ArgumentError(f"flatten_obs must be True or False, got {flatten_obs!r}")
     frequency = check_action_frequency(action_frequency)
     if scene is None:
         scene = scenes.rooms(seed=0)
     elif not isinstance(scene, scenes.Scene):
-        raise ValueError(f"scene must be a pointnav_core Scene or None, got {scene!r}")
+        raise ArgumentError(f"scene must be a pointnav_core Scene or None, got {scene!r}")
     if backend_kwargs is not None and not isinstance(backend_kwargs, Mapping):
-        raise ValueError(f"backend_kwargs must be None or a dict, got {backend_kwargs!r}")
+        raise ArgumentError(f"backend_kwargs must be None or a dict, got {backend_kwargs!r}")
     return scene, frequency
 
 
@@ -194,7 +195,7 @@ MIN_FREQUENCY, MAX_FREQUENCY = 0.1, 10_000.0
 
 def check_action_frequency(action_frequency: Any) -> float:
     """Return ``action_frequency`` (Hz) as a float in ``[MIN_FREQUENCY, MAX_FREQUENCY]``,
-    or raise ValueError naming it."""
+    or raise ArgumentError (a ValueError) naming it."""
     return validation.real(
         "action_frequency", action_frequency, minimum=MIN_FREQUENCY, maximum=MAX_FREQUENCY, unit="Hz"
     )
@@ -298,7 +299,7 @@ def add_stop(task: Any, discrete: Any, name: str = "task") -> Any:
         task = {}
     if isinstance(task, PointNavigationTask):
         if not isinstance(task.termination_conditions.get("pointgoal"), StopAtGoal):
-            raise ValueError(
+            raise ArgumentError(
                 f"{name} is a ready PointNavigationTask without the STOP rule: with discrete "
                 f"actions and STOP, pass the task as a dict, or give it "
                 f"termination_conditions=[StopAtGoal()]"
@@ -334,7 +335,7 @@ def observation_space(task: PointNavigationTask, flatten: bool) -> spaces.Space[
 def check_action(
     action: Any, shape: tuple[int], drive: str, name: str = "action", *, finite: bool = True
 ) -> np.ndarray:
-    """Return ``action`` as a float array of ``shape``, or raise ValueError naming ``name``.
+    """Return ``action`` as a float array of ``shape``, or raise ArgumentError (a ValueError) naming ``name``.
 
     A float ndarray of the right shape passes through as is (the per-step fast path);
     anything else is converted. Values outside ``[-1, 1]`` are kept (the backend clips
@@ -349,22 +350,22 @@ def check_action(
     >>> check_action([0.5], (2,), "differential", name="action for robot_1")
     Traceback (most recent call last):
     ...
-    ValueError: action for robot_1 must have shape (2,) for a differential drive, got shape (1,)
+    pointnav_core.errors.ArgumentError: action for robot_1 must have shape (2,) for a differential drive, got shape (1,)
     """
     if not (type(action) is np.ndarray and action.shape == shape and action.dtype.kind == "f"):
         # Real numbers only: no strings ("1"), bools or complex values.
         raw = action
         if not isinstance(raw, (np.ndarray, list, tuple)) or not validation.is_real_array(raw):
-            raise ValueError(
+            raise ArgumentError(
                 f"{name} must be an array of {shape[0]} real numbers in [-1, 1], got {raw!r}"
             )
         action = np.asarray(raw, dtype=np.float64)
         if action.shape != shape:
-            raise ValueError(
+            raise ArgumentError(
                 f"{name} must have shape {shape} for a {drive} drive, got shape {action.shape}"
             )
     if finite:
         for value in action.tolist():
             if not -math.inf < value < math.inf:  # also False for NaN
-                raise ValueError(f"{name} must be finite, got {action.tolist()}")
+                raise ArgumentError(f"{name} must be finite, got {action.tolist()}")
     return action

@@ -17,6 +17,7 @@ import numpy as np
 
 from pointnav_core import _envcommon
 from pointnav_core.actions import check_discrete_action
+from pointnav_core.errors import ArgumentError
 from pointnav_core.task import TaskStateError
 
 __all__ = ["bad_keys_error", "check_actions", "named_action_error", "no_agents_error"]
@@ -66,7 +67,7 @@ def bad_keys_error(
     alive = set(agents)
     for agent in agents:
         if agent not in actions:
-            return ValueError(
+            return ArgumentError(
                 f"missing action for {agent}: every agent in env.agents {agents} must "
                 f"act (agents whose episode ended must not)"
             )
@@ -74,15 +75,15 @@ def bad_keys_error(
         if key in alive:
             continue
         if key in known:
-            return ValueError(
+            return ArgumentError(
                 f"got an action for {key}, which is not alive: its episode has ended; step() "
                 f"takes actions only for the agents in env.agents {agents}"
             )
-        return ValueError(
+        return ArgumentError(
             f"got an action for unknown agent {key!r}; step() takes actions only for the "
             f"agents in env.agents {agents}"
         )
-    return ValueError(  # only a Mapping whose len() disagrees with its keys gets here
+    return ArgumentError(  # only a Mapping whose len() disagrees with its keys gets here
         f"actions must hold exactly one action per agent in env.agents {agents}, "
         f"got {len(actions)} for keys {list(actions)}"
     )
@@ -125,7 +126,7 @@ def check_actions(
         the wrong shape or value, naming the agent.
     """
     if type(actions) is not dict and not isinstance(actions, Mapping):
-        raise ValueError(
+        raise ArgumentError(
             f"actions must be a dict of agent -> action for the agents in env.agents "
             f"{agents}, got {type(actions).__name__}"
         )
@@ -141,7 +142,7 @@ def check_actions(
         except KeyError:  # as many keys as agents, so one is missing and one is extra
             raise bad_keys_error(agents, actions, known)
         if action is None:
-            raise ValueError(
+            raise ArgumentError(
                 f"missing action for {agent}: got None, but {agent} is alive; every agent "
                 f"in env.agents must act"
             )
@@ -151,7 +152,7 @@ def check_actions(
             else:
                 action = check_discrete_action(action, len(plans[i]))
         except ValueError as err:
-            raise ValueError(f"{agent}: {err}") from None
+            raise ArgumentError(f"{agent}: {err}") from None
         commands[i] = action
         todo.append((agent, i, action, task_step, observe))
     return commands, todo
@@ -162,5 +163,5 @@ def named_action_error(err: ValueError, todo: Sequence[Todo]) -> ValueError:
     finite (the backend refuses the first bad action it meets, in the agents' order)."""
     for agent, _, action, *_ in todo:
         if not np.isfinite(action).all():
-            return ValueError(f"{agent}: {err}")
+            return ArgumentError(f"{agent}: {err}")
     return err

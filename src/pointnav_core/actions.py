@@ -45,7 +45,7 @@ Examples
 >>> DiscreteActions(forward_step=0.0)
 Traceback (most recent call last):
 ...
-ValueError: forward_step must be a finite number > 0 (m), got 0.0
+pointnav_core.errors.ArgumentError: forward_step must be a finite number > 0 (m), got 0.0
 """
 
 from __future__ import annotations
@@ -58,6 +58,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from pointnav_core import validation
+from pointnav_core.errors import ArgumentError
 from pointnav_core.sensors._checks import check_number
 from pointnav_core.terminations import TerminationCondition
 
@@ -109,7 +110,7 @@ class DiscreteActions:
             "turn_angle", turn_angle, low=0.0, strict_low=True, high=math.pi, unit="rad"
         )
         if not isinstance(stop, (bool, np.bool_)):
-            raise ValueError(f"stop must be True or False, got {stop!r}")
+            raise ArgumentError(f"stop must be True or False, got {stop!r}")
         self.stop = bool(stop)
         self.n = 4 if self.stop else 3
         self.names = _NAMES[: self.n]
@@ -161,24 +162,24 @@ def make_discrete_actions(
         continuous actions.
     """
     if not isinstance(action_space, str) or action_space not in ACTION_SPACES:
-        raise ValueError(f"action_space must be one of {list(ACTION_SPACES)}, got {action_space!r}")
+        raise ArgumentError(f"action_space must be one of {list(ACTION_SPACES)}, got {action_space!r}")
     if action_space == "continuous":
         if discrete_actions is not None:
-            raise ValueError('discrete_actions needs action_space="discrete"')
+            raise ArgumentError('discrete_actions needs action_space="discrete"')
         return None
     if discrete_actions is None:
         return DiscreteActions()
     if isinstance(discrete_actions, DiscreteActions):
         return discrete_actions
     if not isinstance(discrete_actions, Mapping):
-        raise ValueError(f"discrete_actions must be None or a dict, got {discrete_actions!r}")
+        raise ArgumentError(f"discrete_actions must be None or a dict, got {discrete_actions!r}")
     valid = ["forward_step", "turn_angle", "stop"]
     validation.known_keys("discrete_actions", discrete_actions, valid)
     return DiscreteActions(**discrete_actions)
 
 
 def check_discrete_action(action: Any, n: int, name: str = "action") -> int:
-    """Return ``action`` as an int in ``[0, n)``, or raise ValueError naming ``name``.
+    """Return ``action`` as an int in ``[0, n)``, or raise ArgumentError (a ValueError) naming ``name``.
 
     Takes a Python or numpy integer, or an integer array holding one value (as vectorised
     learners pass it); a bool, a float or anything else is an error.
@@ -187,7 +188,7 @@ def check_discrete_action(action: Any, n: int, name: str = "action") -> int:
     if isinstance(value, np.ndarray) and value.size == 1 and value.dtype.kind in "iu":
         value = value.reshape(()).item()
     if isinstance(value, (bool, np.bool_)) or not isinstance(value, (int, np.integer)) or not 0 <= value < n:
-        raise ValueError(f"{name} must be an integer in [0, {n}) (a discrete action), got {action!r}")
+        raise ArgumentError(f"{name} must be an integer in [0, {n}) (a discrete action), got {action!r}")
     return int(value)
 
 

@@ -68,7 +68,7 @@ from typing import TYPE_CHECKING, Any, Protocol, runtime_checkable
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from pointnav_core.errors import BackendError
+from pointnav_core.errors import ArgumentError, BackendError
 from pointnav_core.robot_spec import DRIVES, RobotSpec
 
 __all__ = [
@@ -415,7 +415,7 @@ def make_backend(backend: str | type | Backend = "kinematic", **kwargs: Any) -> 
         return backend(**kwargs)
     check_backend(backend)
     if kwargs:
-        raise ValueError(
+        raise ArgumentError(
             f"backend arguments {sorted(kwargs)} only apply when backend is a name or a "
             f"class, got an instance of {type(backend).__name__}"
         )

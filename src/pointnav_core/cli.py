@@ -29,6 +29,7 @@ from tqdm import tqdm
 
 from pointnav_core import scenes
 from pointnav_core.env import PointNavEnv
+from pointnav_core.errors import ArgumentError
 from pointnav_core.policies import ShortestPathFollower
 
 __all__ = ["main", "run_demo"]
@@ -88,11 +89,11 @@ def run_demo(
         ``collisions`` (mean per episode), ``steps``, ``steps_per_second``.
     """
     if episodes < 1:
-        raise ValueError(f"episodes must be >= 1, got {episodes}")
+        raise ArgumentError(f"episodes must be >= 1, got {episodes}")
     if houses < 1:
-        raise ValueError(f"houses must be >= 1, got {houses}")
+        raise ArgumentError(f"houses must be >= 1, got {houses}")
     if every < 1:
-        raise ValueError(f"every must be >= 1, got {every}")
+        raise ArgumentError(f"every must be >= 1, got {every}")
     task: dict = {"termination_config": {"max_steps": max_steps}}
     if frames is not None:
         task.update(visualize_goal=True, visualize_path=True)

@@ -30,6 +30,8 @@ import sys
 from collections.abc import Callable
 from typing import Any
 
+from pointnav_core.errors import ArgumentError
+
 __all__ = ["add_commands", "reporting"]
 
 
@@ -76,7 +78,7 @@ def _count(name: str, text: str | None) -> int | None:
     except ValueError:
         value = 0
     if value < 1:
-        raise ValueError(f"{name} must be an integer >= 1, got {text!r}")
+        raise ArgumentError(f"{name} must be an integer >= 1, got {text!r}")
     return value
 
 
@@ -128,7 +130,7 @@ def _env_config(args: argparse.Namespace, factory: Any) -> None:
             value = default if getattr(args, name) is None else getattr(args, name)
         elif getattr(args, name) is not None:
             flag = "--" + name.replace("_", "-")
-            raise ValueError(
+            raise ArgumentError(
                 f"{flag} given beside {source}, whose env config sets it: "
                 + ("edit the config file instead" if args.env_config is not None else
                    "pass an edited copy of its config with --env-config")
@@ -196,7 +198,7 @@ def _eval(args: argparse.Namespace) -> int:
         check_output("--results (its summary)", summary_path(results_path), [*inputs, plot_path])
     scenes_dir = args.scenes_dir if args.scenes_dir is not None else "."
     if not os.path.isdir(scenes_dir):
-        raise ValueError(f"--scenes-dir {scenes_dir!r} is not a folder")
+        raise ArgumentError(f"--scenes-dir {scenes_dir!r} is not a folder")
     dataset = EpisodeDataset.load(args.dataset)
     episodes = select_episodes(dataset, args.limit, args.stride)
     check_scene_ids(episodes, scenes_dir)

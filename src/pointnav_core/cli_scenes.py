@@ -22,6 +22,7 @@ import time
 from collections.abc import Sequence
 from typing import Any
 
+from pointnav_core.errors import ArgumentError
 from pointnav_core.workers import WorkerError, WorkerPool, usable_cores
 
 __all__ = ["add_commands", "build_scenes"]
@@ -86,7 +87,7 @@ def build_scenes(
                         bar.update(1)
                 except WorkerError as err:
                     where = "" if err.key is None else f"scene {jobs[err.key][0]!r}: "  # type: ignore[index]
-                    raise ValueError(f"{where}{err.cause}") from None
+                    raise ArgumentError(f"{where}{err.cause}") from None
     return [done[i] for i in range(len(jobs))]
 
 
@@ -96,16 +97,16 @@ def _scene_build(args: argparse.Namespace) -> int:
 
     folder = cache.cache_dir()
     if folder is None:
-        raise ValueError(f"the geometry cache is off ({cache.ENV_VAR}={os.environ.get(cache.ENV_VAR)!r}): nothing to keep")
+        raise ArgumentError(f"the geometry cache is off ({cache.ENV_VAR}={os.environ.get(cache.ENV_VAR)!r}): nothing to keep")
     ids = list(args.scene)
     if args.scenes is not None:
         ids += scene_set(args.scenes).scene_ids(args.split)
     if not ids:
-        raise ValueError("give at least one SCENE, or --scenes SET")
+        raise ArgumentError("give at least one SCENE, or --scenes SET")
     radii = sorted({*args.robot_radius, *(r + _ORACLE_MARGIN for r in args.robot_radius if args.oracle)})
     for r in radii:
         if not r > 0:
-            raise ValueError(f"--robot-radius must be > 0 (m), got {r}")
+            raise ArgumentError(f"--robot-radius must be > 0 (m), got {r}")
     started = time.perf_counter()
     rows = build_scenes(ids, radii, root=args.scenes_dir, workers=args.workers, progress=not args.quiet)
     floors, kept = sum(row[2] for row in rows), sum(row[3] for row in rows)

@@ -17,6 +17,8 @@ import argparse
 from collections.abc import Callable
 from typing import Any
 
+from pointnav_core.errors import ArgumentError
+
 __all__ = ["add_command"]
 
 
@@ -24,7 +26,7 @@ def _train(args: argparse.Namespace) -> int:
     try:
         import torch  # noqa: F401
     except ImportError:
-        raise ValueError("pointnav train needs torch (pip install 'pointnav-core[vector]')") from None
+        raise ArgumentError("pointnav train needs torch (pip install 'pointnav-core[vector]')") from None
     from tqdm import tqdm
 
     from pointnav_core.training.config import TrainConfig

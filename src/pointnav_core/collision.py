@@ -36,6 +36,7 @@ import shapely
 from numpy.typing import ArrayLike, NDArray
 
 from pointnav_core import _compiled
+from pointnav_core.errors import ArgumentError
 
 __all__ = ["TOUCH_TOL", "FloorCollision", "convex_corners"]
 
@@ -82,7 +83,7 @@ class FloorCollision:
     ) -> None:
         mask = np.asarray(blocked, dtype=bool)
         if mask.ndim != 2 or mask.size == 0:
-            raise ValueError(f"blocked must be a non-empty 2D array, got shape {mask.shape}")
+            raise ArgumentError(f"blocked must be a non-empty 2D array, got shape {mask.shape}")
         self.blocked = mask.copy()
         self.blocked.flags.writeable = False
         self.resolution = float(resolution)

@@ -23,6 +23,7 @@ from pettingzoo.utils.wrappers import BaseParallelWrapper
 from pointnav_core.datasets.format import PointNavEpisode
 from pointnav_core.datasets.playback import EpisodeSchedule
 from pointnav_core.datasets.scene_sets import load_scene
+from pointnav_core.errors import ArgumentError
 
 __all__ = ["DatasetEpisodes", "ParallelDatasetEpisodes", "dataset_env"]
 
@@ -131,13 +132,13 @@ def dataset_env(
     """
     mine = [ep for ep in episodes if ep.scene_id == scene_id]
     if not mine:
-        raise ValueError(f"no episode has scene_id {scene_id!r}")
+        raise ArgumentError(f"no episode has scene_id {scene_id!r}")
     for field_name, values in (
         ("info.floor", {ep.floor for ep in mine}),
         ("info.robot_radius", {ep.robot_radius for ep in mine}),
     ):
         if len(values) > 1:
-            raise ValueError(
+            raise ArgumentError(
                 f"the episodes of scene {scene_id!r} differ in field '{field_name}' ({sorted(values)}); "
                 f"one env plays one floor with one robot: split them"
             )

@@ -13,6 +13,7 @@ from pointnav_core import _envcommon, scenes
 from pointnav_core.actions import check_discrete_action, make_discrete_actions
 from pointnav_core.backend import Backend, RobotSpec, make_backend
 from pointnav_core.env_config import EnvConfig, takes_config
+from pointnav_core.errors import ArgumentError
 from pointnav_core.maps import BoundedCache
 from pointnav_core.task import PointNavigationTask
 
@@ -222,7 +223,7 @@ class PointNavEnv(gym.Env[Any, np.ndarray]):
         #: The :class:`~pointnav_core.env_config.EnvConfig` this env was built from, or None.
         self.config = config
         if render_mode is not None and render_mode not in self.metadata["render_modes"]:
-            raise ValueError(
+            raise ArgumentError(
                 f"render_mode must be None or one of {self.metadata['render_modes']}, "
                 f"got {render_mode!r}"
             )
@@ -266,7 +267,7 @@ class PointNavEnv(gym.Env[Any, np.ndarray]):
         """
         super().reset(seed=seed)
         if options is not None and not isinstance(options, Mapping):
-            raise ValueError(f"options must be None or a dict, got {options!r}")
+            raise ArgumentError(f"options must be None or a dict, got {options!r}")
         self.backend.reset()
         info = self.task.reset(self, episode=(options or {}).get("episode"))
         return self._get_obs(), info
@@ -364,7 +365,7 @@ class TaskStepLimit(gym.Wrapper[Any, np.ndarray, Any, np.ndarray], gym.utils.Rec
             if isinstance(inner, gym.wrappers.TimeLimit):
                 limit, config = inner._max_episode_steps, getattr(env.unwrapped, "config", None)
                 if config is not None and limit != config.max_steps:
-                    raise ValueError(
+                    raise ArgumentError(
                         f"max_episode_steps={limit} given beside config, which sets "
                         f"max_steps={config.max_steps}: change the config instead"
                     )

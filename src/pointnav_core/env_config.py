@@ -32,7 +32,7 @@ TypeError: EnvConfig.__init__() got an unexpected keyword argument 'max_step'
 >>> EnvConfig.from_dict({"max_step": 150})  # doctest: +ELLIPSIS
 Traceback (most recent call last):
 ...
-ValueError: env config has an unknown key 'max_step'; valid keys are ['robot', ...]
+pointnav_core.errors.ArgumentError: env config has an unknown key 'max_step'; valid keys are ['robot', ...]
 """
 
 from __future__ import annotations
@@ -49,6 +49,7 @@ from typing import Any
 import numpy as np
 
 from pointnav_core import validation
+from pointnav_core.errors import ArgumentError
 from pointnav_core.frozen import FrozenMapping
 from pointnav_core.robot_spec import RobotSpec
 
@@ -72,16 +73,16 @@ def _plain(name: str, value: Any) -> Any:
     if validation.is_real(value):
         number = value.item() if isinstance(value, np.generic) else value
         if isinstance(number, float) and not math.isfinite(number):
-            raise ValueError(f"{name} must be a finite number, got {value!r}")
+            raise ArgumentError(f"{name} must be a finite number, got {value!r}")
         return number
     if isinstance(value, Mapping):
         for key in value:
             if not isinstance(key, str):
-                raise ValueError(f"{name} must have string keys, got {key!r}")
+                raise ArgumentError(f"{name} must have string keys, got {key!r}")
         return FrozenMapping({k: _plain(f"{name}[{k!r}]", v) for k, v in value.items()})
     if isinstance(value, (list, tuple)):
         return tuple(_plain(f"{name}[{i}]", v) for i, v in enumerate(value))
-    raise ValueError(
+    raise ArgumentError(
         f"{name} must hold only numbers, strings, booleans, None, lists and dicts (what YAML "
         f"and JSON store), got {value!r}"
     )
@@ -102,14 +103,14 @@ def _check_task(task: Mapping[str, Any]) -> None:
 
     validation.known_keys("task", task, [k for k in TASK_KEYS if k not in _NOT_IN_TASK])
     if "max_steps" in (task.get("termination_config") or {}):
-        raise ValueError(
+        raise ArgumentError(
             "task['termination_config'] sets max_steps; give it as the config's own max_steps "
             "field (actions per episode)"
         )
     try:
         PointNavigationTask(**_thaw(task))  # the task's own checks, naming the parameter
     except ValueError as err:
-        raise ValueError(f"task: {err}") from None
+        raise ArgumentError(f"task: {err}") from None
 
 
 @dataclasses.dataclass(frozen=True, kw_only=True)
@@ -179,7 +180,7 @@ class EnvConfig:
         set_(self, "flatten_obs", validation.boolean("flatten_obs", self.flatten_obs))
         set_(self, "action_frequency", check_action_frequency(self.action_frequency))
         if not isinstance(self.backend, str) or self.backend not in available_backends():
-            raise ValueError(f"backend must be one of {available_backends()}, got {self.backend!r}")
+            raise ArgumentError(f"backend must be one of {available_backends()}, got {self.backend!r}")
 
     def __hash__(self) -> int:
         return hash(json.dumps(self.to_dict(), sort_keys=True))
@@ -197,7 +198,7 @@ class EnvConfig:
         """The config of a dict (:meth:`to_dict`'s, or a YAML or JSON file's); missing keys
         take their defaults. ValueError for an unknown key or a bad value, naming it."""
         if not isinstance(data, Mapping):
-            raise ValueError(f"{name} must be a mapping of its fields, got {data!r}")
+            raise ArgumentError(f"{name} must be a mapping of its fields, got {data!r}")
         validation.known_keys(name, data, [f.name for f in dataclasses.fields(cls)])
         return cls(**data)
 
@@ -218,7 +219,7 @@ class EnvConfig:
         try:
             return cls.from_dict(data)
         except ValueError as err:
-            raise ValueError(f"env config {path!r}: {err}") from None
+            raise ArgumentError(f"env config {path!r}: {err}") from None
 
     def save(self, path: str | os.PathLike[str]) -> None:
         """Write the config as YAML (``.yaml``/``.yml``) or JSON (``.json``), atomically."""
@@ -259,7 +260,7 @@ class EnvConfig:
 def _suffix(path: str, what: str = "env config") -> str:
     suffix = os.path.splitext(path)[1].lower()
     if suffix not in CONFIG_FORMATS:
-        raise ValueError(f"{what} {path!r} must be a {', '.join(CONFIG_FORMATS)} file")
+        raise ArgumentError(f"{what} {path!r} must be a {', '.join(CONFIG_FORMATS)} file")
     return suffix
 
 
@@ -284,7 +285,7 @@ def read_config_file(path: str | os.PathLike[str], what: str = "env config") -> 
         return json.loads(text) if suffix == ".json" else yaml.safe_load(text)
     except (ValueError, yaml.YAMLError) as err:  # json.JSONDecodeError is a ValueError
         kind = "JSON" if suffix == ".json" else "YAML"
-        raise ValueError(f"{what} {path!r} is not valid {kind}: {err}") from None
+        raise ArgumentError(f"{what} {path!r} is not valid {kind}: {err}") from None
 
 
 #: What each engine does with the config's fields: None if they become constructor
@@ -310,12 +311,12 @@ def takes_config(adapt: _Adapt | None = None, extra: tuple[str, ...] = ()) -> Ca
             if config is None:
                 return init(self, *args, **kwargs)
             if not isinstance(config, EnvConfig):
-                raise ValueError(f"config must be an EnvConfig or None, got {config!r}")
+                raise ArgumentError(f"config must be an EnvConfig or None, got {config!r}")
             given = signature.bind(self, *args, **kwargs).arguments
             supplied = config.env_arguments() if adapt is None else adapt(config, given)
             clash = [k for k in (*supplied, *extra) if k in given]
             if clash:
-                raise ValueError(
+                raise ArgumentError(
                     f"{', '.join(clash)} given beside config, which sets "
                     f"{'it' if len(clash) == 1 else 'them'}: change the config instead "
                     f"(dataclasses.replace(config, ...))"
@@ -343,12 +344,12 @@ def vector_arguments(config: EnvConfig, given: Mapping[str, Any]) -> dict[str, A
     backend or ``flatten_obs=False`` is a ValueError naming the field."""
     out = config.env_arguments()
     if out.pop("backend") != "kinematic":
-        raise ValueError(
+        raise ArgumentError(
             f"config.backend is {config.backend!r}, but the batched engine reproduces the "
             f"'kinematic' backend only"
         )
     if not out.pop("flatten_obs"):
-        raise ValueError("config.flatten_obs is False, but the batched engine's observations are flat: set it True")
+        raise ArgumentError("config.flatten_obs is False, but the batched engine's observations are flat: set it True")
     return out
 
 

@@ -48,7 +48,7 @@ from pointnav_core.datasets.format import EpisodeDataset, PointNavEpisode
 from pointnav_core.datasets.playback import episode_seed
 from pointnav_core.datasets.scene_sets import load_scene, locate_scene
 from pointnav_core.env_config import EnvConfig
-from pointnav_core.errors import EpisodeError
+from pointnav_core.errors import ArgumentError, EpisodeError
 from pointnav_core.evaluation_config import (
     check_beside_config,
     check_robot_radius,
@@ -130,12 +130,12 @@ class _SB3Policy:
             try:
                 import stable_baselines3
             except ImportError:
-                raise ValueError(
+                raise ArgumentError(
                     "an SB3 .zip policy needs stable-baselines3 (pip install 'pointnav-core[rl]')"
                 ) from None
             cls = getattr(stable_baselines3, self.algo, None)
             if cls is None:
-                raise ValueError(
+                raise ArgumentError(
                     f"sb3_algo must name a Stable-Baselines3 algorithm (PPO, SAC, ...), got {self.algo!r}"
                 )
             self._model = cls.load(self.path, device="cpu")
@@ -173,22 +173,22 @@ def make_policy(spec: str, sb3_algo: str = "PPO", trust_policy_file: bool = Fals
         torch).
     """
     if not isinstance(spec, str) or not spec:
-        raise ValueError(f"policy must be {POLICY_FORMS}, got {spec!r}")
+        raise ArgumentError(f"policy must be {POLICY_FORMS}, got {spec!r}")
     if spec == "oracle":
         return _oracle
     if spec.endswith(CHECKPOINT_SUFFIX):
         if not os.path.isfile(spec):
-            raise ValueError(f"policy {spec!r}: no such checkpoint file")
+            raise ArgumentError(f"policy {spec!r}: no such checkpoint file")
         try:
             from pointnav_core.training.policy import CheckpointPolicy
         except ImportError:
-            raise ValueError(f"policy {spec!r}: a checkpoint needs torch (pip install 'pointnav-core[vector]')") from None
+            raise ArgumentError(f"policy {spec!r}: a checkpoint needs torch (pip install 'pointnav-core[vector]')") from None
         return CheckpointPolicy(spec)
     if spec.endswith(".zip"):
         if not os.path.isfile(spec):
-            raise ValueError(f"policy {spec!r}: no such SB3 .zip file")
+            raise ArgumentError(f"policy {spec!r}: no such SB3 .zip file")
         if trust_policy_file is not True:
-            raise ValueError(
+            raise ArgumentError(
                 f"policy {spec!r}: an SB3 .zip holds pickled Python objects that can run any "
                 "code when loaded; load only a file you trust, with --trust-policy-file "
                 "(trust_policy_file=True)"
@@ -196,17 +196,17 @@ def make_policy(spec: str, sb3_algo: str = "PPO", trust_policy_file: bool = Fals
         return _SB3Policy(spec, sb3_algo)
     module_name, sep, attr = spec.partition(":")
     if not sep or not module_name or not attr:
-        raise ValueError(f"unknown policy {spec!r}: expected {POLICY_FORMS}")
+        raise ArgumentError(f"unknown policy {spec!r}: expected {POLICY_FORMS}")
     try:
         target: Any = importlib.import_module(module_name)
     except ImportError as err:
-        raise ValueError(f"policy {spec!r}: cannot import module {module_name!r} ({err})") from None
+        raise ArgumentError(f"policy {spec!r}: cannot import module {module_name!r} ({err})") from None
     for part in attr.split("."):
         if not hasattr(target, part):
-            raise ValueError(f"policy {spec!r}: module {module_name!r} has no attribute {attr!r}")
+            raise ArgumentError(f"policy {spec!r}: module {module_name!r} has no attribute {attr!r}")
         target = getattr(target, part)
     if not callable(target):
-        raise ValueError(f"policy {spec!r}: {attr!r} is not callable")
+        raise ArgumentError(f"policy {spec!r}: {attr!r} is not callable")
     return target
 
 
@@ -242,9 +242,9 @@ class _Runner:
             try:
                 scene = load_scene(ep.scene_id, self.scenes_root)
             except (ValueError, FileNotFoundError) as err:
-                raise ValueError(f"episode {ep.episode_id!r}: field 'scene_id': {err}") from None
+                raise ArgumentError(f"episode {ep.episode_id!r}: field 'scene_id': {err}") from None
             if ep.floor >= scene.n_floors:
-                raise ValueError(
+                raise ArgumentError(
                     f"episode {ep.episode_id!r}: field 'info.floor' is {ep.floor}, but scene "
                     f"{ep.scene_id!r} has {scene.n_floors} floor(s)"
                 )
@@ -334,7 +334,7 @@ def check_scene_ids(episodes: Sequence[PointNavEpisode], scenes_root: str | None
             try:
                 locate_scene(ep.scene_id, scenes_root)
             except (ValueError, FileNotFoundError) as err:
-                raise ValueError(f"episode {ep.episode_id!r}: field 'scene_id': {err}") from None
+                raise ArgumentError(f"episode {ep.episode_id!r}: field 'scene_id': {err}") from None
 
 
 def select_episodes(
@@ -440,9 +440,9 @@ def evaluate(
     episodes = select_episodes(episodes, limit, stride)
     for name, value in (("workers", workers), ("max_steps", max_steps)):
         if isinstance(value, bool) or not isinstance(value, int) or value < 1:
-            raise ValueError(f"{name} must be an integer >= 1, got {value!r}")
+            raise ArgumentError(f"{name} must be an integer >= 1, got {value!r}")
     if on_error not in ON_ERROR:
-        raise ValueError(f"on_error must be one of {list(ON_ERROR)}, got {on_error!r}")
+        raise ArgumentError(f"on_error must be one of {list(ON_ERROR)}, got {on_error!r}")
     factory = make_policy(policy, sb3_algo, trust_policy_file) if isinstance(policy, str) else policy
     if env_config is None:  # a checkpoint carries the config it was trained with
         env_config = getattr(factory, "env_config", None)
@@ -458,7 +458,7 @@ def evaluate(
 
     def record(i: int, kind: str, payload: Any) -> None:
         if kind == "input":
-            raise ValueError(payload)
+            raise ArgumentError(payload)
         if kind == "error":
             if on_error == "stop":
                 raise EpisodeError(payload)

@@ -16,6 +16,7 @@ from typing import Any
 
 from pointnav_core.datasets.format import PointNavEpisode
 from pointnav_core.env_config import EnvConfig
+from pointnav_core.errors import ArgumentError
 
 __all__ = ["RADIUS_TOLERANCE", "check_beside_config", "check_robot_radius", "check_spaces", "episode_config"]
 
@@ -39,7 +40,7 @@ def check_robot_radius(config: EnvConfig, episodes: Sequence[PointNavEpisode]) -
     config's, with both radii: a policy must be played by the robot it was trained as."""
     for ep in episodes:
         if abs(ep.robot_radius - config.robot.radius) > RADIUS_TOLERANCE:
-            raise ValueError(
+            raise ArgumentError(
                 f"the env config's robot radius is {config.robot.radius:g} m, but episode "
                 f"{ep.episode_id!r} (scene {ep.scene_id!r}) was made for a robot of radius "
                 f"{ep.robot_radius:g} m: evaluate on a dataset made for this robot "
@@ -68,7 +69,7 @@ def check_spaces(name: str, model: Any, env: Any, advice: str | None = None) -> 
         want = _shape_of(getattr(model, f"{what}_space"))
         got = _shape_of(getattr(env, f"{what}_space"))
         if want != got:
-            raise ValueError(
+            raise ArgumentError(
                 f"{name} takes {what}s of shape {want}, but the env built for it gives {got}: "
                 + (advice or "pass the env config the policy was trained with (pointnav eval "
                    "--env-config FILE, evaluate(env_config=...); pointnav_core.env_config.EnvConfig)")
@@ -79,13 +80,13 @@ def check_beside_config(config: Any, **given: Any) -> None:
     """ValueError naming the ``evaluate`` arguments the env config sets that were given
     other values than their defaults beside it."""
     if not isinstance(config, EnvConfig):
-        raise ValueError(f"env_config must be an EnvConfig or None, got {config!r}")
+        raise ArgumentError(f"env_config must be an EnvConfig or None, got {config!r}")
     from pointnav_core.evaluation import DEFAULT_MAX_STEPS
 
     defaults = {"backend": "kinematic", "max_steps": DEFAULT_MAX_STEPS, "drive": "differential"}
     clash = [name for name, value in given.items() if value != defaults[name]]
     if clash:
-        raise ValueError(
+        raise ArgumentError(
             f"{', '.join(clash)} given beside env_config, which sets them (backend, "
             f"max_steps, robot.drive): change the config instead"
         )

@@ -19,7 +19,7 @@ from collections.abc import Mapping, Sequence
 from typing import Any
 
 from pointnav_core.datasets.format import PointNavEpisode
-from pointnav_core.errors import PointNavError
+from pointnav_core.errors import ArgumentError, PointNavError
 from pointnav_core.evaluation_report import (
     EpisodeResult,
     result_line,
@@ -71,7 +71,7 @@ class ResultsLog:
         """
         if os.path.exists(self.path) and os.path.getsize(self.path) > len(self.header.encode()):
             if not resume:
-                raise ValueError(
+                raise ArgumentError(
                     f"{self.path} holds the finished episodes of an earlier run: add --resume "
                     "to finish that run, or delete the file to start again"
                 )
@@ -91,7 +91,7 @@ class ResultsLog:
         with open(self.path, "rb") as fh:
             lines = fh.read().split(b"\n")
         if not lines[0] or lines[0] + b"\n" != self.header.encode():
-            raise ValueError(
+            raise ArgumentError(
                 f"{self.path} was written by a run with other arguments or inputs (dataset or "
                 "its contents, policy, backend, drive, max steps, scenes folder, --limit, "
                 "--stride or library version): rerun with those, or delete it"
@@ -103,7 +103,7 @@ class ResultsLog:
             except (ValueError, TypeError):
                 break  # a torn last line (the disk filled as it was written): dropped
             if scenes.get(result.episode_id) != result.scene_id:
-                raise ValueError(
+                raise ArgumentError(
                     f"{self.path}, line {number}: episode {result.episode_id!r} of scene "
                     f"{result.scene_id!r} is not in the dataset"
                 )

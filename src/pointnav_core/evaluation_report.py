@@ -31,6 +31,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from pointnav_core.errors import ArgumentError
 from pointnav_core.outputs import atomic_writer
 from pointnav_core.validation import integer, real
 
@@ -99,7 +100,7 @@ def summarize(results: Sequence[EpisodeResult]) -> dict[str, float]:
     """Means over episodes: ``success``, ``spl``, ``soft_spl``, ``distance_to_goal`` (m),
     ``path_length`` (m), ``collisions`` (per episode), ``steps``; and ``episodes``."""
     if not results:
-        raise ValueError("no results to summarize")
+        raise ArgumentError("no results to summarize")
     keys = ("success", "spl", "soft_spl", "distance_to_goal", "path_length", "collisions", "steps")
     summary = {k: float(np.mean([float(getattr(r, k)) for r in results])) for k in keys}
     summary["episodes"] = float(len(results))
@@ -133,7 +134,7 @@ def bootstrap_interval(
     """
     data = np.asarray(values, dtype=float)
     if data.ndim not in (1, 2) or data.shape[0] < 1 or not np.isfinite(data).all():
-        raise ValueError(
+        raise ArgumentError(
             f"values must be a non-empty (n,) or (n, k) array of finite numbers, got shape {data.shape}"
         )
     real("confidence", confidence, minimum=0.0, strict=True, maximum=1.0, unit="")
@@ -266,7 +267,7 @@ def plot_results(
     from PIL import Image, ImageDraw
 
     if not results:
-        raise ValueError("no results to plot")
+        raise ArgumentError("no results to plot")
     width, height, left, right, top, bottom = 720, 420, 60, 20, 40, 50
     geo = np.array([r.geodesic_distance for r in results])
     spl = np.array([r.spl for r in results])

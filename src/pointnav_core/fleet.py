@@ -16,6 +16,7 @@ from collections.abc import Sequence
 from typing import Any
 
 from pointnav_core import _envcommon, scenes
+from pointnav_core.errors import ArgumentError
 from pointnav_core.robot_spec import RobotSpec
 from pointnav_core.sampling import GoalConstraint
 from pointnav_core.task import PointNavigationTask
@@ -41,14 +42,14 @@ FINISHED_MODES = ("park", "remove")
 def check_finished(finished: Any) -> str:
     """``finished`` if it is one of :data:`FINISHED_MODES`; else ValueError naming it."""
     if not isinstance(finished, str) or finished not in FINISHED_MODES:
-        raise ValueError(f"finished must be one of {list(FINISHED_MODES)}, got {finished!r}")
+        raise ArgumentError(f"finished must be one of {list(FINISHED_MODES)}, got {finished!r}")
     return finished
 
 
 def prefixed(name: str, err: ValueError) -> ValueError:
     """``err`` as a ValueError whose message starts with ``name`` (added if missing)."""
     message = str(err)
-    return ValueError(message if message.startswith(name) else f"{name}: {message}")
+    return ArgumentError(message if message.startswith(name) else f"{name}: {message}")
 
 
 def per_robot(value: Any, n: int, name: str) -> list[Any] | None:
@@ -56,7 +57,7 @@ def per_robot(value: Any, n: int, name: str) -> list[Any] | None:
     if not isinstance(value, (list, tuple)):
         return None
     if len(value) != n:
-        raise ValueError(
+        raise ArgumentError(
             f"{name} must be one value for all robots or a list with one entry per robot "
             f"(n_robots={n}), got a list of {len(value)}"
         )
@@ -83,7 +84,7 @@ def make_tasks(task: Any, n: int) -> list[PointNavigationTask]:
     entries = per_robot(task, n, "task")
     if entries is None:
         if isinstance(task, PointNavigationTask) and n > 1:
-            raise ValueError(
+            raise ArgumentError(
                 f"task is a single PointNavigationTask, which drives one robot; for "
                 f"n_robots={n} pass a dict of its arguments (shared by all robots) or a list "
                 f"of {n} tasks or dicts"
@@ -96,7 +97,7 @@ def make_tasks(task: Any, n: int) -> list[PointNavigationTask]:
         except ValueError as err:
             raise prefixed(f"task[{i}]", err) from None
     if len({id(t) for t in tasks}) != n:
-        raise ValueError("task must not hold the same PointNavigationTask twice")
+        raise ArgumentError("task must not hold the same PointNavigationTask twice")
     return tasks
 
 
@@ -143,7 +144,7 @@ def check_fixed_positions(
                 gap = math.hypot(*(si[:2] - sj[:2]))
                 need = robots[i].radius + robots[j].radius
                 if gap < need:
-                    raise ValueError(
+                    raise ArgumentError(
                         f"task[{i}] and task[{j}] have fixed initial_pos {si[:2].tolist()} "
                         f"and {sj[:2].tolist()}, {gap:.3g} m apart: the robots would "
                         f"overlap (fixed starts must be at least the sum of the radii, "
@@ -154,7 +155,7 @@ def check_fixed_positions(
                 gap = math.hypot(*(gi[:2] - gj[:2]))
                 need = separation[i][j]
                 if gap < need:
-                    raise ValueError(
+                    raise ArgumentError(
                         f"task[{i}] and task[{j}] have fixed goal_pos {gi[:2].tolist()} and "
                         f"{gj[:2].tolist()}, {gap:.3g} m apart: goals must be distinct, at "
                         f"least max(sum of goal tolerances, sum of radii, one cell) = "

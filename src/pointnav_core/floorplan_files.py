@@ -34,6 +34,7 @@ from shapely import affinity
 from shapely.geometry import LineString, Polygon, box
 
 from pointnav_core import validation
+from pointnav_core.errors import ArgumentError
 from pointnav_core.floorplans import FloorPlan
 
 __all__ = ["DOOR_MODES", "read_houseexpo", "read_procthor", "sniff_plan_format"]
@@ -49,9 +50,9 @@ def _load(path: str | os.PathLike[str]) -> tuple[dict[str, Any], str]:
         try:
             doc = json.load(file)
         except json.JSONDecodeError as exc:
-            raise ValueError(f"{where} is not valid JSON: {exc}") from None
+            raise ArgumentError(f"{where} is not valid JSON: {exc}") from None
     if not isinstance(doc, dict):
-        raise ValueError(f"{where} must hold a JSON object, got {type(doc).__name__}")
+        raise ArgumentError(f"{where} must hold a JSON object, got {type(doc).__name__}")
     return doc, where
 
 
@@ -64,7 +65,7 @@ def sniff_plan_format(path: str | os.PathLike[str]) -> str:
         return "houseexpo"
     if {"rooms", "walls", "doors"} & doc.keys():
         return "procthor"
-    raise ValueError(
+    raise ArgumentError(
         f"{where} is neither a ProcTHOR house (rooms, walls, doors) nor a HouseExpo plan (verts)"
     )
 
@@ -72,48 +73,48 @@ def sniff_plan_format(path: str | os.PathLike[str]) -> str:
 def _xz(points: Any, where: str) -> list[tuple[float, float]]:
     """THOR points ``[{x, y, z}, ...]`` as world ``(x, z)`` pairs."""
     if not isinstance(points, list) or not all(isinstance(p, dict) for p in points):
-        raise ValueError(f"{where} must be a list of {{x, y, z}} points, got {points!r:.80}")
+        raise ArgumentError(f"{where} must be a list of {{x, y, z}} points, got {points!r:.80}")
     out = []
     for p in points:
         x, z = p.get("x"), p.get("z")
         if not (validation.is_real(x) and validation.is_real(z) and math.isfinite(x) and math.isfinite(z)):
-            raise ValueError(f"{where} has a point without finite x and z: {p!r}")
+            raise ArgumentError(f"{where} has a point without finite x and z: {p!r}")
         out.append((float(x), float(z)))
     return out
 
 
 def _polygon(points: list[tuple[float, float]], where: str) -> Polygon:
     if len(points) < 3:
-        raise ValueError(f"{where} must have at least 3 points, got {len(points)}")
+        raise ArgumentError(f"{where} must have at least 3 points, got {len(points)}")
     poly = Polygon(points)
     if poly.is_empty or poly.area <= 0 or not poly.is_valid:
         reason = shapely.is_valid_reason(poly) if not poly.is_valid else "zero area"
-        raise ValueError(f"{where} is not a valid polygon: {reason}")
+        raise ArgumentError(f"{where} is not a valid polygon: {reason}")
     return poly
 
 
 def _outline(parts: Sequence[Polygon], where: str) -> Polygon:
     union = shapely.unary_union(list(parts))
     if not isinstance(union, Polygon):
-        raise ValueError(f"{where}: the floor is {len(shapely.get_parts(union))} separate pieces; one is expected")
+        raise ArgumentError(f"{where}: the floor is {len(shapely.get_parts(union))} separate pieces; one is expected")
     return union
 
 
 def _walls(doc: dict[str, Any], where: str, thickness: float) -> tuple[dict[str, LineString], Any]:
     walls = doc.get("walls")
     if not isinstance(walls, list):
-        raise ValueError(f"{where}: walls must be a list, got {walls!r:.80}")
+        raise ArgumentError(f"{where}: walls must be a list, got {walls!r:.80}")
     bases: dict[str, LineString] = {}
     empty: set[str] = set()
     for i, wall in enumerate(walls):
         field = f"{where}: walls[{i}].polygon"
         if not isinstance(wall, dict) or not isinstance(wall.get("id"), str):
-            raise ValueError(f"{where}: walls[{i}] must be an object with an id, got {wall!r:.80}")
+            raise ArgumentError(f"{where}: walls[{i}] must be an object with an id, got {wall!r:.80}")
         points = _xz(wall.get("polygon"), field)
         heights = [p.get("y", 0) for p in wall["polygon"]]
         base = [pt for pt, h in zip(points, heights) if h == min(heights)]
         if len(base) < 2 or base[0] == base[1]:
-            raise ValueError(f"{field} must have two distinct points at its lowest y")
+            raise ArgumentError(f"{field} must have two distinct points at its lowest y")
         bases[wall["id"]] = LineString(base[:2])
         if wall.get("empty") is True:  # an open side between two rooms: no wall is built
             empty.add(wall["id"])
@@ -132,7 +133,7 @@ def _is_closed(door: dict[str, Any], field: str, mode: str) -> bool:
         return mode == "closed"
     openness = door.get("openness", 1)
     if not (validation.is_real(openness) and 0.0 <= openness <= 1.0):
-        raise ValueError(f"{field}.openness must be a number in [0, 1], got {openness!r}")
+        raise ArgumentError(f"{field}.openness must be a number in [0, 1], got {openness!r}")
     return openness == 0
 
 
@@ -140,18 +141,18 @@ def _door_holes(doc: dict[str, Any], where: str, bases: Mapping[str, LineString]
                 mode: str) -> list[Polygon]:
     doors = doc.get("doors", [])
     if not isinstance(doors, list):
-        raise ValueError(f"{where}: doors must be a list, got {doors!r:.80}")
+        raise ArgumentError(f"{where}: doors must be a list, got {doors!r:.80}")
     holes = []
     for i, door in enumerate(doors):
         field = f"{where}: doors[{i}]"
         wall = door.get("wall0") if isinstance(door, dict) else None
         if wall not in bases:
-            raise ValueError(f"{field}.wall0 must name a wall of walls, got {wall!r}")
+            raise ArgumentError(f"{field}.wall0 must name a wall of walls, got {wall!r}")
         if _is_closed(door, field, mode):  # its hole stays filled (the door's file is still checked)
             continue
         span = [x for x, _ in _xz(door.get("holePolygon"), f"{field}.holePolygon")]
         if len(span) < 2:
-            raise ValueError(f"{field}.holePolygon must have two corners")
+            raise ArgumentError(f"{field}.holePolygon must have two corners")
         line = bases[wall]
         (x0, y0), (x1, y1) = line.coords[0], line.coords[-1]
         ux, uy = (x1 - x0) / line.length, (y1 - y0) / line.length
@@ -168,12 +169,12 @@ def _objects(doc: dict[str, Any], where: str, sizes: Mapping[str, Sequence[float
         field = f"{where}: objects[{i}]"
         asset = obj.get("assetId") if isinstance(obj, dict) else None
         if asset not in sizes:
-            raise ValueError(f"{field}: object_sizes has no footprint for assetId {asset!r}")
+            raise ArgumentError(f"{field}: object_sizes has no footprint for assetId {asset!r}")
         (cx, cz), = _xz([obj.get("position")], f"{field}.position")
         sx, sz = validation.vector(f"object_sizes[{asset!r}]", sizes[asset], sizes=(2,))
         yaw = (obj.get("rotation") or {}).get("y", 0.0)
         if not validation.is_real(yaw):
-            raise ValueError(f"{field}.rotation.y must be a number (degrees), got {yaw!r}")
+            raise ArgumentError(f"{field}.rotation.y must be a number (degrees), got {yaw!r}")
         rect = box(cx - sx / 2, cz - sz / 2, cx + sx / 2, cz + sz / 2)
         out.append(affinity.rotate(rect, -float(yaw), origin=(cx, cz)))
     return out
@@ -208,12 +209,12 @@ def read_procthor(
         ``openness`` is not a number in [0, 1] (with ``"as_stored"``).
     """
     if not isinstance(doors, str) or doors not in DOOR_MODES:
-        raise ValueError(f"doors must be one of {', '.join(map(repr, DOOR_MODES))}, got {doors!r}")
+        raise ArgumentError(f"doors must be one of {', '.join(map(repr, DOOR_MODES))}, got {doors!r}")
     thickness = validation.real("wall_thickness", wall_thickness, minimum=0.0, strict=True)
     doc, where = _load(path)
     rooms = doc.get("rooms")
     if not isinstance(rooms, list) or not rooms:
-        raise ValueError(f"{where}: rooms must be a non-empty list of rooms with a floorPolygon, got {rooms!r:.80}")
+        raise ArgumentError(f"{where}: rooms must be a non-empty list of rooms with a floorPolygon, got {rooms!r:.80}")
     floors = []
     for i, room in enumerate(rooms):
         field = f"{where}: rooms[{i}].floorPolygon"
@@ -234,15 +235,15 @@ def read_houseexpo(path: str | os.PathLike[str]) -> FloorPlan:
     doc, where = _load(path)
     verts = doc.get("verts")
     if not isinstance(verts, list) or not all(isinstance(v, list) and len(v) == 2 for v in verts):
-        raise ValueError(f"{where}: verts must be a list of [x, y] points in metres, got {verts!r:.80}")
+        raise ArgumentError(f"{where}: verts must be a list of [x, y] points in metres, got {verts!r:.80}")
     points = []
     for v in verts:
         if not all(validation.is_real(c) and math.isfinite(c) for c in v):
-            raise ValueError(f"{where}: verts has a point that is not two finite numbers: {v!r}")
+            raise ArgumentError(f"{where}: verts has a point that is not two finite numbers: {v!r}")
         points.append((float(v[0]), float(v[1])))
     rooms = doc.get("room_category", {})
     if not isinstance(rooms, dict) or not all(
         isinstance(b, list) and all(isinstance(r, list) and len(r) == 4 for r in b) for b in rooms.values()
     ):
-        raise ValueError(f"{where}: room_category must map a category to [xmin, ymin, xmax, ymax] boxes")
+        raise ArgumentError(f"{where}: room_category must map a category to [xmin, ymin, xmax, ymax] boxes")
     return FloorPlan(outline=_polygon(points, f"{where}: verts"))

@@ -20,7 +20,7 @@ Examples
 >>> move(TaskState.DONE, Event.STEP)
 Traceback (most recent call last):
 ...
-pointnav_core.lifecycle.TaskStateError: step() is not allowed while the task is DONE: the episode has ended (terminated or truncated): call reset(env) to start another
+pointnav_core.errors.TaskStateError: step() is not allowed while the task is DONE: the episode has ended (terminated or truncated): call reset(env) to start another
 """
 
 from __future__ import annotations
@@ -29,16 +29,9 @@ import enum
 from collections.abc import Mapping
 from types import MappingProxyType
 
-from pointnav_core.errors import PointNavError
+from pointnav_core.errors import TaskStateError
 
 __all__ = ["TaskState", "TaskStateError", "Event", "TRANSITIONS", "move", "allows", "diagram"]
-
-
-class TaskStateError(PointNavError, RuntimeError):
-    """A task method was called in a state that does not allow it (e.g. step before reset).
-
-    The task's state is unchanged when this is raised.
-    """
 
 
 class TaskState(enum.Enum):

@@ -20,6 +20,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from pointnav_core import validation
+from pointnav_core.errors import ArgumentError
 from pointnav_core.maps import FREE, OBSTACLE
 
 __all__ = ["MOVINGAI_CELLS", "open_image", "read_movingai", "read_trav_png"]
@@ -135,14 +136,14 @@ def read_trav_png(
             image.load()
             mode, (width, height) = image.mode, image.size
             if mode != "L":
-                raise ValueError(
+                raise ArgumentError(
                     f"{where} must be an 8-bit greyscale image (mode 'L'), got mode {mode!r}; "
                     "convert it explicitly if its values mean traversability"
                 )
             if image.format == "PPM":
-                raise ValueError(f"{where} is a PGM image, as ROS map_server maps are: {_ROS_HINT}")
+                raise ArgumentError(f"{where} is a PGM image, as ROS map_server maps are: {_ROS_HINT}")
             if width != height:
-                raise ValueError(
+                raise ArgumentError(
                     f"{where} must be a square image (OmniGibson's are), got {width}x{height} "
                     f"pixels: {_ROS_HINT}"
                 )
@@ -151,10 +152,10 @@ def read_trav_png(
         raise
     except (UnidentifiedImageError, OSError, SyntaxError) as exc:
         # Pillow reports undecodable or truncated files as any of these.
-        raise ValueError(f"{where} is not a readable image: {exc}") from exc
+        raise ArgumentError(f"{where} is not a readable image: {exc}") from exc
     if np.isin(_ROS_SHADES, pixels).all():
         # map_saver's free (254) and unknown (205) would all read as blocked here.
-        raise ValueError(f"{where} holds ROS map_saver's free (254) and unknown (205) shades: {_ROS_HINT}")
+        raise ArgumentError(f"{where} holds ROS map_saver's free (254) and unknown (205) shades: {_ROS_HINT}")
     blocked = pixels < 255
     n_pixels = blocked.shape[0]
     factor = resolution / source_resolution  # source pixels per cell, along one axis
@@ -185,7 +186,7 @@ def open_image(path: str | os.PathLike[str], where: str):  # -> PIL.Image.Image
             warnings.simplefilter("ignore", Image.DecompressionBombWarning)
             image = Image.open(path)
     except Image.DecompressionBombError:
-        raise ValueError(
+        raise ArgumentError(
             f"{where} (image) is over the cell budget of {validation.MAX_CELLS} "
             "(pointnav_core.validation.MAX_CELLS)"
         ) from None
@@ -273,7 +274,7 @@ def read_movingai(path: str | os.PathLike[str]) -> NDArray[np.uint8]:
     try:
         text = raw.decode("ascii")
     except UnicodeDecodeError as exc:
-        raise ValueError(
+        raise ArgumentError(
             f"path {os.fspath(path)!r} must be an ASCII MovingAI .map file; byte {exc.start} is "
             f"{raw[exc.start:exc.start + 1]!r}"
         ) from None
@@ -291,23 +292,23 @@ def _parse_movingai(text: str, source: str) -> NDArray[np.uint8]:
             break
         match = _HEADER_LINE.match(stripped)
         if match is None or match.group(1) in header:
-            raise ValueError(
+            raise ArgumentError(
                 f"{where}: bad MovingAI header at line {number}; expected the lines "
                 "'type octile', 'height <H>', 'width <W>' (once each), then 'map'"
             )
         header[match.group(1)] = match.group(2)
     else:
-        raise ValueError(f"{where}: bad MovingAI header: no 'map' line before the end of the file")
+        raise ArgumentError(f"{where}: bad MovingAI header: no 'map' line before the end of the file")
     missing = [key for key in ("type", "height", "width") if key not in header]
     if missing:
-        raise ValueError(f"{where}: bad MovingAI header: missing {', '.join(missing)} before 'map'")
+        raise ArgumentError(f"{where}: bad MovingAI header: missing {', '.join(missing)} before 'map'")
     if header["type"] != "octile":
-        raise ValueError(f"{where}: bad MovingAI header: type must be 'octile', got {header['type']!r}")
+        raise ArgumentError(f"{where}: bad MovingAI header: type must be 'octile', got {header['type']!r}")
     size = {}
     for key in ("height", "width"):
         value = header[key]
         if not value.isdigit() or int(value) < 1:
-            raise ValueError(f"{where}: bad MovingAI header: {key} must be an integer >= 1, got {value!r}")
+            raise ArgumentError(f"{where}: bad MovingAI header: {key} must be an integer >= 1, got {value!r}")
         size[key] = int(value)
     height, width = size["height"], size["width"]
     validation.cell_budget(f"{where} (map)", height, width)
@@ -316,10 +317,10 @@ def _parse_movingai(text: str, source: str) -> NDArray[np.uint8]:
     while rows and not rows[-1].strip():  # trailing blank lines are harmless
         rows.pop()
     if len(rows) != height:
-        raise ValueError(f"{where}: the header says height {height} but the map has {len(rows)} rows")
+        raise ArgumentError(f"{where}: the header says height {height} but the map has {len(rows)} rows")
     for i, row in enumerate(rows):
         if len(row) != width:
-            raise ValueError(
+            raise ArgumentError(
                 f"{where}: map row {i} has {len(row)} characters, expected width {width}"
             )
     chars = np.frombuffer("".join(rows).encode("ascii"), dtype=np.uint8).reshape(height, width)
@@ -330,7 +331,7 @@ def _parse_movingai(text: str, source: str) -> NDArray[np.uint8]:
     bad = np.argwhere(codes == 255)
     if bad.size:
         i, j = (int(v) for v in bad[0])
-        raise ValueError(
+        raise ArgumentError(
             f"{where}: unknown character {chr(chars[i, j])!r} at map row {i}, column {j}; "
             f"valid: {''.join(MOVINGAI_CELLS)!r} (free: '.GS', blocked: '@OTW')"
         )

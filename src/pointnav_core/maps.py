@@ -33,6 +33,7 @@ from scipy import ndimage
 
 from pointnav_core import validation
 from pointnav_core.collision import FloorCollision
+from pointnav_core.errors import ArgumentError
 
 __all__ = ["FREE", "OBSTACLE", "VOID", "CELL_CLASSES", "TraversableMap", "BoundedCache"]
 
@@ -55,7 +56,7 @@ class BoundedCache:
 
     def __init__(self, maxsize: int) -> None:
         if maxsize < 1:
-            raise ValueError(f"maxsize must be >= 1, got {maxsize!r}")
+            raise ArgumentError(f"maxsize must be >= 1, got {maxsize!r}")
         self.maxsize = int(maxsize)
         self._data: OrderedDict[Hashable, Any] = OrderedDict()
 
@@ -129,17 +130,17 @@ class TraversableMap:
     ) -> None:
         codes = np.asarray(grid)
         if codes.ndim != 2 or codes.shape[0] < 1 or codes.shape[1] < 1:
-            raise ValueError(f"grid must be a non-empty 2D array, got shape {codes.shape}")
+            raise ArgumentError(f"grid must be a non-empty 2D array, got shape {codes.shape}")
         validation.cell_budget("grid", *codes.shape)
         if codes.dtype == bool:
             codes = np.where(codes, FREE, OBSTACLE)
         elif not np.issubdtype(codes.dtype, np.integer):
-            raise ValueError(
+            raise ArgumentError(
                 f"grid must hold integer cell codes or booleans, got dtype {codes.dtype}"
             )
         bad = ~np.isin(codes, (FREE, OBSTACLE, VOID))
         if bad.any():
-            raise ValueError(
+            raise ArgumentError(
                 "grid holds unknown cell codes "
                 f"{sorted(set(np.unique(codes[bad]).tolist()))[:5]}; valid: {CELL_CLASSES}"
             )
@@ -217,7 +218,7 @@ class TraversableMap:
         """World ``(x, y)`` of cell centres."""
         cells = np.asarray(cells)
         if cells.shape[-1:] != (2,):
-            raise ValueError(f"cells must have shape (..., 2), got {cells.shape}")
+            raise ArgumentError(f"cells must have shape (..., 2), got {cells.shape}")
         return self.grid_to_world(cells.astype(np.float64) + 0.5)
 
     def in_bounds(self, cells: ArrayLike) -> NDArray[np.bool_]:
@@ -411,7 +412,7 @@ class TraversableMap:
 def _as_points(xy: ArrayLike, name: str) -> NDArray[np.float64]:
     arr = np.asarray(xy, dtype=np.float64)
     if arr.shape[-1:] != (2,):
-        raise ValueError(f"{name} must have shape (..., 2) (x, y in metres), got {arr.shape}")
+        raise ArgumentError(f"{name} must have shape (..., 2) (x, y in metres), got {arr.shape}")
     if not np.isfinite(arr).all():
-        raise ValueError(f"{name} must be finite, got {xy!r}")
+        raise ArgumentError(f"{name} must be finite, got {xy!r}")
     return arr

@@ -46,6 +46,8 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from pointnav_core.errors import ArgumentError
+
 __all__ = ["MARKER_KINDS", "TaskMarkers", "VisualMarker", "place_waypoints"]
 
 #: Valid values of :attr:`VisualMarker.kind`.
@@ -82,7 +84,7 @@ class VisualMarker:
     >>> VisualMarker(kind="flag", position=(0, 0, 0), radius=0.5)
     Traceback (most recent call last):
     ...
-    ValueError: kind must be one of ['start', 'goal', 'waypoint'], got 'flag'
+    pointnav_core.errors.ArgumentError: kind must be one of ['start', 'goal', 'waypoint'], got 'flag'
     """
 
     kind: str
@@ -92,13 +94,13 @@ class VisualMarker:
 
     def __post_init__(self) -> None:
         if not isinstance(self.kind, str) or self.kind not in MARKER_KINDS:
-            raise ValueError(f"kind must be one of {list(MARKER_KINDS)}, got {self.kind!r}")
+            raise ArgumentError(f"kind must be one of {list(MARKER_KINDS)}, got {self.kind!r}")
         try:
             position = tuple(float(c) for c in self.position)
         except (TypeError, ValueError):
             position = ()
         if len(position) != 3 or not all(math.isfinite(c) for c in position):
-            raise ValueError(
+            raise ArgumentError(
                 f"position must be a finite (x, y, z) point in metres, got {self.position!r}"
             )
         object.__setattr__(self, "position", position)
@@ -107,10 +109,10 @@ class VisualMarker:
         except (TypeError, ValueError):
             radius = math.nan
         if isinstance(self.radius, bool) or not (math.isfinite(radius) and radius >= 0.0):
-            raise ValueError(f"radius must be a finite number >= 0 (m), got {self.radius!r}")
+            raise ArgumentError(f"radius must be a finite number >= 0 (m), got {self.radius!r}")
         object.__setattr__(self, "radius", radius)
         if not isinstance(self.visible, (bool, np.bool_)):
-            raise ValueError(f"visible must be True or False, got {self.visible!r}")
+            raise ArgumentError(f"visible must be True or False, got {self.visible!r}")
         object.__setattr__(self, "visible", bool(self.visible))
 
 
@@ -165,14 +167,14 @@ def place_waypoints(
     """
     pts = np.asarray(path, dtype=np.float64)
     if pts.ndim != 2 or pts.shape[0] < 1 or pts.shape[1] != 2 or not np.isfinite(pts).all():
-        raise ValueError(
+        raise ArgumentError(
             f"path must be a finite (N, 2) polyline in metres with N >= 1, got shape {pts.shape}"
         )
     if isinstance(count, bool) or int(count) != count or count < 1:
-        raise ValueError(f"count must be an integer >= 1, got {count!r}")
+        raise ArgumentError(f"count must be an integer >= 1, got {count!r}")
     count = int(count)
     if not (math.isfinite(min_spacing) and min_spacing > 0.0):
-        raise ValueError(f"min_spacing must be a finite number > 0 (m), got {min_spacing!r}")
+        raise ArgumentError(f"min_spacing must be a finite number > 0 (m), got {min_spacing!r}")
     return _waypoints_along(pts, count, float(min_spacing))
 
 

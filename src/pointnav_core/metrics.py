@@ -23,6 +23,8 @@ import math
 from collections.abc import Callable
 from typing import Any
 
+from pointnav_core.errors import ArgumentError
+
 __all__ = ["scalar_where", "soft_spl", "soft_spl_values", "spl", "spl_values"]
 
 
@@ -30,10 +32,10 @@ def _check_distance(name: str, value: float, *, allow_inf: bool) -> float:
     try:
         d = float(value)
     except (TypeError, ValueError):
-        raise ValueError(f"{name} must be a number >= 0 (m), got {value!r}") from None
+        raise ArgumentError(f"{name} must be a number >= 0 (m), got {value!r}") from None
     if not d >= 0.0 or (d == math.inf and not allow_inf):  # `not >=` also catches NaN
         kind = "a number >= 0, or inf," if allow_inf else "a finite number >= 0"
-        raise ValueError(f"{name} must be {kind} (m), got {value!r}")
+        raise ArgumentError(f"{name} must be {kind} (m), got {value!r}")
     return d
 
 

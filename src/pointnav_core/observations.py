@@ -45,6 +45,8 @@ from typing import Any, ClassVar
 import numpy as np
 from numpy.typing import NDArray
 
+from pointnav_core.errors import ArgumentError
+
 __all__ = [
     "Frame",
     "ObservationTerm",
@@ -305,12 +307,12 @@ class ObservationLayout:
         for term in terms:
             lo, hi = (tuple(float(v) for v in b) for b in term.bounds(task, env))
             if len(lo) != term.size or len(hi) != term.size:
-                raise ValueError(
+                raise ArgumentError(
                     f"observation term {term.name!r} must give {term.size} low and high bounds, "
                     f"got {len(lo)} and {len(hi)}"
                 )
             if not all(math.isfinite(a) and math.isfinite(b) and a <= b for a, b in zip(lo, hi)):
-                raise ValueError(
+                raise ArgumentError(
                     f"observation term {term.name!r} bounds must be finite with low <= high, "
                     f"got low={list(lo)}, high={list(hi)}"
                 )
@@ -364,7 +366,7 @@ def markdown_table(terms: Sequence[ObservationTerm]) -> str:
     rows = [("Num", "Key", "Observation", "Min", "Max")]
     for term in terms:
         if len(term.doc_rows) != term.size:
-            raise ValueError(f"observation term {term.name!r} must have {term.size} doc_rows, got {len(term.doc_rows)}")
+            raise ArgumentError(f"observation term {term.name!r} must have {term.size} doc_rows, got {len(term.doc_rows)}")
         for what, lo, hi in term.doc_rows:
             rows.append((str(len(rows) - 1), f"`{term.name}`", what, lo, hi))
     widths = [max(len(r[i]) for r in rows) for i in range(5)]

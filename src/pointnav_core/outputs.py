@@ -18,6 +18,8 @@ from collections.abc import Iterator, Sequence
 from contextlib import contextmanager
 from typing import IO, Any
 
+from pointnav_core.errors import ArgumentError
+
 __all__ = ["atomic_writer", "check_output", "same_file"]
 
 PathArg = str | os.PathLike[str]
@@ -41,7 +43,7 @@ def atomic_writer(path: PathArg, mode: str = "wb", **kwargs: Any) -> Iterator[IO
     ``open`` would give it (0o666 less the umask), not ``mkstemp``'s 0o600.
     """
     if mode not in ("w", "wb"):
-        raise ValueError(f"mode must be 'w' or 'wb', got {mode!r}")
+        raise ArgumentError(f"mode must be 'w' or 'wb', got {mode!r}")
     target = os.fspath(path)
     folder, name = os.path.split(os.path.abspath(target))
     fd, tmp = tempfile.mkstemp(dir=folder, prefix=f".{name}.", suffix=".tmp")
@@ -96,14 +98,14 @@ def check_output(name: str, path: PathArg, inputs: Sequence[PathArg] = ()) -> st
     target = os.fspath(path)
     folder = os.path.dirname(os.path.abspath(target))
     if not target or os.path.isdir(target):
-        raise ValueError(f"{name} {target!r} is a folder; give a file path")
+        raise ArgumentError(f"{name} {target!r} is a folder; give a file path")
     if not os.path.isdir(folder):
-        raise ValueError(f"{name} {target!r}: folder {folder!r} does not exist")
+        raise ArgumentError(f"{name} {target!r}: folder {folder!r} does not exist")
     if not os.access(folder, os.W_OK | os.X_OK):
-        raise ValueError(f"{name} {target!r}: folder {folder!r} is not writable")
+        raise ArgumentError(f"{name} {target!r}: folder {folder!r} is not writable")
     if os.path.exists(target) and not os.access(target, os.W_OK):
-        raise ValueError(f"{name} {target!r} exists and is not writable")
+        raise ArgumentError(f"{name} {target!r} exists and is not writable")
     for source in inputs:
         if same_file(target, source):
-            raise ValueError(f"{name} {target!r} is an input of this run; give another path")
+            raise ArgumentError(f"{name} {target!r} is an input of this run; give another path")
     return target

@@ -190,6 +190,7 @@ from pointnav_core._parallel_state import STATE_FIELDS, global_state, state_spac
 from pointnav_core.actions import make_discrete_actions
 from pointnav_core.backend import Backend, RobotSpec, make_backend
 from pointnav_core.env_config import EnvConfig, multi_robot_arguments, takes_config
+from pointnav_core.errors import ArgumentError
 from pointnav_core.fleet import (
     FINISHED_MODES,
     check_finished,
@@ -284,7 +285,7 @@ class MultiPointNavEnv(ParallelEnv[str, Any, np.ndarray]):
         #: The :class:`~pointnav_core.env_config.EnvConfig` this env was built from, or None.
         self.config = config
         if render_mode is not None and render_mode not in (*self.metadata["render_modes"], "human"):
-            raise ValueError(
+            raise ArgumentError(
                 f"render_mode must be None or one of {self.metadata['render_modes']}, "
                 f"got {render_mode!r}"
             )
@@ -397,7 +398,7 @@ class MultiPointNavEnv(ParallelEnv[str, Any, np.ndarray]):
         that robot's task info at step 0).
         """
         if options is not None and not isinstance(options, Mapping):
-            raise ValueError(f"options must be None or a dict, got {options!r}")
+            raise ArgumentError(f"options must be None or a dict, got {options!r}")
         given = self._given_episodes((options or {}).get("episodes"))
         if seed is not None or self._np_random is None:
             self._np_random, self._np_random_seed = seeding.np_random(seed)
@@ -426,11 +427,11 @@ class MultiPointNavEnv(ParallelEnv[str, Any, np.ndarray]):
         if isinstance(episodes, Mapping):
             unknown = [a for a in episodes if a not in self.possible_agents]
             if unknown:
-                raise ValueError(f"options['episodes'] has unknown agent {unknown[0]!r}; agents are {self.possible_agents}")
+                raise ArgumentError(f"options['episodes'] has unknown agent {unknown[0]!r}; agents are {self.possible_agents}")
             return [episodes.get(agent) for agent in self.possible_agents]
         episodes = list(episodes)
         if len(episodes) != n:
-            raise ValueError(f"options['episodes'] must hold one episode per robot ({n}), got {len(episodes)}")
+            raise ArgumentError(f"options['episodes'] must hold one episode per robot ({n}), got {len(episodes)}")
         return episodes
 
     def _reset_robot(self, i: int, placed: list[int], episode: Any = None) -> dict[str, Any]:
@@ -550,7 +551,7 @@ class MultiPointNavEnv(ParallelEnv[str, Any, np.ndarray]):
         ``mode``, if given, must be the ``render_mode`` chosen at construction.
         """
         if mode is not None and mode != self.render_mode:
-            raise ValueError(
+            raise ArgumentError(
                 f"render() draws in the render_mode given at construction "
                 f"({self.render_mode!r}), got mode={mode!r}"
             )

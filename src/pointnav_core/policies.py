@@ -14,6 +14,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from pointnav_core.errors import ArgumentError
 from pointnav_core.paths import resample_path
 from pointnav_core.transforms import quat2yaw
 
@@ -215,9 +216,9 @@ class ShortestPathFollower:
         self.env = env
         self.task = task if task is not None else env.task
         if isinstance(margin, bool) or not isinstance(margin, (int, float)) or not math.isfinite(margin) or margin < 0:
-            raise ValueError(f"margin must be a finite number >= 0 (m), got {margin!r}")
+            raise ArgumentError(f"margin must be a finite number >= 0 (m), got {margin!r}")
         if isinstance(lookahead, bool) or not isinstance(lookahead, (int, float)) or not math.isfinite(lookahead) or lookahead <= 0:
-            raise ValueError(f"lookahead must be a finite number > 0 (m), got {lookahead!r}")
+            raise ArgumentError(f"lookahead must be a finite number > 0 (m), got {lookahead!r}")
         self.margin = float(margin)
         self.lookahead = float(lookahead)
         self._aims: dict[tuple[float, float, float], NDArray[np.float64] | None] = {}

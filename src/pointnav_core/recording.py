@@ -11,6 +11,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from PIL import Image
 
+from pointnav_core.errors import ArgumentError
 from pointnav_core.maps import BoundedCache, TraversableMap
 from pointnav_core.outputs import atomic_writer
 from pointnav_core.render import (
@@ -33,7 +34,7 @@ __all__ = ["record_episode", "render_env", "save_gif", "save_png"]
 def _check_frame(frame: object, name: str) -> NDArray[np.uint8]:
     arr = np.asarray(frame)
     if arr.dtype != np.uint8 or arr.ndim != 3 or arr.shape[2] != 3 or arr.shape[0] < 1 or arr.shape[1] < 1:
-        raise ValueError(
+        raise ArgumentError(
             f"{name} must be a uint8 RGB image of shape (H, W, 3), got dtype {arr.dtype} and shape {arr.shape}"
         )
     return np.ascontiguousarray(arr)
@@ -87,10 +88,10 @@ def save_gif(frames: Iterable[ArrayLike], path: PathArg, fps: float = 10) -> Non
         if first_shape is None:
             first_shape = arr.shape
         elif arr.shape != first_shape:
-            raise ValueError(f"frames[{i}] has shape {arr.shape}, but frames[0] has {first_shape}")
+            raise ArgumentError(f"frames[{i}] has shape {arr.shape}, but frames[0] has {first_shape}")
         images.append(Image.fromarray(arr))
     if not images:
-        raise ValueError("frames must hold at least one frame, got none")
+        raise ArgumentError("frames must hold at least one frame, got none")
     duration = max(20, 10 * round(100.0 / rate))
     with atomic_writer(path) as fh:  # whole or not at all
         images[0].save(
@@ -270,7 +271,7 @@ def record_episode(
     (True, (300, 400, 3))
     """
     if isinstance(every, bool) or int(every) != every or every < 1:
-        raise ValueError(f"every must be an integer >= 1, got {every!r}")
+        raise ArgumentError(f"every must be an integer >= 1, got {every!r}")
     every = int(every)
     obs, _ = env.reset(seed=seed)
     renderers = BoundedCache(1)

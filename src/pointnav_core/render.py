@@ -63,6 +63,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from pointnav_core import validation
+from pointnav_core.errors import ArgumentError, ArgumentTypeError
 from pointnav_core.maps import FREE, OBSTACLE, VOID, TraversableMap
 
 __all__ = [
@@ -146,14 +147,14 @@ def _check_color(value: object, name: str) -> RGB:
     if len(channels) != 3 or not all(
         isinstance(c, (int, np.integer)) and not isinstance(c, bool) and 0 <= c <= 255 for c in channels
     ):
-        raise ValueError(f"{name} must be three ints in [0, 255] (r, g, b), got {value!r}")
+        raise ArgumentError(f"{name} must be three ints in [0, 255] (r, g, b), got {value!r}")
     return (int(channels[0]), int(channels[1]), int(channels[2]))
 
 
 def _check_xy(value: object, name: str) -> tuple[float, float]:
     arr = np.asarray(value, dtype=np.float64).reshape(-1) if value is not None else np.empty(0)
     if arr.shape not in ((2,), (3,)) or not np.isfinite(arr).all():
-        raise ValueError(f"{name} must be a finite (x, y) or (x, y, z) point in metres, got {value!r}")
+        raise ArgumentError(f"{name} must be a finite (x, y) or (x, y, z) point in metres, got {value!r}")
     return (float(arr[0]), float(arr[1]))
 
 
@@ -171,7 +172,7 @@ def _check_number(
             bounds = f" {'>' if strict else '>='} {low:g}"
         else:
             bounds = ""
-        raise ValueError(f"{name} must be a finite number{bounds}{unit}, got {value!r}")
+        raise ArgumentError(f"{name} must be a finite number{bounds}{unit}, got {value!r}")
     return number
 
 
@@ -312,7 +313,7 @@ class ScanGlyph:
         ends = np.array(self.ends_xy, dtype=np.float64).reshape(-1, 2)
         hit = np.array(self.hit, dtype=bool).reshape(-1)
         if len(hit) != len(ends) or not np.isfinite(ends).all():
-            raise ValueError(
+            raise ArgumentError(
                 f"ends_xy must be finite (R, 2) points and hit R flags, got shapes {ends.shape} and {hit.shape}"
             )
         ends.flags.writeable = False
@@ -379,12 +380,12 @@ class TopDownRenderer:
         colors: Mapping[str, ArrayLike] | None = None,
     ) -> None:
         if not isinstance(tmap, TraversableMap):
-            raise TypeError(f"tmap must be a TraversableMap, got {type(tmap).__name__}")
+            raise ArgumentTypeError(f"tmap must be a TraversableMap, got {type(tmap).__name__}")
         ppm = _check_number(pixels_per_meter, "pixels_per_meter", " (px/m)", low=0.0, strict=True)
         palette = dict(FLOOR_COLORS)
         for key, value in (colors or {}).items():
             if key not in _FLOOR_CODES:
-                raise ValueError(f"colors has an unknown key {key!r}; valid keys: {sorted(_FLOOR_CODES)}")
+                raise ArgumentError(f"colors has an unknown key {key!r}; valid keys: {sorted(_FLOOR_CODES)}")
             palette[key] = _check_color(value, f"colors[{key!r}]")
 
         xmin, xmax, ymin, ymax = tmap.extent
@@ -392,7 +393,7 @@ class TopDownRenderer:
         width = max(1, math.floor(width_m * ppm + 0.5))
         height = max(1, math.floor(height_m * ppm + 0.5))
         if width * height > _MAX_PIXELS:
-            raise ValueError(
+            raise ArgumentError(
                 f"pixels_per_meter={ppm:g} gives a {width} x {height} px picture of this "
                 f"{width_m:g} m x {height_m:g} m map, beyond {_MAX_PIXELS} pixels; use a smaller scale"
             )
@@ -447,7 +448,7 @@ class TopDownRenderer:
         """
         xy = np.asarray(xy, dtype=np.float64)
         if xy.shape[-1:] != (2,):
-            raise ValueError(f"xy must have shape (..., 2) (x, y in metres), got {xy.shape}")
+            raise ArgumentError(f"xy must have shape (..., 2) (x, y in metres), got {xy.shape}")
         out = np.empty_like(xy)
         out[..., 0] = (xy[..., 0] - self._xmin) * self.scale[0]
         out[..., 1] = (self._ymax - xy[..., 1]) * self.scale[1]
@@ -477,7 +478,7 @@ class TopDownRenderer:
         sx, sy = self.scale
         for k, marker in enumerate(markers):
             if not isinstance(marker, Marker):
-                raise TypeError(f"markers[{k}] must be a Marker, got {type(marker).__name__}")
+                raise ArgumentTypeError(f"markers[{k}] must be a Marker, got {type(marker).__name__}")
             if marker.alpha == 0.0:
                 continue
             x, y = marker.position_xy
@@ -491,11 +492,11 @@ class TopDownRenderer:
             patch[mask] = (below + marker.alpha * (color - below) + 0.5).astype(np.uint8)
         for k, scan in enumerate(scans):
             if not isinstance(scan, ScanGlyph):
-                raise TypeError(f"scans[{k}] must be a ScanGlyph, got {type(scan).__name__}")
+                raise ArgumentTypeError(f"scans[{k}] must be a ScanGlyph, got {type(scan).__name__}")
             self._draw_scan(image, scan)
         for k, robot in enumerate(robots):
             if not isinstance(robot, RobotGlyph):
-                raise TypeError(f"robots[{k}] must be a RobotGlyph, got {type(robot).__name__}")
+                raise ArgumentTypeError(f"robots[{k}] must be a RobotGlyph, got {type(robot).__name__}")
             x, y = robot.position_xy
             radius_px = robot.radius * sx
             disc = _disc(image.shape, (x - self._xmin) * sx, (self._ymax - y) * sy, radius_px)

@@ -42,6 +42,7 @@ from __future__ import annotations
 from collections.abc import Callable
 from typing import Any, ClassVar
 
+from pointnav_core.errors import ArgumentError
 from pointnav_core.metrics import scalar_where
 from pointnav_core.terminations import _check_length
 
@@ -191,14 +192,14 @@ class PointGoalReward(RewardFunction):
         super().__init__()
         self.r_pointgoal = _check_scale("r_pointgoal", r_pointgoal)
         if not isinstance(condition, str):
-            raise ValueError(f"condition must be a termination condition name, got {condition!r}")
+            raise ArgumentError(f"condition must be a termination condition name, got {condition!r}")
         self.condition = condition
 
     def reset(self, task: Any, env: Any) -> None:
         super().reset(task, env)
         names = list(task.termination_conditions)
         if self.condition not in names:
-            raise ValueError(
+            raise ArgumentError(
                 f"PointGoalReward pays the success of termination condition {self.condition!r}, "
                 f"which the task does not have; its conditions are {names}"
             )

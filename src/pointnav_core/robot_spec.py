@@ -12,6 +12,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from pointnav_core import validation
+from pointnav_core.errors import ArgumentError
 
 __all__ = ["DRIVES", "RobotSpec"]
 
@@ -54,7 +55,7 @@ class RobotSpec:
     >>> RobotSpec(drive="tank")
     Traceback (most recent call last):
     ...
-    ValueError: drive must be one of ['differential', 'holonomic'], got 'tank'
+    pointnav_core.errors.ArgumentError: drive must be one of ['differential', 'holonomic'], got 'tank'
     """
 
     radius: float = 0.18
@@ -82,7 +83,7 @@ class RobotSpec:
             _positive("max_angular_velocity", self.max_angular_velocity, strict=True, unit="rad/s"),
         )
         if not isinstance(self.drive, str) or self.drive not in DRIVES:
-            raise ValueError(f"drive must be one of {sorted(DRIVES)}, got {self.drive!r}")
+            raise ArgumentError(f"drive must be one of {sorted(DRIVES)}, got {self.drive!r}")
         lin, ang = self.max_linear_velocity, self.max_angular_velocity
         # Velocity each action component maps to: derived, so not a field (asdict, eq).
         set_(self, "_maxima", (lin, ang) if self.drive == "differential" else (lin, lin, ang))
@@ -118,7 +119,7 @@ class RobotSpec:
         >>> RobotSpec().scale_action([float("nan"), 0.0])
         Traceback (most recent call last):
         ...
-        ValueError: action must be finite, got [nan, 0.0]
+        pointnav_core.errors.ArgumentError: action must be finite, got [nan, 0.0]
         """
         return np.array(self.scale_action_floats(action))
 
@@ -150,13 +151,13 @@ class RobotSpec:
             )
         if not ok:
             shape = getattr(np.asarray(action, dtype=object), "shape", None)
-            raise ValueError(
+            raise ArgumentError(
                 f"action must have shape ({len(maxima)},) for a {self.drive} drive "
                 f"({', '.join(DRIVES[self.drive])}), got shape {shape}"
             )
         out = []
         for v, m in zip(values, maxima):
             if not -math.inf < v < math.inf:  # also False for NaN
-                raise ValueError(f"action must be finite, got {values}")
+                raise ArgumentError(f"action must be finite, got {values}")
             out.append(m if v >= 1.0 else -m if v <= -1.0 else v * m)
         return tuple(out)

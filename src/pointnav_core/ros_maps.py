@@ -34,6 +34,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from pointnav_core import validation
+from pointnav_core.errors import ArgumentError
 from pointnav_core.maps import FREE, OBSTACLE, VOID, TraversableMap
 
 __all__ = ["MODES", "RosMap", "occupancy", "read_ros_map", "ros_map_floor", "write_ros_map"]
@@ -126,7 +127,7 @@ def occupancy(
 
 def _field(doc: dict[str, Any], key: str, where: str, **bounds: Any) -> float:
     if key not in doc:
-        raise ValueError(f"{where}: no {key!r} (map_server needs it)")
+        raise ArgumentError(f"{where}: no {key!r} (map_server needs it)")
     return validation.real(f"{where}: {key}", doc[key], **bounds)
 
 
@@ -137,30 +138,30 @@ def _parse_yaml(path: str) -> dict[str, Any]:
         try:
             doc = yaml.safe_load(file)
         except yaml.YAMLError as exc:
-            raise ValueError(f"{path!r} is not valid YAML: {exc}") from None
+            raise ArgumentError(f"{path!r} is not valid YAML: {exc}") from None
     if not isinstance(doc, dict):
-        raise ValueError(f"{path!r} must be a map_server yaml (a mapping with image, resolution, ...)")
+        raise ArgumentError(f"{path!r} must be a map_server yaml (a mapping with image, resolution, ...)")
     where = repr(path)
     out: dict[str, Any] = {"resolution": _field(doc, "resolution", where, minimum=0.0, strict=True, unit="m per pixel")}
     image = doc.get("image")
     if not isinstance(image, str) or not image:
-        raise ValueError(f"{where}: image must name the map's image file, got {image!r}")
+        raise ArgumentError(f"{where}: image must name the map's image file, got {image!r}")
     out["image"] = os.path.join(os.path.dirname(path), image)
     origin = doc.get("origin")
     if not (isinstance(origin, list) and len(origin) == 3 and all(validation.is_real(v) for v in origin)
             and all(math.isfinite(v) for v in origin)):
-        raise ValueError(f"{where}: origin must be [x, y, yaw] (m, m, rad), got {origin!r}")
+        raise ArgumentError(f"{where}: origin must be [x, y, yaw] (m, m, rad), got {origin!r}")
     out["origin"] = tuple(float(v) for v in origin)
     mode = doc.get("mode", "trinary")
     if mode not in MODES:
-        raise ValueError(f"{where}: mode must be one of {list(MODES)}, got {mode!r}")
+        raise ArgumentError(f"{where}: mode must be one of {list(MODES)}, got {mode!r}")
     negate = doc.get("negate")
     if negate not in (0, 1):  # True and False compare equal to 1 and 0, as yaml-cpp reads them
-        raise ValueError(f"{where}: negate must be 0 or 1, got {negate!r}")
+        raise ArgumentError(f"{where}: negate must be 0 or 1, got {negate!r}")
     occ = _field(doc, "occupied_thresh", where, minimum=0.0, maximum=1.0, unit="")
     free = _field(doc, "free_thresh", where, minimum=0.0, maximum=1.0, unit="")
     if free > occ:
-        raise ValueError(f"{where}: free_thresh ({free}) must not exceed occupied_thresh ({occ})")
+        raise ArgumentError(f"{where}: free_thresh ({free}) must not exceed occupied_thresh ({occ})")
     out.update(mode=mode, negate=bool(negate), occupied_thresh=occ, free_thresh=free)
     return out
 
@@ -180,14 +181,14 @@ def _read_image(path: str, where: str) -> tuple[NDArray[Any], NDArray[Any] | Non
                 image = image.convert("RGBA" if "transparency" in image.info or image.mode == "PA" else "L")
             mode, pixels = image.mode, np.asarray(image)
     except (UnidentifiedImageError, OSError, SyntaxError) as exc:
-        raise ValueError(f"{where}: image {path!r} is not a readable image: {exc}") from None
+        raise ArgumentError(f"{where}: image {path!r} is not a readable image: {exc}") from None
     if mode in ("L", "RGB"):
         return pixels, None, 255.0
     if mode in ("LA", "RGBA"):
         return pixels[..., :-1], pixels[..., -1], 255.0
     if mode in ("I", "I;16", "I;16B", "I;16L") and pixels.min() >= 0 and pixels.max() <= 65535:
         return pixels, None, 65535.0
-    raise ValueError(f"{where}: image {path!r} has pixel mode {mode!r}; expected grey, RGB(A) or 16-bit grey")
+    raise ArgumentError(f"{where}: image {path!r} has pixel mode {mode!r}; expected grey, RGB(A) or 16-bit grey")
 
 
 def read_ros_map(yaml_path: str | os.PathLike[str]) -> RosMap:
@@ -220,7 +221,7 @@ def _turn(codes: NDArray[np.uint8], res: float, origin: tuple[float, float, floa
     if ignore_yaw or k == 0 and abs(quarter - round(quarter)) <= _YAW_TOL:
         return codes, (x0, y0)
     if abs(quarter - round(quarter)) > _YAW_TOL:
-        raise ValueError(
+        raise ArgumentError(
             f"{where}: origin yaw {yaw} rad is not a quarter turn; a floor grid is axis-aligned, "
             "so pass ignore_yaw=True to read the map in its own frame (as most ROS nodes do)"
         )
@@ -257,10 +258,10 @@ def ros_map_floor(
         Floor height (m).
     """
     if unknown not in UNKNOWN_AS:
-        raise ValueError(f"unknown must be one of {list(UNKNOWN_AS)}, got {unknown!r}")
+        raise ArgumentError(f"unknown must be one of {list(UNKNOWN_AS)}, got {unknown!r}")
     lethal = validation.integer("lethal_threshold", lethal_threshold, minimum=1)
     if lethal > 100:
-        raise ValueError(f"lethal_threshold must be an integer in 1..100, got {lethal_threshold!r}")
+        raise ArgumentError(f"lethal_threshold must be an integer in 1..100, got {lethal_threshold!r}")
     ignore_yaw = validation.boolean("ignore_yaw", ignore_yaw)
     ros = read_ros_map(yaml_path)
     codes = np.where(ros.data < 0, UNKNOWN_AS[unknown], np.where(ros.data >= lethal, OBSTACLE, FREE))
@@ -281,7 +282,7 @@ def write_ros_map(tmap: TraversableMap, yaml_path: str | os.PathLike[str], image
 
     path = os.fspath(yaml_path)
     if not path.endswith((".yaml", ".yml")):
-        raise ValueError(f"yaml_path must end with .yaml or .yml, got {path!r}")
+        raise ArgumentError(f"yaml_path must end with .yaml or .yml, got {path!r}")
     name = image or os.path.splitext(os.path.basename(path))[0] + ".pgm"
     pixels = np.zeros(tmap.shape, np.uint8)
     for code, value in _SAVED.items():

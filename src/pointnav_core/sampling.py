@@ -26,7 +26,7 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
 
-from pointnav_core.errors import SamplingError
+from pointnav_core.errors import ArgumentError, SamplingError
 
 __all__ = ["Episode", "GoalConstraint", "sample_episode", "sample_task_episode"]
 
@@ -121,7 +121,7 @@ def sample_episode(
         backend.land(robot_idn, floor, (sx, sy, floor_height), quat)
         if not backend.is_valid_pose(robot_idn, (sx, sy, floor_height), quat):
             if initial_pos is not None:
-                raise ValueError(
+                raise ArgumentError(
                     f"initial_pos {[sx, sy]} is not a valid pose for robot {robot_idn}: its disc "
                     f"overlaps an obstacle or another robot"
                 )
@@ -205,4 +205,4 @@ def sample_task_episode(
     except ValueError as err:
         if given is None:
             raise
-        raise ValueError(f"episode {given.episode_id!r}: field 'start_position': {err}") from None
+        raise ArgumentError(f"episode {given.episode_id!r}: field 'start_position': {err}") from None

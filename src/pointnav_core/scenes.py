@@ -35,7 +35,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from pointnav_core import floorplans, loaders, reachability, validation
-from pointnav_core.errors import SamplingError
+from pointnav_core.errors import ArgumentError, SamplingError
 from pointnav_core.floorplans import FloorPlan
 from pointnav_core.maps import OBSTACLE, TraversableMap
 from pointnav_core.paths import resample_path
@@ -50,7 +50,7 @@ def robot_radius(robot: Any) -> float:
         return 0.0
     radius = getattr(robot, "radius", robot)
     if not validation.is_real(radius):
-        raise ValueError(
+        raise ArgumentError(
             f"robot must be a robot spec with a radius, a radius in metres, or None; got {robot!r}"
         )
     return validation.real("robot radius", radius, minimum=0.0)
@@ -60,7 +60,7 @@ def _as_xy(value: ArrayLike, name: str) -> NDArray[np.float64]:
     try:
         return validation.vector(name, value, sizes=(2, 3))[:2]
     except ValueError:
-        raise ValueError(f"{name} must be a finite (x, y) or (x, y, z) point in metres, got {value!r}") from None
+        raise ArgumentError(f"{name} must be a finite (x, y) or (x, y, z) point in metres, got {value!r}") from None
 
 
 def _as_rng(rng: np.random.Generator | int | None) -> np.random.Generator:
@@ -146,25 +146,25 @@ class Scene:
     ) -> None:
         floors = list(floors)
         if not floors or not all(isinstance(f, TraversableMap) for f in floors):
-            raise ValueError("floors must be a non-empty sequence of TraversableMap")
+            raise ArgumentError("floors must be a non-empty sequence of TraversableMap")
         if int(num_waypoints) != num_waypoints or num_waypoints < 1:
-            raise ValueError(f"num_waypoints must be an integer >= 1, got {num_waypoints!r}")
+            raise ArgumentError(f"num_waypoints must be an integer >= 1, got {num_waypoints!r}")
         if not math.isfinite(waypoint_spacing) or waypoint_spacing <= 0:
-            raise ValueError(f"waypoint_spacing must be > 0 (m), got {waypoint_spacing!r}")
+            raise ArgumentError(f"waypoint_spacing must be > 0 (m), got {waypoint_spacing!r}")
         if floor_plans is not None:
             plans = list(floor_plans)
             if len(plans) != len(floors):
-                raise ValueError(
+                raise ArgumentError(
                     f"floor_plans must have one entry per floor ({len(floors)}), got {len(plans)}"
                 )
             for i, (plan, tmap) in enumerate(zip(plans, floors)):
                 if plan is not None and plan is not tmap.geometry:
-                    raise ValueError(
+                    raise ArgumentError(
                         f"floor_plans[{i}] is not floor {i}'s geometry: a floor's plan lives on "
                         f"its map, TraversableMap(..., geometry=plan)"
                     )
         if scene_id is not None and (not isinstance(scene_id, str) or not scene_id):
-            raise ValueError(f"scene_id must be None or a non-empty string, got {scene_id!r}")
+            raise ArgumentError(f"scene_id must be None or a non-empty string, got {scene_id!r}")
         self.scene_id = scene_id
         self.floors = floors
         self.num_waypoints = int(num_waypoints)
@@ -309,7 +309,7 @@ class Scene:
             return [3.0 * i for i in range(n)]
         heights = [float(h) for h in heights]
         if len(heights) != n:
-            raise ValueError(f"heights must have one value per floor ({n}), got {len(heights)}")
+            raise ArgumentError(f"heights must have one value per floor ({n}), got {len(heights)}")
         return heights
 
     # ------------------------------------------------------------------ floors
@@ -320,9 +320,9 @@ class Scene:
 
     def _floor(self, floor: int) -> TraversableMap:
         if isinstance(floor, bool) or not isinstance(floor, (int, np.integer)):
-            raise ValueError(f"floor must be an integer in [0, {self.n_floors}), got {floor!r}")
+            raise ArgumentError(f"floor must be an integer in [0, {self.n_floors}), got {floor!r}")
         if not 0 <= floor < self.n_floors:
-            raise ValueError(f"floor must be in [0, {self.n_floors}), got {floor}")
+            raise ArgumentError(f"floor must be in [0, {self.n_floors}), got {floor}")
         return self.floors[int(floor)]
 
     def get_floor_height(self, floor: int = 0) -> float:
@@ -378,9 +378,9 @@ class Scene:
         radius = robot_radius(robot)
         if max_distance is not None:
             if reference_point is None:
-                raise ValueError("max_distance needs a reference_point to measure from")
+                raise ArgumentError("max_distance needs a reference_point to measure from")
             if not (validation.is_real(max_distance) and max_distance >= 0):
-                raise ValueError(f"max_distance must be None or a number >= 0 (m), got {max_distance!r}")
+                raise ArgumentError(f"max_distance must be None or a number >= 0 (m), got {max_distance!r}")
         if floor is None:
             candidates = [i for i, f in enumerate(self.floors) if f.usable(radius).any()]
             if not candidates:
@@ -395,7 +395,7 @@ class Scene:
             ref = _as_xy(reference_point, "reference_point")
             label = int(tmap.component_at(ref, radius))
             if label == 0:
-                raise ValueError(
+                raise ArgumentError(
                     f"reference_point {ref.tolist()} is not usable on floor {floor} for a robot "
                     f"of radius {radius} m (blocked, too close to an obstacle, or off the map)"
                 )

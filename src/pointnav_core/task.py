@@ -46,6 +46,7 @@ from numpy.typing import ArrayLike
 
 from pointnav_core.backend import float_twin
 from pointnav_core.episode_state import EpisodeState
+from pointnav_core.errors import ArgumentError
 from pointnav_core.frozen import FrozenMapping
 from pointnav_core.lifecycle import IDLE, TaskState, TaskStateError, allows, move
 from pointnav_core.lifecycle import Event as _Event
@@ -208,7 +209,7 @@ class PointNavigationTask(OmniGibsonTaskAPI):
     >>> PointNavigationTask(reward_type="manhattan")
     Traceback (most recent call last):
     ...
-    ValueError: reward_type must be one of ['l2', 'geodesic'], got 'manhattan'
+    pointnav_core.errors.ArgumentError: reward_type must be one of ['l2', 'geodesic'], got 'manhattan'
     """
 
     #: Attempts at sampling a valid start and goal before :class:`SamplingError`.
@@ -266,11 +267,11 @@ class PointNavigationTask(OmniGibsonTaskAPI):
         try:
             terminations = dict(self._create_termination_conditions())
         except ValueError as err:
-            raise ValueError(f"termination_config: {err}") from None
+            raise ArgumentError(f"termination_config: {err}") from None
         try:
             rewards = dict(self._create_reward_functions())
         except ValueError as err:
-            raise ValueError(f"reward_config: {err}") from None
+            raise ArgumentError(f"reward_config: {err}") from None
         terminations = compose_terms("termination_conditions", TerminationCondition, list(terminations.values()), termination_conditions)
         rewards = compose_terms("reward_functions", RewardFunction, list(rewards.values()), reward_functions)
         observations = compose_terms(
@@ -355,19 +356,19 @@ class PointNavigationTask(OmniGibsonTaskAPI):
         cfg, robots, scene = self._config, env.robots, env.scene
         idn, floor = cfg.robot_idn, cfg.floor
         if idn >= len(robots):
-            raise ValueError(
+            raise ArgumentError(
                 f"robot_idn must be in [0, {len(robots)}) for an environment with "
                 f"{len(robots)} robot(s), got {idn}"
             )
         if floor >= scene.n_floors:
-            raise ValueError(
+            raise ArgumentError(
                 f"floor must be in [0, {scene.n_floors}) for a scene with {scene.n_floors} "
                 f"floor(s), got {floor}"
             )
         spec = robots[idn]
         for name, xy in (("initial_pos", cfg.initial_pos), ("goal_pos", cfg.goal_pos)):
             if xy is not None and not scene.is_usable(floor, xy, spec):
-                raise ValueError(
+                raise ArgumentError(
                     f"{name} {list(xy)} is not usable on floor {floor} by robot "
                     f"{idn} (radius {spec.radius} m): it is off the map, on an "
                     f"obstacle or void, or closer than the radius to one"

@@ -21,7 +21,7 @@ Examples
 >>> TaskConfig(path_range="12")
 Traceback (most recent call last):
 ...
-ValueError: path_range must be None or (min, max) geodesic distances in metres, got '12'
+pointnav_core.errors.ArgumentError: path_range must be None or (min, max) geodesic distances in metres, got '12'
 """
 
 from __future__ import annotations
@@ -32,6 +32,7 @@ from collections.abc import Mapping, Sequence
 from typing import Any
 
 from pointnav_core import validation
+from pointnav_core.errors import ArgumentError
 from pointnav_core.frozen import FrozenMapping
 
 __all__ = ["REWARD_TYPES", "TaskConfig", "compose_terms", "merge_config"]
@@ -49,7 +50,7 @@ def _check_position(name: str, value: Any) -> tuple[float, float] | None:
     try:
         arr = validation.vector(name, value, sizes=(2, 3))
     except ValueError:
-        raise ValueError(
+        raise ArgumentError(
             f"{name} must be None or a finite position (x, y, z) in metres (z is replaced by "
             f"the floor height), got {value!r}"
         ) from None
@@ -62,12 +63,12 @@ def _check_quat(name: str, value: Any) -> tuple[float, float, float, float] | No
     try:
         arr = validation.vector(name, value, sizes=(4,))
     except ValueError:
-        raise ValueError(
+        raise ArgumentError(
             f"{name} must be None or a finite unit quaternion (x, y, z, w), got {value!r}"
         ) from None
     norm = math.sqrt(float(arr @ arr))
     if abs(norm - 1.0) > _QUAT_NORM_TOL:
-        raise ValueError(
+        raise ArgumentError(
             f"{name} must be a unit quaternion (x, y, z, w), got {value!r} of norm {norm:.6g}"
         )
     x, y, z, w = (float(c) / norm for c in arr)
@@ -81,11 +82,11 @@ def _check_path_range(value: Any) -> tuple[float, float] | None:
         # Not finite-only: the maximum may be inf. '12' is not (1.0, 2.0), nor True 1.0.
         lo, hi = validation.vector("path_range", value, sizes=(2,), finite=False)
     except (TypeError, ValueError):
-        raise ValueError(
+        raise ArgumentError(
             f"path_range must be None or (min, max) geodesic distances in metres, got {value!r}"
         ) from None
     if not (math.isfinite(lo) and lo >= 0.0 and hi > lo):  # hi may be inf; NaN fails
-        raise ValueError(
+        raise ArgumentError(
             f"path_range must be (min, max) with 0 <= min < max (m), min finite, got {value!r}"
         )
     return float(lo), float(hi)
@@ -113,13 +114,13 @@ def merge_config(
     >>> merge_config("reward_config", {"a": 1}, {"c": 3})
     Traceback (most recent call last):
     ...
-    ValueError: reward_config has an unknown key 'c'; valid keys are ['a']
+    pointnav_core.errors.ArgumentError: reward_config has an unknown key 'c'; valid keys are ['a']
     """
     merged = dict(defaults)
     if overrides is None:
         return FrozenMapping(merged)
     if not isinstance(overrides, Mapping):
-        raise ValueError(f"{name} must be None or a dict, got {overrides!r}")
+        raise ArgumentError(f"{name} must be None or a dict, got {overrides!r}")
     validation.known_keys(name, overrides, defaults)
     merged.update(overrides)
     return FrozenMapping(merged)
@@ -151,16 +152,16 @@ def compose_terms(kind: str, base: type, defaults: Sequence[Any], extra: Any) ->
     if extra is None:
         return terms
     if isinstance(extra, (str, bytes, Mapping)) or not isinstance(extra, Sequence):
-        raise ValueError(f"{kind} must be None or a sequence of {base.__name__} objects, got {extra!r}")
+        raise ArgumentError(f"{kind} must be None or a sequence of {base.__name__} objects, got {extra!r}")
     seen: set[str] = set()
     for term in extra:
         if not isinstance(term, base):
-            raise ValueError(f"{kind} must hold {base.__name__} objects, got {term!r}")
+            raise ArgumentError(f"{kind} must hold {base.__name__} objects, got {term!r}")
         name = term.name
         if not isinstance(name, str) or not name:
-            raise ValueError(f"{kind}: {term!r} must have a non-empty str name, got {name!r}")
+            raise ArgumentError(f"{kind}: {term!r} must have a non-empty str name, got {name!r}")
         if name in seen:
-            raise ValueError(f"{kind} has two terms named {name!r}")
+            raise ArgumentError(f"{kind} has two terms named {name!r}")
         seen.add(name)
         terms[name] = term
     return terms
@@ -218,14 +219,14 @@ class TaskConfig:
         set_(self, "waypoint_height", _check_length("waypoint_height", self.waypoint_height))
         width = _check_length("waypoint_width", self.waypoint_width)
         if width == 0.0:
-            raise ValueError(
+            raise ArgumentError(
                 f"waypoint_width must be a finite number > 0 (m), got {self.waypoint_width!r}"
             )
         set_(self, "waypoint_width", width)
         set_(self, "n_vis_waypoints",
              validation.integer("n_vis_waypoints", self.n_vis_waypoints, minimum=1))
         if not isinstance(self.reward_type, str) or self.reward_type not in REWARD_TYPES:
-            raise ValueError(
+            raise ArgumentError(
                 f"reward_type must be one of {list(REWARD_TYPES)}, got {self.reward_type!r}"
             )
         for name in ("termination_config", "reward_config"):
@@ -233,5 +234,5 @@ class TaskConfig:
             if value is None:
                 value = {}
             if not isinstance(value, Mapping):
-                raise ValueError(f"{name} must be None or a dict, got {value!r}")
+                raise ArgumentError(f"{name} must be None or a dict, got {value!r}")
             set_(self, name, value if isinstance(value, FrozenMapping) else FrozenMapping(value))

@@ -54,7 +54,7 @@ __all__ = [
 
 
 def _check_count(name: str, value: Any, minimum: int) -> int:
-    """Return ``value`` as an int ``>= minimum``, or raise ValueError naming ``name``.
+    """Return ``value`` as an int ``>= minimum``, or raise ArgumentError (a ValueError) naming ``name``.
 
     Booleans and non-integral numbers are refused (``True`` is not a step count).
 
@@ -63,20 +63,20 @@ def _check_count(name: str, value: Any, minimum: int) -> int:
     >>> _check_count("max_steps", 0, minimum=1)
     Traceback (most recent call last):
     ...
-    ValueError: max_steps must be an integer >= 1, got 0
+    pointnav_core.errors.ArgumentError: max_steps must be an integer >= 1, got 0
     """
     return validation.integer(name, value, minimum=minimum)
 
 
 def _check_length(name: str, value: Any, unit: str = "m") -> float:
-    """Return ``value`` as a finite float ``>= 0``, or raise ValueError naming ``name``.
+    """Return ``value`` as a finite float ``>= 0``, or raise ArgumentError (a ValueError) naming ``name``.
 
     Examples
     --------
     >>> _check_length("fall_height", -1)
     Traceback (most recent call last):
     ...
-    ValueError: fall_height must be a finite number >= 0 (m), got -1
+    pointnav_core.errors.ArgumentError: fall_height must be a finite number >= 0 (m), got -1
     """
     return validation.real(name, value, minimum=0.0, unit=unit)
 

@@ -16,11 +16,11 @@ the same value is accepted or refused the same way wherever it is passed. The ru
 >>> real("radius", True, minimum=0.0)
 Traceback (most recent call last):
 ...
-ValueError: radius must be a finite number >= 0 (m), got True
+pointnav_core.errors.ArgumentError: radius must be a finite number >= 0 (m), got True
 >>> vector("goal_pos", "12", sizes=(2, 3))
 Traceback (most recent call last):
 ...
-ValueError: goal_pos must be 2 or 3 finite numbers, got '12'
+pointnav_core.errors.ArgumentError: goal_pos must be 2 or 3 finite numbers, got '12'
 """
 
 from __future__ import annotations
@@ -31,6 +31,8 @@ from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
+
+from pointnav_core.errors import ArgumentError
 
 __all__ = [
     "MAX_CELLS", "boolean", "cell_budget", "goal_tolerance", "integer", "is_real", "is_real_array",
@@ -116,7 +118,7 @@ def real(
     if not ok:
         kind = "a finite number" if finite else "a number"
         suffix = f" ({unit})" if unit else ""
-        raise ValueError(f"{name} must be {kind}{_bound(minimum, strict, maximum)}{suffix}, got {value!r}")
+        raise ArgumentError(f"{name} must be {kind}{_bound(minimum, strict, maximum)}{suffix}, got {value!r}")
     return number
 
 
@@ -129,7 +131,7 @@ def goal_tolerance(name: str, value: Any) -> float:
     >>> goal_tolerance("goal_tolerance", 0)
     Traceback (most recent call last):
     ...
-    ValueError: goal_tolerance must be a finite number > 0 (m), got 0
+    pointnav_core.errors.ArgumentError: goal_tolerance must be a finite number > 0 (m), got 0
     """
     return real(name, value, minimum=0.0, strict=True, unit="m")
 
@@ -144,7 +146,7 @@ def integer(name: str, value: Any, *, minimum: int | None = None) -> int:
             number = None
     if number is None or (minimum is not None and number < minimum):
         bound = "" if minimum is None else f" >= {minimum}"
-        raise ValueError(f"{name} must be an integer{bound}, got {value!r}")
+        raise ArgumentError(f"{name} must be an integer{bound}, got {value!r}")
     return int(number)
 
 
@@ -154,11 +156,11 @@ def known_keys(name: str, keys: Any, valid: Any) -> None:
     >>> known_keys("robot", {"size": 1}, ("radius", "drive"))
     Traceback (most recent call last):
     ...
-    ValueError: robot has an unknown key 'size'; valid keys are ['radius', 'drive']
+    pointnav_core.errors.ArgumentError: robot has an unknown key 'size'; valid keys are ['radius', 'drive']
     """
     for key in keys:
         if key not in valid:
-            raise ValueError(f"{name} has an unknown key {key!r}; valid keys are {list(valid)}")
+            raise ArgumentError(f"{name} has an unknown key {key!r}; valid keys are {list(valid)}")
 
 
 def cell_budget(name: str, rows: int, cols: int) -> None:
@@ -170,10 +172,10 @@ def cell_budget(name: str, rows: int, cols: int) -> None:
     >>> cell_budget("grid", 20000, 20000)
     Traceback (most recent call last):
     ...
-    ValueError: grid is 20000 x 20000 = 400000000 cells, over the cell budget of 100000000 (pointnav_core.validation.MAX_CELLS)
+    pointnav_core.errors.ArgumentError: grid is 20000 x 20000 = 400000000 cells, over the cell budget of 100000000 (pointnav_core.validation.MAX_CELLS)
     """
     if rows * cols > MAX_CELLS:
-        raise ValueError(
+        raise ArgumentError(
             f"{name} is {rows} x {cols} = {rows * cols} cells, over the cell budget of "
             f"{MAX_CELLS} (pointnav_core.validation.MAX_CELLS)"
         )
@@ -182,7 +184,7 @@ def cell_budget(name: str, rows: int, cols: int) -> None:
 def boolean(name: str, value: Any) -> bool:
     """``value`` as a bool: only ``True``/``False`` (and numpy's) are accepted."""
     if not isinstance(value, (bool, np.bool_)):
-        raise ValueError(f"{name} must be True or False, got {value!r}")
+        raise ArgumentError(f"{name} must be True or False, got {value!r}")
     return bool(value)
 
 
@@ -206,5 +208,5 @@ def vector(
     if not ok:
         count = " or ".join(str(s) for s in sizes)
         kind = "finite numbers" if finite else "numbers"
-        raise ValueError(f"{name} must be {count} {kind}, got {value!r}")
+        raise ArgumentError(f"{name} must be {count} {kind}, got {value!r}")
     return arr  # type: ignore[return-value]

@@ -24,13 +24,15 @@ from contextlib import contextmanager
 from multiprocessing import connection, get_context
 from typing import Any
 
+from pointnav_core.errors import PointNavError
+
 __all__ = ["WorkerError", "WorkerPool", "in_worker", "mark_worker", "usable_cores"]
 
 #: How often (s) a worker checks that its parent is alive.
 _WATCH_PERIOD = 0.2
 
 
-class WorkerError(RuntimeError):
+class WorkerError(PointNavError, RuntimeError):
     """A worker died, or raised, while it held an item (``key``; None: while starting)."""
 
     def __init__(self, key: Hashable | None, cause: str) -> None:

@@ -15,6 +15,7 @@ from pointnav_core.backend_kit import (
     check_load,
     drive_arc,
 )
+from pointnav_core.errors import ArgumentError
 from pointnav_kinematic.contacts import advance
 from pointnav_kinematic.geometry import FloorGeometry
 
@@ -102,7 +103,7 @@ class KinematicBackend(RobotStateBackend):
 
     def __init__(self, collision_mode: str = "slide", fall_speed: float = 1.0) -> None:
         if collision_mode not in COLLISION_MODES:
-            raise ValueError(
+            raise ArgumentError(
                 f"collision_mode must be one of {list(COLLISION_MODES)}, got {collision_mode!r}"
             )
         super().__init__(fall_speed=fall_speed)

@@ -17,6 +17,8 @@ import numpy as np
 import shapely
 from numpy.typing import NDArray
 
+from pointnav_core.errors import ArgumentError
+
 __all__ = ["EdgeIndex", "Segment"]
 
 #: A polygon edge as stored for the hot path: ``(ax, ay, bx, by, ux, uy, length)``, the
@@ -45,7 +47,7 @@ class EdgeIndex:
 
     def __init__(self, polygons: Sequence[Any], bucket: float) -> None:
         if not (math.isfinite(bucket) and bucket > 0.0):
-            raise ValueError(f"bucket must be a finite number > 0 (m), got {bucket!r}")
+            raise ArgumentError(f"bucket must be a finite number > 0 (m), got {bucket!r}")
         self.polygons = tuple(polygons)
         self.bucket = float(bucket)
         segments: list[Segment] = []

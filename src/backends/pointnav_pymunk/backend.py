@@ -18,6 +18,7 @@ from pointnav_core.backend_kit import (
     check_load,
     drive_arc,
 )
+from pointnav_core.errors import ArgumentError
 from pointnav_core.maps import VOID
 from pointnav_pymunk.floor import (
     _ROBOT,
@@ -219,7 +220,7 @@ class PymunkBackend(RobotStateBackend):
             or not isinstance(min_substeps, (int, np.integer))
             or not 1 <= min_substeps <= _MAX_SUBSTEPS
         ):
-            raise ValueError(
+            raise ArgumentError(
                 f"min_substeps must be an int in [1, {_MAX_SUBSTEPS}], got {min_substeps!r}"
             )
         super().__init__(fall_speed=fall_speed)

@@ -25,6 +25,7 @@ import shapely
 from numpy.typing import ArrayLike
 from shapely.geometry import Polygon, box
 
+from pointnav_core.errors import ArgumentError, ArgumentTypeError
 from pointnav_core.maps import OBSTACLE, TraversableMap
 
 __all__ = ["convex_pieces", "floor_pieces", "merge_cells", "min_thickness"]
@@ -59,7 +60,7 @@ def merge_cells(mask: ArrayLike) -> list[tuple[int, int, int, int]]:
     """
     cells = np.asarray(mask, dtype=bool)
     if cells.ndim != 2:
-        raise ValueError(f"mask must be a 2D array, got shape {cells.shape}")
+        raise ArgumentError(f"mask must be a 2D array, got shape {cells.shape}")
     rects: list[tuple[int, int, int, int]] = []
     open_runs: dict[tuple[int, int], int] = {}  # (col0, col1) -> first row
     for row in range(cells.shape[0]):
@@ -130,7 +131,7 @@ def convex_pieces(polygon: Polygon) -> list[list[tuple[float, float]]]:
     (4, 12.0)
     """
     if not isinstance(polygon, Polygon) or polygon.is_empty:
-        raise TypeError(f"polygon must be a non-empty shapely Polygon, got {polygon!r}")
+        raise ArgumentTypeError(f"polygon must be a non-empty shapely Polygon, got {polygon!r}")
     if _is_convex(polygon):
         return [_ring(polygon)]
     xmin, ymin, xmax, ymax = polygon.bounds

@@ -20,6 +20,7 @@ from pointnav_core.backend_kit.checks import (
 from pointnav_core.backend_kit.state import _NO_COMMAND, _STILL
 from pointnav_core.backend_kit.world import robots_overlap
 from pointnav_core.collision import TOUCH_TOL
+from pointnav_core.errors import ArgumentError, TaskStateError
 
 __all__ = ["RobotStateBackend"]
 
@@ -120,7 +121,7 @@ class RobotStateBackend:
     >>> backend.in_contact(1)
     Traceback (most recent call last):
     ...
-    ValueError: idn must be in [0, 1), got 1
+    pointnav_core.errors.ArgumentError: idn must be in [0, 1), got 1
     """
 
     #: Overlap (m) up to which two robots count as touching in is_valid_pose.
@@ -133,7 +134,7 @@ class RobotStateBackend:
     def __init__(self, *, fall_speed: float = 1.0) -> None:
         fall_speed_f = float(fall_speed)
         if not math.isfinite(fall_speed_f) or fall_speed_f <= 0.0:
-            raise ValueError(f"fall_speed must be a finite number > 0 (m/s), got {fall_speed!r}")
+            raise ArgumentError(f"fall_speed must be a finite number > 0 (m/s), got {fall_speed!r}")
         self.fall_speed = fall_speed_f
         self._floors = []
         self._robots = []
@@ -155,7 +156,7 @@ class RobotStateBackend:
         if type(idn) is int and 0 <= idn < len(robots):
             return robots[idn]  # the common case, checked without a call
         if not robots and _is_index(idn):
-            raise RuntimeError("no robots: call load(scene, robots) first")
+            raise TaskStateError("no robots: call load(scene, robots) first")
         return robots[check_index(idn, len(robots), name="idn", what="robot")]
 
     def _floor(self, floor: int) -> Any:

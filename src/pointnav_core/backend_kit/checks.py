@@ -14,6 +14,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from pointnav_core.backend import RobotSpec
+from pointnav_core.errors import ArgumentError, ArgumentTypeError
 
 __all__ = [
     "check_index",
@@ -62,16 +63,16 @@ def check_index(value: Any, count: int, *, name: str, what: str) -> int:
     >>> check_index(2, 2, name="floor", what="floor")
     Traceback (most recent call last):
     ...
-    ValueError: floor must be in [0, 2), got 2
+    pointnav_core.errors.ArgumentError: floor must be in [0, 2), got 2
     >>> check_index(True, 2, name="idn", what="robot")
     Traceback (most recent call last):
     ...
-    TypeError: idn must be an int robot index, got True
+    pointnav_core.errors.ArgumentTypeError: idn must be an int robot index, got True
     """
     if not _is_index(value):
-        raise TypeError(f"{name} must be an int {what} index, got {value!r}")
+        raise ArgumentTypeError(f"{name} must be an int {what} index, got {value!r}")
     if not 0 <= value < count:
-        raise ValueError(f"{name} must be in [0, {count}), got {value}")
+        raise ArgumentError(f"{name} must be in [0, {count}), got {value}")
     return int(value)
 
 
@@ -115,20 +116,20 @@ def check_load(
     >>> check_load(scene, [RobotSpec(), "robot"], 10.0)
     Traceback (most recent call last):
     ...
-    TypeError: robots[1] must be a RobotSpec, got str
+    pointnav_core.errors.ArgumentTypeError: robots[1] must be a RobotSpec, got str
     """
     freq = float(action_frequency)
     if not math.isfinite(freq) or freq <= 0.0:
-        raise ValueError(
+        raise ArgumentError(
             f"action_frequency must be a finite number > 0 (Hz), got {action_frequency!r}"
         )
     specs = list(robots)
     for i, spec in enumerate(specs):
         if not isinstance(spec, RobotSpec):
-            raise TypeError(f"robots[{i}] must be a RobotSpec, got {type(spec).__name__}")
+            raise ArgumentTypeError(f"robots[{i}] must be a RobotSpec, got {type(spec).__name__}")
     n_floors = int(scene.n_floors)
     if n_floors < 1 or len(scene.floors) != n_floors:
-        raise ValueError(
+        raise ArgumentError(
             f"scene must have n_floors >= 1 floors, got n_floors={n_floors} "
             f"and {len(scene.floors)} maps"
         )
@@ -166,13 +167,13 @@ def parse_position(
     >>> parse_position([1.0, 2.0])
     Traceback (most recent call last):
     ...
-    ValueError: position must be finite (x, y, z) in metres, got [1.0, 2.0]
+    pointnav_core.errors.ArgumentError: position must be finite (x, y, z) in metres, got [1.0, 2.0]
     """
     p = np.asarray(position, dtype=np.float64)
     shapes = ((2,), (3,)) if allow_2d else ((3,),)
     if p.shape not in shapes or not np.isfinite(p).all():
         want = "(x, y) or (x, y, z)" if allow_2d else "(x, y, z)"
-        raise ValueError(f"{name} must be finite {want} in metres, got {position!r}")
+        raise ArgumentError(f"{name} must be finite {want} in metres, got {position!r}")
     return tuple(p.tolist())
 
 
@@ -211,17 +212,17 @@ def parse_orientation(orientation: ArrayLike, *, name: str = "orientation") -> f
     >>> parse_orientation((0.0, 0.0, 0.0, 0.0))
     Traceback (most recent call last):
     ...
-    ValueError: orientation must be a non-zero quaternion, got (0.0, 0.0, 0.0, 0.0)
+    pointnav_core.errors.ArgumentError: orientation must be a non-zero quaternion, got (0.0, 0.0, 0.0, 0.0)
     """
     q = np.asarray(orientation, dtype=np.float64)
     if q.shape != (4,) or not np.isfinite(q).all():
-        raise ValueError(
+        raise ArgumentError(
             f"{name} must be a finite (x, y, z, w) quaternion of shape (4,), "
             f"got {orientation!r}"
         )
     x, y, z, w = q.tolist()
     if x * x + y * y + z * z + w * w < 1e-12:
-        raise ValueError(f"{name} must be a non-zero quaternion, got {orientation!r}")
+        raise ArgumentError(f"{name} must be a non-zero quaternion, got {orientation!r}")
     return math.atan2(2.0 * (w * z + x * y), w * w + x * x - y * y - z * z)
 
 

@@ -39,6 +39,7 @@ from dataclasses import dataclass, field
 from typing import Any
 
 from pointnav_core import validation
+from pointnav_core.errors import ArgumentError
 
 __all__ = [
     "EpisodeDataset",
@@ -195,7 +196,7 @@ class _Where:
         self.prefix = f"{name} (index {index}{' of ' + source if source else ''})"
 
     def error(self, field_name: str, must: str, got: Any) -> ValueError:
-        return ValueError(f"{self.prefix}: field '{field_name}' must be {must}, got {got!r}")
+        return ArgumentError(f"{self.prefix}: field '{field_name}' must be {must}, got {got!r}")
 
 
 def _is_number(value: Any) -> bool:
@@ -320,9 +321,9 @@ class EpisodeDataset:
         seen: dict[str, int] = {}
         for i, ep in enumerate(episodes):
             if not isinstance(ep, PointNavEpisode):
-                raise ValueError(f"episodes[{i}] must be a PointNavEpisode, got {ep!r}")
+                raise ArgumentError(f"episodes[{i}] must be a PointNavEpisode, got {ep!r}")
             if ep.episode_id in seen:
-                raise ValueError(
+                raise ArgumentError(
                     f"episode {ep.episode_id!r} (index {i}): field 'episode_id' must be unique, "
                     f"but index {seen[ep.episode_id]} has it too"
                 )
@@ -347,7 +348,7 @@ class EpisodeDataset:
     def to_json(self, frame: str = "z-up") -> dict[str, Any]:
         """The dataset as a JSON-able dict in ``frame`` (``"z-up"``, ours, or ``"habitat"``)."""
         if frame not in ("z-up", "habitat"):
-            raise ValueError(f"frame must be one of ['z-up', 'habitat'], got {frame!r}")
+            raise ArgumentError(f"frame must be one of ['z-up', 'habitat'], got {frame!r}")
         meta = {**self.metadata, "format_version": FORMAT_VERSION, "frame": frame}
         return {"episodes": [ep.to_json(frame) for ep in self.episodes], "pointnav_core": meta}
 
@@ -357,13 +358,13 @@ class EpisodeDataset:
         metadata). Raises ``ValueError`` naming the episode and the field for bad input."""
         where = f" in {source}" if source else ""
         if not isinstance(data, Mapping) or not isinstance(data.get("episodes"), list):
-            raise ValueError(f"a dataset must be an object with an 'episodes' list{where}")
+            raise ArgumentError(f"a dataset must be an object with an 'episodes' list{where}")
         meta = data.get("pointnav_core", {"frame": "habitat"})
         if not isinstance(meta, Mapping):
-            raise ValueError(f"field 'pointnav_core' must be an object{where}, got {meta!r}")
+            raise ArgumentError(f"field 'pointnav_core' must be an object{where}, got {meta!r}")
         frame = meta.get("frame", "z-up")
         if frame not in ("z-up", "habitat"):
-            raise ValueError(
+            raise ArgumentError(
                 f"field 'pointnav_core.frame' must be 'z-up' or 'habitat'{where}, got {frame!r}"
             )
         episodes = [
@@ -419,7 +420,7 @@ class EpisodeDataset:
         where = os.fspath(path)
         limit = MAX_DATASET_BYTES if max_bytes is None else validation.integer("max_bytes", max_bytes, minimum=1)
         if os.path.getsize(where) > limit:
-            raise ValueError(f"{where} is over the dataset budget of {limit} bytes (max_bytes)")
+            raise ArgumentError(f"{where} is over the dataset budget of {limit} bytes (max_bytes)")
         with open(where, "rb") as fh:
             raw = fh.read()
         if raw[:2] == b"\x1f\x8b":
@@ -427,7 +428,7 @@ class EpisodeDataset:
         try:
             data = json.loads(raw.decode("utf-8"))
         except (UnicodeDecodeError, json.JSONDecodeError) as err:
-            raise ValueError(f"{where} is not a JSON dataset: {err}") from None
+            raise ArgumentError(f"{where} is not a JSON dataset: {err}") from None
         return cls.from_json(data, source=os.path.basename(where))
 
 
@@ -441,13 +442,13 @@ def _gunzip(raw: bytes, limit: int, where: str) -> bytes:
                 # At most one byte past the budget: enough to know it is over.
                 out += inflate.decompress(raw, limit + 1 - len(out))
                 if len(out) > limit:
-                    raise ValueError(
+                    raise ArgumentError(
                         f"{where} inflates past the dataset budget of {limit} bytes (max_bytes)"
                     )
                 raw = inflate.unconsumed_tail
             if not inflate.eof:
-                raise ValueError(f"{where} is a truncated gzip file")
+                raise ArgumentError(f"{where} is a truncated gzip file")
             raw = inflate.unused_data
     except zlib.error as err:
-        raise ValueError(f"{where} is a corrupt gzip file: {err}") from None
+        raise ArgumentError(f"{where} is a corrupt gzip file: {err}") from None
     return bytes(out)

@@ -33,7 +33,7 @@ from numpy.typing import NDArray
 from pointnav_core import validation
 from pointnav_core.datasets.format import EpisodeDataset, PointNavEpisode
 from pointnav_core.datasets.scene_sets import SceneSet, load_scene
-from pointnav_core.errors import SamplingError
+from pointnav_core.errors import ArgumentError, SamplingError
 from pointnav_core.scenes import Scene, robot_radius
 
 __all__ = [
@@ -139,15 +139,15 @@ class GeneratorConfig:
                 or not math.isfinite(value)
                 or value < minimum
             ):
-                raise ValueError(f"{name} must be a finite number >= {minimum}, got {value!r}")
+                raise ArgumentError(f"{name} must be a finite number >= {minimum}, got {value!r}")
 
         lo_hi = self.geodesic_range
         if not isinstance(lo_hi, (tuple, list)) or len(lo_hi) != 2:
-            raise ValueError(f"geodesic_range must be (min, max) in metres, got {lo_hi!r}")
+            raise ArgumentError(f"geodesic_range must be (min, max) in metres, got {lo_hi!r}")
         number("geodesic_range[0]", lo_hi[0], 0.0)
         number("geodesic_range[1]", lo_hi[1], 0.0)
         if not lo_hi[0] < lo_hi[1]:
-            raise ValueError(f"geodesic_range must have min < max, got {lo_hi!r}")
+            raise ArgumentError(f"geodesic_range must have min < max, got {lo_hi!r}")
         number("ratio_threshold", self.ratio_threshold, 1.0)
         number("island_radius_limit", self.island_radius_limit, 0.0)
         number("robot_radius", self.robot_radius, 0.0)
@@ -156,7 +156,7 @@ class GeneratorConfig:
         for name in ("retries_per_goal", "max_goals_per_episode"):
             value = getattr(self, name)
             if isinstance(value, bool) or not isinstance(value, int) or value < 1:
-                raise ValueError(f"{name} must be an integer >= 1, got {value!r}")
+                raise ArgumentError(f"{name} must be an integer >= 1, got {value!r}")
 
 
 def _pick_cell(tmap: Any, radius: float, rng: np.random.Generator) -> NDArray[np.float64]:
@@ -208,7 +208,7 @@ def generate_episodes(
     """
     config = config or GeneratorConfig()
     if isinstance(n_episodes, bool) or not isinstance(n_episodes, int) or n_episodes < 0:
-        raise ValueError(f"n_episodes must be an integer >= 0, got {n_episodes!r}")
+        raise ArgumentError(f"n_episodes must be an integer >= 0, got {n_episodes!r}")
     rng = np.random.default_rng(seed)
     radius = config.robot_radius
     near, far = config.geodesic_range
@@ -327,9 +327,9 @@ def generate_split(
     config = config or GeneratorConfig()
     ids = scene_set.scene_ids(split)
     if not ids:
-        raise ValueError(f"split {split!r} of scene set {scene_set.name!r} has no scenes")
+        raise ArgumentError(f"split {split!r} of scene set {scene_set.name!r} has no scenes")
     if isinstance(n_episodes, bool) or not isinstance(n_episodes, int) or n_episodes < 1:
-        raise ValueError(f"n_episodes must be an integer >= 1, got {n_episodes!r}")
+        raise ArgumentError(f"n_episodes must be an integer >= 1, got {n_episodes!r}")
     episodes: list[PointNavEpisode] = []
     for k, scene_id in enumerate(ids):
         count = n_episodes // len(ids) + (k < n_episodes % len(ids))

@@ -26,6 +26,7 @@ from typing import Any
 import numpy as np
 
 from pointnav_core.datasets.format import PointNavEpisode
+from pointnav_core.errors import ArgumentError
 from pointnav_core.scenes import Scene
 
 __all__ = ["EpisodeSchedule", "episode_poses", "episode_seed"]
@@ -74,11 +75,11 @@ class EpisodeSchedule:
         seed: int | None = None,
     ) -> None:
         if not isinstance(shuffle, (bool, np.bool_)):
-            raise ValueError(f"shuffle must be True or False, got {shuffle!r}")
+            raise ArgumentError(f"shuffle must be True or False, got {shuffle!r}")
         self.episodes = [ep for ep in episodes if scene_id is None or ep.scene_id == scene_id]
         if not self.episodes:
             where = "" if scene_id is None else f" for scene_id {scene_id!r}"
-            raise ValueError(f"the schedule has no episodes{where}")
+            raise ArgumentError(f"the schedule has no episodes{where}")
         self.shuffle = bool(shuffle)
         self._rng = np.random.default_rng(seed)
         self._order: list[int] = []
@@ -126,21 +127,21 @@ def episode_poses(
         ``start_position``, ``goals[0].position``) that does not suit the env.
     """
     if not isinstance(episode, PointNavEpisode):
-        raise ValueError(f"episode must be a PointNavEpisode, got {episode!r}")
+        raise ArgumentError(f"episode must be a PointNavEpisode, got {episode!r}")
     name = f"episode {episode.episode_id!r} (scene {episode.scene_id!r})"
     here = getattr(scene, "scene_id", None)
     if here is not None and episode.scene_id != here:  # another house: its geodesics mean nothing here
-        raise ValueError(
+        raise ArgumentError(
             f"{name}: field 'scene_id' is {episode.scene_id!r}, but the env's scene is {here!r}; "
             "play it on an env of its own scene (datasets.load_scene)"
         )
     if episode.floor != floor:
-        raise ValueError(
+        raise ArgumentError(
             f"{name}: field 'info.floor' is {episode.floor}, but robot {robot_idn}'s task navigates "
             f"floor {floor}; build the env with task={{'floor': {episode.floor}}}"
         )
     if floor >= scene.n_floors:
-        raise ValueError(
+        raise ArgumentError(
             f"{name}: field 'info.floor' is {floor}, but the scene has {scene.n_floors} floor(s)"
         )
     height = scene.get_floor_height(floor)
@@ -150,13 +151,13 @@ def episode_poses(
         ("goals[0].position", episode.goal_position),
     ):
         if not all(math.isfinite(v) for v in xyz):
-            raise ValueError(f"{name}: field '{field_name}' must be 3 finite numbers (m), got {list(xyz)}")
+            raise ArgumentError(f"{name}: field '{field_name}' must be 3 finite numbers (m), got {list(xyz)}")
         if abs(xyz[2] - height) > _HEIGHT_TOL:
-            raise ValueError(
+            raise ArgumentError(
                 f"{name}: field '{field_name}' has z = {xyz[2]} m, but floor {floor} is at {height} m"
             )
         if not scene.is_usable(floor, xyz[:2], robot):
-            raise ValueError(
+            raise ArgumentError(
                 f"{name}: field '{field_name}' {list(xyz)} is not valid for robot {robot_idn} "
                 f"(radius {radius} m) on floor {floor}: off the map, on an obstacle or void, or closer "
                 f"than the radius to one (the episode was made for radius {episode.robot_radius} m)"
@@ -164,7 +165,7 @@ def episode_poses(
     _, _, qz, qw = episode.start_rotation
     norm = math.hypot(qz, qw)
     if not (math.isfinite(norm) and norm > 0.0):  # a NaN yaw would reach every observation
-        raise ValueError(
+        raise ArgumentError(
             f"{name}: field 'start_rotation' must be a finite yaw quaternion "
             f"(0, 0, sin(yaw/2), cos(yaw/2)), got {list(episode.start_rotation)}"
         )

@@ -41,6 +41,7 @@ from typing import Any
 import numpy as np
 
 from pointnav_core import scenes
+from pointnav_core.errors import ArgumentError
 from pointnav_core.maps import BoundedCache
 from pointnav_core.scenes import Scene
 
@@ -89,7 +90,7 @@ class SceneSet:
         for split, ids in self.splits.items():
             for scene_id in ids:
                 if scene_id in seen:
-                    raise ValueError(
+                    raise ArgumentError(
                         f"scene set {self.name!r}: scene {scene_id!r} is in both {seen[scene_id]!r} "
                         f"and {split!r}; splits must not share scenes"
                     )
@@ -98,7 +99,7 @@ class SceneSet:
     def scene_ids(self, split: str) -> tuple[str, ...]:
         """The scene ids of ``split``; ``ValueError`` naming the valid splits otherwise."""
         if split not in self.splits:
-            raise ValueError(f"split must be one of {list(self.splits)}, got {split!r}")
+            raise ArgumentError(f"split must be one of {list(self.splits)}, got {split!r}")
         return self.splits[split]
 
 
@@ -114,7 +115,7 @@ def generated_scene_set(
     {'train': ('rooms:0', 'rooms:1'), 'val': ('rooms:2',), 'test': ('rooms:3',)}
     """
     if generator not in GENERATORS:
-        raise ValueError(f"generator must be one of {sorted(GENERATORS)}, got {generator!r}")
+        raise ArgumentError(f"generator must be one of {sorted(GENERATORS)}, got {generator!r}")
     splits, seed = {}, first_seed
     for split, size in zip(SPLITS, sizes):
         splits[split] = tuple(f"{generator}:{s}" for s in range(seed, seed + size))
@@ -167,13 +168,13 @@ def folder_scene_set(
     """
     folder = os.fspath(folder)
     if not os.path.isdir(folder):
-        raise ValueError(f"scene folder {folder!r} does not exist or is not a folder")
+        raise ArgumentError(f"scene folder {folder!r} does not exist or is not a folder")
     if (
         len(fractions) != 3
         or any(f < 0 for f in fractions)
         or not math.isclose(sum(fractions), 1.0)
     ):
-        raise ValueError(f"fractions must be three numbers >= 0 summing to 1, got {fractions!r}")
+        raise ArgumentError(f"fractions must be three numbers >= 0 summing to 1, got {fractions!r}")
     ids = []
     for name in sorted(os.listdir(folder)):
         path = os.path.join(folder, name).replace(os.sep, "/")
@@ -183,7 +184,7 @@ def folder_scene_set(
         elif os.path.isdir(path) and _trav_images(path):
             ids.append(f"trav:{path}")
     if not ids:
-        raise ValueError(
+        raise ArgumentError(
             f"scene folder {folder!r} holds no scene: no .map, map_server .yaml, ProcTHOR or "
             "HouseExpo .json file, and no folder with floor_trav_*.png"
         )
@@ -209,7 +210,7 @@ def scene_set(spec: str, seed: int = 0) -> SceneSet:
         return SCENE_SETS[spec]
     if os.path.isdir(spec):
         return folder_scene_set(spec, seed=seed)
-    raise ValueError(
+    raise ArgumentError(
         f"scene set must be one of {sorted(SCENE_SETS)} or a folder of scenes, got {spec!r}"
     )
 
@@ -261,23 +262,23 @@ def locate_scene(scene_id: Any, root: str | os.PathLike[str] | None = None) -> t
         For a path that does not exist.
     """
     if not isinstance(scene_id, str) or not scene_id:
-        raise ValueError(f"scene_id must be a non-empty string ({_FORMS}), got {scene_id!r}")
+        raise ArgumentError(f"scene_id must be a non-empty string ({_FORMS}), got {scene_id!r}")
     scheme, _, rest = scene_id.partition(":")
     if scheme in GENERATORS:
         if not re.fullmatch(r"-?\d+", rest):
-            raise ValueError(f"unknown scene_id {scene_id!r}: {scheme}: takes an integer seed")
+            raise ArgumentError(f"unknown scene_id {scene_id!r}: {scheme}: takes an integer seed")
         return scheme, None
     if scheme in FILE_SCHEMES and rest:
         path = rest
     elif ":" not in scene_id or re.match(r"^[A-Za-z]:[\\/]", scene_id):  # a plain (or Windows) path
         path, scheme = scene_id, ""
     else:
-        raise ValueError(f"unknown scene_id {scene_id!r}: expected one of {_FORMS}")
+        raise ArgumentError(f"unknown scene_id {scene_id!r}: expected one of {_FORMS}")
     if root is not None:
         base = os.path.realpath(root)
         path = os.path.realpath(os.path.join(base, path))
         if os.path.commonpath([base, path]) != base:
-            raise ValueError(
+            raise ArgumentError(
                 f"scene_id {scene_id!r}: the path leaves the scenes folder {os.fspath(root)!r} "
                 "(scenes_root, --scenes-dir)"
             )
@@ -297,8 +298,8 @@ def _build(scene_id: Any, root: str | os.PathLike[str] | None) -> Scene:
     if os.path.isdir(path):
         images = _trav_images(path)
         if not images:
-            raise ValueError(f"scene_id {scene_id!r}: folder {path!r} has no floor_trav_<n>.png")
+            raise ArgumentError(f"scene_id {scene_id!r}: folder {path!r} has no floor_trav_<n>.png")
         return Scene.from_png(images)
     if path.endswith(".png"):
         return Scene.from_png(path)
-    raise ValueError(f"unknown scene_id {scene_id!r}: expected one of {_FORMS}")
+    raise ArgumentError(f"unknown scene_id {scene_id!r}: expected one of {_FORMS}")

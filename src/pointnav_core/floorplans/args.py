@@ -9,6 +9,7 @@ import shapely
 from shapely.geometry import MultiPolygon, Polygon
 
 from pointnav_core import validation
+from pointnav_core.errors import ArgumentError, ArgumentTypeError
 
 __all__ = [
     "Seed",
@@ -26,11 +27,11 @@ Seed = int | np.random.SeedSequence | np.random.Generator | None
 def check_polygon(geom: object, name: str) -> None:
     if not isinstance(geom, Polygon):
         hint = " (split it with shapely.get_parts)" if isinstance(geom, MultiPolygon) else ""
-        raise TypeError(f"{name} must be a shapely Polygon, got {type(geom).__name__}{hint}")
+        raise ArgumentTypeError(f"{name} must be a shapely Polygon, got {type(geom).__name__}{hint}")
     if geom.is_empty:
-        raise ValueError(f"{name} must be a non-empty Polygon")
+        raise ArgumentError(f"{name} must be a non-empty Polygon")
     if not geom.is_valid:
-        raise ValueError(f"{name} must be a valid Polygon: {shapely.is_valid_reason(geom)}")
+        raise ArgumentError(f"{name} must be a valid Polygon: {shapely.is_valid_reason(geom)}")
 
 
 def check_positive(value: float, name: str, unit: str = "m") -> float:
@@ -41,16 +42,16 @@ def check_pair(value: Sequence[float], name: str, meaning: str) -> tuple[float, 
     try:
         a, b = validation.vector(name, value, sizes=(2,))
     except ValueError:
-        raise ValueError(f"{name} must be two numbers {meaning}, got {value!r}") from None
+        raise ArgumentError(f"{name} must be two numbers {meaning}, got {value!r}") from None
     if not (a > 0.0 and b > 0.0):
-        raise ValueError(f"{name} must be two finite numbers > 0 {meaning}, got {value!r}")
+        raise ArgumentError(f"{name} must be two finite numbers > 0 {meaning}, got {value!r}")
     return float(a), float(b)
 
 
 def check_range(value: Sequence[float], name: str) -> tuple[float, float]:
     lo, hi = check_pair(value, name, "(min, max) in metres")
     if lo > hi:
-        raise ValueError(f"{name} must be (min, max) with min <= max, got {value!r}")
+        raise ArgumentError(f"{name} must be (min, max) with min <= max, got {value!r}")
     return lo, hi
 
 
@@ -63,5 +64,5 @@ def rng_from(seed: object) -> np.random.Generator:
 
 def check_probability(value: float, name: str) -> float:
     if not (validation.is_real(value) and 0.0 <= value <= 1.0):
-        raise ValueError(f"{name} must be a probability in [0, 1], got {value!r}")
+        raise ArgumentError(f"{name} must be a probability in [0, 1], got {value!r}")
     return float(value)

@@ -9,6 +9,7 @@ import shapely
 from shapely import affinity
 from shapely.geometry import Point, Polygon, box
 
+from pointnav_core.errors import ArgumentError
 from pointnav_core.floorplans.args import (
     Seed,
     check_pair,
@@ -92,7 +93,7 @@ def clutter(
         or not isinstance(n_obstacles, (int, np.integer))
         or n_obstacles < 0
     ):
-        raise ValueError(f"n_obstacles must be an integer >= 0 or None, got {n_obstacles!r}")
+        raise ArgumentError(f"n_obstacles must be an integer >= 0 or None, got {n_obstacles!r}")
     size_lo, size_hi = check_range(obstacle_size, "obstacle_size")
     discs = check_probability(discs, "discs")
     grouped = check_probability(grouped, "grouped")
@@ -101,7 +102,7 @@ def clutter(
     margin = wall + gap  # shapes keep ``gap`` from the wall
     hall = (-width / 2 + margin, -height / 2 + margin, width / 2 - margin, height / 2 - margin)
     if hall[2] - hall[0] < size_hi or hall[3] - hall[1] < size_hi:
-        raise ValueError(
+        raise ArgumentError(
             f"size must leave room for the largest obstacle: at least "
             f"obstacle_size[1] + 2 * (wall + gap) = {size_hi + 2 * (wall + gap)} m a side, got {size!r}"
         )

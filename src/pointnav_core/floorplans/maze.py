@@ -8,6 +8,7 @@ import numpy as np
 from numpy.typing import NDArray
 from shapely.geometry import Polygon, box
 
+from pointnav_core.errors import ArgumentError
 from pointnav_core.floorplans.args import (
     Seed,
     check_pair,
@@ -74,7 +75,7 @@ def maze(
     nx = math.floor((width - wall) / pitch + SNAP_TOL)
     ny = math.floor((height - wall) / pitch + SNAP_TOL)
     if nx < 1 or ny < 1 or nx * ny < 2:
-        raise ValueError(
+        raise ArgumentError(
             f"size must fit at least 2 cells of corridor + wall = {pitch} m (plus one wall), "
             f"got {size!r}"
         )

@@ -12,6 +12,7 @@ from numpy.typing import NDArray
 from shapely.geometry import Polygon, box
 
 from pointnav_core import validation
+from pointnav_core.errors import ArgumentError, ArgumentTypeError
 from pointnav_core.floorplans.args import check_polygon, check_positive
 from pointnav_core.maps import FREE, OBSTACLE, VOID
 
@@ -60,7 +61,7 @@ class FloorPlan:
     def __post_init__(self) -> None:
         check_polygon(self.outline, "outline")
         if isinstance(self.obstacles, (str, bytes)) or not isinstance(self.obstacles, Iterable):
-            raise TypeError(
+            raise ArgumentTypeError(
                 f"obstacles must be an iterable of shapely Polygons, got {type(self.obstacles).__name__}"
             )
         obstacles = tuple(self.obstacles)
@@ -164,7 +165,7 @@ def rasterize(
     try:  # the cell-centre arrays alone would take gigabytes
         validation.cell_budget("the rasterised outline", height, width)
     except ValueError as err:
-        raise ValueError(
+        raise ArgumentError(
             f"resolution {resolution} m/cell is too fine for an outline of "
             f"{xmax - xmin:.3g} x {ymax - ymin:.3g} m: {err}"
         ) from None

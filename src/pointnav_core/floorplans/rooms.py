@@ -11,6 +11,7 @@ from numpy.typing import NDArray
 from shapely import affinity
 from shapely.geometry import Point, Polygon, box
 
+from pointnav_core.errors import ArgumentError
 from pointnav_core.floorplans.args import (
     Seed,
     check_pair,
@@ -121,22 +122,22 @@ def rooms(
     door_lo, door_hi = check_range(door_width, "door_width")
     min_room = check_positive(min_room, "min_room")
     if min_room < door_hi + 2 * _DOOR_MARGIN:
-        raise ValueError(
+        raise ArgumentError(
             f"min_room must be at least the widest door plus {2 * _DOOR_MARGIN} m "
             f"({door_hi + 2 * _DOOR_MARGIN} m), got {min_room}"
         )
     max_room = check_positive(max_room, "max_room")
     if max_room < min_room:
-        raise ValueError(f"max_room must be >= min_room ({min_room} m), got {max_room}")
+        raise ArgumentError(f"max_room must be >= min_room ({min_room} m), got {max_room}")
     l_shape = check_probability(l_shape, "l_shape")
     furniture = float(furniture)
     if not (math.isfinite(furniture) and furniture >= 0.0):
-        raise ValueError(
+        raise ArgumentError(
             f"furniture must be a finite number >= 0 (pieces per room), got {furniture!r}"
         )
     clearance = check_positive(clearance, "clearance")
     if min(width, height) < min_room + 2 * outer_wall:
-        raise ValueError(
+        raise ArgumentError(
             f"size must be at least min_room + 2 * outer_wall = {min_room + 2 * outer_wall} m "
             f"on each side, got {size!r}"
         )

@@ -34,6 +34,8 @@ from typing import TYPE_CHECKING
 import numpy as np
 from numpy.typing import NDArray
 
+from pointnav_core.errors import ArgumentError
+
 if TYPE_CHECKING:
     from pointnav_core.collision import FloorCollision
 
@@ -89,7 +91,7 @@ def load(key: str, n_nodes: int) -> dict[str, NDArray] | None:
         with open(path, "rb") as f, np.load(f, allow_pickle=False) as z:  # our handle: closed on any error
             data = {name: z[name] for name in z.files}
         if str(data["key"]) != key or len(data["sights"]) != n_nodes:
-            raise ValueError("it belongs to another floor")
+            raise ArgumentError("it belongs to another floor")
     except (OSError, ValueError, KeyError, EOFError, zipfile.BadZipFile) as err:
         warnings.warn(f"geometry cache file {path} is unreadable ({err}); rebuilding it", RuntimeWarning, stacklevel=3)
         try:

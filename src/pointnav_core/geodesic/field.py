@@ -18,6 +18,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from pointnav_core.errors import ArgumentError
 from pointnav_core.frozen import ThawOnUnpickle
 from pointnav_core.geodesic.arc_graph import FieldLabels
 from pointnav_core.geodesic.cell_links import centre_cell
@@ -236,10 +237,10 @@ class GoalField(ThawOnUnpickle):
         else:
             idx = np.asarray(cells)
             if idx.ndim != 1 or (idx.size and not np.issubdtype(idx.dtype, np.integer)):
-                raise ValueError(f"cells must be a 1D array of integer cell indices, got shape {idx.shape} of {idx.dtype}")
+                raise ArgumentError(f"cells must be a 1D array of integer cell indices, got shape {idx.shape} of {idx.dtype}")
             idx = idx.astype(np.int64)
             if idx.size and (idx.min() < 0 or idx.max() >= h * w):
-                raise ValueError(f"cells must lie in [0, {h * w}), got {idx.min()} to {idx.max()}")
+                raise ArgumentError(f"cells must lie in [0, {h * w}), got {idx.min()} to {idx.max()}")
         b = BLOCK
         blocks = np.unique((idx // w) // b * t["blocks_w"] + (idx % w) // b)
         todo = blocks[~t["done"][blocks]]

@@ -47,6 +47,7 @@ from scipy import ndimage
 from scipy.spatial import cKDTree
 from tqdm.auto import tqdm
 
+from pointnav_core.errors import ArgumentError
 from pointnav_core.collision import TOUCH_TOL, FloorCollision, convex_corners
 from pointnav_core.frozen import ThawOnUnpickle
 from pointnav_core.paths import path_length, resample_path
@@ -335,7 +336,7 @@ class Planner(ThawOnUnpickle):
         used = self.geometry_nbytes
         if used > self.geometry_bytes:
             h, w = self.geo.shape
-            raise ValueError(
+            raise ArgumentError(
                 f"the geometry of this {h} x {w}-cell floor ({self.n_nodes} corners) for a robot of radius "
                 f"{self.radius} m needs more than Planner.geometry_bytes = {self.geometry_bytes / 2**20:.0f} MiB "
                 f"({used / 2**20:.0f} MiB so far); raise the budget (pointnav_core.geodesic.Planner.geometry_bytes "

@@ -47,6 +47,7 @@ from stable_baselines3.common.vec_env import VecEnv
 from stable_baselines3.common.vec_env.base_vec_env import VecEnvIndices, VecEnvObs, VecEnvStepReturn
 from stable_baselines3.common.vec_env.util import dict_to_obs, obs_space_info
 
+from pointnav_core.errors import ArgumentError, TaskStateError
 from pointnav_core.integrations import METRIC_KEYS, episode_metrics
 from pointnav_core.parallel import MultiPointNavEnv
 
@@ -86,9 +87,9 @@ class MultiRobotVecEnv(VecEnv):
             worlds = [worlds]
         self.worlds: list[World] = [w() if callable(w) else w for w in worlds]
         if not self.worlds:
-            raise ValueError("MultiRobotVecEnv needs at least one world")
+            raise ArgumentError("MultiRobotVecEnv needs at least one world")
         if len({id(w) for w in self.worlds}) != len(self.worlds):
-            raise ValueError(
+            raise ArgumentError(
                 "each world must be its own env object; pass functions that build a new one"
             )
         #: ``(world index, agent)`` of each slot.
@@ -103,13 +104,13 @@ class MultiRobotVecEnv(VecEnv):
         act_space = first_world.action_space(first_agent)
         for w, agent in self.slots:
             if self.worlds[w].observation_space(agent) != obs_space:
-                raise ValueError(
+                raise ArgumentError(
                     f"every robot must have the same observation space: world {w}'s {agent} "
                     f"has {self.worlds[w].observation_space(agent)}, world 0's {first_agent} "
                     f"{obs_space}"
                 )
             if self.worlds[w].action_space(agent) != act_space:
-                raise ValueError(
+                raise ArgumentError(
                     f"every robot must have the same action space (the same drive): world {w}'s "
                     f"{agent} has {self.worlds[w].action_space(agent)}, world 0's {first_agent} "
                     f"{act_space}"
@@ -143,7 +144,7 @@ class MultiRobotVecEnv(VecEnv):
     def step_wait(self) -> VecEnvStepReturn:
         actions = self._actions
         if actions is None:
-            raise RuntimeError("step_wait() needs a step_async(actions) first")
+            raise TaskStateError("step_wait() needs a step_async(actions) first")
         self._actions = None
         rewards = np.zeros(self.num_envs, dtype=np.float32)
         dones = np.zeros(self.num_envs, dtype=bool)
@@ -262,7 +263,7 @@ def make_vec_env(
     (6, (8,), (6, 8))
     """
     if isinstance(n_worlds, bool) or not isinstance(n_worlds, int) or n_worlds < 1:
-        raise ValueError(f"n_worlds must be an integer >= 1, got {n_worlds!r}")
+        raise ArgumentError(f"n_worlds must be an integer >= 1, got {n_worlds!r}")
     venv = MultiRobotVecEnv(
         [MultiPointNavEnv(flatten_obs=flatten_obs, **env_kwargs) for _ in range(n_worlds)]
     )
@@ -300,7 +301,7 @@ class PointNavMetricsCallback(BaseCallback):
     def __init__(self, window: int = 100, verbose: int = 0) -> None:
         super().__init__(verbose)
         if isinstance(window, bool) or not isinstance(window, int) or window < 1:
-            raise ValueError(f"window must be an integer >= 1, got {window!r}")
+            raise ArgumentError(f"window must be an integer >= 1, got {window!r}")
         self.window = window
         self.episodes = 0
         self._recent: dict[str, deque[float]] = {key: deque(maxlen=window) for key in METRIC_KEYS}

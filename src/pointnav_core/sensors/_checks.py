@@ -26,7 +26,7 @@ def check_number(
     >>> check_number("max_range", True, low=0.0)
     Traceback (most recent call last):
     ...
-    ValueError: max_range must be a finite number >= 0, got True
+    pointnav_core.errors.ArgumentError: max_range must be a finite number >= 0, got True
     """
     return validation.real(name, value, minimum=low, strict=strict_low, maximum=high, unit=unit)
 

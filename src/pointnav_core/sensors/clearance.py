@@ -15,6 +15,8 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from pointnav_core.errors import ArgumentError
+
 __all__ = ["QUADRANTS", "quadrant_clearance"]
 
 #: The quadrants' (sign of x, sign of y), in the table's order: index
@@ -50,7 +52,7 @@ def quadrant_clearance(free: ArrayLike) -> NDArray[np.uint8]:
     """
     free = np.asarray(free, dtype=bool)
     if free.ndim != 2:
-        raise ValueError(f"free must be a 2-D array, got shape {free.shape}")
+        raise ArgumentError(f"free must be a 2-D array, got shape {free.shape}")
     hp, wp = free.shape
     out = np.zeros((hp, wp, 4), np.int64)
     for q, (sx, sy) in enumerate(QUADRANTS):

@@ -16,11 +16,11 @@ task.
 >>> make_sensors({"lidar": {}})
 Traceback (most recent call last):
 ...
-ValueError: sensors has an unknown sensor 'lidar'; valid sensors are ['scan', 'local_map']
+pointnav_core.errors.ArgumentError: sensors has an unknown sensor 'lidar'; valid sensors are ['scan', 'local_map']
 >>> make_sensors({"scan": {"rays": 8}})
 Traceback (most recent call last):
 ...
-ValueError: sensors['scan'] has an unknown key 'rays'; valid keys are ['n_rays', 'fov', 'min_range', 'max_range', 'noise_std', 'dropout']
+pointnav_core.errors.ArgumentError: sensors['scan'] has an unknown key 'rays'; valid keys are ['n_rays', 'fov', 'min_range', 'max_range', 'noise_std', 'dropout']
 """
 
 from __future__ import annotations
@@ -29,6 +29,7 @@ import inspect
 from collections.abc import Mapping
 from typing import Any
 
+from pointnav_core.errors import ArgumentError
 from pointnav_core.observations import ObservationTerm
 from pointnav_core.sensors.local_map import LocalMap
 from pointnav_core.sensors.scan import RangeScan
@@ -60,13 +61,13 @@ def make_sensors(sensors: Mapping[str, Any] | None, name: str = "sensors") -> li
     if sensors is None:
         return []
     if not isinstance(sensors, Mapping):
-        raise ValueError(
+        raise ArgumentError(
             f"{name} must be None or a dict of sensor name -> arguments, with names in "
             f"{list(SENSOR_ORDER)}, got {sensors!r}"
         )
     for key in sensors:
         if key not in SENSORS:
-            raise ValueError(
+            raise ArgumentError(
                 f"{name} has an unknown sensor {key!r}; valid sensors are {list(SENSOR_ORDER)}"
             )
     terms: list[ObservationTerm] = []
@@ -80,18 +81,18 @@ def make_sensors(sensors: Mapping[str, Any] | None, name: str = "sensors") -> li
         if args is None:
             args = {}
         if not isinstance(args, Mapping):
-            raise ValueError(
+            raise ArgumentError(
                 f"{name}[{key!r}] must be a dict of {cls.__name__} arguments, None, or a "
                 f"{cls.__name__}, got {args!r}"
             )
         valid = list(inspect.signature(cls).parameters)
         for arg in args:
             if arg not in valid:
-                raise ValueError(
+                raise ArgumentError(
                     f"{name}[{key!r}] has an unknown key {arg!r}; valid keys are {valid}"
                 )
         try:
             terms.append(cls(**args))
         except ValueError as err:
-            raise ValueError(f"{name}[{key!r}]: {err}") from None
+            raise ArgumentError(f"{name}[{key!r}]: {err}") from None
     return terms

@@ -33,7 +33,7 @@ Examples
 >>> LocalMap(cells=0)
 Traceback (most recent call last):
 ...
-ValueError: cells must be an integer >= 1, got 0
+pointnav_core.errors.ArgumentError: cells must be an integer >= 1, got 0
 """
 
 from __future__ import annotations
@@ -45,6 +45,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from pointnav_core.errors import ArgumentError
 from pointnav_core.maps import FREE, OBSTACLE, VOID
 from pointnav_core.observations import Frame, ObservationTerm
 from pointnav_core.sensors._checks import check_int, check_number
@@ -98,7 +99,7 @@ class LocalMap(ObservationTerm):
         self.extent = check_number("size", size, low=0.0, strict_low=True, unit="m")
         self.cells = check_int("cells", cells, 1)
         if not isinstance(dtype, str) or dtype not in LOCAL_MAP_DTYPES:
-            raise ValueError(f"dtype must be one of {list(LOCAL_MAP_DTYPES)}, got {dtype!r}")
+            raise ArgumentError(f"dtype must be one of {list(LOCAL_MAP_DTYPES)}, got {dtype!r}")
         self.dtype = np.dtype(dtype)
         self.shape = (self.cells, self.cells)
         self.size = self.cells * self.cells

@@ -37,6 +37,8 @@ import numpy as np
 from numpy.typing import NDArray
 from scipy.special import ndtri
 
+from pointnav_core.errors import ArgumentError
+
 __all__ = ["DROPOUT", "NOISE", "episode_key", "mix", "normals", "scan_noise", "seed_entropy", "uniforms"]
 
 #: The channel of the Gaussian noise.
@@ -171,7 +173,7 @@ def scan_noise(
         channel :data:`DROPOUT`, each of the keys' shape with ``n_rays`` last.
     """
     if method not in ("auto", "numpy", "numba"):
-        raise ValueError(f"method must be 'auto', 'numpy' or 'numba', got {method!r}")
+        raise ArgumentError(f"method must be 'auto', 'numpy' or 'numba', got {method!r}")
     channels = [c for c, on in ((NOISE, noise_std > 0.0), (DROPOUT, dropout > 0.0)) if on]
     if not channels:
         return None, None
@@ -188,7 +190,7 @@ def _ray_uniforms(h: NDArray[np.uint64], n_rays: int, channels: list[int], metho
     ``(len(channels),) + h.shape[:-1] + (n_rays,)`` (``h`` has a trailing axis of 1)."""
     kernel = _kernel() if method != "numpy" else None
     if method == "numba" and kernel is None:
-        raise ValueError('method="numba" needs numba: pip install "pointnav-core[fast]"')
+        raise ArgumentError('method="numba" needs numba: pip install "pointnav-core[fast]"')
     if kernel is not None:
         flat = np.ascontiguousarray(h, dtype=np.uint64).reshape(-1)
         out = np.empty((len(channels), flat.shape[0], n_rays))

@@ -43,6 +43,7 @@ import shapely
 import shapely.geometry
 from numpy.typing import ArrayLike, NDArray
 
+from pointnav_core.errors import ArgumentError, ArgumentTypeError
 from pointnav_core.maps import OBSTACLE, TraversableMap
 from pointnav_core.sensors import raycast_jit
 from pointnav_core.sensors.clearance import quadrant_clearance
@@ -78,7 +79,7 @@ class ScanGeometry:
 
     def __init__(self, tmap: TraversableMap) -> None:
         if not isinstance(tmap, TraversableMap):
-            raise TypeError(f"tmap must be a TraversableMap, got {type(tmap).__name__}")
+            raise ArgumentTypeError(f"tmap must be a TraversableMap, got {type(tmap).__name__}")
         self.tmap = tmap
         self.resolution = float(tmap.resolution)
         self.origin = (float(tmap.origin[0]), float(tmap.origin[1]))
@@ -238,7 +239,7 @@ def cast_rays(
     [[1.0]]
     """
     if method not in _METHODS:
-        raise ValueError(f"method must be one of {', '.join(map(repr, _METHODS))}, got {method!r}")
+        raise ArgumentError(f"method must be one of {', '.join(map(repr, _METHODS))}, got {method!r}")
     p = np.asarray(origins, dtype=np.float64).reshape(-1, 2)
     yaw = np.asarray(yaws, dtype=np.float64).reshape(-1)
     ang = np.asarray(angles, dtype=np.float64).reshape(-1)
@@ -259,7 +260,7 @@ def cast_rays(
             best[inside_polygon(geometry, p)] = 0.0
         return best
     if method == "numba":
-        raise ValueError('method="numba" needs numba: pip install "pointnav-core[fast]"')
+        raise ArgumentError('method="numba" needs numba: pip install "pointnav-core[fast]"')
     c = cy[:, None] * ca[None, :] - sy[:, None] * sa[None, :]
     s = sy[:, None] * ca[None, :] + cy[:, None] * sa[None, :]
     best = np.minimum(

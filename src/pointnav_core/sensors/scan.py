@@ -37,7 +37,7 @@ Examples
 >>> RangeScan(n_rays=0)
 Traceback (most recent call last):
 ...
-ValueError: n_rays must be an integer >= 1, got 0
+pointnav_core.errors.ArgumentError: n_rays must be an integer >= 1, got 0
 """
 
 from __future__ import annotations
@@ -50,6 +50,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from pointnav_core.backend import float_twin
+from pointnav_core.errors import ArgumentError
 from pointnav_core.observations import Frame, ObservationTerm
 from pointnav_core.sensors._checks import check_int, check_number
 from pointnav_core.sensors.noise import episode_key, scan_noise, seed_entropy
@@ -145,7 +146,7 @@ class RangeScan(ObservationTerm):
         self.max_range = check_number("max_range", max_range, low=0.0, strict_low=True, unit="m")
         self.min_range = check_number("min_range", min_range, low=0.0, unit="m")
         if self.min_range >= self.max_range:
-            raise ValueError(
+            raise ArgumentError(
                 f"min_range must be below max_range ({self.max_range} m), got {min_range!r}"
             )
         self.noise_std = check_number("noise_std", noise_std, low=0.0, unit="m")

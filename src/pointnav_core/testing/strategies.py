@@ -13,6 +13,7 @@ from hypothesis import note
 from hypothesis import strategies as st
 
 from pointnav_core import floorplans
+from pointnav_core.errors import ArgumentError
 from pointnav_core.floorplans import FloorPlan
 from pointnav_core.maps import FREE, OBSTACLE, VOID, TraversableMap
 
@@ -49,7 +50,7 @@ def floor_plans(
     kinds = tuple(kinds)
     unknown = [k for k in kinds if k not in valid]
     if not kinds or unknown:
-        raise ValueError(f"kinds must be a non-empty subset of {valid}, got {kinds!r}")
+        raise ArgumentError(f"kinds must be a non-empty subset of {valid}, got {kinds!r}")
     return _floor_plans(kinds)
 
 
@@ -97,7 +98,7 @@ def yaws(
         Bounds in radians, finite, ``min_value <= max_value``.
     """
     if not (math.isfinite(min_value) and math.isfinite(max_value) and min_value <= max_value):
-        raise ValueError(
+        raise ArgumentError(
             f"min_value and max_value must be finite with min_value <= max_value, "
             f"got {min_value!r} and {max_value!r}"
         )
@@ -117,7 +118,7 @@ def euler_angles(gimbal_margin: float = 0.0) -> st.SearchStrategy[np.ndarray]:
         Distance in radians to keep from pitch = +-pi/2, in [0, pi/2).
     """
     if not 0.0 <= gimbal_margin < math.pi / 2:
-        raise ValueError(f"gimbal_margin must be in [0, pi/2) radians, got {gimbal_margin!r}")
+        raise ArgumentError(f"gimbal_margin must be in [0, pi/2) radians, got {gimbal_margin!r}")
     half_turn = st.floats(-math.pi, math.pi, exclude_min=True)
     limit = math.pi / 2 - gimbal_margin
     return st.tuples(half_turn, st.floats(-limit, limit), half_turn).map(
@@ -139,9 +140,9 @@ def finite_vectors(n: int, max_abs: float = 1e3) -> st.SearchStrategy[np.ndarray
         Largest absolute value of an entry, finite and > 0.
     """
     if not (isinstance(n, int) and n >= 1):
-        raise ValueError(f"n must be an int >= 1, got {n!r}")
+        raise ArgumentError(f"n must be an int >= 1, got {n!r}")
     if not (math.isfinite(max_abs) and max_abs > 0):
-        raise ValueError(f"max_abs must be a finite number > 0, got {max_abs!r}")
+        raise ArgumentError(f"max_abs must be a finite number > 0, got {max_abs!r}")
     return st.lists(st.floats(-max_abs, max_abs), min_size=n, max_size=n).map(
         lambda values: np.array(values, dtype=np.float64)
     )
@@ -174,11 +175,11 @@ def robot_specs(
 
     drives = tuple(drives)
     if not drives or any(d not in DRIVES for d in drives):
-        raise ValueError(f"drives must be a non-empty subset of {tuple(DRIVES)}, got {drives!r}")
+        raise ArgumentError(f"drives must be a non-empty subset of {tuple(DRIVES)}, got {drives!r}")
     if not (math.isfinite(max_radius) and max_radius >= 0.0):
-        raise ValueError(f"max_radius must be a finite number >= 0 (metres), got {max_radius!r}")
+        raise ArgumentError(f"max_radius must be a finite number >= 0 (metres), got {max_radius!r}")
     if not (math.isfinite(max_speed) and max_speed >= 0.01):
-        raise ValueError(f"max_speed must be a finite number >= 0.01 (m/s), got {max_speed!r}")
+        raise ArgumentError(f"max_speed must be a finite number >= 0.01 (m/s), got {max_speed!r}")
     return st.builds(
         RobotSpec,
         radius=st.floats(0.0, max_radius),
@@ -202,7 +203,7 @@ def robot_actions(spec: object, overshoot: float = 0.0) -> st.SearchStrategy[np.
         How far beyond ``[-1, 1]`` components may go, >= 0.
     """
     if not (math.isfinite(overshoot) and overshoot >= 0.0):
-        raise ValueError(f"overshoot must be a finite number >= 0, got {overshoot!r}")
+        raise ArgumentError(f"overshoot must be a finite number >= 0, got {overshoot!r}")
     bound = 1.0 + overshoot
     n = int(spec.action_dim)  # type: ignore[attr-defined]
     return st.lists(st.floats(-bound, bound), min_size=n, max_size=n).map(
@@ -291,7 +292,7 @@ def nav_scenes(draw: st.DrawFn, min_side: int = 16, max_side: int = 22) -> objec
     from pointnav_core.scenes import Scene  # this block was appended: import here
 
     if not 16 <= min_side <= max_side:
-        raise ValueError(
+        raise ArgumentError(
             f"min_side and max_side must satisfy 16 <= min_side <= max_side, got "
             f"{min_side!r} and {max_side!r}"
         )
@@ -345,7 +346,7 @@ def nav_task_kwargs(draw: st.DrawFn, max_steps: int = 60) -> dict:
         Largest ``max_steps`` drawn, >= 1.
     """
     if not (isinstance(max_steps, int) and max_steps >= 1):
-        raise ValueError(f"max_steps must be an int >= 1, got {max_steps!r}")
+        raise ArgumentError(f"max_steps must be an int >= 1, got {max_steps!r}")
     return {
         "reward_type": draw(st.sampled_from(("l2", "geodesic"))),
         "goal_tolerance": draw(st.floats(0.1, 0.5)),
@@ -396,11 +397,11 @@ def scenes(
     from pointnav_core.scenes import Scene  # this block was appended: import here
 
     if not (isinstance(max_floors, int) and max_floors >= 1):
-        raise ValueError(f"max_floors must be an int >= 1, got {max_floors!r}")
+        raise ArgumentError(f"max_floors must be an int >= 1, got {max_floors!r}")
     if not (isinstance(max_side, int) and max_side >= 2):
-        raise ValueError(f"max_side must be an int >= 2, got {max_side!r}")
+        raise ArgumentError(f"max_side must be an int >= 2, got {max_side!r}")
     if not resolutions or not all(math.isfinite(r) and r > 0 for r in resolutions):
-        raise ValueError(
+        raise ArgumentError(
             f"resolutions must be a non-empty tuple of numbers > 0, got {resolutions!r}"
         )
     n = draw(st.integers(1, max_floors))
@@ -417,7 +418,7 @@ def _usable_cells(scene: object, radius: float, floors: object) -> dict[int, np.
     cells = {}
     for f in chosen:
         if not (isinstance(f, int) and 0 <= f < n):
-            raise ValueError(f"floor must be an int in [0, {n}), got {f!r}")
+            raise ArgumentError(f"floor must be an int in [0, {n}), got {f!r}")
         found = np.argwhere(scene.floors[f].usable(radius))  # type: ignore[attr-defined]
         if len(found):
             cells[f] = found
@@ -454,7 +455,7 @@ def valid_poses(
     radius = robot_radius(robot)
     cells = _usable_cells(scene, radius, floor)
     if not cells:
-        raise ValueError(
+        raise ArgumentError(
             f"robot of radius {radius} m fits nowhere on "
             f"{'floor ' + str(floor) if floor is not None else 'any floor'} of {scene!r}"
         )
@@ -542,7 +543,7 @@ def action_sequences(
     """
     ints = isinstance(min_steps, int) and isinstance(max_steps, int)
     if not (ints and 0 <= min_steps <= max_steps):
-        raise ValueError(
+        raise ArgumentError(
             f"min_steps and max_steps must be ints with 0 <= min_steps <= max_steps, got "
             f"{min_steps!r} and {max_steps!r}"
         )

@@ -19,6 +19,8 @@ import numpy as np
 import torch
 from torch import nn
 
+from pointnav_core.errors import ArgumentError
+
 __all__ = ["ActorCritic", "RunningNorm", "as_tensor", "layer"]
 
 
@@ -58,7 +60,7 @@ class RunningNorm:
         """Take the statistics of :meth:`state_dict`; ValueError for another shape."""
         mean, var = state["mean"], state["var"]
         if tuple(mean.shape) != tuple(self.mean.shape) or tuple(var.shape) != tuple(self.var.shape):
-            raise ValueError(
+            raise ArgumentError(
                 f"observation statistics of shape {tuple(mean.shape)}, expected {tuple(self.mean.shape)}"
             )
         self.mean, self.var = mean.double().clone(), var.double().clone()

@@ -33,6 +33,7 @@ from typing import Any
 import torch
 
 from pointnav_core.env_config import EnvConfig
+from pointnav_core.errors import ArgumentError
 from pointnav_core.training.agent import ActorCritic, RunningNorm
 
 __all__ = ["CHECKPOINT_SUFFIX", "FORMAT", "FORMAT_VERSION", "Checkpoint", "load_checkpoint", "save_checkpoint"]
@@ -109,7 +110,7 @@ def save_checkpoint(
     from pointnav_core.outputs import atomic_writer
 
     if not isinstance(env_config, EnvConfig):
-        raise ValueError(f"env_config must be an EnvConfig, got {env_config!r}")
+        raise ArgumentError(f"env_config must be an EnvConfig, got {env_config!r}")
     data = {
         "format": FORMAT,
         "format_version": FORMAT_VERSION,
@@ -134,7 +135,7 @@ def _read(path: str) -> Any:
         raise
     except Exception as err:  # noqa: BLE001 -- torch says "not a zip archive", "weights only load failed", ...
         first = str(err).strip().splitlines()[0] if str(err).strip() else type(err).__name__
-        raise ValueError(
+        raise ArgumentError(
             f"checkpoint {path!r} cannot be read as a pointnav-core checkpoint (a corrupt, truncated "
             f"or foreign file, or one that asks to run code): {first}"
         ) from None
@@ -155,7 +156,7 @@ def load_checkpoint(path: str | os.PathLike[str]) -> Checkpoint:
     data = _read(path)
 
     def bad(what: str) -> ValueError:
-        return ValueError(f"checkpoint {path!r} is not a pointnav-core checkpoint: {what}")
+        return ArgumentError(f"checkpoint {path!r} is not a pointnav-core checkpoint: {what}")
 
     if not isinstance(data, dict) or data.get("format") != FORMAT:
         raise bad(f"it has no 'format': {FORMAT!r} entry")

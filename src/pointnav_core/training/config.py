@@ -36,6 +36,7 @@ from typing import Any
 
 from pointnav_core import validation
 from pointnav_core.env_config import EnvConfig, read_config_file
+from pointnav_core.errors import ArgumentError
 from pointnav_core.training.ppo import PPOSettings
 
 __all__ = ["EngineSettings", "TrainConfig"]
@@ -79,7 +80,7 @@ class EngineSettings:
         if self.workers is not None:
             validation.integer("workers", self.workers, minimum=1)
         if not isinstance(self.device, str):
-            raise ValueError(f"device must be 'numpy', 'cpu' or 'cuda[:n]', got {self.device!r}")
+            raise ArgumentError(f"device must be 'numpy', 'cpu' or 'cuda[:n]', got {self.device!r}")
 
 
 def _section(cls: Any, name: str, data: Any) -> Any:
@@ -87,12 +88,12 @@ def _section(cls: Any, name: str, data: Any) -> Any:
     if isinstance(data, cls):
         return data
     if not isinstance(data, Mapping):
-        raise ValueError(f"{name} must be a mapping of its fields, got {data!r}")
+        raise ArgumentError(f"{name} must be a mapping of its fields, got {data!r}")
     validation.known_keys(name, data, [f.name for f in dataclasses.fields(cls)])
     try:
         return cls(**data)
     except ValueError as err:
-        raise ValueError(f"{name}: {err}") from None
+        raise ArgumentError(f"{name}: {err}") from None
 
 
 @dataclasses.dataclass(frozen=True, kw_only=True)
@@ -122,7 +123,7 @@ class TrainConfig:
         set_(self, "engine", _section(EngineSettings, "engine", self.engine))
         for name in ("eval_dataset", "scenes", "split", "scenes_dir", "out"):
             if not isinstance(getattr(self, name), str) or not getattr(self, name):
-                raise ValueError(f"{name} must be a non-empty string, got {getattr(self, name)!r}")
+                raise ArgumentError(f"{name} must be a non-empty string, got {getattr(self, name)!r}")
         for name in ("eval_every", "eval_stride", "eval_workers"):
             validation.integer(name, getattr(self, name), minimum=1)
         for name in ("max_scenes", "eval_limit"):
@@ -131,12 +132,12 @@ class TrainConfig:
         if self.path_range is not None:
             pr = self.path_range
             if isinstance(pr, (str, bytes)) or not hasattr(pr, "__len__") or len(pr) != 2:
-                raise ValueError(f"path_range must be [min, max] in metres, got {pr!r}")
+                raise ArgumentError(f"path_range must be [min, max] in metres, got {pr!r}")
             lo = validation.real("path_range[0]", pr[0], minimum=0.0)
             hi = validation.real("path_range[1]", pr[1], minimum=lo, strict=True)
             set_(self, "path_range", (lo, hi))
         if self.env.backend != "kinematic" or not self.env.flatten_obs:
-            raise ValueError("env: training runs on the batched engine: backend 'kinematic' and flatten_obs True")
+            raise ArgumentError("env: training runs on the batched engine: backend 'kinematic' and flatten_obs True")
 
     def policy_config(self) -> EnvConfig:
         """The env config the policy is trained with and its checkpoints carry: ``env``,
@@ -158,10 +159,10 @@ class TrainConfig:
         """The config of a mapping; ValueError naming an unknown key, a missing
         ``eval_dataset`` or a bad value."""
         if not isinstance(data, Mapping):
-            raise ValueError(f"{name} must be a mapping of its fields, got {data!r}")
+            raise ArgumentError(f"{name} must be a mapping of its fields, got {data!r}")
         validation.known_keys(name, data, [f.name for f in dataclasses.fields(cls)])
         if "eval_dataset" not in data:
-            raise ValueError(f"{name} needs eval_dataset: the held-out episode dataset (.json.gz) to evaluate on")
+            raise ArgumentError(f"{name} needs eval_dataset: the held-out episode dataset (.json.gz) to evaluate on")
         return cls(**data)
 
     @classmethod
@@ -173,4 +174,4 @@ class TrainConfig:
         try:
             return cls.from_dict(data)
         except ValueError as err:
-            raise ValueError(f"train config {path!r}: {err}") from None
+            raise ArgumentError(f"train config {path!r}: {err}") from None

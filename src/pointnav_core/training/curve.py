@@ -17,6 +17,7 @@ import os
 from collections.abc import Sequence
 from typing import Any
 
+from pointnav_core.errors import ArgumentError
 from pointnav_core.outputs import atomic_writer
 
 __all__ = ["COLUMNS", "plot_curve", "read_curve", "write_curve"]
@@ -42,7 +43,7 @@ def read_curve(path: str | os.PathLike[str]) -> list[dict[str, Any]]:
     with open(path, encoding="utf-8", newline="") as fh:
         reader = csv.DictReader(fh)
         if tuple(reader.fieldnames or ()) != COLUMNS:
-            raise ValueError(f"curve {os.fspath(path)!r} must have the columns {list(COLUMNS)}")
+            raise ArgumentError(f"curve {os.fspath(path)!r} must have the columns {list(COLUMNS)}")
         return [{k: (int(r[k]) if k in _INTEGERS else float(r[k])) for k in COLUMNS} for r in reader]
 
 

@@ -24,6 +24,7 @@ import torch
 from torch import nn
 
 from pointnav_core import validation
+from pointnav_core.errors import ArgumentError
 from pointnav_core.training.agent import ActorCritic, RunningNorm, as_tensor
 
 __all__ = ["PPO", "PPOSettings", "train"]
@@ -82,7 +83,7 @@ class PPOSettings:
                 setattr(self, f.name, validation.real(f.name, value, minimum=0.0, strict=strict, unit=""))
         for name in ("gamma", "gae_lambda"):
             if getattr(self, name) > 1.0:
-                raise ValueError(f"{name} must be in [0, 1], got {getattr(self, name)!r}")
+                raise ArgumentError(f"{name} must be in [0, 1], got {getattr(self, name)!r}")
 
 
 class PPO:

@@ -30,6 +30,7 @@ import time
 from collections.abc import Callable
 from typing import Any
 
+from pointnav_core.errors import ArgumentError
 from pointnav_core.training.checkpoint import load_checkpoint, save_checkpoint
 from pointnav_core.training.config import TrainConfig
 from pointnav_core.training.curve import plot_curve, read_curve, write_curve
@@ -50,7 +51,7 @@ def training_scenes(config: TrainConfig) -> list[Any]:
 
     ids = scene_set(config.scenes, seed=config.ppo.seed).scene_ids(config.split)[: config.max_scenes]
     if not ids:
-        raise ValueError(f"split {config.split!r} of scene set {config.scenes!r} has no scenes to train on")
+        raise ArgumentError(f"split {config.split!r} of scene set {config.scenes!r} has no scenes to train on")
     floor = int(config.env.task.get("floor", 0))
     return [grid_scene(load_scene(scene_id), floor) for scene_id in ids]
 
@@ -99,7 +100,7 @@ class _Run:
         """Take the weights, statistics, optimiser and step of ``ckpt`` (``latest.pt``,
         checked by :func:`_resumable`), and the curve up to its step."""
         if ckpt.network != self.ppo.agent.shape or ckpt.training is None:
-            raise ValueError(f"--resume: {self.paths['latest']!r} holds another network or no training state")
+            raise ArgumentError(f"--resume: {self.paths['latest']!r} holds another network or no training state")
         self.ppo.agent.load_state_dict(ckpt.agent.state_dict())
         self.ppo.obs_norm.load_state_dict(ckpt.obs_norm.state_dict())
         self.ppo.load_training_state(ckpt.training)
@@ -161,7 +162,7 @@ def _resumable(config: TrainConfig) -> Any:
     path = os.path.join(config.out, OUTPUTS["latest"])
     ckpt = load_checkpoint(path)
     if ckpt.env_config != config.policy_config():
-        raise ValueError(
+        raise ArgumentError(
             f"--resume: {path!r} was trained with another env config than the config file's env "
             f"(and path_range); resume with the config it was started with"
         )
@@ -172,14 +173,14 @@ def _check_out(config: TrainConfig, resume: bool) -> None:
     """Refuse to overwrite a run, or to resume none."""
     latest = os.path.join(config.out, OUTPUTS["latest"])
     if resume and not os.path.isfile(latest):
-        raise ValueError(f"--resume: {config.out!r} holds no {OUTPUTS['latest']} to resume from")
+        raise ArgumentError(f"--resume: {config.out!r} holds no {OUTPUTS['latest']} to resume from")
     if not resume and os.path.exists(latest):
-        raise ValueError(
+        raise ArgumentError(
             f"out {config.out!r} already holds a run ({OUTPUTS['latest']}): pass --resume to continue "
             f"it, or choose another out folder"
         )
     if os.path.exists(config.out) and not os.path.isdir(config.out):
-        raise ValueError(f"out {config.out!r} is not a folder")
+        raise ArgumentError(f"out {config.out!r} is not a folder")
 
 
 def run_training(

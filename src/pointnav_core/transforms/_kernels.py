@@ -12,6 +12,8 @@ from typing import Sequence, Union
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from pointnav_core.errors import ArgumentError
+
 # A component is a Python float (single value, fast path) or an array of a batch.
 _Comp = Union[float, NDArray[np.float64]]
 
@@ -36,13 +38,13 @@ def _as_array(value: ArrayLike, name: str, expected: str) -> NDArray[np.float64]
     try:
         return np.asarray(value, dtype=np.float64)
     except (TypeError, ValueError):
-        raise ValueError(f"{name} must be {expected}, got {value!r}") from None
+        raise ArgumentError(f"{name} must be {expected}, got {value!r}") from None
 
 
 def _raise_not_finite(arr: NDArray[np.float64], name: str) -> None:
     index = tuple(int(i) for i in np.argwhere(~np.isfinite(arr))[0])
     where = f" at index {index}" if index else ""
-    raise ValueError(f"{name} must be finite (no NaN or infinity), got {arr[index]}{where}")
+    raise ArgumentError(f"{name} must be finite (no NaN or infinity), got {arr[index]}{where}")
 
 
 def _vectors(
@@ -56,11 +58,11 @@ def _vectors(
     try:
         arr = np.asarray(value, dtype=np.float64)
     except (TypeError, ValueError):
-        raise ValueError(
+        raise ArgumentError(
             f"{name} must be an array of shape (..., {size}) {meaning}, got {value!r}"
         ) from None
     if arr.shape[-1:] != (size,):
-        raise ValueError(f"{name} must have shape (..., {size}) {meaning}, got shape {arr.shape}")
+        raise ArgumentError(f"{name} must have shape (..., {size}) {meaning}, got shape {arr.shape}")
     if arr.ndim == 1:
         comps: list[_Comp] = arr.tolist()
         if not all(map(math.isfinite, comps)):
@@ -97,7 +99,7 @@ def _unit_quat_rescaled(
     if (scale == 0).any():
         index = tuple(int(i) for i in np.argwhere(scale[..., 0] == 0)[0])
         where = f" at index {index}" if index else ""
-        raise ValueError(
+        raise ArgumentError(
             f"{name} must be a non-zero quaternion (x, y, z, w) to be a rotation, "
             f"got (0, 0, 0, 0){where}"
         )
@@ -116,7 +118,7 @@ def _batch(names: str, *shapes: tuple[int, ...]) -> tuple[int, ...]:
         return np.broadcast_shapes(*shapes)
     except ValueError:
         listed = ", ".join(str(s) for s in shapes)
-        raise ValueError(
+        raise ArgumentError(
             f"{names} must have batch shapes (all but the last axis) that broadcast, "
             f"got {listed}"
         ) from None

@@ -10,6 +10,7 @@ import math
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from pointnav_core.errors import ArgumentError
 from pointnav_core.transforms._kernels import (
     _GIMBAL_TOL,
     _angle,
@@ -223,13 +224,13 @@ def polar_to_cartesian(polar: ArrayLike) -> NDArray[np.float64]:
     if shape:
         if (rho < 0.0).any():
             index = tuple(int(i) for i in np.argwhere(arr[..., 0] < 0.0)[0])
-            raise ValueError(
+            raise ArgumentError(
                 f"polar must have rho (polar[..., 0]) >= 0 metres, got {arr[index + (0,)]} "
                 f"at index {index}"
             )
         return _stack((rho * np.cos(phi), rho * np.sin(phi)), shape)
     if rho < 0.0:
-        raise ValueError(f"polar must have rho (polar[..., 0]) >= 0 metres, got {rho}")
+        raise ArgumentError(f"polar must have rho (polar[..., 0]) >= 0 metres, got {rho}")
     return _stack((rho * math.cos(phi), rho * math.sin(phi)), ())
 
 
@@ -271,7 +272,7 @@ def l2_distance(a: ArrayLike, b: ArrayLike) -> np.float64 | NDArray[np.float64]:
     arr_a = _as_array(a, "a", "an array of points of shape (..., k)")
     arr_b = _as_array(b, "b", "an array of points of shape (..., k)")
     if arr_a.ndim == 0 or arr_b.ndim == 0 or not arr_a.shape[-1] == arr_b.shape[-1] > 0:
-        raise ValueError(
+        raise ArgumentError(
             "a and b must have shape (..., k) with the same k (points in metres), "
             f"got shapes {arr_a.shape} and {arr_b.shape}"
         )
@@ -351,7 +352,7 @@ def to_robot_frame(
     pts = _as_array(points, "points", "an array of shape (..., 2) or (..., 3) (metres)")
     planar = pts.shape[-1:] == (2,)
     if not planar and pts.shape[-1:] != (3,):
-        raise ValueError(
+        raise ArgumentError(
             f"points must have shape (..., 2) or (..., 3) (x, y[, z] in metres), "
             f"got shape {pts.shape}"
         )

@@ -8,6 +8,7 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from pointnav_core.errors import ArgumentError
 from pointnav_core.transforms._kernels import (
     _GIMBAL_TOL,
     _ORTHO_TOL,
@@ -247,7 +248,7 @@ def mat2quat(mat: ArrayLike) -> NDArray[np.float64]:
     expected = "an array of shape (..., 3, 3) (rotation matrices)"
     m = _as_array(mat, "mat", expected)
     if m.shape[-2:] != (3, 3):
-        raise ValueError(
+        raise ArgumentError(
             f"mat must have shape (..., 3, 3) (rotation matrices), got shape {m.shape}"
         )
     if not np.isfinite(m).all():
@@ -259,7 +260,7 @@ def mat2quat(mat: ArrayLike) -> NDArray[np.float64]:
     if bad.any():
         i = int(np.argmax(bad))
         where = f" at index {tuple(int(j) for j in np.unravel_index(i, shape))}" if shape else ""
-        raise ValueError(
+        raise ArgumentError(
             "mat must hold rotation matrices (orthonormal to within "
             f"{_ORTHO_TOL:g}, determinant +1), got {m[i].tolist()}{where}"
         )

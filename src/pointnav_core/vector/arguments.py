@@ -9,6 +9,7 @@ from typing import Any
 import numpy as np
 
 from pointnav_core import scenes, validation
+from pointnav_core.errors import ArgumentError
 
 __all__ = ["as_scene_list", "check_real_actions", "default_scene", "grid_scene", "task_arguments"]
 
@@ -29,10 +30,10 @@ def task_arguments(task: Mapping[str, Any] | None) -> dict[str, Any]:
     """A copy of the ``task`` arguments; ValueError for a non-dict, a custom termination or
     observation term, or a reward term the engine cannot run (see :func:`check_batched_rewards`)."""
     if task is not None and not isinstance(task, Mapping):
-        raise ValueError(f"task must be None or a dict of PointNavigationTask arguments, got {task!r}")
+        raise ArgumentError(f"task must be None or a dict of PointNavigationTask arguments, got {task!r}")
     for key in ("termination_conditions", "observation_terms"):
         if task is not None and task.get(key) is not None:
-            raise ValueError(f"task: {key} is not supported by the batched engine")
+            raise ArgumentError(f"task: {key} is not supported by the batched engine")
     if task is not None and task.get("reward_functions") is not None:
         check_batched_rewards(task["reward_functions"])
     return dict(task or {})
@@ -47,9 +48,9 @@ def check_batched_rewards(terms: Any) -> None:
     for term in terms if isinstance(terms, (list, tuple)) else [terms]:
         name = getattr(term, "name", None)
         if name in BUILT_IN_REWARDS:
-            raise ValueError(f"task: reward_functions: the batched engine cannot replace the built-in {name!r} term")
+            raise ArgumentError(f"task: reward_functions: the batched engine cannot replace the built-in {name!r} term")
         if not callable(getattr(term, "batched", None)):
-            raise ValueError(
+            raise ArgumentError(
                 f"task: reward_functions: {term!r} has no batched(task) method; the batched engine runs a custom "
                 f"reward term on every robot at once through it (docs/extending.md)"
             )
@@ -59,7 +60,7 @@ def as_scene_list(scene: scenes.Scene | Sequence[scenes.Scene] | None) -> list[s
     """The worlds' scenes (default: the default house as a grid); ValueError if not Scenes."""
     scene_list = [scene] if isinstance(scene, scenes.Scene) else list(scene) if scene is not None else [default_scene()]
     if not scene_list or not all(isinstance(s, scenes.Scene) for s in scene_list):
-        raise ValueError(f"scene must be a Scene or a non-empty sequence of Scenes, got {scene!r}")
+        raise ArgumentError(f"scene must be a Scene or a non-empty sequence of Scenes, got {scene!r}")
     return scene_list
 
 
@@ -68,4 +69,4 @@ def check_real_actions(actions: Any) -> None:
     env's rule, :func:`pointnav_core.validation.is_real_array`: no bools, complex numbers or strings)."""
     if not validation.is_real_array(actions):
         kind = getattr(actions, "dtype", type(actions).__name__)
-        raise ValueError(f"actions must be real numbers in [-1, 1] (an integer or float array), got {kind}")
+        raise ArgumentError(f"actions must be real numbers in [-1, 1] (an integer or float array), got {kind}")

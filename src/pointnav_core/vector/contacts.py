@@ -17,6 +17,7 @@ from __future__ import annotations
 import math
 from typing import Any
 
+from pointnav_core.errors import ArgumentError
 from pointnav_core.vector.floors import FloorTables
 from pointnav_core.vector.sweep import enter_rounded_square, square_distance
 
@@ -39,7 +40,7 @@ def window(floors: FloorTables, scene: Any, x: Any, y: Any, reach: float) -> tup
     stencil (:meth:`FloorTables.stencil`), gathered here for the robots that need them.
     """
     if floors.has_polygons:  # FloorTables lets them in only where the compiled contacts run
-        raise ValueError("the array contacts collide with grid cells only, and a floor has obstacle polygons")
+        raise ArgumentError("the array contacts collide with grid cells only, and a floor has obstacle polygons")
     a = floors.arrays
     xp = a.xp
     dr, dc, ok = floors.stencil(reach)
@@ -96,7 +97,7 @@ def advance(
     largest = float(rcol.max()) if rcol.shape[0] else 0.0
     reach = rcol + max_span + 4.0 * _ACTIVE
     if max_span > max_travel:
-        raise ValueError(f"a chord of {max_span} m is longer than max_travel {max_travel} m")
+        raise ArgumentError(f"a chord of {max_span} m is longer than max_travel {max_travel} m")
     wx0, wy0, wx1, wy1, valid = window(floors, scene, x, y, largest + max_travel + 4.0 * _ACTIVE)
     d0 = square_distance(xp, x[:, None], y[:, None], wx0, wy0, wx1, wy1)[0]
     # Only walls within reach of the start can be met (sliding only shortens the motion):

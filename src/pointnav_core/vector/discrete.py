@@ -27,7 +27,7 @@ Examples
 >>> plan.check(np.array([0.0, 3.0]), 2)
 Traceback (most recent call last):
 ...
-ValueError: actions must be integers in [0, 4) (discrete actions), got dtype float64
+pointnav_core.errors.ArgumentError: actions must be integers in [0, 4) (discrete actions), got dtype float64
 """
 
 from __future__ import annotations
@@ -37,6 +37,7 @@ from typing import Any
 import numpy as np
 
 from pointnav_core.actions import STOP, DiscreteActions
+from pointnav_core.errors import ArgumentError
 from pointnav_core.vector.xp import Arrays
 
 __all__ = ["DiscretePlan"]
@@ -118,15 +119,15 @@ class DiscretePlan:
         else:
             want, words = ((num_envs, n_robots),), f"({num_envs}, {n_robots})"
         if shape not in want:
-            raise ValueError(f"actions must have shape {words} (discrete actions), got {shape}")
+            raise ArgumentError(f"actions must have shape {words} (discrete actions), got {shape}")
         dtype = getattr(actions, "dtype", None)
         if not _is_integer_dtype(dtype):
-            raise ValueError(f"actions must be integers in [0, {n}) (discrete actions), got dtype {dtype}")
+            raise ArgumentError(f"actions must be integers in [0, {n}) (discrete actions), got dtype {dtype}")
         arr = a.asarray(actions, a.i64).reshape(want[0])
         if bool(((arr < 0) | (arr >= n)).any()):
             bad = a.numpy(arr)
             bad = bad[(bad < 0) | (bad >= n)]
-            raise ValueError(f"actions must be integers in [0, {n}) (discrete actions), got {bad[:5].tolist()}")
+            raise ArgumentError(f"actions must be integers in [0, {n}) (discrete actions), got {bad[:5].tolist()}")
         return arr
 
     def run(self, env: Any, index: Any, acting: Any = None) -> tuple[dict[str, Any], Any, Any]:

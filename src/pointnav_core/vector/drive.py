@@ -30,6 +30,7 @@ from __future__ import annotations
 from collections.abc import Callable, Sequence
 from typing import Any
 
+from pointnav_core.errors import ArgumentError
 from pointnav_core.robot_spec import RobotSpec
 
 __all__ = ["MAX_TURN", "arc", "body_command", "drive_of", "sub_steps", "substep_drive", "travel"]
@@ -51,11 +52,11 @@ def drive_of(specs: Sequence[RobotSpec], name: str = "robot") -> str:
     >>> drive_of([RobotSpec(), RobotSpec(drive="holonomic")])
     Traceback (most recent call last):
     ...
-    ValueError: robot: every robot must have the same drive in the batched engine (one action array), got ['differential', 'holonomic']
+    pointnav_core.errors.ArgumentError: robot: every robot must have the same drive in the batched engine (one action array), got ['differential', 'holonomic']
     """
     drives = sorted({spec.drive for spec in specs})
     if len(drives) > 1:
-        raise ValueError(
+        raise ArgumentError(
             f"{name}: every robot must have the same drive in the batched engine (one action array), got {drives}"
         )
     return drives[0]

@@ -20,6 +20,7 @@ from gymnasium.vector import AutoresetMode, VectorEnv
 
 from pointnav_core import _envcommon, scenes, validation
 from pointnav_core.env_config import EnvConfig, takes_config, vector_arguments
+from pointnav_core.errors import ArgumentError, TaskStateError
 from pointnav_core.metrics import soft_spl_values, spl_values
 from pointnav_core.vector import contacts_jit
 from pointnav_core.vector.contacts import advance
@@ -206,7 +207,7 @@ class VectorPointNavEnv(PoolRefreshing, VectorEnv):
                 return super().__new__(VectorFleetEnv)
             for name in ("max_cycles", "finished"):
                 if name in kwargs:
-                    raise ValueError(f"{name} applies to several robots per world (n_robots > 1), got n_robots={n_robots!r}")
+                    raise ArgumentError(f"{name} applies to several robots per world (n_robots > 1), got n_robots={n_robots!r}")
         return super().__new__(cls)
 
     @takes_config(vector_arguments, extra=("max_episode_steps",))
@@ -237,7 +238,7 @@ class VectorPointNavEnv(PoolRefreshing, VectorEnv):
 
         self.num_envs = validation.integer("num_envs", num_envs, minimum=1)
         if validation.integer("n_robots", n_robots, minimum=1) != 1:  # several: built by __new__
-            raise ValueError(f"n_robots must be 1 here, got {n_robots}: VectorPointNavEnv builds the multi-robot engine")
+            raise ArgumentError(f"n_robots must be 1 here, got {n_robots}: VectorPointNavEnv builds the multi-robot engine")
         scan_term = requested_scan(sensors)
         task = task_arguments(task)
         self.pool_size = validation.integer("pool_size", pool_size, minimum=1)
@@ -362,7 +363,7 @@ class VectorPointNavEnv(PoolRefreshing, VectorEnv):
         self._finish_refresh()
         a = self.arrays
         if options is not None and not isinstance(options, Mapping):
-            raise ValueError(f"options must be None or a dict, got {options!r}")
+            raise ArgumentError(f"options must be None or a dict, got {options!r}")
         episodes = (options or {}).get("episodes")
         if seed is not None:
             self._rng = np.random.default_rng(validation.integer("seed", seed, minimum=0))
@@ -370,7 +371,7 @@ class VectorPointNavEnv(PoolRefreshing, VectorEnv):
                 self.scan.seed(self._rng)
         if episodes is not None:
             if len(episodes) != self.num_envs:
-                raise ValueError(f"options['episodes'] must hold one episode per world ({self.num_envs}), got {len(episodes)}")
+                raise ArgumentError(f"options['episodes'] must hold one episode per world ({self.num_envs}), got {len(episodes)}")
             scene_of = a.numpy(self._world_scene)
             fixed = [self._fixed_episode(i, episode, int(scene_of[i])) for i, episode in enumerate(episodes)]
             self._build_pool(fixed)
@@ -425,13 +426,13 @@ class VectorPointNavEnv(PoolRefreshing, VectorEnv):
         shape = tuple(getattr(actions, "shape", np.shape(actions)))
         n, dim = self.num_envs, self.robot.action_dim
         if shape not in ((n, dim), (n, 1, dim)):
-            raise ValueError(
+            raise ArgumentError(
                 f"actions must have shape ({n}, {dim}) or ({n}, 1, {dim}) for a {self.robot.drive} drive, got {shape}"
             )
         check_real_actions(actions)
         arr = a.asarray(actions).reshape(n, dim)
         if not bool(a.xp.isfinite(arr).all()):
-            raise ValueError("actions must be finite (no NaN or infinity)")
+            raise ArgumentError("actions must be finite (no NaN or infinity)")
         return arr
 
     def step(self, actions: Any) -> tuple[Any, Any, Any, Any, dict[str, Any]]:
@@ -443,7 +444,7 @@ class VectorPointNavEnv(PoolRefreshing, VectorEnv):
 
     def _step(self, actions: Any) -> tuple[Any, Any, Any, Any, dict[str, Any]]:
         if not self._started:
-            raise RuntimeError("call reset() before step()")
+            raise TaskStateError("call reset() before step()")
         st = self._state
         act = self.check_actions(actions)
         if self._discrete is None:

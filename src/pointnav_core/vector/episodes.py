@@ -26,6 +26,7 @@ from typing import Any
 import numpy as np
 
 from pointnav_core import validation
+from pointnav_core.errors import ArgumentError
 from pointnav_core.vector.fields import (
     FieldPart,
     FieldTables,
@@ -70,12 +71,12 @@ def fixed_pose(where: str, episode: Any, scene: Any, floor: int, robot: Any) -> 
     try:
         start, yaw, goal = episode
     except (TypeError, ValueError):
-        raise ValueError(f"{where} must be a (start_xy, yaw, goal_xy) tuple or a PointNavEpisode, got {episode!r}") from None
+        raise ArgumentError(f"{where} must be a (start_xy, yaw, goal_xy) tuple or a PointNavEpisode, got {episode!r}") from None
     yaw = validation.real(f"{where}: yaw", yaw, unit="rad")
     for name, xy in (("start", start), ("goal", goal)):
         point = validation.vector(f"{where}: {name}", xy, sizes=(2, 3))[:2]
         if not scene.is_usable(floor, point, robot):
-            raise ValueError(f"{where}: {name} {list(xy)} is not usable by the robot")
+            raise ArgumentError(f"{where}: {name} {list(xy)} is not usable by the robot")
     return start, yaw, goal
 
 

@@ -27,6 +27,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike
 
+from pointnav_core.errors import ArgumentError
 from pointnav_core.geodesic import GoalField
 from pointnav_core.geodesic.tangents import ANG_TOL, TWO_PI
 from pointnav_core.vector.xp import Arrays
@@ -284,7 +285,7 @@ def check_budget(windows: Sequence[tuple[int, int, int, int]], cells_before: int
     already kept (the scenes built before), would take more than :data:`FIELD_TABLE_BYTES`."""
     cells = cells_before + window_cells(windows)
     if cells * _CELL_BYTES > FIELD_TABLE_BYTES:
-        raise ValueError(
+        raise ArgumentError(
             f"the goal fields of {goals_before + len(windows)} pool goals would take {cells * _CELL_BYTES / 2**20:.0f} MiB "
             f"({cells} cells within the episodes' reach), over FIELD_TABLE_BYTES = "
             f"{FIELD_TABLE_BYTES / 2**20:.0f} MiB: lower pool_size or max_episode_steps (the reach), "

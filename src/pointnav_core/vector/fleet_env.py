@@ -26,6 +26,7 @@ import numpy as np
 
 from pointnav_core import scenes, validation
 from pointnav_core.env_config import EnvConfig, takes_config, vector_fleet_arguments
+from pointnav_core.errors import ArgumentError, TaskStateError
 from pointnav_core.fleet import FINISHED_MODES, check_finished
 from pointnav_core.vector import contacts_jit
 from pointnav_core.vector.contacts import advance
@@ -212,16 +213,16 @@ class VectorFleetEnv(VectorPointNavEnv):
         shape = tuple(getattr(actions, "shape", np.shape(actions)))
         want = (self.num_envs, self.n_robots, self.robot.action_dim)
         if shape != want:
-            raise ValueError(f"actions must have shape {want} for a {self.robot.drive} drive, got {shape}")
+            raise ArgumentError(f"actions must have shape {want} for a {self.robot.drive} drive, got {shape}")
         check_real_actions(actions)
         arr = self.arrays.asarray(actions)
         if not bool(self.arrays.xp.isfinite(arr).all()):
-            raise ValueError("actions must be finite (no NaN or infinity)")
+            raise ArgumentError("actions must be finite (no NaN or infinity)")
         return arr
 
     def _step(self, actions: Any) -> tuple[Any, Any, Any, Any, dict[str, Any]]:
         if not self._started:
-            raise RuntimeError("call reset() before step()")
+            raise TaskStateError("call reset() before step()")
         act = self.check_actions(actions)
         if self._discrete is not None:
             return self._account(*self._discrete.run(self, act, acting=self._active))

@@ -21,6 +21,7 @@ from typing import Any
 
 import numpy as np
 
+from pointnav_core.errors import ArgumentError
 from pointnav_core.vector.episodes import (
     ScenePart,
     assemble_parts,
@@ -46,9 +47,9 @@ def check_fixed_episode(sampler: Any, episode: Sequence[FleetEpisode], where: st
     try:
         entries = list(episode)
     except TypeError:
-        raise ValueError(f"{where} must hold {n} (start_xy, yaw, goal_xy) tuples or PointNavEpisodes, got {episode!r}") from None
+        raise ArgumentError(f"{where} must hold {n} (start_xy, yaw, goal_xy) tuples or PointNavEpisodes, got {episode!r}") from None
     if len(entries) != n:
-        raise ValueError(f"{where} must hold one (start_xy, yaw, goal_xy) per robot ({n}), got {len(entries)}")
+        raise ArgumentError(f"{where} must hold one (start_xy, yaw, goal_xy) per robot ({n}), got {len(entries)}")
     scene, floor, specs = sampler.scene, sampler.tasks[0].floor, sampler.robots
     robots = [fixed_pose(f"{where}[{r}]", entry, scene, floor, specs[r]) for r, entry in enumerate(entries)]
     sep = sampler._separation
@@ -56,9 +57,9 @@ def check_fixed_episode(sampler: Any, episode: Sequence[FleetEpisode], where: st
         for j in range(i + 1, n):
             (si, _, gi), (sj, _, gj) = robots[i], robots[j]
             if math.dist(si[:2], sj[:2]) < specs[i].radius + specs[j].radius:
-                raise ValueError(f"{where}: robots {i} and {j} start overlapping ({math.dist(si[:2], sj[:2]):.3g} m apart)")
+                raise ArgumentError(f"{where}: robots {i} and {j} start overlapping ({math.dist(si[:2], sj[:2]):.3g} m apart)")
             if math.dist(gi[:2], gj[:2]) < sep[i][j]:
-                raise ValueError(
+                raise ArgumentError(
                     f"{where}: robots {i} and {j} have goals {math.dist(gi[:2], gj[:2]):.3g} m apart, "
                     f"closer than the multi-robot env's {sep[i][j]:.3g} m"
                 )

@@ -15,6 +15,7 @@ from typing import Any
 
 import numpy as np
 
+from pointnav_core.errors import ArgumentError
 from pointnav_core.maps import VOID
 from pointnav_core.vector.xp import Arrays
 
@@ -65,7 +66,7 @@ class FloorTables:
         for k, scene in enumerate(scenes):
             tmap = scene.floors[floor]
             if len(tmap.collision.polygons) and not contacts_jit.available(self):
-                raise ValueError(
+                raise ArgumentError(
                     f"scene {k} has obstacle polygons on floor {floor}; the batched engine collides with "
                     "them on the CPU with numba (the fast extra) only: use device='numpy' or 'cpu' with "
                     "numba installed, or build the scene from the floor's cells (Scene.from_array)"

@@ -49,6 +49,7 @@ from typing import Any
 
 import numpy as np
 
+from pointnav_core.errors import ArgumentError
 from pointnav_core.sensors.local_map import _LUT, LOCAL_ROBOT, LOCAL_VOID, LocalMap
 from pointnav_core.vector.floors import FloorTables
 
@@ -114,7 +115,7 @@ class VectorLocalMap:
 
     def __init__(self, term: LocalMap, floors: FloorTables) -> None:
         if not isinstance(term, LocalMap):
-            raise ValueError(f"term must be a LocalMap, got {term!r}")
+            raise ArgumentError(f"term must be a LocalMap, got {term!r}")
         self.term = term
         self.floors = floors
         a = self.arrays = floors.arrays

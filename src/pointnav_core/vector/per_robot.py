@@ -29,6 +29,7 @@ from typing import Any
 
 import numpy as np
 
+from pointnav_core.errors import ArgumentError
 from pointnav_core.fleet import make_robots, per_robot
 from pointnav_core.robot_spec import RobotSpec
 from pointnav_core.vector.drive import drive_of
@@ -42,10 +43,10 @@ _CUSTOM_TERMS = ("termination_conditions", "reward_functions", "observation_term
 def _one_task(entry: Any, name: str) -> dict[str, Any]:
     """A copy of one robot's task arguments; ValueError naming ``name`` if not a dict or custom."""
     if entry is not None and not isinstance(entry, Mapping):
-        raise ValueError(f"{name} must be None or a dict of PointNavigationTask arguments, got {entry!r}")
+        raise ArgumentError(f"{name} must be None or a dict of PointNavigationTask arguments, got {entry!r}")
     for key in _CUSTOM_TERMS:
         if entry is not None and entry.get(key) is not None:
-            raise ValueError(f"{name}: {key} is not supported by the batched engine")
+            raise ArgumentError(f"{name}: {key} is not supported by the batched engine")
     return dict(entry or {})
 
 
@@ -102,7 +103,7 @@ def read_tasks(env: Any, tasks: Sequence[Any], specs: Sequence[RobotSpec], array
     """
     floors = sorted({t.floor for t in tasks})
     if len(floors) > 1:
-        raise ValueError(f"task: every robot of a world must use the same floor in the batched engine, got floors {floors}")
+        raise ArgumentError(f"task: every robot of a world must use the same floor in the batched engine, got floors {floors}")
 
     def row(values: Sequence[Any], dtype: Any = None) -> Any:
         return arrays.asarray(np.asarray(values, dtype=np.float64).reshape(1, -1), dtype)

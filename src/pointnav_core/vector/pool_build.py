@@ -21,6 +21,7 @@ from typing import Any
 import numpy as np
 
 from pointnav_core import validation
+from pointnav_core.errors import ArgumentError
 from pointnav_core.vector.episodes import ScenePart, build_in_process
 from pointnav_core.vector.fields import check_budget
 from pointnav_core.workers import WorkerError, WorkerPool, usable_cores
@@ -48,7 +49,7 @@ def pool_options(workers: Any, progress: Any, n_scenes: int) -> tuple[int, bool 
     """The envs' ``workers`` (:func:`pool_workers`) and ``progress`` (None or a bool),
     checked; ValueError naming the argument."""
     if progress is not None and not isinstance(progress, (bool, np.bool_)):
-        raise ValueError(f"progress must be None, True or False, got {progress!r}")
+        raise ArgumentError(f"progress must be None, True or False, got {progress!r}")
     return pool_workers(workers, n_scenes), None if progress is None else bool(progress)
 
 

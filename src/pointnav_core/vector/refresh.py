@@ -24,6 +24,7 @@ import warnings
 from collections.abc import Sequence
 from typing import Any
 
+from pointnav_core.errors import ArgumentError, TaskStateError
 from pointnav_core.vector.fields import FieldTables
 from pointnav_core.vector.refresh_worker import RefreshWorker
 from pointnav_core.vector.xp import Arrays, make_arrays
@@ -171,9 +172,9 @@ class PoolRefreshing:
             While the worlds run fixed episodes (``reset(options={"episodes": ...})``).
         """
         if self.pool is None:
-            raise RuntimeError("call reset() before refresh_pool()")
+            raise TaskStateError("call reset() before refresh_pool()")
         if self._fixed is not None:
-            raise ValueError("refresh_pool: the worlds run fixed episodes (reset(options={'episodes': ...})); reset without them first")
+            raise ArgumentError("refresh_pool: the worlds run fixed episodes (reset(options={'episodes': ...})); reset without them first")
         self._finish_refresh()
         seeds = self._rng.integers(2**31, size=self.pool_size * len(self.scenes))
         if wait:

@@ -22,6 +22,7 @@ from multiprocessing.reduction import ForkingPickler
 from typing import Any
 
 from pointnav_core import workers
+from pointnav_core.errors import TaskStateError
 
 __all__ = ["RefreshWorker"]
 
@@ -105,7 +106,7 @@ class RefreshWorker:
         few MB, more than the pipe holds.
         """
         if self._busy:
-            raise RuntimeError("the refresh worker is still busy with a job")
+            raise TaskStateError("the refresh worker is still busy with a job")
         payload = bytes(ForkingPickler.dumps((func, args)))
         self._sender = threading.Thread(target=self._send, args=(payload,), name="pointnav-pool-refresh-send", daemon=True)
         self._busy = True

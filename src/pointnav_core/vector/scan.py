@@ -37,6 +37,7 @@ from typing import Any
 
 import numpy as np
 
+from pointnav_core.errors import ArgumentError
 from pointnav_core.sensors.noise import episode_key, scan_noise, seed_entropy
 from pointnav_core.sensors.raycast import (
     TOUCH_EPS,
@@ -116,7 +117,7 @@ def requested_scan(sensors: Any) -> RangeScan | None:
     terms = make_sensors(sensors)
     unsupported = [term.name for term in terms if term.name not in ("scan", "local_map")]
     if unsupported:
-        raise ValueError(f"sensors: {unsupported[0]!r} is not supported by the batched engine (only 'scan', 'local_map')")
+        raise ArgumentError(f"sensors: {unsupported[0]!r} is not supported by the batched engine (only 'scan', 'local_map')")
     return next((term for term in terms if isinstance(term, RangeScan)), None)
 
 
@@ -192,11 +193,11 @@ def cast_batch(
     [[[0.25, 0.08], [0.08, 0.15]]]
     """
     if method not in _METHODS:
-        raise ValueError(f"method must be one of {', '.join(map(repr, _METHODS))}, got {method!r}")
+        raise ArgumentError(f"method must be one of {', '.join(map(repr, _METHODS))}, got {method!r}")
     a = tables.arrays
     on_cpu = not a.is_torch or a.device == "cpu"
     if method == "numba" and not (on_cpu and compiled_available()):
-        raise ValueError('method="numba" needs arrays on the CPU and numba: pip install "pointnav-core[fast]"')
+        raise ArgumentError('method="numba" needs arrays on the CPU and numba: pip install "pointnav-core[fast]"')
     angles = a.asarray(angles)
     radius = a.xp.zeros_like(x) + radius  # (W, R)
     if method != "array" and on_cpu and compiled_available():
@@ -383,7 +384,7 @@ class VectorScan:
 
     def __init__(self, term: RangeScan, tables: ScanTables, method: str = "auto") -> None:
         if not isinstance(term, RangeScan):
-            raise ValueError(f"term must be a RangeScan, got {term!r}")
+            raise ArgumentError(f"term must be a RangeScan, got {term!r}")
         self.term = term
         self.tables = tables
         self.method = method
@@ -429,7 +430,7 @@ class VectorScan:
             return d
         w, r = d.shape[0], d.shape[1]
         if steps is None or self._keys.shape[0] != w:
-            raise ValueError(f"steps: noise needs each robot's step (W, R) after begin() for all {w} worlds")
+            raise ArgumentError(f"steps: noise needs each robot's step (W, R) after begin() for all {w} worlds")
         k = np.asarray(a.numpy(steps) if a.is_torch else steps, dtype=np.int64).reshape(w, r, 1)
         noise, lost = scan_noise(self._keys[:, None, None], np.arange(r)[None, :, None], k, d.shape[2],
                                  t.noise_std, t.dropout)

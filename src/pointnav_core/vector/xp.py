@@ -12,6 +12,8 @@ from typing import Any
 
 import numpy as np
 
+from pointnav_core.errors import ArgumentError
+
 __all__ = ["Arrays", "make_arrays"]
 
 
@@ -95,21 +97,21 @@ def make_arrays(device: Any) -> Arrays:
         on a machine without CUDA.
     """
     if not isinstance(device, str):
-        raise ValueError(f"device must be 'numpy', 'cpu' or 'cuda[:n]', got {device!r}")
+        raise ArgumentError(f"device must be 'numpy', 'cpu' or 'cuda[:n]', got {device!r}")
     if device == "numpy":
         return Arrays(np, "numpy")
     if device != "cpu" and not (device == "cuda" or device.startswith("cuda:")):
-        raise ValueError(f"device must be 'numpy', 'cpu' or 'cuda[:n]', got {device!r}")
+        raise ArgumentError(f"device must be 'numpy', 'cpu' or 'cuda[:n]', got {device!r}")
     try:
         import torch
     except ImportError:
-        raise ValueError(
+        raise ArgumentError(
             f"device {device!r} needs torch: install the 'vector' extra (pip install 'pointnav-core[vector]')"
         ) from None
     if device != "cpu":
         if not torch.cuda.is_available():
-            raise ValueError(f"device {device!r} asks for CUDA, but torch finds no CUDA device here")
+            raise ArgumentError(f"device {device!r} asks for CUDA, but torch finds no CUDA device here")
         index = device.partition(":")[2]
         if index and (not index.isdigit() or int(index) >= torch.cuda.device_count()):
-            raise ValueError(f"device {device!r} names no CUDA device of {torch.cuda.device_count()}")
+            raise ArgumentError(f"device {device!r} names no CUDA device of {torch.cuda.device_count()}")
     return Arrays(torch, device)

@@ -10,6 +10,7 @@ from dataclasses import dataclass
 from typing import Any
 
 from pointnav_core.backend import get_backend
+from pointnav_core.errors import ArgumentError, ArgumentTypeError
 from pointnav_core.testing.conformance.common import BackendFactory, ConformanceError
 from pointnav_core.testing.conformance.motion import (
     check_determinism,
@@ -116,12 +117,12 @@ def get_check(name: str) -> Check:
     >>> get_check("flying")  # doctest: +ELLIPSIS
     Traceback (most recent call last):
     ...
-    ValueError: check must be one of ['protocol', ..., 'determinism'], got 'flying'
+    pointnav_core.errors.ArgumentError: check must be one of ['protocol', ..., 'determinism'], got 'flying'
     """
     for check in CHECKS:
         if check.name == name:
             return check
-    raise ValueError(f"check must be one of {[c.name for c in CHECKS]}, got {name!r}")
+    raise ArgumentError(f"check must be one of {[c.name for c in CHECKS]}, got {name!r}")
 
 
 def backend_factory(backend: str | type | Callable[[], Any]) -> BackendFactory:
@@ -165,7 +166,7 @@ def backend_factory(backend: str | type | Callable[[], Any]) -> BackendFactory:
         return cls
     if callable(backend):
         return backend
-    raise TypeError(
+    raise ArgumentTypeError(
         "backend must be a backend name, a class or a factory callable, got "
         f"{type(backend).__name__}"
     )
