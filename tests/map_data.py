@@ -12,6 +12,22 @@ from pointnav_core.scenes import Scene
 
 DATA = Path(__file__).parent / "data"
 
+#: A MovingAI map of 6 x 4 m at 0.5 m per character: one room with a pillar (the
+#: evaluation and training tests' small scene).
+PILLAR_ROOM = """type octile
+height 8
+width 12
+map
+@@@@@@@@@@@@
+@..........@
+@..........@
+@....@@....@
+@....@@....@
+@..........@
+@..........@
+@@@@@@@@@@@@
+"""
+
 
 def bookstore_codes() -> np.ndarray:
     """The bookstore map's cell codes (``tests/data/bookstore``), row 0 at the bottom:

@@ -11,21 +11,8 @@ from pointnav_core.datasets import EpisodeDataset
 from pointnav_core.env import PointNavEnv
 from pointnav_core.env_config import EnvConfig
 from pointnav_core.evaluation import evaluate, read_results, read_run
+from map_data import PILLAR_ROOM
 
-# 6 x 4 m at 0.5 m per character: one room with a pillar.
-MAP = """type octile
-height 8
-width 12
-map
-@@@@@@@@@@@@
-@..........@
-@..........@
-@....@@....@
-@....@@....@
-@..........@
-@..........@
-@@@@@@@@@@@@
-"""
 
 SCAN = EnvConfig(
     sensors={"scan": {"n_rays": 16}}, action_space="discrete", discrete_actions={"stop": False},
@@ -37,7 +24,7 @@ SCAN = EnvConfig(
 def data(tmp_path_factory):
     """A 3-episode dataset on the room, and the scan config saved as YAML."""
     folder = tmp_path_factory.mktemp("room")
-    (folder / "room.map").write_text(MAP)
+    (folder / "room.map").write_text(PILLAR_ROOM)
     out = folder / "val.json.gz"
     # From inside the folder: the scene ids ("movingai:./room.map"), and with them the
     # episodes drawn, do not depend on where the temporary folder is.

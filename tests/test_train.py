@@ -23,21 +23,8 @@ from pointnav_core.env_config import EnvConfig
 from pointnav_core.evaluation import evaluate, make_policy, read_results
 from pointnav_core.training.agent import ActorCritic, RunningNorm
 from pointnav_core.training.checkpoint import load_checkpoint, save_checkpoint
+from map_data import PILLAR_ROOM
 
-# 6 x 4 m at 0.5 m per character: one room with a pillar.
-MAP = """type octile
-height 8
-width 12
-map
-@@@@@@@@@@@@
-@..........@
-@..........@
-@....@@....@
-@....@@....@
-@..........@
-@..........@
-@@@@@@@@@@@@
-"""
 SCAN = EnvConfig(sensors={"scan": {"n_rays": 8}}, action_space="discrete", discrete_actions={"stop": False},
                  task={"goal_in_polar": True, "reward_type": "geodesic"}, max_steps=30)
 
@@ -145,7 +132,7 @@ def room(tmp_path_factory):
     (val.json.gz) and one of 3 episodes made for a robot of radius 0.25 m (wide.json.gz)."""
     folder = tmp_path_factory.mktemp("train")
     (folder / "maps").mkdir()
-    (folder / "maps" / "room.map").write_text(MAP)
+    (folder / "maps" / "room.map").write_text(PILLAR_ROOM)
     here = os.getcwd()
     os.chdir(folder)  # the scene ids ("movingai:maps/room.map") are relative to it
     try:
