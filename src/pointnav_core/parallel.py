@@ -37,9 +37,8 @@ Arguments
 ``parallel_env(scene=None, n_robots=2, robot=None, task=None, backend="kinematic",
 backend_kwargs=None, max_cycles=500, render_mode=None, flatten_obs=True, finished="park",
 action_frequency=10.0, sensors=None, action_space="continuous", discrete_actions=None,
-config=None)``; ``config`` (an :class:`~pointnav_core.env_config.EnvConfig`) sets every
-argument below but ``scene``, ``n_robots``, ``max_cycles`` (default: its ``max_steps``),
-``render_mode`` and ``finished``.
+config=None)``; ``config`` (an :class:`~pointnav_core.env_config.EnvConfig`) sets every argument below but
+``scene``, ``n_robots``, ``max_cycles`` (default: its ``max_steps``), ``render_mode`` and ``finished``.
 
 | Argument           | Type                        | Default           | Description            |
 |--------------------|-----------------------------|-------------------|------------------------|

@@ -14,8 +14,8 @@ The API (the model, its accuracy and cost: ``docs/geodesic.md``):
 Inside, one module per step: ``tangents`` (the shared constructions and tolerances),
 ``sight`` (strict sight bounds), ``edges`` (common tangents), ``cell_links`` (each cell's
 clear links, once per floor), ``arcs`` (drawing arcs),
-``arc_graph`` (the graph solved by Dijkstra), ``roots`` (exact cell roots), ``field`` and
-``planner``.
+``arc_graph`` (the graph solved by Dijkstra), ``roots`` (exact cell roots), ``field``,
+``point_search`` (one exact path between two points) and ``planner``.
 """
 
 from pointnav_core.geodesic.field import BLOCK, LOOKUP_BOUND, GoalField

@@ -35,8 +35,6 @@ and distance. Everything is in world metres.
 
 from __future__ import annotations
 
-import bisect
-import heapq
 import math
 import time
 from typing import TYPE_CHECKING, Any
@@ -45,6 +43,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy import ndimage
 from scipy.spatial import cKDTree
+from shapely.geometry.polygon import orient
 from tqdm.auto import tqdm
 
 from pointnav_core.errors import ArgumentError
@@ -53,12 +52,12 @@ from pointnav_core.frozen import ThawOnUnpickle
 from pointnav_core.paths import path_length, resample_path
 from pointnav_core.geodesic import cache
 from pointnav_core.geodesic.arc_graph import ArcGraph
-from pointnav_core.geodesic.arcs import arc_points
-from pointnav_core.geodesic.tangents import ANG_TOL, COST_TOL, TWO_PI, ccw_pos, tangent_from_point
+from pointnav_core.geodesic.tangents import ANG_TOL, TWO_PI, ccw_pos, tangent_from_point
 from pointnav_core.geodesic.edges import build_edges
 from pointnav_core.geodesic.field import GoalField
 from pointnav_core.geodesic.roots import compiled
 from pointnav_core.geodesic.cell_links import CellLinks
+from pointnav_core.geodesic.point_search import PointSearch
 from pointnav_core.geodesic.sight import NodeBalls, node_sights
 
 if TYPE_CHECKING:
@@ -529,7 +528,7 @@ class Planner(ThawOnUnpickle):
         finish: dict[tuple[int, int], list[tuple[float, float]]] = {}
         for c, s, pos, length in self.point_links(tx, ty):
             finish.setdefault((c, -s), []).append((self._span[c] - pos, length))
-        search = _Search(self, heuristic_to=(tx, ty))
+        search = PointSearch(self, heuristic_to=(tx, ty))
         for c, s, pos, length in self.point_links(sx, sy):
             search.push(length, c, s, pos, -1, 0.0)
         best = search.run(finish)
@@ -589,103 +588,4 @@ def _runs(sorted_keys: NDArray[np.int64]) -> list[tuple[int, int, int]]:
 
 def _rings(poly: Any) -> list[Any]:
     """Exterior rings of a polygon's parts, counter-clockwise (the blocked side on the left)."""
-    parts = getattr(poly, "geoms", [poly])
-    rings = []
-    for part in parts:
-        ext = part.exterior
-        if not ext.is_ccw:
-            ext = type(ext)(list(ext.coords)[::-1])
-        rings.append(ext)
-    return rings
-
-
-class _Search:
-    """Label-setting search over the tangent graph (Dijkstra, or A* towards a point)."""
-
-    def __init__(self, planner: Planner, heuristic_to: tuple[float, float] | None = None) -> None:
-        self.p = planner
-        self.heap: list[tuple[float, float, int, int, int, float, int, float]] = []
-        self.count = 0
-        self.hx = heuristic_to
-        # Settled labels.
-        self.node: list[int] = []
-        self.side: list[int] = []
-        self.pos: list[float] = []
-        self.cost: list[float] = []
-        self.parent: list[int] = []
-        self.parent_dep: list[float] = []
-        self.settled: dict[tuple[int, int], list[int]] = {}
-
-    def push(self, g: float, node: int, s: int, pos: float, parent: int, dep: float) -> None:
-        f = g
-        if self.hx is not None:
-            x, y = self.p.node_point(node, s, pos)
-            f = g + math.hypot(x - self.hx[0], y - self.hx[1])
-        self.count += 1
-        heapq.heappush(self.heap, (f, g, self.count, node, s, pos, parent, dep))
-
-    def _dominated(self, node: int, s: int, pos: float, g: float) -> bool:
-        labels = self.settled.get((node, s))
-        if not labels:
-            return False
-        r = self.p.radius
-        for lab in labels:
-            lp = self.pos[lab]
-            if lp <= pos + ANG_TOL and self.cost[lab] + r * max(pos - lp, 0.0) <= g + COST_TOL:
-                if self.p._arc_free(node, s, lp, pos):
-                    return True
-        return False
-
-    def run(
-        self, finish: dict[tuple[int, int], list[tuple[float, float]]] | None = None
-    ) -> tuple[float, int, float] | None:
-        """Settle labels in cost order; with ``finish``, stop at the first finished path.
-
-        ``finish`` maps ``(node, side)`` to ``(departure position, length)`` of the final
-        tangents to the target. Returns ``(cost, label, departure)`` of the best finish.
-        """
-        p = self.p
-        r = p.radius
-        heap = self.heap
-        while heap:
-            f, g, _, node, s, pos, parent, dep = heapq.heappop(heap)
-            if node < 0:  # a finished path
-                return g, parent, dep
-            if self._dominated(node, s, pos, g):
-                continue
-            lab = len(self.node)
-            self.node.append(node)
-            self.side.append(s)
-            self.pos.append(pos)
-            self.cost.append(g)
-            self.parent.append(parent)
-            self.parent_dep.append(dep)
-            self.settled.setdefault((node, s), []).append(lab)
-            if finish is not None:
-                for fdep, flen in finish.get((node, s), ()):
-                    if fdep >= pos - ANG_TOL and p._arc_free(node, s, pos, fdep):
-                        total = g + r * max(fdep - pos, 0.0) + flen
-                        self.count += 1
-                        heapq.heappush(heap, (total, total, self.count, -1, 0, 0.0, lab, fdep))
-            deps, to, side, arr, length = p._edge_lists(node, s)
-            start = bisect.bisect_left(deps, pos - ANG_TOL)
-            if start >= len(deps):
-                continue
-            blocked = p._blocked_ccw[node]
-            for i in range(start, len(deps)):
-                d = deps[i]
-                if blocked and not p._arc_free(node, s, pos, d):
-                    break
-                self.push(g + r * max(d - pos, 0.0) + length[i], to[i], side[i], arr[i], lab, d)
-        return None
-
-    def trace(self, label: int, dep: float) -> list[NDArray[np.float64]]:
-        """Points from the departure at ``dep`` on ``label``'s arc back to the first node."""
-        p = self.p
-        pts: list[NDArray[np.float64]] = []
-        while label >= 0:
-            node, s = self.node[label], self.side[label]
-            pts += arc_points(p, node, s, dep, self.pos[label])
-            dep = self.parent_dep[label]
-            label = self.parent[label]
-        return pts
+    return [orient(part, 1.0).exterior for part in getattr(poly, "geoms", [poly])]
