@@ -98,6 +98,7 @@ class FloorCollision:
         self.polygons = tuple(polygons)
         self._poly_tree = shapely.STRtree(list(self.polygons)) if self.polygons else None
         self._poly_edges = _polygon_edges(self.polygons)
+        self._radius_args: dict[float, tuple[Any, ...]] = {}  # _kernel_radius's, per radius
 
     @classmethod
     def from_map(cls, tmap: Any) -> FloorCollision:
@@ -114,6 +115,7 @@ class FloorCollision:
     def __getstate__(self) -> dict[str, Any]:
         state = self.__dict__.copy()
         state["_poly_tree"] = None  # the spatial index is rebuilt, not shipped
+        state["_radius_args"] = {}
         return state
 
     def __setstate__(self, state: dict[str, Any]) -> None:
@@ -121,6 +123,7 @@ class FloorCollision:
         self._poly_tree = shapely.STRtree(list(self.polygons)) if self.polygons else None
         if "_poly_edges" not in state:
             self._poly_edges = _polygon_edges(self.polygons)
+        self.__dict__.setdefault("_radius_args", {})
 
     @property
     def compiled_polygons(self) -> bool:
@@ -157,12 +160,18 @@ class FloorCollision:
     def _kernel_radius(self, radius: float) -> tuple[Any, ...]:
         """:func:`~pointnav_core._collision_kernel.segment_hits`' arguments after the segment,
         for a disc of ``radius`` m (``rho`` and ``reach`` as ``_cells_hit`` and
-        ``_polygons_hit`` derive them)."""
-        ox, oy, res, rowcum, outside, *poly, use_polygons = self.kernel_geometry()
-        inv = 1.0 / res
-        rho = max(radius - TOUCH_TOL, TOUCH_TOL) * inv
-        reach = max(radius - 2 * TOUCH_TOL, TOUCH_TOL / 2)
-        return (ox, oy, inv, rho, rowcum, outside, reach, *poly, use_polygons)
+        ``_polygons_hit`` derive them); kept per radius, as a step's tests ask for one or two."""
+        args = self._radius_args.get(radius)
+        if args is None:
+            ox, oy, res, rowcum, outside, *poly, use_polygons = self.kernel_geometry()
+            inv = 1.0 / res
+            rho = max(radius - TOUCH_TOL, TOUCH_TOL) * inv
+            reach = max(radius - 2 * TOUCH_TOL, TOUCH_TOL / 2)
+            args = (ox, oy, inv, rho, rowcum, outside, reach, *poly, use_polygons)
+            if len(self._radius_args) >= 64:  # an oracle's arcs add their sagitta: many radii
+                self._radius_args.clear()
+            self._radius_args[radius] = args
+        return args
 
     def points_clear(self, points: ArrayLike, radius: float) -> NDArray[np.bool_]:
         """Whether discs of ``radius`` metres centred at world ``points`` miss the blocked set.
