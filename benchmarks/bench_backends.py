@@ -11,7 +11,7 @@ untimed replay), and each backend's speed relative to the first one.
 The second table, from the same run and house, times whole environments on each backend,
 with the task's bookkeeping (rewards, terminations, metrics, observations) on top of the
 backend: ``PointNavEnv`` for one robot (env steps per second) and, for more robots, the
-PettingZoo env ``pointnav_core.parallel.parallel_env(n_robots=n)`` (agent-steps per second:
+PettingZoo env ``pointnav_core.envs.multi_pointnav.parallel_env(n_robots=n)`` (agent-steps per second:
 one agent acting for one step; finished agents leave ``agents``). Robots use the default
 ``RobotSpec`` (differential drive) and random actions held ``--hold`` steps; episodes are
 sampled by the tasks, and resets are counted in the time.
@@ -29,13 +29,12 @@ import math
 import platform
 import time
 from collections.abc import Sequence
-
 from typing import Any
 
 import numpy as np
 
-from pointnav_core.backend import RobotSpec, available_backends, make_backend
-from pointnav_core.env import PointNavEnv
+from pointnav_core.backends.protocol import RobotSpec, available_backends, make_backend
+from pointnav_core.envs.pointnav import PointNavEnv
 from pointnav_core.scenes import Scene, rooms
 
 
@@ -169,11 +168,11 @@ def time_parallel_env(
 
 
 def parallel_env_factory() -> tuple[Any, str]:
-    """``pointnav_core.parallel.parallel_env``, or None and the reason it is unavailable."""
+    """``pointnav_core.envs.multi_pointnav.parallel_env``, or None and the reason it is unavailable."""
     try:
-        from pointnav_core.parallel import parallel_env
+        from pointnav_core.envs.multi_pointnav import parallel_env
     except ImportError as err:
-        return None, f"pointnav_core.parallel is not available ({err})"
+        return None, f"pointnav_core.envs.multi_pointnav is not available ({err})"
     return parallel_env, ""
 
 

@@ -1,10 +1,10 @@
 """The oracle's evaluation as a multiple of stepping the same episodes alone.
 
 ``--episodes`` episodes are generated afresh on the ``houses`` scene set (the split and seed
-given), then played twice through :func:`pointnav_core.evaluation.evaluate` with one
+given), then played twice through :func:`pointnav_core.evaluation.run.evaluate` with one
 worker, the same code as ``pointnav eval --workers 1``:
 
-1. by the oracle (:class:`~pointnav_core.policies.ShortestPathFollower`), whose actions are
+1. by the oracle (:class:`~pointnav_core.evaluation.policies.ShortestPathFollower`), whose actions are
    recorded;
 2. by a policy that replays those actions: the same env builds, resets, steps and final
    distances, with no planning.
@@ -30,8 +30,8 @@ from typing import Any
 
 from pointnav_core.datasets.generator import generate_split
 from pointnav_core.datasets.scene_sets import scene_set
-from pointnav_core.evaluation import evaluate, summarize
-from pointnav_core.policies import ShortestPathFollower
+from pointnav_core.evaluation.policies import ShortestPathFollower
+from pointnav_core.evaluation.run import evaluate, summarize
 
 
 def _play(episodes: list[Any], recorded: list[list[Any]] | None) -> tuple[float, list[Any], list[list[Any]]]:

@@ -79,11 +79,18 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
+from benchkit import (
+    MOVINGAI_DIR,
+    Measurement,
+    machine,
+    measure,
+    movingai_maps,
+    start_children,
+)
 from scipy import ndimage
 
-from benchkit import MOVINGAI_DIR, Measurement, machine, measure, movingai_maps, start_children
 from pointnav_core import scenes
-from pointnav_core.collision import FloorCollision
+from pointnav_core.floor.collision import FloorCollision
 
 RADIUS = 0.18
 
@@ -186,10 +193,10 @@ def speed(args):
 
 def accuracy(args):
     sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "tests"))
-    from test_geodesic_accuracy import RADIUS as R, relative_errors
-
     from geodesic_reference import ContinuousGeodesic, house_plan
     from scipy.sparse import csgraph
+    from test_geodesic_accuracy import RADIUS as R
+    from test_geodesic_accuracy import relative_errors
 
     errors = relative_errors(seeds=tuple(range(args.plans)), pairs_per_plan=args.acc_pairs)
     print(f"pointnav-core any-angle: n={len(errors)} median {np.median(errors)*100:.3f}% "

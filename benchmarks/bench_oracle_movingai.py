@@ -1,11 +1,11 @@
 """Oracle quality on real grid maps: the MovingAI ``den312d`` and ``maze-128-128-1`` maps.
 
-The privileged shortest-path follower (:class:`pointnav_core.policies.ShortestPathFollower`)
+The privileged shortest-path follower (:class:`pointnav_core.evaluation.policies.ShortestPathFollower`)
 drives ``--episodes`` episodes per map and per backend (kinematic and pymunk by default),
 the way :func:`pointnav_core.cli.run_demo` drives generated houses. Each map becomes a
 scene through ``Scene.from_movingai`` (``--resolution`` metres per character, default 0.5,
 so that a corridor one character wide fits the robot of radius ``--radius``, default
-0.18 m), passed to :class:`~pointnav_core.env.PointNavEnv` as its ``scene``. The task's
+0.18 m), passed to :class:`~pointnav_core.envs.pointnav.PointNavEnv` as its ``scene``. The task's
 own sampler picks start and goal (any two points of one connected region); the episode
 seeds are the same on every backend, so only the motion differs. ``max_steps`` is 10,000
 (5,000 s at 10 Hz), so the timeout does not bind: an episode the oracle does not finish
@@ -35,11 +35,11 @@ from collections.abc import Sequence
 from pathlib import Path
 
 import numpy as np
-
 from benchkit import MOVINGAI_DIR, machine, movingai_maps
-from pointnav_core.backend import available_backends
-from pointnav_core.env import PointNavEnv
-from pointnav_core.policies import ShortestPathFollower
+
+from pointnav_core.backends.protocol import available_backends
+from pointnav_core.envs.pointnav import PointNavEnv
+from pointnav_core.evaluation.policies import ShortestPathFollower
 from pointnav_core.scenes import Scene
 
 #: The maps, as named in the MovingAI benchmark sets.

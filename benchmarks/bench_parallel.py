@@ -1,7 +1,7 @@
 """Multi-robot speed: MultiPointNav-v0 agent-steps per second beside MPE2's simple_spread_v3.
 
 Both are PettingZoo parallel envs with 3 agents and continuous actions, measured in the same
-run: ``pointnav_core.parallel.parallel_env(n_robots=3)`` (kinematic backend, the default
+run: ``pointnav_core.envs.multi_pointnav.parallel_env(n_robots=3)`` (kinematic backend, the default
 20 x 15 m ``rooms`` house) and ``mpe2.simple_spread_v3.parallel_env(N=3,
 continuous_actions=True)``. Actions are uniform random in each agent's action space, drawn
 before the clock starts; an agent-step is one agent acting for one env step. Resets happen
@@ -31,7 +31,7 @@ import time
 from collections.abc import Callable
 from typing import Any
 
-from pointnav_core import parallel
+from pointnav_core.envs import multi_pointnav as parallel
 
 
 def _simple_spread() -> tuple[str, Callable[..., Any]]:

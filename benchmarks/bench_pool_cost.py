@@ -60,8 +60,8 @@ def _fill_setup(folder: str) -> Any:
 
 
 def _fill_job(scene: Any, lap: Any) -> bool:
+    from pointnav_core.backends.robot_spec import RobotSpec
     from pointnav_core.geodesic import planner_for
-    from pointnav_core.robot_spec import RobotSpec
 
     planner = planner_for(scene.floors[0], RobotSpec().radius)
     planner.build_all_edges()

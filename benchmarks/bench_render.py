@@ -26,7 +26,7 @@ from collections.abc import Callable, Sequence
 import numpy as np
 from PIL import Image, ImageDraw
 
-from pointnav_core.render import (
+from pointnav_core.render.top_down import (
     GOAL_COLOR,
     ROBOT_PALETTE,
     START_COLOR,
@@ -102,8 +102,8 @@ def time_frames(draw: Callable[[], np.ndarray], frames: int) -> tuple[float, flo
 
 def env_render_times(seed: int, frames: int, pixels_per_meter: float) -> tuple[float, float]:
     """Median and 90th percentile of ``env.render()`` (ms), one frame per oracle step."""
-    from pointnav_core.env import PointNavEnv
-    from pointnav_core.policies import ShortestPathFollower
+    from pointnav_core.envs.pointnav import PointNavEnv
+    from pointnav_core.evaluation.policies import ShortestPathFollower
     from pointnav_core.scenes import rooms
 
     env = PointNavEnv(
@@ -130,7 +130,7 @@ def env_render_times(seed: int, frames: int, pixels_per_meter: float) -> tuple[f
 
 def env_step_times(seed: int, steps: int) -> list[tuple[str, float]]:
     """Median ``env.step`` time (us) with visualisation off, goal markers only, and both."""
-    from pointnav_core.env import PointNavEnv
+    from pointnav_core.envs.pointnav import PointNavEnv
     from pointnav_core.scenes import rooms
 
     scene = rooms(seed=seed, size=(20.0, 20.0))

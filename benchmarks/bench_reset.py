@@ -25,7 +25,7 @@ import numpy as np
 
 import pointnav_core  # noqa: F401  (registers the envs)
 from pointnav_core import scenes
-from pointnav_core.parallel import parallel_env
+from pointnav_core.envs.multi_pointnav import parallel_env
 
 
 def _timed(fn: Any, *args: Any, **kwargs: Any) -> tuple[float, Any]:

@@ -29,8 +29,8 @@ import numpy as np
 
 import pointnav_core  # noqa: F401  (registers pointnav_core/PointNav-v0)
 from pointnav_core import scenes
-from pointnav_core.observations import Frame
 from pointnav_core.sensors import RangeScan, ScanGeometry, cast_rays, raycast_jit
+from pointnav_core.task.observations import Frame
 
 
 def record_poses(scene: Any, n: int, seed: int) -> list[tuple[float, float, float]]:

@@ -22,8 +22,8 @@ from benchkit import machine
 
 from pointnav_core import scenes
 from pointnav_core.geodesic import cache
+from pointnav_core.utils.workers import usable_cores
 from pointnav_core.vector import VectorPointNavEnv
-from pointnav_core.workers import usable_cores
 
 TARGET_S = 120.0
 

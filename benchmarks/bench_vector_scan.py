@@ -37,10 +37,10 @@ from collections.abc import Callable
 import numpy as np
 
 from pointnav_core import scenes
-from pointnav_core.backend_kit.checks import planar_quat_floats
-from pointnav_core.observations import Frame
+from pointnav_core.backends.kit.checks import planar_quat_floats
 from pointnav_core.sensors import LocalMap, ScanGeometry, cast_rays, scan_angles
 from pointnav_core.sensors.raycast import cast_pose_compiled
+from pointnav_core.task.observations import Frame
 from pointnav_core.vector.floors import FloorTables
 from pointnav_core.vector.local_map import VectorLocalMap
 from pointnav_core.vector.scan import ScanTables, cast_batch, compiled_available

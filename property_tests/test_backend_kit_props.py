@@ -17,7 +17,7 @@ import numpy as np
 from hypothesis import assume, given
 from hypothesis import strategies as st
 
-from pointnav_core.backend_kit import (
+from pointnav_core.backends.kit import (
     FloorGrid,
     body_command,
     drive_arc,
@@ -26,8 +26,12 @@ from pointnav_core.backend_kit import (
     planar_quat_floats,
     robots_overlap,
 )
-from pointnav_core.maps import VOID
-from pointnav_core.testing.strategies import robot_actions, robot_specs, traversable_maps
+from pointnav_core.floor.maps import VOID
+from pointnav_core.testing.strategies import (
+    robot_actions,
+    robot_specs,
+    traversable_maps,
+)
 
 headings = st.floats(-20.0, 20.0)
 speeds = st.floats(-3.0, 3.0)

@@ -16,7 +16,7 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-from pointnav_core.maps import TraversableMap
+from pointnav_core.floor.maps import TraversableMap
 from pointnav_core.scenes import Scene
 from pointnav_core.sensors import TOUCH_EPS, ScanGeometry, cast_rays, scan_angles
 from pointnav_core.sensors.clearance import QUADRANTS, quadrant_clearance

@@ -2,7 +2,7 @@
 
 For random grids (random blocked cells, outside blocked or not), radii (0 included) and
 segments of every kind (points, axis-aligned, on grid lines, crossing the map's edge, far
-off it), :meth:`pointnav_core.collision.FloorCollision.segments_clear` answers the same
+off it), :meth:`pointnav_core.floor.collision.FloorCollision.segments_clear` answers the same
 with its numba kernel as with its numpy arrays (the ``fast`` extra's path and the path
 without it). So does the one-segment call, :meth:`FloorCollision.segment_clear`. The numpy path itself is checked against shapely in
 ``property_tests/test_geometry_agreement.py`` and ``tests/test_collision.py``.
@@ -15,8 +15,8 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from pointnav_core._compiled import kernel, numpy_paths
-from pointnav_core.collision import FloorCollision
+from pointnav_core.floor.collision import FloorCollision
+from pointnav_core.utils.compiled import kernel, numpy_paths
 
 pytest.importorskip("numba")
 
@@ -51,10 +51,10 @@ def test_compiled_cell_test_equals_the_numpy_path(
     a[kind == 4] += 50.0 * size  # far off the map
     got = geo.segments_clear(a, b, radius)
     with numpy_paths():
-        assert kernel("pointnav_core._collision_kernel", "cells_hit") is None
+        assert kernel("pointnav_core.floor._collision_kernel", "cells_hit") is None
         want = geo.segments_clear(a, b, radius)
     np.testing.assert_array_equal(got, want)
-    assert kernel("pointnav_core._collision_kernel", "cells_hit") is not None
+    assert kernel("pointnav_core.floor._collision_kernel", "cells_hit") is not None
     # The one-segment call (planners' and worlds' point tests), compiled and not.
     pairs = list(zip(a.tolist(), b.tolist()))
     one = np.array([geo.segment_clear(*p, *q, radius) for p, q in pairs])

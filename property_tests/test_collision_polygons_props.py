@@ -17,8 +17,8 @@ from hypothesis import strategies as st
 from shapely.affinity import rotate
 from shapely.geometry import MultiPolygon, Polygon, box
 
-from pointnav_core._compiled import kernel, numpy_paths
-from pointnav_core.collision import TOUCH_TOL, FloorCollision
+from pointnav_core.floor.collision import TOUCH_TOL, FloorCollision
+from pointnav_core.utils.compiled import kernel, numpy_paths
 
 pytest.importorskip("numba")
 
@@ -48,7 +48,7 @@ def test_compiled_polygon_test_equals_shapely(polys, seed, radius) -> None:
     geo = FloorCollision(np.zeros((60, 60), bool), 0.1, (0.0, 0.0), polygons=polys)
     a = rng.uniform(0.0, 6.0, (200, 2))
     b = a + rng.normal(0.0, 1.0, (200, 2)) * rng.choice([0.0, 0.1, 1.0, 3.0], (200, 1))
-    assert kernel("pointnav_core._collision_kernel", "polygons_hit") is not None
+    assert kernel("pointnav_core.floor._collision_kernel", "polygons_hit") is not None
     got = geo.segments_clear(a, b, radius)
     with numpy_paths():
         want = geo.segments_clear(a, b, radius)

@@ -22,12 +22,12 @@ import pytest
 from hypothesis import HealthCheck, given, note, settings
 from hypothesis import strategies as st
 
-from pointnav_core import _compiled
+from pointnav_core.floor.maps import FREE, OBSTACLE
 from pointnav_core.geodesic import roots
 from pointnav_core.geodesic.cell_links import CellLinks, cell_centres
-from pointnav_core.maps import FREE, OBSTACLE
 from pointnav_core.scenes import Scene
 from pointnav_core.testing.strategies import cluttered_rooms, nav_scenes
+from pointnav_core.utils import compiled as _compiled
 
 
 def cluttered_scenes() -> st.SearchStrategy[Scene]:

@@ -9,7 +9,7 @@ from hypothesis import strategies as st
 from scipy import ndimage
 
 from pointnav_core import floorplans
-from pointnav_core.maps import FREE, OBSTACLE, VOID, TraversableMap
+from pointnav_core.floor.maps import FREE, OBSTACLE, VOID, TraversableMap
 from pointnav_core.testing.strategies import floor_plans
 
 RESOLUTION = 0.1  # coarse enough to be quick, fine enough for 0.12 m walls

@@ -20,7 +20,7 @@ import numpy as np
 from hypothesis import HealthCheck, assume, given, settings
 from hypothesis import strategies as st
 
-from pointnav_core.maps import OBSTACLE
+from pointnav_core.floor.maps import OBSTACLE
 from pointnav_core.scenes import Scene
 
 
@@ -115,7 +115,7 @@ def test_the_compiled_goal_search_equals_scipys(floor, seed) -> None:
     scipy's run on the graph with a source vertex added (the path without numba)."""
     import pytest
 
-    from pointnav_core import _compiled
+    from pointnav_core.utils import compiled as _compiled
 
     pytest.importorskip("numba")
     scene, radius = floor
@@ -139,7 +139,7 @@ def test_the_compiled_point_links_equal_the_numpy_ones(floor, seed) -> None:
     numpy path's, node for node, in order."""
     import pytest
 
-    from pointnav_core import _compiled
+    from pointnav_core.utils import compiled as _compiled
 
     pytest.importorskip("numba")
     scene, radius = floor
@@ -159,7 +159,7 @@ def test_the_compiled_exact_query_equals_the_one_point_search(floor, seed) -> No
     query on numpy arrays) within 1e-9 m, at random points, reachable or not."""
     import pytest
 
-    from pointnav_core import _compiled
+    from pointnav_core.utils import compiled as _compiled
 
     pytest.importorskip("numba")
     scene, radius = floor

@@ -6,8 +6,8 @@ import numpy as np
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from pointnav_core.maps import FREE
-from pointnav_core.paths import path_length
+from pointnav_core.floor.maps import FREE
+from pointnav_core.geodesic.paths import path_length
 from pointnav_core.scenes import Scene
 from pointnav_core.testing.strategies import maps_with_points, traversable_maps
 

@@ -14,17 +14,17 @@ from dataclasses import dataclass
 import numpy as np
 import pytest
 import shapely
-from shapely import affinity
 from hypothesis import HealthCheck, given, note, settings
 from hypothesis import strategies as st
 from hypothesis.stateful import RuleBasedStateMachine, initialize, invariant, rule
+from pointnav_kinematic import KinematicBackend
+from shapely import affinity
 
-from pointnav_core.backend import RobotSpec
-from pointnav_core.maps import FREE, OBSTACLE, VOID, TraversableMap
+from pointnav_core.backends.protocol import RobotSpec
+from pointnav_core.floor.maps import FREE, OBSTACLE, VOID, TraversableMap
 from pointnav_core.scenes import Scene
 from pointnav_core.testing.conformance import obstacle_distance
 from pointnav_core.testing.strategies import robot_actions
-from pointnav_kinematic import KinematicBackend
 
 TOUCH = 1e-9  # allowed overlap, metres
 

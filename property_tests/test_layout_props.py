@@ -6,7 +6,7 @@ import numpy as np
 from hypothesis import given
 from hypothesis import strategies as st
 
-from pointnav_core.observations import Frame, ObservationLayout, ObservationTerm
+from pointnav_core.task.observations import Frame, ObservationLayout, ObservationTerm
 
 
 class Listed(ObservationTerm):

@@ -12,9 +12,20 @@ import numpy as np
 from hypothesis import assume, given
 from hypothesis import strategies as st
 
-from pointnav_core.observations import AngularVelocity, Frame, GoalVector, LinearVelocity
+from pointnav_core.task.observations import (
+    AngularVelocity,
+    Frame,
+    GoalVector,
+    LinearVelocity,
+)
 from pointnav_core.testing.strategies import unit_quaternions, yaws
-from pointnav_core.transforms import cartesian_to_polar, quat2mat, quat2yaw, to_robot_frame, yaw2quat
+from pointnav_core.transforms import (
+    cartesian_to_polar,
+    quat2mat,
+    quat2yaw,
+    to_robot_frame,
+    yaw2quat,
+)
 
 coords = st.floats(-50.0, 50.0)
 speeds = st.tuples(*[st.floats(-3.0, 3.0)] * 3)

@@ -16,8 +16,8 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from pointnav_core import scenes
-from pointnav_core.env import PointNavEnv
-from pointnav_core.policies import ShortestPathFollower
+from pointnav_core.envs.pointnav import PointNavEnv
+from pointnav_core.evaluation.policies import ShortestPathFollower
 
 
 def _checked(follower: ShortestPathFollower, tmap: Any, seen: list[int]) -> None:

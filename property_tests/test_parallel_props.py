@@ -19,8 +19,12 @@ from hypothesis import event, note, settings
 from hypothesis import strategies as st
 from hypothesis.stateful import RuleBasedStateMachine, initialize, invariant, rule
 
-from pointnav_core.backend import available_backends
-from pointnav_core.parallel import FINISHED_MODES, STATE_FIELDS, MultiPointNavEnv
+from pointnav_core.backends.protocol import available_backends
+from pointnav_core.envs.multi_pointnav import (
+    FINISHED_MODES,
+    STATE_FIELDS,
+    MultiPointNavEnv,
+)
 from pointnav_core.task import TaskStateError
 from pointnav_core.testing.strategies import (
     nav_robot_specs,

@@ -7,8 +7,8 @@ from hypothesis import given
 from hypothesis import strategies as st
 from hypothesis.extra.numpy import arrays
 
-from pointnav_core.markers import _waypoints_along
-from pointnav_core.paths import path_length, resample_path
+from pointnav_core.geodesic.paths import path_length, resample_path
+from pointnav_core.task.markers import _waypoints_along
 
 polylines = st.integers(1, 12).flatmap(
     lambda n: arrays(np.float64, (n, 2), elements=st.floats(-20.0, 20.0, allow_subnormal=False))

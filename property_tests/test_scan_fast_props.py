@@ -21,8 +21,8 @@ import shapely.affinity
 from hypothesis import given
 from hypothesis import strategies as st
 
+from pointnav_core.floor.maps import TraversableMap
 from pointnav_core.floorplans import FloorPlan
-from pointnav_core.maps import TraversableMap
 from pointnav_core.sensors import ScanGeometry, cast_rays, scan_angles
 from pointnav_core.sensors.raycast import cast_pose_compiled
 

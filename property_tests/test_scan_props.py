@@ -16,7 +16,7 @@ import shapely
 from hypothesis import given
 from hypothesis import strategies as st
 
-from pointnav_core.maps import TraversableMap
+from pointnav_core.floor.maps import TraversableMap
 from pointnav_core.sensors import ScanGeometry, cast_rays, scan_angles
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))

@@ -19,10 +19,10 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from pointnav_core._compiled import kernel, numpy_paths
-from pointnav_core.collision import FloorCollision
+from pointnav_core.floor.collision import FloorCollision
 from pointnav_core.geodesic import edges, sight
 from pointnav_core.geodesic.planner import Planner
+from pointnav_core.utils.compiled import kernel, numpy_paths
 
 pytest.importorskip("numba")
 

@@ -31,9 +31,9 @@ from scipy.sparse.csgraph import connected_components
 from shapely.affinity import rotate
 from shapely.geometry import box
 
-from pointnav_core.maps import TraversableMap
-from pointnav_core.scenes import Scene
+from pointnav_core.floor.maps import TraversableMap
 from pointnav_core.geodesic.planner import planner_for
+from pointnav_core.scenes import Scene
 
 #: Largest drawn-length to distance ratio: an arc piece of 2 degrees, circumscribed.
 ARC_RATIO = math.tan(math.radians(1.0)) / math.radians(1.0)

@@ -23,11 +23,11 @@ from hypothesis.stateful import (
     run_state_machine_as_test,
 )
 
-from pointnav_core.backend import available_backends
-from pointnav_core.env import PointNavEnv
-from pointnav_core.metrics import soft_spl, spl
+from pointnav_core.backends.protocol import available_backends
+from pointnav_core.envs.pointnav import PointNavEnv
 from pointnav_core.scenes import Scene
 from pointnav_core.task import TaskState, TaskStateError
+from pointnav_core.task.metrics import soft_spl, spl
 from pointnav_core.testing.strategies import (
     nav_robot_specs,
     nav_scenes,

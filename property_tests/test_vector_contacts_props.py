@@ -20,7 +20,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from pointnav_core.maps import OBSTACLE
+from pointnav_core.floor.maps import OBSTACLE
 from pointnav_core.scenes import Scene
 
 pytest.importorskip("numba")

@@ -23,7 +23,7 @@ from hypothesis import HealthCheck, event, given, settings
 from hypothesis import strategies as st
 from vector_reference import compare
 
-from pointnav_core.maps import FREE, OBSTACLE, VOID
+from pointnav_core.floor.maps import FREE, OBSTACLE, VOID
 from pointnav_core.scenes import Scene
 
 DEVICES = ["numpy"] + (["cpu"] if importlib.util.find_spec("torch") else [])

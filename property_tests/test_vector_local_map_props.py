@@ -18,7 +18,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from local_map_reference import reference_map
 
-from pointnav_core.maps import OBSTACLE, VOID
+from pointnav_core.floor.maps import OBSTACLE, VOID
 from pointnav_core.scenes import Scene
 from pointnav_core.sensors import LocalMap
 from pointnav_core.vector import local_map as local_map_module

@@ -25,7 +25,7 @@ from hypothesis import strategies as st
 from scan_reference import assert_within, blocked_shapes, reference_ranges
 from vector_reference import compare, random_episodes
 
-from pointnav_core.maps import FREE, OBSTACLE, VOID
+from pointnav_core.floor.maps import FREE, OBSTACLE, VOID
 from pointnav_core.scenes import Scene
 from pointnav_core.sensors import scan_angles
 from pointnav_core.vector.scan import ScanTables, cast_batch, compiled_available

@@ -15,7 +15,7 @@ from typing import Any
 import numpy as np
 from local_map_reference import assert_obs, obs_ties
 
-from pointnav_core.parallel import parallel_env
+from pointnav_core.envs.multi_pointnav import parallel_env
 from pointnav_core.vector import VectorPointNavEnv
 
 OBS_TOL = 1e-4

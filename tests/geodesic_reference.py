@@ -24,9 +24,9 @@ from __future__ import annotations
 import numpy as np
 import shapely
 from scipy.sparse import csgraph, csr_matrix
+from shapely.affinity import rotate
 from shapely.geometry import Polygon, box
 from shapely.geometry.polygon import orient
-from shapely.affinity import rotate
 
 #: Relative tolerance of the collinearity and tangency tests (unit vectors).
 _TANGENT_TOL = 1e-9

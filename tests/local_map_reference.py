@@ -18,7 +18,7 @@ import numpy as np
 import shapely
 from shapely import STRtree
 
-from pointnav_core.maps import VOID
+from pointnav_core.floor.maps import VOID
 from pointnav_core.sensors import LocalMap
 
 TIE = 1e-9  # m: a centre this close to a square's edge or a disc's rim may read either side

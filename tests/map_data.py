@@ -7,7 +7,7 @@ from pathlib import Path
 import numpy as np
 from PIL import Image
 
-from pointnav_core.maps import FREE, OBSTACLE, VOID
+from pointnav_core.floor.maps import FREE, OBSTACLE, VOID
 from pointnav_core.scenes import Scene
 
 DATA = Path(__file__).parent / "data"

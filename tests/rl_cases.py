@@ -23,8 +23,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from pointnav_core.maps import FREE, OBSTACLE
-from pointnav_core.parallel import MultiPointNavEnv
+from pointnav_core.envs.multi_pointnav import MultiPointNavEnv
+from pointnav_core.floor.maps import FREE, OBSTACLE
 from pointnav_core.scenes import Scene
 
 FACING_X = (0.0, 0.0, 0.0, 1.0)

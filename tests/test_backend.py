@@ -8,8 +8,9 @@ import sys
 
 import numpy as np
 import pytest
+from pointnav_kinematic import KinematicBackend
 
-from pointnav_core.backend import (
+from pointnav_core.backends.protocol import (
     Backend,
     RobotSpec,
     UnknownBackendError,
@@ -19,7 +20,6 @@ from pointnav_core.backend import (
     make_backend,
 )
 from pointnav_core.errors import BackendError, PointNavError
-from pointnav_kinematic import KinematicBackend
 
 PROTOCOL_MEMBERS = {
     "load",
@@ -189,7 +189,7 @@ def test_scale_action_rejects_wrong_shape_naming_expected_shape(drive, action):
 
 
 def test_protocol_has_exactly_the_documented_members():
-    from pointnav_core import backend
+    from pointnav_core.backends import protocol as backend
 
     assert set(backend._protocol_members()) == PROTOCOL_MEMBERS
 
@@ -240,7 +240,7 @@ def test_check_backend_does_not_run_properties():
 
 def test_backend_module_imports_no_backend_package():
     code = (
-        "import sys, pointnav_core.backend\n"
+        "import sys, pointnav_core.backends.protocol\n"
         "assert not [m for m in sys.modules if m.startswith('pointnav_kinematic')]\n"
     )
     subprocess.run([sys.executable, "-c", code], check=True)

@@ -9,16 +9,16 @@ import pathlib
 import numpy as np
 import pytest
 
-import pointnav_core.backend as backend_module
-from pointnav_core import backend_kit
-from pointnav_core.backend import RobotSpec, check_backend, float_twin
-from pointnav_core.backend_kit import (
+import pointnav_core.backends.protocol as backend_module
+from pointnav_core.backends import kit as backend_kit
+from pointnav_core.backends.kit import (
     FloorGrid,
     RobotState,
     RobotStateBackend,
     check_load,
     drive_arc,
 )
+from pointnav_core.backends.protocol import RobotSpec, check_backend, float_twin
 from pointnav_core.scenes import Scene
 from pointnav_core.testing.conformance import run_checks
 
@@ -33,7 +33,7 @@ BACKENDS_DIR = pathlib.Path(__file__).resolve().parents[1] / "src" / "backends"
 def test_the_names_that_moved_are_still_importable_from_backend(name):
     assert getattr(backend_module, name) is getattr(backend_kit, name)
     namespace: dict = {}
-    exec(f"from pointnav_core.backend import {name}", namespace)
+    exec(f"from pointnav_core.backends.protocol import {name}", namespace)
     assert namespace[name] is getattr(backend_kit, name)
 
 

@@ -13,7 +13,7 @@ import pytest
 import shapely
 from shapely.geometry import Point, box
 
-from pointnav_core.collision import FloorCollision, convex_corners
+from pointnav_core.floor.collision import FloorCollision, convex_corners
 
 
 def reference_blocked(grid: np.ndarray, res: float, origin: tuple[float, float], polygons=()):

@@ -10,8 +10,9 @@ import numpy as np
 import pytest
 from hypothesis import given, reject
 from hypothesis import strategies as st
+from pointnav_kinematic import KinematicBackend
 
-from pointnav_core.backend import (
+from pointnav_core.backends.protocol import (
     FLOAT_TWINS,
     RobotSpec,
     UnknownBackendError,
@@ -22,7 +23,7 @@ from pointnav_core.backend import (
     make_backend,
 )
 from pointnav_core.errors import BackendError
-from pointnav_core.maps import FREE, OBSTACLE, VOID, TraversableMap
+from pointnav_core.floor.maps import FREE, OBSTACLE, VOID, TraversableMap
 from pointnav_core.testing import strategies
 from pointnav_core.testing.__main__ import main
 from pointnav_core.testing.conformance import (
@@ -38,7 +39,6 @@ from pointnav_core.testing.conformance import (
     obstacle_distance,
     run_checks,
 )
-from pointnav_kinematic import KinematicBackend
 
 BACKENDS = available_backends()
 

@@ -19,9 +19,9 @@ import cloudpickle
 import numpy as np
 import pytest
 
-from pointnav_core.env import PointNavEnv
-from pointnav_core.frozen import FrozenMapping, thaw
-from pointnav_core.parallel import MultiPointNavEnv
+from pointnav_core.envs.multi_pointnav import MultiPointNavEnv
+from pointnav_core.envs.pointnav import PointNavEnv
+from pointnav_core.utils.frozen import FrozenMapping, thaw
 
 STEPS = 300
 

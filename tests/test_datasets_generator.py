@@ -8,8 +8,13 @@ from collections import deque
 import numpy as np
 import pytest
 
-from pointnav_core import Scene, SamplingError
-from pointnav_core.datasets import EpisodeDataset, GeneratorConfig, generate_episodes, island_radius
+from pointnav_core import SamplingError, Scene
+from pointnav_core.datasets import (
+    EpisodeDataset,
+    GeneratorConfig,
+    generate_episodes,
+    island_radius,
+)
 
 RES = 0.1
 RADIUS = 0.18

@@ -13,8 +13,8 @@ import pytest
 from pointnav_core import Scene
 from pointnav_core.datasets import EpisodeDataset, GeneratorConfig, generate_episodes
 from pointnav_core.datasets.playback import EpisodeSchedule, episode_seed
-from pointnav_core.env import PointNavEnv
-from pointnav_core.parallel import MultiPointNavEnv
+from pointnav_core.envs.multi_pointnav import MultiPointNavEnv
+from pointnav_core.envs.pointnav import PointNavEnv
 from pointnav_core.transforms import quat2yaw
 
 RES = 0.1
@@ -139,7 +139,10 @@ def test_datasets_load_no_env_library():
 
 
 def test_wrappers_play_the_schedule_at_every_reset(scene, dataset):
-    from pointnav_core.dataset_envs import DatasetEpisodes, ParallelDatasetEpisodes
+    from pointnav_core.envs.dataset_wrappers import (
+        DatasetEpisodes,
+        ParallelDatasetEpisodes,
+    )
 
     env = DatasetEpisodes(PointNavEnv(scene=scene, flatten_obs=True), dataset, shuffle=True, seed=5)
     expected = EpisodeSchedule(dataset, shuffle=True, seed=5).take(2 * len(dataset))
@@ -164,7 +167,7 @@ def test_wrappers_play_the_schedule_at_every_reset(scene, dataset):
 
 
 def test_dataset_env_builds_the_scene_robot_and_floor(tmp_path):
-    from pointnav_core.dataset_envs import dataset_env
+    from pointnav_core.envs.dataset_wrappers import dataset_env
 
     map_path = tmp_path / "room.map"
     map_path.write_text(

@@ -153,7 +153,11 @@ def test_generate_split_spreads_episodes_and_is_reproducible(scene_folder):
 
 
 def test_shipped_validation_dataset_regenerates_byte_identically():
-    from pointnav_core.datasets import SCENE_SETS, VALIDATION_DATASET, validation_dataset
+    from pointnav_core.datasets import (
+        SCENE_SETS,
+        VALIDATION_DATASET,
+        validation_dataset,
+    )
     from pointnav_core.datasets.generator import generate_split
 
     shipped = validation_dataset()

@@ -16,10 +16,10 @@ import pytest
 
 import pointnav_core  # noqa: F401  (registers the ids)
 from pointnav_core import scenes
+from pointnav_core.envs.multi_pointnav import MultiPointNavEnv
+from pointnav_core.envs.pointnav import PointNavEnv, TaskStepLimit
 from pointnav_core.errors import SamplingError
-from pointnav_core.env import PointNavEnv, TaskStepLimit
-from pointnav_core.maps import FREE, OBSTACLE
-from pointnav_core.parallel import MultiPointNavEnv
+from pointnav_core.floor.maps import FREE, OBSTACLE
 from pointnav_core.scenes import Scene
 from pointnav_core.task import PointNavigationTask
 

@@ -19,10 +19,10 @@ import pytest
 from pointnav_core import scenes
 from pointnav_core.datasets import EpisodeDataset, GeneratorConfig, load_scene
 from pointnav_core.datasets.format import PointNavEpisode
-from pointnav_core.env import PointNavEnv
-from pointnav_core.maps import OBSTACLE
-from pointnav_core.parallel import parallel_env
-from pointnav_core.terminations import PointGoal
+from pointnav_core.envs.multi_pointnav import parallel_env
+from pointnav_core.envs.pointnav import PointNavEnv
+from pointnav_core.floor.maps import OBSTACLE
+from pointnav_core.task.terminations import PointGoal
 from pointnav_core.vector import VectorPointNavEnv
 
 TORCH = importlib.util.find_spec("torch") is not None

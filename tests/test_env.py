@@ -12,10 +12,10 @@ import pytest
 from gymnasium.utils.env_checker import check_env
 from gymnasium.wrappers import FlattenObservation
 
-from pointnav_core.backend import RobotSpec, available_backends
-from pointnav_core.env import PointNavEnv
-from pointnav_core.maps import FREE, OBSTACLE
-from pointnav_core.registration import ENV_IDS, register_envs
+from pointnav_core.backends.protocol import RobotSpec, available_backends
+from pointnav_core.envs.pointnav import PointNavEnv
+from pointnav_core.envs.registration import ENV_IDS, register_envs
+from pointnav_core.floor.maps import FREE, OBSTACLE
 from pointnav_core.scenes import Scene
 from pointnav_core.task import PointNavigationTask
 
@@ -82,7 +82,7 @@ def test_register_envs_is_idempotent():
     spec = gym.spec(ENV_ID)
     register_envs()  # no "overriding" warning (warnings are errors here)
     assert gym.spec(ENV_ID) is spec
-    assert ENV_IDS[ENV_ID] == "pointnav_core.env:PointNavEnv"
+    assert ENV_IDS[ENV_ID] == "pointnav_core.envs.pointnav:PointNavEnv"
 
 
 def test_gymnasium_check_env_render_modes():

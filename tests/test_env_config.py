@@ -12,11 +12,11 @@ import numpy as np
 import pytest
 
 from pointnav_core import scenes
-from pointnav_core.backend import RobotSpec
+from pointnav_core.backends.protocol import RobotSpec
 from pointnav_core.datasets import PointNavEpisode
-from pointnav_core.env import PointNavEnv
-from pointnav_core.env_config import EnvConfig
-from pointnav_core.parallel import parallel_env
+from pointnav_core.envs.config import EnvConfig
+from pointnav_core.envs.multi_pointnav import parallel_env
+from pointnav_core.envs.pointnav import PointNavEnv
 from pointnav_core.vector import VectorPointNavEnv
 
 # Every field away from its default, and floats that only an exact writer round-trips.

@@ -7,7 +7,7 @@ from types import SimpleNamespace
 
 import pytest
 
-from pointnav_core.episode_state import EpisodeState
+from pointnav_core.task.episode_state import EpisodeState
 
 
 class _Field:

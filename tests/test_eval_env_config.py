@@ -5,14 +5,13 @@ from __future__ import annotations
 import os
 
 import pytest
+from map_data import PILLAR_ROOM
 
 from pointnav_core.cli import main
 from pointnav_core.datasets import EpisodeDataset
-from pointnav_core.env import PointNavEnv
-from pointnav_core.env_config import EnvConfig
-from pointnav_core.evaluation import evaluate, read_results, read_run
-from map_data import PILLAR_ROOM
-
+from pointnav_core.envs.config import EnvConfig
+from pointnav_core.envs.pointnav import PointNavEnv
+from pointnav_core.evaluation.run import evaluate, read_results, read_run
 
 SCAN = EnvConfig(
     sensors={"scan": {"n_rays": 16}}, action_space="discrete", discrete_actions={"stop": False},

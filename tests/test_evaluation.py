@@ -17,7 +17,7 @@ from PIL import Image
 import pointnav_core
 from pointnav_core.cli import main
 from pointnav_core.datasets import EpisodeDataset
-from pointnav_core.evaluation import (
+from pointnav_core.evaluation.run import (
     bootstrap_interval,
     evaluate,
     make_policy,
@@ -258,7 +258,7 @@ def test_demo_on_a_scene_file(dataset_file, capsys):
 
 def test_sb3_zip_policy(dataset_file, tmp_path):
     sb3 = pytest.importorskip("stable_baselines3")
-    from pointnav_core.env import PointNavEnv
+    from pointnav_core.envs.pointnav import PointNavEnv
 
     model = sb3.PPO(
         "MlpPolicy", PointNavEnv(flatten_obs=True), n_steps=16, batch_size=16, device="cpu", seed=0

@@ -12,7 +12,7 @@ import pytest
 
 torch = pytest.importorskip("torch")
 
-from pointnav_core.maps import OBSTACLE
+from pointnav_core.floor.maps import OBSTACLE
 from pointnav_core.scenes import Scene
 from pointnav_core.vector import VectorPointNavEnv
 

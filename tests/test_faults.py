@@ -272,7 +272,7 @@ def test_outputs_are_checked_before_any_episode(work, tmp_path, capsys):
 
 
 def test_workers_are_capped_by_episodes_and_cores(work, monkeypatch):
-    from pointnav_core import evaluation
+    from pointnav_core.evaluation import run as evaluation
 
     made = []
 

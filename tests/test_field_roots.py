@@ -7,9 +7,9 @@ import math
 import numpy as np
 import pytest
 
-from pointnav_core import _compiled
-from pointnav_core.maps import OBSTACLE
+from pointnav_core.floor.maps import OBSTACLE
 from pointnav_core.scenes import Scene
+from pointnav_core.utils import compiled as _compiled
 
 RES = 0.1
 

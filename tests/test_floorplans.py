@@ -11,8 +11,8 @@ import shapely
 from scipy import ndimage
 from shapely.geometry import Point, Polygon, box
 
+from pointnav_core.floor.maps import FREE, OBSTACLE, VOID, TraversableMap
 from pointnav_core.floorplans import FloorPlan, clutter, maze, rasterize, rooms
-from pointnav_core.maps import FREE, OBSTACLE, VOID, TraversableMap
 
 GENERATORS = {"rooms": rooms, "maze": maze, "clutter": clutter}
 

@@ -5,11 +5,11 @@ import math
 import numpy as np
 import pytest
 
-from pointnav_core.collision import FloorCollision
+from pointnav_core.floor.collision import FloorCollision
+from pointnav_core.floor.maps import OBSTACLE, VOID, TraversableMap
 from pointnav_core.geodesic import Planner
-from pointnav_core.paths import path_length, resample_path
+from pointnav_core.geodesic.paths import path_length, resample_path
 from pointnav_core.geodesic.planner import planner_for
-from pointnav_core.maps import OBSTACLE, VOID, TraversableMap
 from pointnav_core.scenes import Scene
 
 

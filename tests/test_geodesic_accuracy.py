@@ -7,8 +7,8 @@ visibility-graph geodesic computed here from the same polygons grown by the robo
 
 import numpy as np
 import shapely
-
 from geodesic_reference import ContinuousGeodesic, house_plan
+
 from pointnav_core.scenes import Scene
 
 RADIUS = 0.2

@@ -9,10 +9,10 @@ import textwrap
 import numpy as np
 import pytest
 
-from pointnav_core.collision import FloorCollision
+from pointnav_core.floor.collision import FloorCollision
+from pointnav_core.floor.maps import OBSTACLE
 from pointnav_core.geodesic import cache
 from pointnav_core.geodesic.planner import Planner
-from pointnav_core.maps import OBSTACLE
 from pointnav_core.scenes import Scene
 
 

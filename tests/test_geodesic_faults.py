@@ -21,7 +21,7 @@ import pytest
 from PIL import Image
 
 from pointnav_core import scenes
-from pointnav_core.maps import FREE, OBSTACLE, VOID
+from pointnav_core.floor.maps import FREE, OBSTACLE, VOID
 from pointnav_core.scenes import Scene
 
 DATA = Path(__file__).parent / "data" / "bookstore"

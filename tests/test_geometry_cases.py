@@ -13,7 +13,7 @@ import pytest
 import shapely
 from shapely.geometry import LineString, Point
 
-from pointnav_core.maps import OBSTACLE
+from pointnav_core.floor.maps import OBSTACLE
 from pointnav_core.scenes import Scene
 
 

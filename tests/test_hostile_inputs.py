@@ -17,11 +17,11 @@ import numpy as np
 import pytest
 
 import pointnav_core
-from pointnav_core import validation
 from pointnav_core.cli import main
 from pointnav_core.datasets import EpisodeDataset
-from pointnav_core.loaders import read_movingai, read_trav_png
+from pointnav_core.floor.loaders import read_movingai, read_trav_png
 from pointnav_core.scenes import Scene
+from pointnav_core.utils import validation
 
 SRC = Path(pointnav_core.__file__).resolve().parents[1]
 MAP = "type octile\nheight 6\nwidth 10\nmap\n" + "@" * 10 + "\n" + "@........@\n" * 4 + "@" * 10 + "\n"
@@ -97,7 +97,7 @@ def _png_header(path: Path, width: int, height: int) -> None:
 
 
 def test_one_cell_budget_for_every_grid_and_image(tmp_path):
-    budget = r"over the cell budget of 100000000 \(pointnav_core.validation.MAX_CELLS\)"
+    budget = r"over the cell budget of 100000000 \(pointnav_core.utils.validation.MAX_CELLS\)"
     png = tmp_path / "floor_trav_0.png"
     _png_header(png, 20000, 20000)  # Pillow's own bomb limit: DecompressionBombError before
     with pytest.raises(ValueError, match=budget):
@@ -157,9 +157,9 @@ def test_compiled_kernels_on_a_read_only_install(tmp_path):
     env = {k: v for k, v in os.environ.items() if k not in ("NUMBA_CACHE_DIR", "XDG_CACHE_HOME")}
     env.update(HOME="/dev/null", TMPDIR=str(temp), PYTHONPATH=str(install), PYTHONDONTWRITEBYTECODE="1")
     code = (
-        "from pointnav_core import _compiled\n"
+        "from pointnav_core.utils import compiled as _compiled\n"
         "from pointnav_core.sensors import raycast_jit\n"
-        "row = _compiled.kernel('pointnav_core._collision_kernel', 'stadium_row')\n"
+        "row = _compiled.kernel('pointnav_core.floor._collision_kernel', 'stadium_row')\n"
         "lo, hi = row(0.0, 0.0, 2.0, 0.0, 0.5, 0.25)\n"
         "print(lo, hi, raycast_jit.available())\n"
     )

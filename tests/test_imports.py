@@ -19,8 +19,8 @@ def run(code: str) -> str:
     "modules",
     [
         "pointnav_core.scenes, pointnav_core.task",
-        "pointnav_core.maps, pointnav_core.transforms, pointnav_core.metrics, pointnav_core.backend",
-        "pointnav_core.geodesic.planner, pointnav_core.geodesic.field, pointnav_core.collision",
+        "pointnav_core.floor.maps, pointnav_core.transforms, pointnav_core.task.metrics, pointnav_core.backends.protocol",
+        "pointnav_core.geodesic.planner, pointnav_core.geodesic.field, pointnav_core.floor.collision",
         "pointnav_kinematic, pointnav_pymunk",
     ],
 )
@@ -60,7 +60,7 @@ def test_the_envs_are_exported_lazily():
         "from pointnav_core import PointNavEnv, MultiPointNavEnv\n"
         "print(before, PointNavEnv.__module__, MultiPointNavEnv.__module__, 'PointNavEnv' in dir(pointnav_core))\n"
     )
-    assert run(code) == "False pointnav_core.env pointnav_core.parallel True"
+    assert run(code) == "False pointnav_core.envs.pointnav pointnav_core.envs.multi_pointnav True"
 
 
 def test_an_unknown_attribute_is_an_attribute_error():

@@ -8,6 +8,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 import ray
+import rl_cases
 from ray.rllib.algorithms.ppo import PPOConfig
 from ray.rllib.core.rl_module.default_model_config import DefaultModelConfig
 from ray.rllib.env.multi_agent_episode import MultiAgentEpisode
@@ -18,7 +19,8 @@ from ray.rllib.utils.pre_checks.env import check_multiagent_environments
 from ray.tune.registry import ENV_CREATOR, _global_registry
 
 from pointnav_core import scenes
-from pointnav_core.env import PointNavEnv
+from pointnav_core.envs.multi_pointnav import MultiPointNavEnv
+from pointnav_core.envs.pointnav import PointNavEnv
 from pointnav_core.integrations.rllib import (
     MULTI_ENV_ID,
     SINGLE_ENV_ID,
@@ -28,9 +30,6 @@ from pointnav_core.integrations.rllib import (
     make_single_env,
     register_rllib_envs,
 )
-from pointnav_core.parallel import MultiPointNavEnv
-
-import rl_cases
 
 
 def small_house() -> scenes.Scene:

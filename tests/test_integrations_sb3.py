@@ -6,16 +6,19 @@ from __future__ import annotations
 import gymnasium as gym
 import numpy as np
 import pytest
+import rl_cases
 from stable_baselines3 import PPO
 from stable_baselines3.common.env_checker import check_env
 from stable_baselines3.common.logger import KVWriter, Logger
 from stable_baselines3.common.vec_env import DummyVecEnv, VecMonitor
 
 from pointnav_core import scenes
-from pointnav_core.integrations.sb3 import MultiRobotVecEnv, PointNavMetricsCallback, make_vec_env
-from pointnav_core.parallel import MultiPointNavEnv
-
-import rl_cases
+from pointnav_core.envs.multi_pointnav import MultiPointNavEnv
+from pointnav_core.integrations.sb3 import (
+    MultiRobotVecEnv,
+    PointNavMetricsCallback,
+    make_vec_env,
+)
 
 ENV_ID = "pointnav_core/PointNav-v0"
 

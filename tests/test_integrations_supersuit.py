@@ -27,8 +27,8 @@ with warnings.catch_warnings():
         pettingzoo_env_to_vec_env_v1,
     )
 
-from pointnav_core.lifecycle import TaskStateError  # noqa: E402
-from pointnav_core.parallel import parallel_env  # noqa: E402
+from pointnav_core.envs.multi_pointnav import parallel_env  # noqa: E402
+from pointnav_core.task.lifecycle import TaskStateError  # noqa: E402
 
 
 def test_frame_stacking_and_action_clipping_pass_the_parallel_api_test():

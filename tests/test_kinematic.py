@@ -7,11 +7,11 @@ import types
 
 import numpy as np
 import pytest
-
-from pointnav_core.backend import RobotSpec
-from pointnav_core.maps import FREE, OBSTACLE, VOID, TraversableMap
-from pointnav_core.testing.conformance import obstacle_distance
 from pointnav_kinematic import KinematicBackend
+
+from pointnav_core.backends.protocol import RobotSpec
+from pointnav_core.floor.maps import FREE, OBSTACLE, VOID, TraversableMap
+from pointnav_core.testing.conformance import obstacle_distance
 
 IDENTITY = (0.0, 0.0, 0.0, 1.0)
 

@@ -12,13 +12,13 @@ import numpy as np
 import pytest
 import shapely
 import shapely.ops
+from pointnav_kinematic import KinematicBackend
 from shapely import affinity
 from shapely.geometry import Point
 
-from pointnav_core.backend import RobotSpec
-from pointnav_core.maps import FREE, OBSTACLE
+from pointnav_core.backends.protocol import RobotSpec
+from pointnav_core.floor.maps import FREE, OBSTACLE
 from pointnav_core.scenes import Scene
-from pointnav_kinematic import KinematicBackend
 
 R = 0.18
 TOUCH = 1e-9

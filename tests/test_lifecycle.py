@@ -5,7 +5,15 @@ from pathlib import Path
 
 import pytest
 
-from pointnav_core.lifecycle import TRANSITIONS, Event, TaskState, TaskStateError, allows, diagram, move
+from pointnav_core.task.lifecycle import (
+    TRANSITIONS,
+    Event,
+    TaskState,
+    TaskStateError,
+    allows,
+    diagram,
+    move,
+)
 
 DOCS = Path(__file__).resolve().parents[1] / "docs" / "lifecycle.md"
 

@@ -9,8 +9,8 @@ import numpy as np
 import pytest
 from PIL import Image
 
-from pointnav_core.loaders import MOVINGAI_CELLS, read_movingai, read_trav_png
-from pointnav_core.maps import FREE, OBSTACLE, TraversableMap
+from pointnav_core.floor.loaders import MOVINGAI_CELLS, read_movingai, read_trav_png
+from pointnav_core.floor.maps import FREE, OBSTACLE, TraversableMap
 
 
 def write_png(path, pixels, mode="L"):

@@ -6,8 +6,8 @@ import numpy as np
 import pytest
 from shapely.geometry import box
 
+from pointnav_core.floor.maps import FREE, OBSTACLE, VOID, BoundedCache, TraversableMap
 from pointnav_core.floorplans import FloorPlan
-from pointnav_core.maps import FREE, OBSTACLE, VOID, BoundedCache, TraversableMap
 
 
 def test_cell_centres_round_trip_exactly_with_negative_origin():

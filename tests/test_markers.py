@@ -15,13 +15,13 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-import pointnav_core.markers as markers_module
-from pointnav_core.backend import RobotSpec
-from pointnav_core.env import PointNavEnv
-from pointnav_core.maps import FREE, OBSTACLE
-from pointnav_core.markers import MARKER_KINDS, VisualMarker, place_waypoints
+import pointnav_core.task.markers as markers_module
+from pointnav_core.backends.protocol import RobotSpec
+from pointnav_core.envs.pointnav import PointNavEnv
+from pointnav_core.floor.maps import FREE, OBSTACLE
 from pointnav_core.scenes import Scene
 from pointnav_core.task import TaskState
+from pointnav_core.task.markers import MARKER_KINDS, VisualMarker, place_waypoints
 
 RES = 0.1
 ROBOT = RobotSpec(radius=0.1)

@@ -8,7 +8,7 @@ import math
 import numpy as np
 import pytest
 
-from pointnav_core.metrics import soft_spl, soft_spl_values, spl, spl_values
+from pointnav_core.task.metrics import soft_spl, soft_spl_values, spl, spl_values
 
 INF = math.inf
 

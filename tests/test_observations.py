@@ -9,19 +9,19 @@ import numpy as np
 import pytest
 from gymnasium.utils.env_checker import check_env
 
-from pointnav_core.env import PointNavEnv
-from pointnav_core.maps import FREE, OBSTACLE
-from pointnav_core.observations import (
+from pointnav_core.envs.multi_pointnav import MultiPointNavEnv
+from pointnav_core.envs.pointnav import PointNavEnv
+from pointnav_core.floor.maps import FREE, OBSTACLE
+from pointnav_core.scenes import Scene
+from pointnav_core.task import PointNavigationTask
+from pointnav_core.task.observations import (
     GoalVector,
     ObservationTerm,
     default_observation_terms,
     markdown_table,
 )
-from pointnav_core.parallel import MultiPointNavEnv
-from pointnav_core.rewards import RewardFunction
-from pointnav_core.scenes import Scene
-from pointnav_core.task import PointNavigationTask
-from pointnav_core.terminations import Falling, TerminationCondition
+from pointnav_core.task.rewards import RewardFunction
+from pointnav_core.task.terminations import Falling, TerminationCondition
 
 
 def small_scene() -> Scene:

@@ -11,10 +11,10 @@ import numpy as np
 import pytest
 
 from pointnav_core import scenes
-from pointnav_core.backend import available_backends
+from pointnav_core.backends.protocol import available_backends
 from pointnav_core.cli import run_demo
-from pointnav_core.env import PointNavEnv
-from pointnav_core.policies import ShortestPathFollower
+from pointnav_core.envs.pointnav import PointNavEnv
+from pointnav_core.evaluation.policies import ShortestPathFollower
 from pointnav_core.scenes import Scene
 
 BACKENDS = available_backends()

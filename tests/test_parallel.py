@@ -13,12 +13,13 @@ import pytest
 from pettingzoo.utils.conversions import parallel_to_aec
 
 import pointnav_core  # noqa: F401  (registers the PettingZoo ids)
-from pointnav_core import parallel, scenes
-from pointnav_core.backend import RobotSpec, available_backends
+from pointnav_core import scenes
+from pointnav_core.backends.protocol import RobotSpec, available_backends
+from pointnav_core.envs import multi_pointnav as parallel
+from pointnav_core.envs.multi_pointnav import MultiPointNavEnv
+from pointnav_core.envs.registration import AEC_ENV_IDS, PARALLEL_ENV_IDS, register_envs
 from pointnav_core.errors import SamplingError
-from pointnav_core.maps import FREE, OBSTACLE, VOID
-from pointnav_core.parallel import MultiPointNavEnv
-from pointnav_core.registration import AEC_ENV_IDS, PARALLEL_ENV_IDS, register_envs
+from pointnav_core.floor.maps import FREE, OBSTACLE, VOID
 from pointnav_core.scenes import Scene
 from pointnav_core.task import PointNavigationTask, TaskStateError
 

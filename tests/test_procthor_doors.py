@@ -15,7 +15,7 @@ import pytest
 import shapely
 from shapely.geometry import Point
 
-from pointnav_core.floorplan_files import read_procthor
+from pointnav_core.floorplans.files import read_procthor
 from pointnav_core.scenes import Scene
 
 HOUSE = Path(__file__).parent / "data" / "procthor" / "procthor_train_1.json"

@@ -17,17 +17,17 @@ import pytest
 import shapely
 from hypothesis import given
 from hypothesis import strategies as st
-from shapely.geometry import Point, Polygon, box
-
-from pointnav_core import floorplans, scenes
-from pointnav_core.backend import RobotSpec, get_backend, make_backend
-from pointnav_core.maps import OBSTACLE, VOID, TraversableMap
-from pointnav_core.scenes import Scene
-from pointnav_core.testing import strategies
 from pointnav_kinematic import KinematicBackend
 from pointnav_pymunk import OVERLAP_TOLERANCE, TOUCH_TOLERANCE, PymunkBackend
 from pointnav_pymunk.backend import _project
 from pointnav_pymunk.geometry import convex_pieces, floor_pieces, merge_cells
+from shapely.geometry import Point, Polygon, box
+
+from pointnav_core import floorplans, scenes
+from pointnav_core.backends.protocol import RobotSpec, get_backend, make_backend
+from pointnav_core.floor.maps import OBSTACLE, VOID, TraversableMap
+from pointnav_core.scenes import Scene
+from pointnav_core.testing import strategies
 
 IDENTITY = (0.0, 0.0, 0.0, 1.0)
 
@@ -447,7 +447,7 @@ def test_no_pymunk_noise_when_a_backend_lives_until_interpreter_exit(tmp_path):
         '"""\n'
         ">>> import numpy as np\n"
         ">>> from pointnav_core.scenes import Scene\n"
-        ">>> from pointnav_core.backend import RobotSpec\n"
+        ">>> from pointnav_core.backends.protocol import RobotSpec\n"
         ">>> from pointnav_pymunk import PymunkBackend\n"
         ">>> b = PymunkBackend()\n"
         ">>> b.load(Scene.from_array(np.ones((20, 20), bool), 0.1), [RobotSpec()])\n"

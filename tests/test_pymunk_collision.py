@@ -16,12 +16,12 @@ import shapely
 import shapely.ops
 from hypothesis import assume, given
 from hypothesis import strategies as st
+from pointnav_pymunk import TOUCH_TOLERANCE, PymunkBackend
 from shapely.geometry import Point, box
 
-from pointnav_core.backend import RobotSpec
-from pointnav_core.maps import FREE, OBSTACLE, VOID, TraversableMap
+from pointnav_core.backends.protocol import RobotSpec
+from pointnav_core.floor.maps import FREE, OBSTACLE, VOID, TraversableMap
 from pointnav_core.scenes import Scene
-from pointnav_pymunk import TOUCH_TOLERANCE, PymunkBackend
 
 IDENTITY = (0.0, 0.0, 0.0, 1.0)
 R = 0.18  # the default robot's radius, m

@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 from shapely.geometry import box
 
-from pointnav_core import reachability
+from pointnav_core.floor import reachability
 from pointnav_core.scenes import Scene
 
 

@@ -8,18 +8,23 @@ from __future__ import annotations
 
 import dataclasses
 import math
-
 import re
 
 import numpy as np
 import pytest
 from PIL import Image
 
-from pointnav_core.backend import RobotSpec, make_backend
-from pointnav_core.env import PointNavEnv
-from pointnav_core.maps import FREE, OBSTACLE, VOID, TraversableMap
-from pointnav_core.policies import ShortestPathFollower
-from pointnav_core.render import (
+from pointnav_core.backends.protocol import RobotSpec, make_backend
+from pointnav_core.envs.pointnav import PointNavEnv
+from pointnav_core.evaluation.policies import ShortestPathFollower
+from pointnav_core.floor.maps import FREE, OBSTACLE, VOID, TraversableMap
+from pointnav_core.render.recording import (
+    record_episode,
+    render_env,
+    save_gif,
+    save_png,
+)
+from pointnav_core.render.top_down import (
     FLOOR_COLORS,
     GOAL_COLOR,
     ROBOT_PALETTE,
@@ -29,10 +34,6 @@ from pointnav_core.render import (
     RobotGlyph,
     TopDownRenderer,
     contrast_color,
-    record_episode,
-    render_env,
-    save_gif,
-    save_png,
 )
 from pointnav_core.scenes import Scene
 from pointnav_core.task import PointNavigationTask

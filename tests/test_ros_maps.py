@@ -16,8 +16,8 @@ import pytest
 from PIL import Image
 
 from pointnav_core.datasets import load_scene
-from pointnav_core.maps import FREE, OBSTACLE, VOID
-from pointnav_core.ros_maps import read_ros_map
+from pointnav_core.floor.maps import FREE, OBSTACLE, VOID
+from pointnav_core.floor.ros_maps import read_ros_map
 from pointnav_core.scenes import Scene
 
 DATA = Path(__file__).parent / "data"

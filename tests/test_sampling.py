@@ -5,12 +5,12 @@ import math
 import numpy as np
 import pytest
 
-from pointnav_core import parallel
-from pointnav_core.env import PointNavEnv
+from pointnav_core.envs import multi_pointnav as parallel
+from pointnav_core.envs.pointnav import PointNavEnv
 from pointnav_core.errors import SamplingError
-from pointnav_core.maps import FREE, OBSTACLE
-from pointnav_core.sampling import sample_episode
+from pointnav_core.floor.maps import FREE, OBSTACLE
 from pointnav_core.scenes import Scene
+from pointnav_core.task.sampling import sample_episode
 
 
 def room(cells: int = 40) -> Scene:
@@ -96,6 +96,6 @@ def test_points_within_max_distance_are_exactly_those_math_hypot_keeps(resolutio
     for cells in (5, 10, 12.5, 15):
         bound = cells * resolution
         want = [i for i, (x, y) in zip(flat.tolist(), xy.tolist()) if math.hypot(x - ref[0], y - ref[1]) <= bound]
-        from pointnav_core.scenes import _cells_of
+        from pointnav_core.scenes.scene import _cells_of
 
         assert _cells_of(tmap, 0.0, label, ref, bound).tolist() == want

@@ -8,10 +8,19 @@ import numpy as np
 import pytest
 from scipy import stats
 
-from pointnav_core.env import PointNavEnv
-from pointnav_core.maps import OBSTACLE
+from pointnav_core.envs.pointnav import PointNavEnv
+from pointnav_core.floor.maps import OBSTACLE
 from pointnav_core.scenes import Scene
-from pointnav_core.sensors.noise import DROPOUT, NOISE, episode_key, mix, normals, scan_noise, seed_entropy, uniforms
+from pointnav_core.sensors.noise import (
+    DROPOUT,
+    NOISE,
+    episode_key,
+    mix,
+    normals,
+    scan_noise,
+    seed_entropy,
+    uniforms,
+)
 from pointnav_core.vector import VectorPointNavEnv
 
 M64 = 0xFFFFFFFFFFFFFFFF

@@ -8,8 +8,8 @@ from PIL import Image
 from shapely.geometry import Point, box
 
 from pointnav_core.errors import SamplingError
+from pointnav_core.floor.maps import OBSTACLE, VOID
 from pointnav_core.floorplans import FloorPlan
-from pointnav_core.maps import OBSTACLE, VOID
 from pointnav_core.scenes import Scene, clutter, maze, robot_radius, rooms
 
 

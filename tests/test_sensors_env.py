@@ -13,11 +13,11 @@ from scan_reference import assert_within, blocked_shapes, reference_ranges
 from stable_baselines3.common.env_checker import check_env as sb3_check_env
 
 import pointnav_core  # noqa: F401  (registers the envs)
-from pointnav_core import parallel
-from pointnav_core.actions import MOVE_FORWARD, STOP, TURN_LEFT, TURN_RIGHT
-from pointnav_core.env import PointNavEnv
-from pointnav_core.maps import FREE, OBSTACLE, VOID
+from pointnav_core.envs import multi_pointnav as parallel
+from pointnav_core.envs.pointnav import PointNavEnv
+from pointnav_core.floor.maps import FREE, OBSTACLE, VOID
 from pointnav_core.scenes import Scene
+from pointnav_core.task.actions import MOVE_FORWARD, STOP, TURN_LEFT, TURN_RIGHT
 from pointnav_core.transforms import quat2yaw
 
 with warnings.catch_warnings():
@@ -374,7 +374,7 @@ def test_robots_cast_together_exactly_as_each_alone():
 
 
 def test_render_draws_the_scan_rays_and_hits():
-    from pointnav_core.render import SCAN_HIT_COLOR, SCAN_RAY_COLOR, ScanGlyph
+    from pointnav_core.render.top_down import SCAN_HIT_COLOR, SCAN_RAY_COLOR, ScanGlyph
 
     def colours(frame, colour):
         return int((frame == np.array(colour, np.uint8)).all(axis=2).sum())
@@ -392,7 +392,7 @@ def test_render_draws_the_scan_rays_and_hits():
 
 
 def test_multi_robot_render_draws_every_robots_scan():
-    from pointnav_core.render import SCAN_HIT_COLOR
+    from pointnav_core.render.top_down import SCAN_HIT_COLOR
 
     penv = parallel.parallel_env(scene=small_scene(), n_robots=2, sensors={"scan": {"n_rays": 8}}, render_mode="rgb_array")
     penv.reset(seed=0)

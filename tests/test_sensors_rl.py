@@ -6,9 +6,9 @@ import numpy as np
 import pytest
 from stable_baselines3 import PPO
 
-from pointnav_core.env import PointNavEnv
+from pointnav_core.envs.pointnav import PointNavEnv
+from pointnav_core.floor.maps import FREE, OBSTACLE
 from pointnav_core.integrations.sb3 import make_vec_env
-from pointnav_core.maps import FREE, OBSTACLE
 from pointnav_core.scenes import Scene
 
 LAYOUTS = [None, {"scan": {"n_rays": 8}}, {"local_map": {"cells": 6}}, {"scan": {"n_rays": 8}, "local_map": {"cells": 6}}]

@@ -10,7 +10,7 @@ import shapely
 from scan_reference import assert_within, blocked_shapes, reference_ranges
 
 from pointnav_core import scenes
-from pointnav_core.maps import TraversableMap
+from pointnav_core.floor.maps import TraversableMap
 from pointnav_core.sensors import RangeScan, ScanGeometry, cast_rays, scan_angles
 
 FULL = scan_angles(64, 2 * math.pi)

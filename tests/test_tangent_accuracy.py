@@ -28,14 +28,14 @@ from dataclasses import dataclass
 import numpy as np
 import pytest
 import shapely
+from geodesic_reference import ContinuousGeodesic, blocked_cells
 from shapely.affinity import rotate
 from shapely.geometry import Polygon, box
 
-from geodesic_reference import ContinuousGeodesic, blocked_cells
 from pointnav_core import scenes
-from pointnav_core.maps import TraversableMap
-from pointnav_core.scenes import Scene
+from pointnav_core.floor.maps import TraversableMap
 from pointnav_core.geodesic.planner import planner_for
+from pointnav_core.scenes import Scene
 
 #: Clearance margin (m) of sampled end points beyond the robot radius.
 MARGIN = 1e-3

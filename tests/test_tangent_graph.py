@@ -13,12 +13,12 @@ import math
 import numpy as np
 import pytest
 import shapely
+from geodesic_reference import ContinuousGeodesic
 from shapely.geometry import box
 
-from geodesic_reference import ContinuousGeodesic
-from pointnav_core.maps import TraversableMap
+from pointnav_core.floor.collision import FloorCollision
+from pointnav_core.floor.maps import TraversableMap
 from pointnav_core.geodesic.planner import Planner, path_length, planner_for
-from pointnav_core.collision import FloorCollision
 
 
 def test_radius_below_half_a_cell_is_not_ignored():

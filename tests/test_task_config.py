@@ -10,8 +10,8 @@ import numpy as np
 import pytest
 
 from pointnav_core.task import PointNavigationTask, TaskConfig
-from pointnav_core.task_config import compose_terms, merge_config
-from pointnav_core.terminations import Timeout
+from pointnav_core.task.config import compose_terms, merge_config
+from pointnav_core.task.terminations import Timeout
 
 
 def test_a_config_is_frozen_and_keyword_only():

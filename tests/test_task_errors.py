@@ -7,10 +7,10 @@ import math
 import numpy as np
 import pytest
 
-from pointnav_core.backend import RobotSpec, UnknownBackendError
-from pointnav_core.env import PointNavEnv
+from pointnav_core.backends.protocol import RobotSpec, UnknownBackendError
+from pointnav_core.envs.pointnav import PointNavEnv
 from pointnav_core.errors import PointNavError, SamplingError
-from pointnav_core.maps import FREE, OBSTACLE
+from pointnav_core.floor.maps import FREE, OBSTACLE
 from pointnav_core.scenes import Scene
 from pointnav_core.task import PointNavigationTask, TaskState, TaskStateError
 

@@ -19,14 +19,14 @@ import math
 import numpy as np
 import pytest
 
-from pointnav_core.backend import RobotSpec, available_backends, get_backend
-from pointnav_core.env import PointNavEnv
-from pointnav_core.maps import FREE, OBSTACLE, VOID
-from pointnav_core.rewards import PointGoalReward
 from pointnav_core import scenes
+from pointnav_core.backends.protocol import RobotSpec, available_backends, get_backend
+from pointnav_core.envs.pointnav import PointNavEnv
+from pointnav_core.floor.maps import FREE, OBSTACLE, VOID
 from pointnav_core.scenes import Scene
 from pointnav_core.task import PointNavigationTask, TaskState, TaskStateError
-from pointnav_core.terminations import TerminationCondition
+from pointnav_core.task.rewards import PointGoalReward
+from pointnav_core.task.terminations import TerminationCondition
 from pointnav_core.transforms import quat2yaw
 
 RES = 0.1

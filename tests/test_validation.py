@@ -10,13 +10,13 @@ import numpy as np
 import pytest
 
 from pointnav_core import scenes
-from pointnav_core.backend import RobotSpec
-from pointnav_core.env import PointNavEnv
-from pointnav_core.maps import FREE, OBSTACLE
-from pointnav_core.parallel import MultiPointNavEnv
+from pointnav_core.backends.protocol import RobotSpec
+from pointnav_core.envs.multi_pointnav import MultiPointNavEnv
+from pointnav_core.envs.pointnav import PointNavEnv
+from pointnav_core.floor.maps import FREE, OBSTACLE
 from pointnav_core.scenes import Scene
 from pointnav_core.task import PointNavigationTask
-from pointnav_core.validation import boolean, integer, is_real, real, vector
+from pointnav_core.utils.validation import boolean, integer, is_real, real, vector
 
 
 def small_scene() -> Scene:

@@ -11,7 +11,7 @@ import pytest
 from vector_reference import compare, random_episodes
 
 import pointnav_core  # noqa: F401  (registers the ids)
-from pointnav_core.maps import OBSTACLE, VOID
+from pointnav_core.floor.maps import OBSTACLE, VOID
 from pointnav_core.scenes import Scene
 from pointnav_core.vector import VectorPointNavEnv
 
@@ -181,7 +181,8 @@ def test_unsupported_arguments_are_named(kwargs: dict, name: str) -> None:
 
 
 def test_floors_with_polygons_are_refused_on_a_gpu_or_without_numba() -> None:
-    from pointnav_core import _compiled, scenes
+    from pointnav_core import scenes
+    from pointnav_core.utils import compiled as _compiled
 
     with _compiled.numpy_paths(), pytest.raises(ValueError, match="scene 0 has obstacle polygons.*numba"):
         VectorPointNavEnv(1, scene=scenes.rooms(seed=0))

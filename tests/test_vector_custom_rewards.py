@@ -15,9 +15,9 @@ import numpy as np
 import pytest
 from vector_reference import compare, random_episodes
 
-from pointnav_core.maps import OBSTACLE
-from pointnav_core.rewards import PotentialReward, RewardFunction
+from pointnav_core.floor.maps import OBSTACLE
 from pointnav_core.scenes import Scene
+from pointnav_core.task.rewards import PotentialReward, RewardFunction
 from pointnav_core.vector import VectorPointNavEnv
 
 DEVICES = ["numpy"] + (["cpu"] if importlib.util.find_spec("torch") else [])

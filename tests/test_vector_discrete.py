@@ -15,7 +15,7 @@ import gymnasium as gym
 import numpy as np
 import pytest
 
-from pointnav_core.maps import OBSTACLE
+from pointnav_core.floor.maps import OBSTACLE
 from pointnav_core.scenes import Scene
 from pointnav_core.vector import VectorPointNavEnv
 
@@ -129,7 +129,7 @@ def test_starts_per_goal_share_goals_with_exact_geodesics() -> None:
 def test_discrete_matches_single_envs_in_clutter(device: str, stop: bool, sensors: dict | None) -> None:
     from vector_reference import compare, random_episodes
 
-    from pointnav_core.maps import VOID
+    from pointnav_core.floor.maps import VOID
 
     rng = np.random.default_rng(11)
     grid = np.zeros((22, 28), np.uint8)
@@ -246,7 +246,7 @@ def test_fleet_discrete_matches_parallel_envs_in_a_crowded_room(device: str) -> 
     # the parked ones and the walls; some fall, some stop on their goal.
     from fleet_reference import compare_fleet, fleet_episodes
 
-    from pointnav_core.maps import VOID
+    from pointnav_core.floor.maps import VOID
 
     rng = np.random.default_rng(3)
     grid = np.zeros((20, 16), np.uint8)

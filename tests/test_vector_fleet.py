@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 from fleet_reference import compare_fleet, fleet_episodes
 
-from pointnav_core.maps import OBSTACLE, VOID
+from pointnav_core.floor.maps import OBSTACLE, VOID
 from pointnav_core.scenes import Scene
 from pointnav_core.vector import VectorPointNavEnv
 

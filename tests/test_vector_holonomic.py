@@ -13,7 +13,7 @@ import math
 import numpy as np
 import pytest
 
-from pointnav_core.env import PointNavEnv
+from pointnav_core.envs.pointnav import PointNavEnv
 from pointnav_core.scenes import Scene
 from pointnav_core.vector import VectorPointNavEnv
 

@@ -8,12 +8,12 @@ import math
 import numpy as np
 import pytest
 
-from pointnav_core.backend_kit.checks import planar_quat_floats
-from pointnav_core.env import PointNavEnv
-from pointnav_core.maps import OBSTACLE, VOID
-from pointnav_core.observations import Frame
+from pointnav_core.backends.kit.checks import planar_quat_floats
+from pointnav_core.envs.pointnav import PointNavEnv
+from pointnav_core.floor.maps import OBSTACLE, VOID
 from pointnav_core.scenes import Scene
 from pointnav_core.sensors import LocalMap
+from pointnav_core.task.observations import Frame
 from pointnav_core.vector import VectorPointNavEnv
 from pointnav_core.vector.floors import FloorTables
 from pointnav_core.vector.local_map import VectorLocalMap

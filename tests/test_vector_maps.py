@@ -28,9 +28,10 @@ from vector_reference import (
     random_episodes,
 )
 
-from pointnav_core import _compiled, scenes
-from pointnav_core.maps import OBSTACLE, VOID
+from pointnav_core import scenes
+from pointnav_core.floor.maps import OBSTACLE, VOID
 from pointnav_core.scenes import Scene
+from pointnav_core.utils import compiled as _compiled
 
 ARRAY_DEVICE = "cpu" if importlib.util.find_spec("torch") else "numpy"
 TASK = {"reward_type": "geodesic", "termination_config": {"max_steps": 80, "max_collisions": 30}}

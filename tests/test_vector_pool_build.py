@@ -8,11 +8,11 @@ import numpy as np
 import pytest
 
 from pointnav_core.errors import SamplingError
-from pointnav_core.maps import OBSTACLE
+from pointnav_core.floor.maps import OBSTACLE
 from pointnav_core.scenes import Scene
+from pointnav_core.utils.workers import usable_cores
 from pointnav_core.vector import VectorPointNavEnv
 from pointnav_core.vector.pool_build import PARALLEL_SCENES, pool_workers
-from pointnav_core.workers import usable_cores
 
 
 def room(width: int, height: int = 25) -> Scene:

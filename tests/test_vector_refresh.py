@@ -8,8 +8,8 @@ import math
 import numpy as np
 import pytest
 
-from pointnav_core.maps import OBSTACLE
-from pointnav_core.robot_spec import RobotSpec
+from pointnav_core.backends.robot_spec import RobotSpec
+from pointnav_core.floor.maps import OBSTACLE
 from pointnav_core.scenes import Scene
 from pointnav_core.vector import VectorPointNavEnv
 from pointnav_core.vector.fields import FieldTables

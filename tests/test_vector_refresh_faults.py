@@ -24,7 +24,7 @@ import numpy as np
 import pytest
 from refresh_faults import StalledBuild, failing_build
 
-from pointnav_core.maps import OBSTACLE
+from pointnav_core.floor.maps import OBSTACLE
 from pointnav_core.scenes import Scene
 from pointnav_core.vector import VectorPointNavEnv
 from pointnav_core.vector.refresh import PoolRefreshWarning

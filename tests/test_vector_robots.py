@@ -10,7 +10,7 @@ import pytest
 from pointnav_kinematic.contacts import advance
 from pointnav_kinematic.geometry import FloorGeometry
 
-from pointnav_core.maps import OBSTACLE, TraversableMap
+from pointnav_core.floor.maps import OBSTACLE, TraversableMap
 from pointnav_core.scenes import Scene
 from pointnav_core.vector.robots import advance_robots, robot_walls
 from pointnav_core.vector.xp import make_arrays

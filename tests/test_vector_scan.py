@@ -7,8 +7,8 @@ import importlib.util
 import numpy as np
 import pytest
 
-from pointnav_core.env import PointNavEnv
-from pointnav_core.maps import OBSTACLE
+from pointnav_core.envs.pointnav import PointNavEnv
+from pointnav_core.floor.maps import OBSTACLE
 from pointnav_core.scenes import Scene
 from pointnav_core.sensors import RangeScan
 from pointnav_core.vector import VectorPointNavEnv

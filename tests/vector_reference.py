@@ -14,7 +14,7 @@ from typing import Any
 import numpy as np
 from local_map_reference import assert_obs, obs_ties
 
-from pointnav_core.env import PointNavEnv
+from pointnav_core.envs.pointnav import PointNavEnv
 from pointnav_core.vector import VectorPointNavEnv
 
 OBS_TOL = 1e-4

@@ -9,6 +9,7 @@ library as soon as both it and this package are imported (see ``registration``).
 
 from typing import Any
 
+from pointnav_core.envs.registration import register_envs, register_when_imported
 from pointnav_core.errors import (
     ArgumentError,
     ArgumentTypeError,
@@ -16,11 +17,10 @@ from pointnav_core.errors import (
     PointNavError,
     SamplingError,
 )
-from pointnav_core.maps import FREE, OBSTACLE, VOID, TraversableMap
-from pointnav_core.metrics import soft_spl, spl
-from pointnav_core.registration import register_envs, register_when_imported
+from pointnav_core.floor.maps import FREE, OBSTACLE, VOID, TraversableMap
 from pointnav_core.scenes import Scene
 from pointnav_core.task import PointNavigationTask, TaskState, TaskStateError
+from pointnav_core.task.metrics import soft_spl, spl
 
 __version__ = "0.1.0"
 
@@ -50,9 +50,9 @@ __all__ = [
 #: Exports that load Gymnasium or PettingZoo (EnvConfig checks its fields with the envs' own
 #: code), imported on first access.
 _LAZY = {
-    "PointNavEnv": "pointnav_core.env",
-    "MultiPointNavEnv": "pointnav_core.parallel",
-    "EnvConfig": "pointnav_core.env_config",
+    "PointNavEnv": "pointnav_core.envs.pointnav",
+    "MultiPointNavEnv": "pointnav_core.envs.multi_pointnav",
+    "EnvConfig": "pointnav_core.envs.config",
 }
 
 

@@ -22,20 +22,20 @@ class                        also a                       raised when
                                                           constraints was not found
 :class:`BackendError`        ``TypeError``                a backend does not implement the protocol
 ``UnknownBackendError``      ``BackendError``,            a backend name is not registered
-                             ``ValueError``               (``pointnav_core.backend``)
+                             ``ValueError``               (``pointnav_core.backends.protocol``)
 ``ConformanceError``         ``BackendError``,            a backend fails the conformance kit
                              ``AssertionError``           (``pointnav_core.testing.conformance``)
 :class:`EpisodeError`        ``RuntimeError``             playing an evaluation episode failed
 ``WorkerError``              ``RuntimeError``             a worker process died or raised
-                                                          (``pointnav_core.workers``)
+                                                          (``pointnav_core.utils.workers``)
 ``ResultsWriteError``        ``OSError``                  a results file could not be written
-                                                          (``pointnav_core.evaluation_log``)
+                                                          (``pointnav_core.evaluation.log``)
 ===========================  ===========================  ===============================================
 
 The names follow Python's own ``argparse.ArgumentError`` and ``ArgumentTypeError``: an
 argument error is a ``ValueError``, as Gymnasium's and PettingZoo's argument checks raise.
 
->>> from pointnav_core.validation import real
+>>> from pointnav_core.utils.validation import real
 >>> try:
 ...     real("radius", True, minimum=0.0)
 ... except ValueError as err:

@@ -2,7 +2,7 @@
 
 Registered as ``"kinematic"`` in the entry-point group ``pointnav_core.backends``:
 
->>> from pointnav_core.backend import get_backend
+>>> from pointnav_core.backends.protocol import get_backend
 >>> get_backend("kinematic") is KinematicBackend
 True
 """

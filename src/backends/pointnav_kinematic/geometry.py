@@ -20,8 +20,8 @@ import math
 import numpy as np
 from scipy import ndimage
 
-from pointnav_core.backend_kit import FloorGrid
-from pointnav_core.maps import OBSTACLE, VOID, TraversableMap
+from pointnav_core.backends.kit import FloorGrid
+from pointnav_core.floor.maps import OBSTACLE, VOID, TraversableMap
 from pointnav_kinematic.polygons import EdgeIndex, Segment
 
 __all__ = [
@@ -241,7 +241,7 @@ def square_distance(
 class FloorGeometry(FloorGrid):
     """One floor's blocked set, preprocessed for fast motion queries.
 
-    A :class:`~pointnav_core.backend_kit.FloorGrid` (cell lookups, the exact disc test)
+    A :class:`~pointnav_core.backends.kit.FloorGrid` (cell lookups, the exact disc test)
     with the clearance tables and wall indices of the kinematic backend's motion.
 
     Parameters

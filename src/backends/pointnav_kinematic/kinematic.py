@@ -8,13 +8,13 @@ from typing import Any
 
 from numpy.typing import ArrayLike
 
-from pointnav_core.backend import RobotSpec
-from pointnav_core.backend_kit import (
+from pointnav_core.backends.kit import (
     RobotState,
     RobotStateBackend,
     check_load,
     drive_arc,
 )
+from pointnav_core.backends.protocol import RobotSpec
 from pointnav_core.errors import ArgumentError
 from pointnav_kinematic.contacts import advance
 from pointnav_kinematic.geometry import FloorGeometry
@@ -86,7 +86,7 @@ class KinematicBackend(RobotStateBackend):
     --------
     >>> import types
     >>> import numpy as np
-    >>> from pointnav_core.maps import TraversableMap
+    >>> from pointnav_core.floor.maps import TraversableMap
     >>> floor = TraversableMap([[0, 0, 0, 0, 1]], resolution=1.0)
     >>> scene = types.SimpleNamespace(floors=[floor], n_floors=1, get_floor_height=lambda f=0: 0.0)
     >>> backend = KinematicBackend()

@@ -11,15 +11,15 @@ import numpy as np
 import pymunk
 from numpy.typing import ArrayLike
 
-from pointnav_core.backend import RobotSpec
-from pointnav_core.backend_kit import (
+from pointnav_core.backends.kit import (
     RobotState,
     RobotStateBackend,
     check_load,
     drive_arc,
 )
+from pointnav_core.backends.protocol import RobotSpec
 from pointnav_core.errors import ArgumentError
-from pointnav_core.maps import VOID
+from pointnav_core.floor.maps import VOID
 from pointnav_pymunk.floor import (
     _ROBOT,
     _WALL_SKIN,
@@ -197,7 +197,7 @@ class PymunkBackend(RobotStateBackend):
     Examples
     --------
     >>> import types
-    >>> from pointnav_core.maps import TraversableMap
+    >>> from pointnav_core.floor.maps import TraversableMap
     >>> floor = TraversableMap([[0, 0, 0, 0, 1]], resolution=1.0)
     >>> scene = types.SimpleNamespace(floors=[floor], n_floors=1, get_floor_height=lambda f=0: 0.0)
     >>> backend = PymunkBackend()

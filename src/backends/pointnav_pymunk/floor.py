@@ -4,7 +4,7 @@ The static shapes are the floor's blocked set for motion (OBSTACLE cell squares 
 floor plan's polygons, :func:`~pointnav_pymunk.geometry.floor_pieces`), each grown by a thin
 skin. pymunk leaves a resting contact overlapping by its slop, so without the skin a robot
 resting on a wall would overlap the true blocked set and stand where ``is_valid_pose``,
-which asks the floor's :class:`~pointnav_core.collision.FloorCollision`, says it may not.
+which asks the floor's :class:`~pointnav_core.floor.collision.FloorCollision`, says it may not.
 """
 
 from __future__ import annotations
@@ -15,7 +15,7 @@ from typing import Any
 import numpy as np
 import pymunk
 
-from pointnav_core.backend_kit import FloorGrid
+from pointnav_core.backends.kit import FloorGrid
 from pointnav_pymunk.geometry import floor_pieces
 
 __all__ = ["CONTACT_SLOP", "TOUCH_TOLERANCE"]

@@ -1,7 +1,7 @@
 """Static geometry for the pymunk backend: obstacle grids and polygons as convex pieces.
 
 The shapes robots collide with are the floor's blocked set for motion
-(:class:`~pointnav_core.collision.FloorCollision`, less VOID): every OBSTACLE cell square
+(:class:`~pointnav_core.floor.collision.FloorCollision`, less VOID): every OBSTACLE cell square
 plus the obstacle polygons the floor was built from, so a hand-edited OBSTACLE cell with no
 polygon under it and a polygon thinner than a cell both stop a robot. pymunk's polygon
 shapes are convex (it takes the hull of whatever it is given), and every shape costs a
@@ -26,7 +26,7 @@ from numpy.typing import ArrayLike
 from shapely.geometry import Polygon, box
 
 from pointnav_core.errors import ArgumentError, ArgumentTypeError
-from pointnav_core.maps import OBSTACLE, TraversableMap
+from pointnav_core.floor.maps import OBSTACLE, TraversableMap
 
 __all__ = ["convex_pieces", "floor_pieces", "merge_cells", "min_thickness"]
 

@@ -38,8 +38,8 @@ from collections.abc import Iterable, Iterator, Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
-from pointnav_core import validation
 from pointnav_core.errors import ArgumentError
+from pointnav_core.utils import validation
 
 __all__ = [
     "EpisodeDataset",
@@ -387,10 +387,10 @@ class EpisodeDataset:
         """Write the dataset to ``path`` (``.json.gz``; a ``.json`` path is written plain).
 
         The file is written whole or not at all (a temporary file renamed over ``path``,
-        :func:`pointnav_core.outputs.atomic_writer`): a full disk leaves an existing file as
+        :func:`pointnav_core.utils.outputs.atomic_writer`): a full disk leaves an existing file as
         it was.
         """
-        from pointnav_core.outputs import atomic_writer
+        from pointnav_core.utils.outputs import atomic_writer
 
         data = self.to_bytes(frame)
         if os.fspath(path).endswith(".json"):

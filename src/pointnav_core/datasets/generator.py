@@ -30,11 +30,11 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from pointnav_core import validation
 from pointnav_core.datasets.format import EpisodeDataset, PointNavEpisode
 from pointnav_core.datasets.scene_sets import SceneSet, load_scene
 from pointnav_core.errors import ArgumentError, SamplingError
 from pointnav_core.scenes import Scene, robot_radius
+from pointnav_core.utils import validation
 
 __all__ = [
     "GeneratorConfig",

@@ -42,7 +42,7 @@ import numpy as np
 
 from pointnav_core import scenes
 from pointnav_core.errors import ArgumentError
-from pointnav_core.maps import BoundedCache
+from pointnav_core.floor.maps import BoundedCache
 from pointnav_core.scenes import Scene
 
 __all__ = [
@@ -148,7 +148,7 @@ def _file_scheme(path: str) -> str | None:
     if path.endswith((".yaml", ".yml")):
         return "ros"
     if path.endswith(".json"):
-        from pointnav_core.floorplan_files import sniff_plan_format
+        from pointnav_core.floorplans.files import sniff_plan_format
 
         return sniff_plan_format(path)
     return None

@@ -2,7 +2,7 @@
 
 A :class:`FloorPlan` is a floor outline (outside it there is no floor: VOID) and obstacle
 polygons inside it (walls and furniture: OBSTACLE). :func:`rasterize` turns any outline and
-obstacles into the cell codes of a :class:`~pointnav_core.maps.TraversableMap`.
+obstacles into the cell codes of a :class:`~pointnav_core.floor.maps.TraversableMap`.
 
 Three generators build house-like plans, deterministically for a seed:
 

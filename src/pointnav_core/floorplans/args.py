@@ -1,4 +1,4 @@
-"""Argument checks shared by the floor-plan generators (see :mod:`pointnav_core.validation`)."""
+"""Argument checks shared by the floor-plan generators (see :mod:`pointnav_core.utils.validation`)."""
 
 from __future__ import annotations
 
@@ -8,8 +8,8 @@ import numpy as np
 import shapely
 from shapely.geometry import MultiPolygon, Polygon
 
-from pointnav_core import validation
 from pointnav_core.errors import ArgumentError, ArgumentTypeError
+from pointnav_core.utils import validation
 
 __all__ = [
     "Seed",

@@ -11,10 +11,10 @@ import shapely
 from numpy.typing import NDArray
 from shapely.geometry import Polygon, box
 
-from pointnav_core import validation
 from pointnav_core.errors import ArgumentError, ArgumentTypeError
+from pointnav_core.floor.maps import FREE, OBSTACLE, VOID
 from pointnav_core.floorplans.args import check_polygon, check_positive
-from pointnav_core.maps import FREE, OBSTACLE, VOID
+from pointnav_core.utils import validation
 
 __all__ = ["SNAP_TOL", "FloorPlan", "rasterize", "walled_box"]
 
@@ -112,8 +112,8 @@ def rasterize(
     Returns
     -------
     codes : ndarray of uint8, shape (H, W)
-        :data:`~pointnav_core.maps.FREE`, :data:`~pointnav_core.maps.OBSTACLE` or
-        :data:`~pointnav_core.maps.VOID` per cell; row grows with +y, column with +x.
+        :data:`~pointnav_core.floor.maps.FREE`, :data:`~pointnav_core.floor.maps.OBSTACLE` or
+        :data:`~pointnav_core.floor.maps.VOID` per cell; row grows with +y, column with +x.
     origin : (float, float)
         World ``(x, y)`` in metres of the outer corner of cell ``(0, 0)``.
 
@@ -128,7 +128,7 @@ def rasterize(
     See Also
     --------
     FloorPlan.rasterize : the same for a plan.
-    pointnav_core.maps.TraversableMap : wraps ``codes``, ``resolution`` and ``origin``.
+    pointnav_core.floor.maps.TraversableMap : wraps ``codes``, ``resolution`` and ``origin``.
 
     Notes
     -----

@@ -19,7 +19,13 @@ clear links, once per floor), ``arcs`` (drawing arcs),
 """
 
 from pointnav_core.geodesic.field import BLOCK, LOOKUP_BOUND, GoalField
-from pointnav_core.geodesic.planner import FIELD_CACHE_BYTES, GEOMETRY_BYTES, MIN_RADIUS, Planner, planner_for
+from pointnav_core.geodesic.planner import (
+    FIELD_CACHE_BYTES,
+    GEOMETRY_BYTES,
+    MIN_RADIUS,
+    Planner,
+    planner_for,
+)
 
 __all__ = [
     "BLOCK", "FIELD_CACHE_BYTES", "GEOMETRY_BYTES", "LOOKUP_BOUND", "MIN_RADIUS", "GoalField", "Planner", "planner_for",

@@ -1,6 +1,6 @@
 """The compiled path of :func:`pointnav_core.geodesic.roots.cell_roots` (imports numba).
 
-Imported only through :func:`pointnav_core._compiled.kernel` when numba is installed (the
+Imported only through :func:`pointnav_core.utils.compiled.kernel` when numba is installed (the
 ``fast`` extra). :func:`best_links` makes the numpy path's decision one cell at a time: of
 the direct segment and every visible link, the smallest ``(total, order)``. The previous
 cell's winner is tried first (neighbours mostly share a root); every other candidate whose
@@ -19,7 +19,7 @@ import math
 
 import numba
 
-from pointnav_core._collision_kernel import segment_hits as _hits
+from pointnav_core.floor._collision_kernel import segment_hits as _hits
 
 __all__ = ["best_links", "cell_links", "point_links", "table_roots"]
 

@@ -1,6 +1,6 @@
 """The compiled goal-field search of :mod:`pointnav_core.geodesic.arc_graph` (imports numba).
 
-Imported only through :func:`pointnav_core._compiled.kernel` when numba is installed (the
+Imported only through :func:`pointnav_core.utils.compiled.kernel` when numba is installed (the
 ``fast`` extra). :func:`seeded_dijkstra` is ``arc_graph.seeded_dijkstra`` itself, compiled:
 a binary-heap Dijkstra on the graph built once per floor, seeded with the goal's tangents,
 so that a new goal builds no matrix.

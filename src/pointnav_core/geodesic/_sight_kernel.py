@@ -1,6 +1,6 @@
 """The compiled paths of :mod:`pointnav_core.geodesic.sight` and ``edges`` (imports numba).
 
-Imported only through :func:`pointnav_core._compiled.kernel` when numba is installed (the
+Imported only through :func:`pointnav_core.utils.compiled.kernel` when numba is installed (the
 ``fast`` extra), so the package imports without it. :func:`sight_rays` is
 :func:`pointnav_core.geodesic.sight.sight_rays` itself, compiled. :func:`misses_full` is
 ``edges._misses_full``'s: each segment's samples, at the numpy path's positions, stop at the

@@ -28,8 +28,8 @@ from numpy.typing import NDArray
 from scipy import sparse
 from scipy.sparse import csgraph
 
-from pointnav_core import _compiled
 from pointnav_core.geodesic.tangents import ANG_TOL
+from pointnav_core.utils import compiled as _compiled
 
 if TYPE_CHECKING:
     from pointnav_core.geodesic.planner import Planner

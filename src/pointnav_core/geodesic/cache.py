@@ -37,7 +37,7 @@ from numpy.typing import NDArray
 from pointnav_core.errors import ArgumentError
 
 if TYPE_CHECKING:
-    from pointnav_core.collision import FloorCollision
+    from pointnav_core.floor.collision import FloorCollision
 
 __all__ = ["ENV_VAR", "MIN_SECONDS", "cache_dir", "floor_key", "load", "save"]
 

@@ -26,9 +26,9 @@ import numpy as np
 from numpy.typing import NDArray
 from tqdm.auto import tqdm
 
-from pointnav_core import _compiled
-from pointnav_core.collision import TOUCH_TOL
+from pointnav_core.floor.collision import TOUCH_TOL
 from pointnav_core.geodesic.tangents import ANG_TOL
+from pointnav_core.utils import compiled as _compiled
 
 if TYPE_CHECKING:
     from pointnav_core.geodesic.planner import Planner

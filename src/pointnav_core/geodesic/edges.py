@@ -15,9 +15,9 @@ from typing import TYPE_CHECKING
 import numpy as np
 from numpy.typing import NDArray
 
-from pointnav_core import _compiled
 from pointnav_core.geodesic.sight import blocked_by_profile
 from pointnav_core.geodesic.tangents import ccw_pos
+from pointnav_core.utils import compiled as _compiled
 
 if TYPE_CHECKING:
     from pointnav_core.geodesic.planner import Planner

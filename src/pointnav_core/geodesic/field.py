@@ -19,11 +19,17 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from pointnav_core.errors import ArgumentError
-from pointnav_core.frozen import ThawOnUnpickle
 from pointnav_core.geodesic.arc_graph import FieldLabels
 from pointnav_core.geodesic.cell_links import centre_cell
-from pointnav_core.geodesic.roots import ArcTables, cell_roots, compiled, compiled_roots, table_roots
+from pointnav_core.geodesic.roots import (
+    ArcTables,
+    cell_roots,
+    compiled,
+    compiled_roots,
+    table_roots,
+)
 from pointnav_core.geodesic.tangents import ANG_TOL, TWO_PI
+from pointnav_core.utils.frozen import ThawOnUnpickle
 
 if TYPE_CHECKING:
     from pointnav_core.geodesic.planner import Planner

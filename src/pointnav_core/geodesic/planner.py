@@ -4,7 +4,7 @@ This is the planner behind :class:`~pointnav_core.scenes.Scene`'s shortest paths
 distances and goal fields (the model, its accuracy and cost: ``docs/geodesic.md``).
 
 The robot's centre may go wherever its disc of radius ``r`` misses the blocked set of
-:class:`~pointnav_core.collision.FloorCollision`. A shortest path in that space is taut: a
+:class:`~pointnav_core.floor.collision.FloorCollision`. A shortest path in that space is taut: a
 chain of straight segments, each tangent to circles of radius ``r`` centred at convex
 corners of the blocked set, joined by arcs of those circles. The planner therefore works
 on the *tangent graph*:
@@ -47,21 +47,21 @@ from shapely.geometry.polygon import orient
 from tqdm.auto import tqdm
 
 from pointnav_core.errors import ArgumentError
-from pointnav_core.collision import TOUCH_TOL, FloorCollision, convex_corners
-from pointnav_core.frozen import ThawOnUnpickle
-from pointnav_core.paths import path_length, resample_path
+from pointnav_core.floor.collision import TOUCH_TOL, FloorCollision, convex_corners
 from pointnav_core.geodesic import cache
 from pointnav_core.geodesic.arc_graph import ArcGraph
-from pointnav_core.geodesic.tangents import ANG_TOL, TWO_PI, ccw_pos, tangent_from_point
+from pointnav_core.geodesic.cell_links import CellLinks
 from pointnav_core.geodesic.edges import build_edges
 from pointnav_core.geodesic.field import GoalField
-from pointnav_core.geodesic.roots import compiled
-from pointnav_core.geodesic.cell_links import CellLinks
+from pointnav_core.geodesic.paths import path_length, resample_path
 from pointnav_core.geodesic.point_search import PointSearch
+from pointnav_core.geodesic.roots import compiled
 from pointnav_core.geodesic.sight import NodeBalls, node_sights
+from pointnav_core.geodesic.tangents import ANG_TOL, TWO_PI, ccw_pos, tangent_from_point
+from pointnav_core.utils.frozen import ThawOnUnpickle
 
 if TYPE_CHECKING:
-    from pointnav_core.maps import TraversableMap
+    from pointnav_core.floor.maps import TraversableMap
 
 __all__ = ["Planner", "planner_for", "resample_path", "path_length"]
 

@@ -43,15 +43,16 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 from numpy.typing import NDArray
 
-from pointnav_core import _compiled, workers
-from pointnav_core.collision import TOUCH_TOL
+from pointnav_core.floor.collision import TOUCH_TOL
 from pointnav_core.geodesic.tangents import ANG_TOL, ccw_pos, tangent_from_point
+from pointnav_core.utils import compiled as _compiled
+from pointnav_core.utils import workers
 
 if TYPE_CHECKING:
-    from pointnav_core.geodesic.cell_links import CellLinks
-    from pointnav_core.geodesic.planner import Planner
     from pointnav_core.geodesic.arc_graph import FieldLabels
+    from pointnav_core.geodesic.cell_links import CellLinks
     from pointnav_core.geodesic.field import GoalField
+    from pointnav_core.geodesic.planner import Planner
 
 __all__ = ["CHUNK", "ArcTables", "cell_roots", "compiled", "compiled_roots", "table_roots"]
 

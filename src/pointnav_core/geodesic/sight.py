@@ -35,12 +35,12 @@ from scipy import ndimage
 from scipy.spatial import cKDTree
 from tqdm.auto import tqdm
 
-from pointnav_core import _compiled
-from pointnav_core.collision import TOUCH_TOL
+from pointnav_core.floor.collision import TOUCH_TOL
 from pointnav_core.geodesic.tangents import ANG_TOL
+from pointnav_core.utils import compiled as _compiled
 
 if TYPE_CHECKING:
-    from pointnav_core.collision import FloorCollision
+    from pointnav_core.floor.collision import FloorCollision
 
 __all__ = ["PROFILE_BINS", "NodeBalls", "blocked_by_profile", "node_sights", "sight_rays"]
 

@@ -13,7 +13,7 @@ from typing import Any
 
 import numpy as np
 
-from pointnav_core.collision import TOUCH_TOL
+from pointnav_core.floor.collision import TOUCH_TOL
 
 __all__ = ["ANG_TOL", "COST_TOL", "TWO_PI", "ccw_pos", "tangent_from_point"]
 

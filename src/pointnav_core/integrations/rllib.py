@@ -43,8 +43,8 @@ from ray.rllib.callbacks.callbacks import RLlibCallback
 from ray.rllib.env.multi_agent_env import MultiAgentEnv
 from ray.tune.registry import register_env
 
+from pointnav_core.envs.multi_pointnav import MultiPointNavEnv
 from pointnav_core.integrations import episode_metrics
-from pointnav_core.parallel import MultiPointNavEnv
 
 __all__ = [
     "MULTI_ENV_ID",
@@ -133,7 +133,7 @@ def make_multi_env(config: Mapping[str, Any] | None = None) -> PointNavMultiAgen
 
 def make_single_env(config: Mapping[str, Any] | None = None) -> Any:
     """RLlib env creator of ``pointnav_core/PointNav-v0`` (flat observations by default)."""
-    from pointnav_core.env import PointNavEnv
+    from pointnav_core.envs.pointnav import PointNavEnv
 
     return PointNavEnv(**{"flatten_obs": True, **dict(config or {})})
 

@@ -44,12 +44,16 @@ from typing import Any
 import numpy as np
 from stable_baselines3.common.callbacks import BaseCallback
 from stable_baselines3.common.vec_env import VecEnv
-from stable_baselines3.common.vec_env.base_vec_env import VecEnvIndices, VecEnvObs, VecEnvStepReturn
+from stable_baselines3.common.vec_env.base_vec_env import (
+    VecEnvIndices,
+    VecEnvObs,
+    VecEnvStepReturn,
+)
 from stable_baselines3.common.vec_env.util import dict_to_obs, obs_space_info
 
+from pointnav_core.envs.multi_pointnav import MultiPointNavEnv
 from pointnav_core.errors import ArgumentError, TaskStateError
 from pointnav_core.integrations import METRIC_KEYS, episode_metrics
-from pointnav_core.parallel import MultiPointNavEnv
 
 __all__ = ["MultiRobotVecEnv", "PointNavMetricsCallback", "make_vec_env"]
 

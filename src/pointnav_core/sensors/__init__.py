@@ -8,7 +8,7 @@ class                  name             what it observes
 :class:`LocalMap`      ``"local_map"``  an egocentric grid of the floor, heading up
 =====================  ===============  ===================================================
 
-Both are :class:`~pointnav_core.observations.ObservationTerm` objects: name them in the
+Both are :class:`~pointnav_core.task.observations.ObservationTerm` objects: name them in the
 envs' ``sensors`` argument (:func:`make_sensors`), or pass them in a task's
 ``observation_terms``. The exact ray casting is :mod:`pointnav_core.sensors.raycast`; with
 numba installed (the ``fast`` extra) it runs the compiled kernel of

@@ -1,11 +1,11 @@
-"""The sensors' argument checks: :mod:`pointnav_core.validation` under the names and
+"""The sensors' argument checks: :mod:`pointnav_core.utils.validation` under the names and
 keywords the sensor modules use. Each error names the parameter."""
 
 from __future__ import annotations
 
 from typing import Any
 
-from pointnav_core import validation
+from pointnav_core.utils import validation
 
 __all__ = ["check_int", "check_number"]
 

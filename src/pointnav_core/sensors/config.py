@@ -30,9 +30,9 @@ from collections.abc import Mapping
 from typing import Any
 
 from pointnav_core.errors import ArgumentError
-from pointnav_core.observations import ObservationTerm
 from pointnav_core.sensors.local_map import LocalMap
 from pointnav_core.sensors.scan import RangeScan
+from pointnav_core.task.observations import ObservationTerm
 
 __all__ = ["SENSORS", "SENSOR_ORDER", "make_sensors"]
 

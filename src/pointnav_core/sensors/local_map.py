@@ -26,7 +26,7 @@ observation, and row by row (row 0 first) in the flat one.
 
 Examples
 --------
->>> from pointnav_core.maps import TraversableMap
+>>> from pointnav_core.floor.maps import TraversableMap
 >>> lm = LocalMap(size=1.0, cells=4)
 >>> lm.cell_size
 0.25
@@ -46,10 +46,10 @@ import numpy as np
 from numpy.typing import NDArray
 
 from pointnav_core.errors import ArgumentError
-from pointnav_core.maps import FREE, OBSTACLE, VOID
-from pointnav_core.observations import Frame, ObservationTerm
+from pointnav_core.floor.maps import FREE, OBSTACLE, VOID
 from pointnav_core.sensors._checks import check_int, check_number
 from pointnav_core.sensors.scan import other_robot_discs
+from pointnav_core.task.observations import Frame, ObservationTerm
 
 __all__ = ["LOCAL_BLOCKED", "LOCAL_FREE", "LOCAL_MAP_DTYPES", "LOCAL_ROBOT", "LOCAL_VOID", "LocalMap"]
 

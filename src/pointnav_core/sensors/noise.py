@@ -210,7 +210,7 @@ _KERNEL: list[Any] = []  # the compiled loop, or None without numba, once looked
 def _kernel() -> Any:
     """The compiled loop of :func:`_ray_uniforms`, or None without numba (looked up once)."""
     if not _KERNEL:
-        from pointnav_core._compiled import kernel_module
+        from pointnav_core.utils.compiled import kernel_module
 
         module = kernel_module("pointnav_core.sensors._noise_kernel")
         _KERNEL.append(None if module is None else module.ray_uniforms)

@@ -4,7 +4,7 @@
 
 - the square of every OBSTACLE cell,
 - everything off the map (the edge of the map reads as a wall: a ray has to end somewhere,
-  and :class:`~pointnav_core.collision.FloorCollision` blocks off-map too), and
+  and :class:`~pointnav_core.floor.collision.FloorCollision` blocks off-map too), and
 - the edges of the floor plan's obstacle polygons (a wall thinner than a cell is seen).
 
 VOID cells (holes, stairwells) are *not* seen: a ray passes over them, as a real lidar's
@@ -44,7 +44,7 @@ import shapely.geometry
 from numpy.typing import ArrayLike, NDArray
 
 from pointnav_core.errors import ArgumentError, ArgumentTypeError
-from pointnav_core.maps import OBSTACLE, TraversableMap
+from pointnav_core.floor.maps import OBSTACLE, TraversableMap
 from pointnav_core.sensors import raycast_jit
 from pointnav_core.sensors.clearance import quadrant_clearance
 
@@ -67,7 +67,7 @@ class ScanGeometry:
     ----------
     tmap : TraversableMap
         The floor. Its OBSTACLE cells, its edge and the obstacle polygons of its
-        :attr:`~pointnav_core.maps.TraversableMap.collision` geometry are seen.
+        :attr:`~pointnav_core.floor.maps.TraversableMap.collision` geometry are seen.
 
     Examples
     --------

@@ -41,7 +41,7 @@ def kernel() -> Any:
     global _KERNEL, _TRIED
     if not _TRIED:
         _TRIED = True
-        from pointnav_core._compiled import kernel_module
+        from pointnav_core.utils.compiled import kernel_module
 
         module = kernel_module("pointnav_core.sensors._raycast_kernel")
         _KERNEL = None if module is None else module.cast

@@ -49,12 +49,12 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from pointnav_core.backend import float_twin
+from pointnav_core.backends.protocol import float_twin
 from pointnav_core.errors import ArgumentError
-from pointnav_core.observations import Frame, ObservationTerm
 from pointnav_core.sensors._checks import check_int, check_number
 from pointnav_core.sensors.noise import episode_key, scan_noise, seed_entropy
 from pointnav_core.sensors.raycast import ScanGeometry, cast_pose_compiled, cast_rays
+from pointnav_core.task.observations import Frame, ObservationTerm
 
 __all__ = ["RangeScan", "ScanShare", "other_robot_discs", "scan_angles"]
 
@@ -260,7 +260,7 @@ class RangeScan(ObservationTerm):
 
 
 def _heading(qx: float, qy: float, qz: float, qw: float) -> float:
-    """Yaw (rad) of a quaternion, as :class:`~pointnav_core.observations.Frame` derives it."""
+    """Yaw (rad) of a quaternion, as :class:`~pointnav_core.task.observations.Frame` derives it."""
     q2 = 2.0 / (qx * qx + qy * qy + qz * qz + qw * qw)
     r00 = 1.0 - q2 * (qy * qy + qz * qz)
     r10 = q2 * (qx * qy + qz * qw)
@@ -301,7 +301,7 @@ class ScanShare:
 
     def ranges(self, env: Any, idn: int, floor: int) -> NDArray[np.float64] | None:
         """Robot ``idn``'s exact ranges (a fresh array), or None if it is not in the batch."""
-        from pointnav_core.lifecycle import TaskState
+        from pointnav_core.task.lifecycle import TaskState
 
         backend = env.backend
         pose = float_twin(backend, "get_pose_floats")

@@ -17,8 +17,13 @@ import argparse
 import sys
 from collections.abc import Sequence
 
-from pointnav_core.backend import UnknownBackendError, available_backends
-from pointnav_core.testing.conformance import CHECKS, backend_factory, format_report, run_checks
+from pointnav_core.backends.protocol import UnknownBackendError, available_backends
+from pointnav_core.testing.conformance import (
+    CHECKS,
+    backend_factory,
+    format_report,
+    run_checks,
+)
 
 __all__ = ["main"]
 

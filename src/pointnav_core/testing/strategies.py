@@ -14,8 +14,8 @@ from hypothesis import strategies as st
 
 from pointnav_core import floorplans
 from pointnav_core.errors import ArgumentError
+from pointnav_core.floor.maps import FREE, OBSTACLE, VOID, TraversableMap
 from pointnav_core.floorplans import FloorPlan
-from pointnav_core.maps import FREE, OBSTACLE, VOID, TraversableMap
 
 __all__: list[str] = [
     "code_grids",
@@ -156,7 +156,7 @@ def robot_specs(
     max_radius: float = 0.5,
     max_speed: float = 2.0,
 ) -> st.SearchStrategy:
-    """Valid :class:`~pointnav_core.backend.RobotSpec` values.
+    """Valid :class:`~pointnav_core.backends.protocol.RobotSpec` values.
 
     Radii lie in ``[0, max_radius]`` metres (shrinking to 0, a point robot), linear speed
     limits in ``[0.01, max_speed]`` m/s, yaw-rate limits in ``[0.01, 2 pi]`` rad/s, and the
@@ -171,7 +171,10 @@ def robot_specs(
     max_speed : float
         Largest ``max_linear_velocity`` in m/s, >= 0.01.
     """
-    from pointnav_core.backend import DRIVES, RobotSpec  # this block was appended: import here
+    from pointnav_core.backends.protocol import (  # this block was appended: import here
+        DRIVES,
+        RobotSpec,
+    )
 
     drives = tuple(drives)
     if not drives or any(d not in DRIVES for d in drives):
@@ -237,7 +240,7 @@ def code_grids(draw: st.DrawFn, min_side: int = 2, max_side: int = 24) -> np.nda
 
 @st.composite
 def traversable_maps(draw: st.DrawFn, max_side: int = 24) -> TraversableMap:
-    """Small :class:`~pointnav_core.maps.TraversableMap` values with a random origin."""
+    """Small :class:`~pointnav_core.floor.maps.TraversableMap` values with a random origin."""
     grid = draw(code_grids(max_side=max_side))
     resolution = draw(st.sampled_from((0.1, 0.05, 0.25, 1.0)))
     origin = (draw(st.floats(-50.0, 50.0)), draw(st.floats(-50.0, 50.0)))
@@ -322,7 +325,9 @@ def nav_robot_specs() -> st.SearchStrategy:
 
     Shrinks towards a point robot with differential drive.
     """
-    from pointnav_core.backend import RobotSpec  # this block was appended: import here
+    from pointnav_core.backends.protocol import (
+        RobotSpec,  # this block was appended: import here
+    )
 
     return st.builds(
         RobotSpec,
@@ -450,7 +455,9 @@ def valid_poses(
     ValueError
         When the robot fits nowhere on the chosen floors.
     """
-    from pointnav_core.scenes import robot_radius  # this block was appended: import here
+    from pointnav_core.scenes import (
+        robot_radius,  # this block was appended: import here
+    )
 
     radius = robot_radius(robot)
     cells = _usable_cells(scene, radius, floor)

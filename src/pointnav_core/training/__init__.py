@@ -5,7 +5,7 @@
 - :mod:`~pointnav_core.training.checkpoint`: one checkpoint file, saved and loaded safely;
 - :mod:`~pointnav_core.training.config`: ``pointnav train``'s config file;
 - :mod:`~pointnav_core.training.trainer`: the training run (checkpoints, curve, held-out
-  evaluation through :func:`pointnav_core.evaluation.evaluate`, resume);
+  evaluation through :func:`pointnav_core.evaluation.run.evaluate`, resume);
 - :mod:`~pointnav_core.training.curve`: the curve's CSV and PNG.
 
 The submodules import torch; this package itself does not, so that ``pointnav`` works

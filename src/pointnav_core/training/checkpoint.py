@@ -2,7 +2,7 @@
 
 A checkpoint (``.pt``) is a torch file of plain data only: the actor-critic's state dict
 (tensors), the observation normalisation statistics (tensors), the network's shape, the
-:class:`~pointnav_core.env_config.EnvConfig` it was trained with (as JSON text), the
+:class:`~pointnav_core.envs.config.EnvConfig` it was trained with (as JSON text), the
 training step and the library version; ``latest.pt`` of a training run also holds the
 optimiser and the return statistics, to resume. It is read with
 ``torch.load(..., weights_only=True)``, which rebuilds tensors, dicts, lists, strings and
@@ -12,7 +12,7 @@ someone else made cannot run code when it is loaded.
 Examples
 --------
 >>> import tempfile, os
->>> from pointnav_core.env_config import EnvConfig
+>>> from pointnav_core.envs.config import EnvConfig
 >>> from pointnav_core.training.agent import ActorCritic, RunningNorm
 >>> agent, norm = ActorCritic(8, 3, 16), RunningNorm((8,))
 >>> path = os.path.join(tempfile.mkdtemp(), "policy.pt")
@@ -32,7 +32,7 @@ from typing import Any
 
 import torch
 
-from pointnav_core.env_config import EnvConfig
+from pointnav_core.envs.config import EnvConfig
 from pointnav_core.errors import ArgumentError
 from pointnav_core.training.agent import ActorCritic, RunningNorm
 
@@ -107,7 +107,7 @@ def save_checkpoint(
         Figures to keep with it (plain numbers).
     """
     from pointnav_core import __version__
-    from pointnav_core.outputs import atomic_writer
+    from pointnav_core.utils.outputs import atomic_writer
 
     if not isinstance(env_config, EnvConfig):
         raise ArgumentError(f"env_config must be an EnvConfig, got {env_config!r}")

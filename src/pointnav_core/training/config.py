@@ -4,7 +4,7 @@ A YAML or JSON file (:meth:`TrainConfig.load`) with these sections, every field 
 ``eval_dataset`` optional:
 
 ``env``
-    The :class:`~pointnav_core.env_config.EnvConfig` the policy is trained with (and that
+    The :class:`~pointnav_core.envs.config.EnvConfig` the policy is trained with (and that
     its checkpoints carry): sensors, actions, robot, task settings, ``max_steps``.
 ``scenes``, ``split``, ``max_scenes``
     The scene set (``houses``, ``mazes``, ``clutter`` or a folder of scene files) and the
@@ -14,7 +14,7 @@ A YAML or JSON file (:meth:`TrainConfig.load`) with these sections, every field 
     ``path_range``; default the task's own).
 ``eval_dataset``, ``eval_every``, ``eval_limit``, ``eval_stride``, ``eval_workers``, ``scenes_dir``
     The held-out episode dataset played every ``eval_every`` env steps and at the end,
-    through :func:`pointnav_core.evaluation.evaluate` (``pointnav eval``'s code), its subset
+    through :func:`pointnav_core.evaluation.run.evaluate` (``pointnav eval``'s code), its subset
     (as ``--limit`` and ``--stride``), worker processes, and the folder its scene paths are
     read from (default the current one, as ``pointnav eval --scenes-dir``).
 ``out``
@@ -34,10 +34,10 @@ import os
 from collections.abc import Mapping
 from typing import Any
 
-from pointnav_core import validation
-from pointnav_core.env_config import EnvConfig, read_config_file
+from pointnav_core.envs.config import EnvConfig, read_config_file
 from pointnav_core.errors import ArgumentError
 from pointnav_core.training.ppo import PPOSettings
+from pointnav_core.utils import validation
 
 __all__ = ["EngineSettings", "TrainConfig"]
 

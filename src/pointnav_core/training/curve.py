@@ -18,7 +18,7 @@ from collections.abc import Sequence
 from typing import Any
 
 from pointnav_core.errors import ArgumentError
-from pointnav_core.outputs import atomic_writer
+from pointnav_core.utils.outputs import atomic_writer
 
 __all__ = ["COLUMNS", "plot_curve", "read_curve", "write_curve"]
 

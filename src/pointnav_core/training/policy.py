@@ -1,6 +1,6 @@
 """A checkpoint as an evaluation policy: ``pointnav eval --policy CHECKPOINT.pt``.
 
-:class:`CheckpointPolicy` is the policy factory :func:`pointnav_core.evaluation.evaluate`
+:class:`CheckpointPolicy` is the policy factory :func:`pointnav_core.evaluation.run.evaluate`
 plays a checkpoint with: its env config is the checkpoint's own (unless the caller gives
 one), and it acts deterministically (the most likely discrete action, or the Gaussian's
 mean). The file is read once per process; the factory itself pickles as its path, so
@@ -14,7 +14,7 @@ from typing import Any
 
 import numpy as np
 
-from pointnav_core.env_config import EnvConfig
+from pointnav_core.envs.config import EnvConfig
 
 __all__ = ["CheckpointPolicy"]
 
@@ -71,7 +71,7 @@ class CheckpointPolicy:
 
     def check_env(self, env: Any) -> None:
         """ValueError unless ``env``'s spaces have the shapes the network was built for."""
-        from pointnav_core.evaluation_config import check_spaces
+        from pointnav_core.evaluation.config import check_spaces
 
         own = self.env_config.to_dict()
         check_spaces(

@@ -7,7 +7,7 @@ the benchmark trains so), and every ``eval_every`` env steps and at the end it
 1. saves ``latest.pt`` (the network, the observation statistics, the env config and the
    optimiser: :mod:`pointnav_core.training.checkpoint`);
 2. plays the held-out episodes with that file through
-   :func:`pointnav_core.evaluation.evaluate` and a
+   :func:`pointnav_core.evaluation.run.evaluate` and a
    :class:`~pointnav_core.training.policy.CheckpointPolicy`, the code and policy
    ``pointnav eval --policy latest.pt`` uses, so that its numbers are eval's to the
    episode; the per-episode results go to ``heldout/step_<N>.jsonl`` (eval's results file);
@@ -60,7 +60,7 @@ def heldout_episodes(config: TrainConfig) -> list[Any]:
     """The held-out episodes (``eval_limit`` and ``eval_stride`` applied), checked before
     any training: their scenes exist, and their robot radius is the config's."""
     from pointnav_core.datasets import EpisodeDataset
-    from pointnav_core.evaluation import (
+    from pointnav_core.evaluation.run import (
         check_robot_radius,
         check_scene_ids,
         select_episodes,
@@ -125,7 +125,7 @@ class _Run:
 
     def evaluate(self, wall: float) -> dict[str, Any]:
         """Save ``latest.pt``, play the held-out episodes with it, keep the row and the best."""
-        from pointnav_core.evaluation import evaluate, summary_record, write_results
+        from pointnav_core.evaluation.run import evaluate, summary_record, write_results
         from pointnav_core.training.policy import CheckpointPolicy
 
         self.save_latest()
@@ -222,7 +222,7 @@ def run_training(
         else:
             import yaml
 
-            from pointnav_core.outputs import atomic_writer
+            from pointnav_core.utils.outputs import atomic_writer
 
             with atomic_writer(run.paths["config"], "w", encoding="utf-8") as fh:
                 yaml.safe_dump(config.to_dict(), fh, sort_keys=False)

@@ -16,8 +16,8 @@ import math
 from collections.abc import Mapping
 from typing import Any, NamedTuple
 
-from pointnav_core.rewards import CollisionReward, PointGoalReward, PotentialReward
-from pointnav_core.terminations import Falling, MaxCollision, Timeout
+from pointnav_core.task.rewards import CollisionReward, PointGoalReward, PotentialReward
+from pointnav_core.task.terminations import Falling, MaxCollision, Timeout
 
 __all__ = ["BatchedTask", "TaskStep", "custom_rewards", "task_step"]
 
@@ -27,7 +27,7 @@ BUILT_IN_REWARDS = ("potential", "collision", "pointgoal")
 
 class BatchedTask(NamedTuple):
     """What a custom reward term's ``batched(task)`` reads: the single task's per-step
-    snapshot (``pointnav_core.rewards``) for every robot at once, as arrays of the robots'
+    snapshot (``pointnav_core.task.rewards``) for every robot at once, as arrays of the robots'
     shape (numpy or torch, as the engine's ``device``)."""
 
     xp: Any  #: the array module (numpy, or torch)

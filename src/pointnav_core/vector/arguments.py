@@ -8,8 +8,9 @@ from typing import Any
 
 import numpy as np
 
-from pointnav_core import scenes, validation
+from pointnav_core import scenes
 from pointnav_core.errors import ArgumentError
+from pointnav_core.utils import validation
 
 __all__ = ["as_scene_list", "check_real_actions", "default_scene", "grid_scene", "task_arguments"]
 
@@ -66,7 +67,7 @@ def as_scene_list(scene: scenes.Scene | Sequence[scenes.Scene] | None) -> list[s
 
 def check_real_actions(actions: Any) -> None:
     """ValueError naming ``actions`` unless they are real numbers (both engines; the single
-    env's rule, :func:`pointnav_core.validation.is_real_array`: no bools, complex numbers or strings)."""
+    env's rule, :func:`pointnav_core.utils.validation.is_real_array`: no bools, complex numbers or strings)."""
     if not validation.is_real_array(actions):
         kind = getattr(actions, "dtype", type(actions).__name__)
         raise ArgumentError(f"actions must be real numbers in [-1, 1] (an integer or float array), got {kind}")

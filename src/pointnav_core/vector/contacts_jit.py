@@ -21,7 +21,7 @@ from typing import Any
 
 import numpy as np
 
-from pointnav_core import _compiled
+from pointnav_core.utils import compiled as _compiled
 from pointnav_core.vector.floors import FloorTables
 
 __all__ = ["advance_compiled", "advance_one", "available", "prepare"]

@@ -1,6 +1,6 @@
 """Discrete actions in the batched engine: Habitat's actions as batched control steps.
 
-A discrete action (:mod:`pointnav_core.actions`) is a velocity command held for a number
+A discrete action (:mod:`pointnav_core.task.actions`) is a velocity command held for a number
 of control steps, cut short by a contact. The single env runs these control steps one by
 one for its one robot; here every world runs its action's control steps together: sub-step
 ``k`` advances, with one batched control step, the worlds whose action has more than ``k``
@@ -16,8 +16,8 @@ robots whose action lasts and that have touched nothing drive, the others get no
 
 Examples
 --------
->>> from pointnav_core.actions import DiscreteActions
->>> from pointnav_core.backend import RobotSpec
+>>> from pointnav_core.task.actions import DiscreteActions
+>>> from pointnav_core.backends.protocol import RobotSpec
 >>> from pointnav_core.vector.xp import make_arrays
 >>> plan = DiscretePlan(DiscreteActions(), RobotSpec(), 10.0, make_arrays("numpy"))
 >>> plan.steps.tolist(), plan.n, plan.max_steps
@@ -36,8 +36,8 @@ from typing import Any
 
 import numpy as np
 
-from pointnav_core.actions import STOP, DiscreteActions
 from pointnav_core.errors import ArgumentError
+from pointnav_core.task.actions import STOP, DiscreteActions
 from pointnav_core.vector.xp import Arrays
 
 __all__ = ["DiscretePlan"]
@@ -79,7 +79,7 @@ class DiscretePlan:
 
     Examples
     --------
-    >>> from pointnav_core.backend import RobotSpec
+    >>> from pointnav_core.backends.protocol import RobotSpec
     >>> from pointnav_core.vector.xp import make_arrays
     >>> slow = RobotSpec(max_linear_velocity=0.25)
     >>> DiscretePlan(DiscreteActions(), [RobotSpec(), slow], 10.0, make_arrays("numpy")).steps.tolist()

@@ -1,11 +1,11 @@
 """The drive of the batched engines: commands, arcs and sub-steps, as the kinematic backend.
 
-Both drives of :class:`~pointnav_core.robot_spec.RobotSpec` run here as arrays: an action
+Both drives of :class:`~pointnav_core.backends.robot_spec.RobotSpec` run here as arrays: an action
 in ``[-1, 1]`` becomes the body-frame command ``(vx, vy, w)`` (m/s, m/s, rad/s) exactly as
 :meth:`RobotSpec.scale_action` clips and scales it (a differential drive's ``(v, w)`` is
-``(v, 0, w)``, as :func:`~pointnav_core.backend_kit.body_command` makes it), and the
+``(v, 0, w)``, as :func:`~pointnav_core.backends.kit.body_command` makes it), and the
 command moves the robot by the exact arc of
-:func:`~pointnav_core.backend_kit.drive_arc`.
+:func:`~pointnav_core.backends.kit.drive_arc`.
 
 A robot near something (the engine's slow path) advances as the backend's ``_slow_step``
 does: in ``n`` equal sub-steps, ``n`` the backend's count (the step's travel over half a
@@ -30,8 +30,8 @@ from __future__ import annotations
 from collections.abc import Callable, Sequence
 from typing import Any
 
+from pointnav_core.backends.robot_spec import RobotSpec
 from pointnav_core.errors import ArgumentError
-from pointnav_core.robot_spec import RobotSpec
 
 __all__ = ["MAX_TURN", "arc", "body_command", "drive_of", "sub_steps", "substep_drive", "travel"]
 
@@ -95,7 +95,7 @@ def body_command(xp: Any, act: Any, vmax: Any, wmax: Any, holonomic: bool) -> tu
 def arc(xp: Any, yaw: Any, vx: Any, vy: Any, w: Any, h: Any) -> tuple[Any, Any]:
     """The displacement (m) of ``h`` seconds of body command ``(vx, vy, w)`` from heading ``yaw``.
 
-    :func:`~pointnav_core.backend_kit.drive_arc` as arrays: the integral of
+    :func:`~pointnav_core.backends.kit.drive_arc` as arrays: the integral of
     ``R(yaw + w t) (vx, vy)`` over ``[0, h]``, with the same expressions in the same order.
     """
     half = 0.5 * w * h

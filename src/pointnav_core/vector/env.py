@@ -1,6 +1,6 @@
 """``VectorPointNavEnv``: many point-navigation worlds stepped together as arrays.
 
-Every world is a :class:`~pointnav_core.env.PointNavEnv` with one robot on the kinematic
+Every world is a :class:`~pointnav_core.envs.pointnav.PointNavEnv` with one robot on the kinematic
 backend (several robots per world: :mod:`pointnav_core.vector.fleet_env`), and the batched
 step reproduces them (drive, contacts and sliding, the task's rewards, terminations, SPL
 and SoftSPL, the flat ``low_dim`` observation, the range scan and the local map) with array operations
@@ -18,16 +18,28 @@ import gymnasium as gym
 import numpy as np
 from gymnasium.vector import AutoresetMode, VectorEnv
 
-from pointnav_core import _envcommon, scenes, validation
-from pointnav_core.env_config import EnvConfig, takes_config, vector_arguments
+from pointnav_core import scenes
+from pointnav_core.envs import common as _envcommon
+from pointnav_core.envs.config import EnvConfig, takes_config, vector_arguments
 from pointnav_core.errors import ArgumentError, TaskStateError
-from pointnav_core.metrics import soft_spl_values, spl_values
+from pointnav_core.task.metrics import soft_spl_values, spl_values
+from pointnav_core.utils import validation
 from pointnav_core.vector import contacts_jit
-from pointnav_core.vector.contacts import advance
 from pointnav_core.vector.accounting import custom_rewards, task_step
-from pointnav_core.vector.arguments import as_scene_list, check_real_actions, task_arguments
+from pointnav_core.vector.arguments import (
+    as_scene_list,
+    check_real_actions,
+    task_arguments,
+)
+from pointnav_core.vector.contacts import advance
 from pointnav_core.vector.discrete import MOVED, DiscretePlan
-from pointnav_core.vector.drive import arc, body_command, sub_steps, substep_drive, travel
+from pointnav_core.vector.drive import (
+    arc,
+    body_command,
+    sub_steps,
+    substep_drive,
+    travel,
+)
 from pointnav_core.vector.episodes import EpisodePool, fixed_pose
 from pointnav_core.vector.falls import apply_falls
 from pointnav_core.vector.floors import FloorTables
@@ -44,7 +56,7 @@ class VectorPointNavEnv(PoolRefreshing, VectorEnv):
     """``num_envs`` single-robot point-navigation worlds, stepped as arrays.
 
     A ``gymnasium.vector.VectorEnv`` with next-step autoreset. Each world behaves as a
-    :class:`~pointnav_core.env.PointNavEnv` with ``flatten_obs=True`` on the kinematic
+    :class:`~pointnav_core.envs.pointnav.PointNavEnv` with ``flatten_obs=True`` on the kinematic
     backend (same reward terms, terminations, SPL and SoftSPL; the differences are in
     ``docs/decisions.md``, "The batched engine").
 
@@ -56,7 +68,7 @@ class VectorPointNavEnv(PoolRefreshing, VectorEnv):
         Robots per world, >= 1. With more than one, the engine is the multi-robot one
         (see "Several robots per world" below), which also takes ``max_cycles`` (int,
         default 500) and ``finished`` (``"park"``, the default, or ``"remove"``), as
-        :func:`pointnav_core.parallel.parallel_env` does.
+        :func:`pointnav_core.envs.multi_pointnav.parallel_env` does.
     scene : Scene or sequence of Scene, optional
         World ``i`` runs on ``scene[i % len(scene)]``, at its own resolution. Floors with
         obstacle polygons (floor plans, the generated houses) need the compiled contacts
@@ -67,7 +79,7 @@ class VectorPointNavEnv(PoolRefreshing, VectorEnv):
         (actions ``(vx, vy, w)`` in the robot frame, +x ahead, +y to the left), scaled and
         integrated as the kinematic backend does (:mod:`pointnav_core.vector.drive`). With
         several robots per world, also a list with one entry per robot, as for
-        :func:`~pointnav_core.parallel.parallel_env`: their speed limits and radii may
+        :func:`~pointnav_core.envs.multi_pointnav.parallel_env`: their speed limits and radii may
         differ, their drive may not (the actions are one array).
     task : dict, optional
         ``PointNavigationTask`` keyword arguments, as for the single env (its default
@@ -97,7 +109,7 @@ class VectorPointNavEnv(PoolRefreshing, VectorEnv):
         Control steps per second (Hz).
     action_space : str
         ``"continuous"`` (default) or ``"discrete"``: Habitat's actions, as the single env
-        (:mod:`pointnav_core.actions`), each run as its control steps
+        (:mod:`pointnav_core.task.actions`), each run as its control steps
         (:mod:`pointnav_core.vector.discrete`).
     discrete_actions : dict, optional
         ``forward_step``, ``turn_angle``, ``stop``, as the single env.
@@ -108,11 +120,11 @@ class VectorPointNavEnv(PoolRefreshing, VectorEnv):
         The task's ``max_steps``, as ``gymnasium.make(..., max_episode_steps=N)`` sets it for
         the single env (the derived ``path_range`` follows).
     config : EnvConfig, optional
-        :class:`~pointnav_core.env_config.EnvConfig`: ``robot``, ``task``, ``max_steps``,
+        :class:`~pointnav_core.envs.config.EnvConfig`: ``robot``, ``task``, ``max_steps``,
         ``sensors``, ``action_frequency``, ``action_space`` and ``discrete_actions``, which
         may then not be given (nor ``max_episode_steps``); its ``backend`` must be
         ``"kinematic"`` and its ``flatten_obs`` True. A single env built from the same
-        config has the same spaces (:mod:`pointnav_core.env_config`).
+        config has the same spaces (:mod:`pointnav_core.envs.config`).
     workers : int, optional
         Processes that build a pool over several scenes, each scene's episodes and goal
         fields in one (:mod:`pointnav_core.vector.pool_build`); the pool is the same, byte
@@ -140,7 +152,7 @@ class VectorPointNavEnv(PoolRefreshing, VectorEnv):
 
     **Several robots per world** (``n_robots=R > 1``; an instance of the subclass
     :class:`~pointnav_core.vector.fleet_env.VectorFleetEnv`). Each world behaves as a
-    :func:`pointnav_core.parallel.parallel_env` with ``n_robots=R`` on the kinematic backend
+    :func:`pointnav_core.envs.multi_pointnav.parallel_env` with ``n_robots=R`` on the kinematic backend
     with the same ``finished`` and ``max_cycles``: robots are solid for each other, a
     robot-robot contact counts as a collision for both, every robot has its own task
     (rewards, terminations, SPL), and all robots still active are truncated after
@@ -161,7 +173,7 @@ class VectorPointNavEnv(PoolRefreshing, VectorEnv):
     active robot left resets all its robots at the next step (next-step autoreset, as
     above, with ``autoreset`` True for all of them). Episodes are drawn, per scene, by that
     scene's ``parallel_env`` (non-overlapping starts, goals kept
-    :func:`pointnav_core.fleet.goal_separation` apart); ``reset(options={"episodes": [[
+    :func:`pointnav_core.envs.fleet.goal_separation` apart); ``reset(options={"episodes": [[
     (start_xy, yaw, goal_xy), ...], ...]})`` fixes, per world, one tuple per robot.
     Discrete actions run as the multi-robot env runs them: a world takes as many control
     steps as its robots' longest action; in each, a robot whose action lasts and has
@@ -231,9 +243,9 @@ class VectorPointNavEnv(PoolRefreshing, VectorEnv):
         workers: int | None = None,
         progress: bool | None = None,
     ) -> None:
-        from pointnav_core.env import PointNavEnv
+        from pointnav_core.envs.pointnav import PointNavEnv
 
-        #: The :class:`~pointnav_core.env_config.EnvConfig` these worlds were built from, or None.
+        #: The :class:`~pointnav_core.envs.config.EnvConfig` these worlds were built from, or None.
         self.config = config
 
         self.num_envs = validation.integer("num_envs", num_envs, minimum=1)

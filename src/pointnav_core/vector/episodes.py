@@ -1,6 +1,6 @@
 """Start/goal pools prepared ahead: episodes drawn by the single env's own sampler.
 
-Each scene gets ``pool_size`` episodes, sampled by a :class:`~pointnav_core.env.PointNavEnv`
+Each scene gets ``pool_size`` episodes, sampled by a :class:`~pointnav_core.envs.pointnav.PointNavEnv`
 of that scene (the same rules: usable start, reachable goal, ``path_range``), each with its
 goal field settled into a :class:`~pointnav_core.vector.fields.FieldTables`. An autoreset
 draws from the pool, so no reset ever samples or plans during a batched step.
@@ -25,8 +25,8 @@ from typing import Any
 
 import numpy as np
 
-from pointnav_core import validation
 from pointnav_core.errors import ArgumentError
+from pointnav_core.utils import validation
 from pointnav_core.vector.fields import (
     FieldPart,
     FieldTables,
@@ -185,7 +185,7 @@ class EpisodePool:
                    cells_before: int = 0, goals_before: int = 0) -> ScenePart:
         """Scene ``s``'s part: ``pool_size`` episodes drawn by its sampler ``env`` from
         ``seeds`` (one per goal), each goal with ``starts`` starts, its fields settled."""
-        from pointnav_core.sampling import sample_episode
+        from pointnav_core.task.sampling import sample_episode
 
         rows, fields, field_of = [], [], []
         for seed in seeds:

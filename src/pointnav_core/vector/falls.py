@@ -29,7 +29,7 @@ from __future__ import annotations
 from collections.abc import Mapping
 from typing import Any
 
-from pointnav_core.backend_kit.base import _GRAVITY, _MIN_FIRST_DROP
+from pointnav_core.backends.kit.base import _GRAVITY, _MIN_FIRST_DROP
 
 __all__ = ["FALL_SPEED", "GRAVITY", "MIN_FIRST_DROP", "apply_falls", "first_drop"]
 

@@ -1,6 +1,6 @@
 """Several robots per world in the batched engine: ``VectorPointNavEnv(n, n_robots=R)``.
 
-Every world is a :class:`~pointnav_core.parallel.MultiPointNavEnv` with ``R`` robots on
+Every world is a :class:`~pointnav_core.envs.multi_pointnav.MultiPointNavEnv` with ``R`` robots on
 the kinematic backend (``finished="park"`` by default, or ``"remove"``), stepped as
 ``(num_envs, n_robots)`` arrays: robots that could meet a wall or each other are resolved
 together by :func:`~pointnav_core.vector.robots.advance_robots` on one clock per world
@@ -24,28 +24,35 @@ from typing import Any
 import gymnasium as gym
 import numpy as np
 
-from pointnav_core import scenes, validation
-from pointnav_core.env_config import EnvConfig, takes_config, vector_fleet_arguments
+from pointnav_core import scenes
+from pointnav_core.envs.config import EnvConfig, takes_config, vector_fleet_arguments
+from pointnav_core.envs.fleet import FINISHED_MODES, check_finished
 from pointnav_core.errors import ArgumentError, TaskStateError
-from pointnav_core.fleet import FINISHED_MODES, check_finished
+from pointnav_core.utils import validation
 from pointnav_core.vector import contacts_jit
-from pointnav_core.vector.contacts import advance
 from pointnav_core.vector.accounting import task_step
+from pointnav_core.vector.arguments import as_scene_list, check_real_actions
+from pointnav_core.vector.contacts import advance
 from pointnav_core.vector.contacts_jit import advance_compiled
 from pointnav_core.vector.discrete import MOVED, DiscretePlan
-from pointnav_core.vector.drive import arc, body_command, sub_steps, substep_drive, travel
-from pointnav_core.vector.arguments import as_scene_list, check_real_actions
+from pointnav_core.vector.drive import (
+    arc,
+    body_command,
+    sub_steps,
+    substep_drive,
+    travel,
+)
 from pointnav_core.vector.env import VectorPointNavEnv
 from pointnav_core.vector.falls import apply_falls
 from pointnav_core.vector.fleet_pool import FleetPool, check_fixed_episode
 from pointnav_core.vector.floors import FloorTables
-from pointnav_core.vector.pool_build import pool_options
 from pointnav_core.vector.per_robot import (
     envelope,
     read_tasks,
     robot_specs,
     task_arguments,
 )
+from pointnav_core.vector.pool_build import pool_options
 from pointnav_core.vector.robots import advance_robots, robot_walls
 from pointnav_core.vector.scan import requested_scan
 from pointnav_core.vector.xp import make_arrays
@@ -109,7 +116,7 @@ class VectorFleetEnv(VectorPointNavEnv):
         workers: int | None = None,
         progress: bool | None = None,
     ) -> None:
-        from pointnav_core.parallel import parallel_env
+        from pointnav_core.envs.multi_pointnav import parallel_env
 
         self.config = config  # applied by takes_config; max_cycles defaults to its max_steps
 

@@ -1,9 +1,9 @@
 """Episode pools for several robots per world, drawn by the multi-robot env's own reset.
 
 Each scene gets ``pool_size`` episodes of ``n_robots`` robots, sampled by a
-:class:`~pointnav_core.parallel.MultiPointNavEnv` of that scene on the kinematic backend,
+:class:`~pointnav_core.envs.multi_pointnav.MultiPointNavEnv` of that scene on the kinematic backend,
 so its rules hold: starts that do not overlap, goals kept
-:func:`~pointnav_core.fleet.goal_separation` apart, the derived ``path_range``. Every
+:func:`~pointnav_core.envs.fleet.goal_separation` apart, the derived ``path_range``. Every
 robot's goal field is settled into one :class:`~pointnav_core.vector.fields.FieldTables`
 (``field[episode, robot]`` is its entry).
 
@@ -41,7 +41,7 @@ def check_fixed_episode(sampler: Any, episode: Sequence[FleetEpisode], where: st
     """One world's fixed robots, checked by the multi-robot env's rules; ValueError naming ``where``.
 
     Each start and goal must be usable by its robot, starts at least the sum of the two
-    robots' radii apart and goals :func:`~pointnav_core.fleet.goal_separation` apart.
+    robots' radii apart and goals :func:`~pointnav_core.envs.fleet.goal_separation` apart.
     """
     n = len(sampler.tasks)
     try:
@@ -148,7 +148,7 @@ class FleetPool:
 def _more_starts(env: Any, goals: Sequence[tuple[float, float]]) -> list[tuple[float, ...]]:
     """One more set of starts for ``goals`` (one per robot), by ``env``'s own sampler: the
     robots are placed one by one in its reset order, each clear of those placed before."""
-    from pointnav_core.sampling import sample_episode
+    from pointnav_core.task.sampling import sample_episode
 
     env.backend.reset()  # every robot unplaced: none blocks until it lands
     rows: dict[int, tuple[float, ...]] = {}

@@ -16,7 +16,7 @@ from typing import Any
 import numpy as np
 
 from pointnav_core.errors import ArgumentError
-from pointnav_core.maps import VOID
+from pointnav_core.floor.maps import VOID
 from pointnav_core.vector.xp import Arrays
 
 __all__ = ["FloorTables", "stencil_offsets"]

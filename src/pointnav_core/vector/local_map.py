@@ -72,7 +72,7 @@ def frame_heading(xp: Any, yaw: Any) -> tuple[Any, Any]:
     """Cosine and sine of the heading as the single env's frame reads them.
 
     The backend reports the planar quaternion of ``remainder(yaw, 2 pi)``
-    (``backend_kit.planar_quat_floats``); :meth:`~pointnav_core.observations.Frame.set_pose`
+    (``backend_kit.planar_quat_floats``); :meth:`~pointnav_core.task.observations.Frame.set_pose`
     takes the heading from its rotation matrix. These are the same operations on arrays.
 
     Parameters

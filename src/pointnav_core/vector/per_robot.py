@@ -1,7 +1,7 @@
 """Per-robot ``robot`` and ``task`` lists for several robots per world in the batched engine.
 
 ``VectorPointNavEnv(n, n_robots=R, robot=[...], task=[...])`` takes, as
-:func:`pointnav_core.parallel.parallel_env` does, one value shared by all robots or a list
+:func:`pointnav_core.envs.multi_pointnav.parallel_env` does, one value shared by all robots or a list
 with one entry per robot. The numbers that may differ per robot become arrays with a
 robot axis ``(1, R)`` that the step broadcasts over its ``(num_envs, R)`` state:
 
@@ -29,9 +29,9 @@ from typing import Any
 
 import numpy as np
 
+from pointnav_core.backends.robot_spec import RobotSpec
+from pointnav_core.envs.fleet import make_robots, per_robot
 from pointnav_core.errors import ArgumentError
-from pointnav_core.fleet import make_robots, per_robot
-from pointnav_core.robot_spec import RobotSpec
 from pointnav_core.vector.drive import drive_of
 from pointnav_core.vector.xp import Arrays
 

@@ -3,7 +3,7 @@
 A pool's scenes are independent: scene ``s``'s part (its episodes, sampled by its own
 sampler from its own seeds, and their goal fields settled) depends on nothing else, and
 the seeds of every scene are drawn up front. So the parts are built by
-:class:`~pointnav_core.workers.WorkerPool` (spawned workers that die with this process,
+:class:`~pointnav_core.utils.workers.WorkerPool` (spawned workers that die with this process,
 ignore Ctrl-C and report the item they held) on every usable core, and assembled here in
 scene order: the same arrays as a build in this process, byte for byte.
 
@@ -20,11 +20,11 @@ from typing import Any
 
 import numpy as np
 
-from pointnav_core import validation
 from pointnav_core.errors import ArgumentError
+from pointnav_core.utils import validation
+from pointnav_core.utils.workers import WorkerError, WorkerPool, usable_cores
 from pointnav_core.vector.episodes import ScenePart, build_in_process
 from pointnav_core.vector.fields import check_budget
-from pointnav_core.workers import WorkerError, WorkerPool, usable_cores
 
 __all__ = ["PARALLEL_SCENES", "PROGRESS_SCENES", "build_parts", "pool_options", "pool_workers"]
 
@@ -87,7 +87,7 @@ def build_parts(kind: Any, samplers: Sequence[Any], pool_size: int, seeds: Seque
     ------
     Exception
         A scene's error, of its own type, naming the scene (``scene 3: ...``); a worker
-        that dies raises :class:`~pointnav_core.workers.WorkerError` naming its scene.
+        that dies raises :class:`~pointnav_core.utils.workers.WorkerError` naming its scene.
         The byte budget (:data:`~pointnav_core.vector.fields.FIELD_TABLE_BYTES`) is
         checked as the parts come in, before any further one is kept. Workers that cannot
         start (a script without the ``__main__`` guard) give a ``RuntimeWarning``, and the

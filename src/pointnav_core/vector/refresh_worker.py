@@ -21,8 +21,8 @@ from multiprocessing.connection import Connection, wait
 from multiprocessing.reduction import ForkingPickler
 from typing import Any
 
-from pointnav_core import workers
 from pointnav_core.errors import TaskStateError
+from pointnav_core.utils import workers
 
 __all__ = ["RefreshWorker"]
 

@@ -7,9 +7,14 @@ from typing import Any
 
 import numpy as np
 
-from pointnav_core.backend import FLOAT_TWINS, RobotSpec, check_backend, float_twin
+from pointnav_core.backends.protocol import (
+    FLOAT_TWINS,
+    RobotSpec,
+    check_backend,
+    float_twin,
+)
 from pointnav_core.errors import BackendError
-from pointnav_core.maps import OBSTACLE, VOID
+from pointnav_core.floor.maps import OBSTACLE, VOID
 from pointnav_core.scenes import Scene
 from pointnav_core.testing.conformance.common import (
     _IDENTITY,
@@ -333,8 +338,8 @@ def check_fast_paths(factory: BackendFactory) -> None:
     """Float twins the task reads give exactly the numbers of ``get_pose``/``get_velocity``.
 
     The twins ``get_pose_floats`` and ``get_velocity_floats`` are optional (see
-    :data:`~pointnav_core.backend.FLOAT_TWINS`); a backend without them passes. Each twin
-    that :func:`~pointnav_core.backend.float_twin` binds (the ones the task reads instead
+    :data:`~pointnav_core.backends.protocol.FLOAT_TWINS`); a backend without them passes. Each twin
+    that :func:`~pointnav_core.backends.protocol.float_twin` binds (the ones the task reads instead
     of their methods) must return a flat tuple of Python floats equal, value for value, to
     the arrays of the method it mirrors: after ``land`` and ``set_pose`` at random headings
     and after each of 60 steps of random actions (held 10 steps each) by three robots, in a

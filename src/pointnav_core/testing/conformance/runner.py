@@ -9,7 +9,7 @@ from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass
 from typing import Any
 
-from pointnav_core.backend import get_backend
+from pointnav_core.backends.protocol import get_backend
 from pointnav_core.errors import ArgumentError, ArgumentTypeError
 from pointnav_core.testing.conformance.common import BackendFactory, ConformanceError
 from pointnav_core.testing.conformance.motion import (
@@ -131,7 +131,7 @@ def backend_factory(backend: str | type | Callable[[], Any]) -> BackendFactory:
     Parameters
     ----------
     backend : str or type or callable
-        A registered name (see :func:`~pointnav_core.backend.available_backends`), a
+        A registered name (see :func:`~pointnav_core.backends.protocol.available_backends`), a
         ``"package.module:Class"`` path, a backend class (built with no arguments), or a
         callable returning a fresh, unloaded backend each time it is called.
 

@@ -1,0 +1,23 @@
+"""Evaluating a policy on an episode dataset: the run (workers, resumable log), the env it
+plays from a saved config, per-episode results and their summary, and the reference policy
+(the privileged shortest-path follower).
+"""
+
+from pointnav_core.evaluation.policies import ShortestPathFollower
+from pointnav_core.evaluation.report import (
+    EpisodeResult,
+    read_results,
+    summarize,
+    write_results,
+)
+from pointnav_core.evaluation.run import evaluate, make_policy
+
+__all__ = [
+    "EpisodeResult",
+    "ShortestPathFollower",
+    "evaluate",
+    "make_policy",
+    "read_results",
+    "summarize",
+    "write_results",
+]

@@ -1,0 +1,492 @@
+"""Evaluate a policy on an episode dataset: per-episode results, summary, and a plot.
+
+Every episode is played in its own fresh start: the env is reset with the episode's own
+seed (:func:`~pointnav_core.datasets.playback.episode_seed`, from its scene and episode ids)
+and the policy is built anew for it, so an episode's result is the same whatever the order
+of the episodes or the number of worker processes.
+
+Each episode is played by a robot of the radius it was made for (``info.robot_radius``),
+with the goal tolerance it records (``goals[0].radius``; the task's 0.5 m when None), on
+the floor it records, for at most ``max_steps`` steps.
+
+Policies (``policy`` argument, or ``pointnav eval --policy``):
+
+- ``"oracle"``: :class:`~pointnav_core.evaluation.policies.ShortestPathFollower`;
+- ``"MODULE:CALLABLE"``: ``CALLABLE(env)`` is called after each reset and returns a
+  function ``observation -> action``;
+- a path to a Stable-Baselines3 ``.zip``: the model (``sb3_algo``, PPO by default) acts
+  deterministically; it gets the flat observation when its observation space is a ``Box``;
+- a path to a checkpoint ``.pt`` (``pointnav train``'s,
+  :mod:`pointnav_core.training.checkpoint`): its network acts deterministically (the most
+  likely action, or the mean), in envs built from the env config it carries, unless
+  ``env_config`` is given. Loading one runs no code, so it needs no trust flag.
+
+``limit`` and ``stride`` (``--limit N``, ``--stride K``) play a subset: every ``K``-th
+episode of the dataset from the first, then the first ``N`` of those
+(:func:`select_episodes`).
+
+An SB3 ``.zip`` holds pickled Python objects that run code when they are loaded: it is
+loaded only with ``trust_policy_file=True`` (``--trust-policy-file``).
+
+A run survives its faults (:func:`evaluate`): each result is handed to ``on_result`` as
+its episode ends, an episode whose policy raises is named and stopped on or skipped
+(``on_error``), and worker processes end with the run, whatever ends it.
+
+This module drives the envs, so it is not part of the core; the CLI uses it.
+"""
+
+from __future__ import annotations
+
+import importlib
+import os
+import warnings
+from collections.abc import Callable, Sequence
+from typing import Any
+
+from pointnav_core.datasets.format import EpisodeDataset, PointNavEpisode
+from pointnav_core.datasets.playback import episode_seed
+from pointnav_core.datasets.scene_sets import load_scene, locate_scene
+from pointnav_core.envs.config import EnvConfig
+from pointnav_core.errors import ArgumentError, EpisodeError
+from pointnav_core.evaluation.config import (
+    check_beside_config,
+    check_robot_radius,
+    check_spaces,
+    episode_config,
+)
+from pointnav_core.evaluation.report import (
+    EpisodeResult,
+    bootstrap_interval,
+    plot_results,
+    read_results,
+    read_run,
+    result_line,
+    summarize,
+    summary_record,
+    write_results,
+)
+from pointnav_core.task import metrics
+from pointnav_core.utils.validation import integer
+from pointnav_core.utils.workers import WorkerError, WorkerPool, usable_cores
+
+__all__ = [
+    "POLICY_FORMS",
+    "EpisodeResult",
+    "bootstrap_interval",
+    "check_robot_radius",
+    "check_scene_ids",
+    "check_spaces",
+    "episode_config",
+    "evaluate",
+    "make_policy",
+    "plot_results",
+    "read_results",
+    "read_run",
+    "result_line",
+    "select_episodes",
+    "summarize",
+    "summary_record",
+    "write_results",
+]
+
+#: Default step limit: a 30 m geodesic at 0.5 m/s and 10 Hz takes 600 steps, plus turns.
+DEFAULT_MAX_STEPS = 1000
+#: What ``on_error`` may say when an episode's policy raises.
+ON_ERROR = ("stop", "skip")
+#: The accepted forms of a policy spec, for messages.
+POLICY_FORMS = (
+    "'oracle', MODULE:CALLABLE (a function env -> (observation -> action)), the path to "
+    "a checkpoint .pt (pointnav train's) or the path to a Stable-Baselines3 .zip"
+)
+#: The suffix of a checkpoint (pointnav_core.training.checkpoint.CHECKPOINT_SUFFIX, which
+#: imports torch).
+CHECKPOINT_SUFFIX = ".pt"
+
+Policy = Callable[[Any], Any]
+PolicyFactory = Callable[[Any], Policy]
+
+
+# ---------------------------------------------------------------------- policies
+def _oracle(env: Any) -> Policy:
+    from pointnav_core.evaluation.policies import ShortestPathFollower
+
+    follower = ShortestPathFollower(env)
+    return lambda _obs: follower.act()
+
+
+class _SB3Policy:
+    """A picklable factory for a Stable-Baselines3 model, loaded once per process."""
+
+    def __init__(self, path: str, algo: str) -> None:
+        self.path, self.algo = path, algo
+        self._model: Any = None
+
+    def __getstate__(self) -> dict[str, Any]:
+        return {"path": self.path, "algo": self.algo, "_model": None}
+
+    @property
+    def model(self) -> Any:
+        if self._model is None:
+            try:
+                import stable_baselines3
+            except ImportError:
+                raise ArgumentError(
+                    "an SB3 .zip policy needs stable-baselines3 (pip install 'pointnav-core[rl]')"
+                ) from None
+            cls = getattr(stable_baselines3, self.algo, None)
+            if cls is None:
+                raise ArgumentError(
+                    f"sb3_algo must name a Stable-Baselines3 algorithm (PPO, SAC, ...), got {self.algo!r}"
+                )
+            self._model = cls.load(self.path, device="cpu")
+        return self._model
+
+    @property
+    def flat(self) -> bool:
+        from gymnasium import spaces
+
+        return isinstance(self.model.observation_space, spaces.Box)
+
+    def check_env(self, env: Any) -> None:
+        """ValueError unless ``env``'s observation and action spaces have the shapes the
+        model was trained on (their bounds may differ: they follow the scene's size)."""
+        check_spaces(f"policy {self.path!r}", self.model, env)
+
+    def __call__(self, env: Any) -> Policy:
+        model = self.model
+        return lambda obs: model.predict(obs, deterministic=True)[0]
+
+
+
+def make_policy(spec: str, sb3_algo: str = "PPO", trust_policy_file: bool = False) -> PolicyFactory:
+    """The policy factory named by ``spec`` (see the module notes).
+
+    ``trust_policy_file`` must be True for an SB3 ``.zip``: loading one unpickles Python
+    objects stored in it, which can run any code (see the module notes). A checkpoint
+    ``.pt`` is plain data and needs no trust; it is read when first used.
+
+    Raises
+    ------
+    ValueError
+        For a spec of no known form, a module or attribute that does not exist, a ``.zip``
+        that does not exist or is not trusted, or a ``.pt`` that does not exist (or without
+        torch).
+    """
+    if not isinstance(spec, str) or not spec:
+        raise ArgumentError(f"policy must be {POLICY_FORMS}, got {spec!r}")
+    if spec == "oracle":
+        return _oracle
+    if spec.endswith(CHECKPOINT_SUFFIX):
+        if not os.path.isfile(spec):
+            raise ArgumentError(f"policy {spec!r}: no such checkpoint file")
+        try:
+            from pointnav_core.training.policy import CheckpointPolicy
+        except ImportError:
+            raise ArgumentError(f"policy {spec!r}: a checkpoint needs torch (pip install 'pointnav-core[vector]')") from None
+        return CheckpointPolicy(spec)
+    if spec.endswith(".zip"):
+        if not os.path.isfile(spec):
+            raise ArgumentError(f"policy {spec!r}: no such SB3 .zip file")
+        if trust_policy_file is not True:
+            raise ArgumentError(
+                f"policy {spec!r}: an SB3 .zip holds pickled Python objects that can run any "
+                "code when loaded; load only a file you trust, with --trust-policy-file "
+                "(trust_policy_file=True)"
+            )
+        return _SB3Policy(spec, sb3_algo)
+    module_name, sep, attr = spec.partition(":")
+    if not sep or not module_name or not attr:
+        raise ArgumentError(f"unknown policy {spec!r}: expected {POLICY_FORMS}")
+    try:
+        target: Any = importlib.import_module(module_name)
+    except ImportError as err:
+        raise ArgumentError(f"policy {spec!r}: cannot import module {module_name!r} ({err})") from None
+    for part in attr.split("."):
+        if not hasattr(target, part):
+            raise ArgumentError(f"policy {spec!r}: module {module_name!r} has no attribute {attr!r}")
+        target = getattr(target, part)
+    if not callable(target):
+        raise ArgumentError(f"policy {spec!r}: {attr!r} is not callable")
+    return target
+
+
+# ---------------------------------------------------------------------- playing
+class _Runner:
+    """Plays episodes in one process, keeping one env per (scene, floor, robot, tolerance)."""
+
+    def __init__(
+        self,
+        policy: str | PolicyFactory,
+        backend: str,
+        max_steps: int,
+        drive: str,
+        scenes_root: str | None,
+        sb3_algo: str,
+        trust_policy_file: bool = False,
+        env_config: EnvConfig | None = None,
+    ) -> None:
+        self.factory = (
+            make_policy(policy, sb3_algo, trust_policy_file) if isinstance(policy, str) else policy
+        )
+        self.backend, self.max_steps, self.drive = backend, max_steps, drive
+        self.scenes_root, self.envs = scenes_root, {}
+        self.env_config = env_config
+
+    def env_for(self, ep: PointNavEpisode) -> Any:
+        from pointnav_core.envs.pointnav import PointNavEnv
+
+        key = (ep.scene_id, ep.floor, ep.robot_radius, ep.goal_radius)
+        if key not in self.envs:
+            if len(self.envs) >= 4:  # a worker moves on from scene to scene
+                self.envs.pop(next(iter(self.envs))).close()
+            try:
+                scene = load_scene(ep.scene_id, self.scenes_root)
+            except (ValueError, FileNotFoundError) as err:
+                raise ArgumentError(f"episode {ep.episode_id!r}: field 'scene_id': {err}") from None
+            if ep.floor >= scene.n_floors:
+                raise ArgumentError(
+                    f"episode {ep.episode_id!r}: field 'info.floor' is {ep.floor}, but scene "
+                    f"{ep.scene_id!r} has {scene.n_floors} floor(s)"
+                )
+            if self.env_config is not None:
+                self.envs[key] = PointNavEnv(scene=scene, config=episode_config(self.env_config, ep))
+                return self.envs[key]
+            task: dict[str, Any] = {
+                "floor": ep.floor,
+                "termination_config": {"max_steps": self.max_steps},
+            }
+            if ep.goal_radius is not None:
+                task["goal_tolerance"] = ep.goal_radius
+            flat = bool(getattr(self.factory, "flat", False))
+            self.envs[key] = PointNavEnv(
+                scene=scene,
+                robot={"radius": ep.robot_radius, "drive": self.drive},
+                task=task,
+                backend=self.backend,
+                flatten_obs=flat,
+            )
+        return self.envs[key]
+
+    def outcome(self, ep: PointNavEpisode) -> tuple[str, Any]:
+        """Play ``ep``: ``("ok", EpisodeResult)``, ``("input", message)`` for an episode that
+        does not suit its scene, or ``("error", message)`` for a policy that raised."""
+        step = 0
+        try:
+            try:
+                env = self.env_for(ep)
+                check = getattr(self.factory, "check_env", None)
+                if check is not None:  # a model that cannot read this env is bad input
+                    check(env)
+                obs, info = env.reset(seed=episode_seed(ep), options={"episode": ep})
+            except (ValueError, FileNotFoundError) as err:
+                return "input", str(err)
+            policy = self.factory(env)
+            done = False
+            while not done:
+                obs, _, terminated, truncated, info = env.step(policy(obs))
+                done = terminated or truncated
+                step += 1
+        except Exception as err:  # whatever the user's policy raises names its episode
+            return "error", (
+                f"episode {ep.episode_id!r} (scene {ep.scene_id!r}) failed at step {step}: "
+                f"{type(err).__name__}: {err}"
+            )
+        return "ok", self.result(ep, env, info)
+
+    def result(self, ep: PointNavEpisode, env: Any, info: dict[str, Any]) -> EpisodeResult:
+        """The record of ``ep``, played to its end in ``env`` (last step's ``info``)."""
+        ended = "+".join(name for name, r in info["termination_conditions"].items() if r["done"])
+        # The step infos read distances from the goal field's lookup table, whose cells settle
+        # as queries arrive, so a value can depend on what this worker played before (within
+        # the table's accuracy). The results use the exact distance at the end, which does not.
+        final = env.task.get_current_pos(env)
+        distance = env.scene.geodesic_distance(ep.floor, final, env.task.get_goal_pos(), robot=ep.robot_radius)
+        d0, length = float(info["geodesic_dist"]), float(info["path_length"])
+        return EpisodeResult(
+            episode_id=ep.episode_id,
+            scene_id=ep.scene_id,
+            floor=ep.floor,
+            geodesic_distance=ep.geodesic_distance,
+            success=bool(info["success"]),
+            spl=float(info["spl"]),
+            soft_spl=metrics.soft_spl(distance, d0, length),
+            distance_to_goal=float(distance),
+            path_length=float(info["path_length"]),
+            collisions=int(info["collisions"]),
+            steps=int(info["episode_length"]),
+            ended_by=ended,
+        )
+
+
+
+def _play(runner: _Runner, ep: PointNavEpisode) -> tuple[str, Any]:
+    """A worker's task (module level, so that ``spawn`` can find it)."""
+    return runner.outcome(ep)
+
+
+def check_scene_ids(episodes: Sequence[PointNavEpisode], scenes_root: str | None) -> None:
+    """Refuse an unknown, missing or escaping scene (a ValueError naming the first episode
+    that has it) without building any scene."""
+    seen: set[str] = set()
+    for ep in episodes:
+        if ep.scene_id not in seen:
+            seen.add(ep.scene_id)
+            try:
+                locate_scene(ep.scene_id, scenes_root)
+            except (ValueError, FileNotFoundError) as err:
+                raise ArgumentError(f"episode {ep.episode_id!r}: field 'scene_id': {err}") from None
+
+
+def select_episodes(
+    episodes: EpisodeDataset | Sequence[PointNavEpisode],
+    limit: int | None = None,
+    stride: int = 1,
+) -> list[PointNavEpisode]:
+    """Every ``stride``-th episode from the first, then the first ``limit`` of those (all
+    with None): ``list(episodes)[::stride][:limit]``.
+
+    Raises
+    ------
+    ValueError
+        For a ``limit`` or ``stride`` that is not an integer >= 1.
+    """
+    integer("stride", stride, minimum=1)
+    if limit is not None:
+        integer("limit", limit, minimum=1)
+    return list(episodes)[::stride][:limit]
+
+
+def evaluate(
+    episodes: EpisodeDataset | Sequence[PointNavEpisode],
+    policy: str | PolicyFactory = "oracle",
+    *,
+    backend: str = "kinematic",
+    workers: int = 1,
+    max_steps: int = DEFAULT_MAX_STEPS,
+    drive: str = "differential",
+    scenes_root: str | None = None,
+    sb3_algo: str = "PPO",
+    progress: bool = False,
+    trust_policy_file: bool = False,
+    on_error: str = "stop",
+    on_result: Callable[[EpisodeResult], None] | None = None,
+    on_failure: Callable[[PointNavEpisode, str], None] | None = None,
+    limit: int | None = None,
+    stride: int = 1,
+    env_config: EnvConfig | None = None,
+    isolate: bool = False,
+) -> list[EpisodeResult]:
+    """Play every episode once (or the subset ``limit`` and ``stride`` select); the
+    results in the episodes' order.
+
+    Parameters
+    ----------
+    episodes : EpisodeDataset or sequence of PointNavEpisode
+    policy : str or callable
+        ``"oracle"``, ``"MODULE:CALLABLE"``, a path to a checkpoint ``.pt`` or to an SB3
+        ``.zip``, or a factory ``env -> (observation -> action)`` (with ``workers > 1`` it
+        must be picklable); a factory with an ``env_config`` attribute (a checkpoint's)
+        plays in envs built from it when ``env_config`` is None.
+    backend : str
+        Registered backend name.
+    workers : int
+        Worker processes (1: play here); at most one per episode and per usable core.
+    max_steps : int
+        Step limit per episode.
+    drive : str
+        ``"differential"`` or ``"holonomic"``.
+    scenes_root : str, optional
+        Folder relative scene paths in ``scene_id`` are read from; a scene path must then
+        stay under it (:func:`~pointnav_core.datasets.scene_sets.locate_scene`).
+    sb3_algo : str
+        Stable-Baselines3 algorithm class of a ``.zip`` policy.
+    progress : bool
+        Show a progress bar.
+    trust_policy_file : bool
+        Allow an SB3 ``.zip`` policy (see the module notes).
+    on_error : {"stop", "skip"}
+        When the policy raises in an episode: raise :class:`~pointnav_core.errors.EpisodeError`
+        at once, or leave the episode out and go on.
+    on_result : callable, optional
+        Called with each result as its episode ends (in the order they end), so that a
+        caller can keep it whatever happens to the run later.
+    on_failure : callable, optional
+        With ``on_error="skip"``: called with each failed episode and the message naming
+        it (by default a ``RuntimeWarning``).
+    limit, stride : int, optional
+        Play only :func:`select_episodes` ``(episodes, limit, stride)``: every
+        ``stride``-th episode, then the first ``limit`` of those.
+    env_config : EnvConfig, optional
+        Build every episode's env from this config (sensors, actions, robot, backend, task
+        settings, ``max_steps``; :mod:`pointnav_core.envs.config`), with the episode's scene,
+        floor, start, goal and goal radius; ``backend``, ``max_steps`` and ``drive`` must
+        then keep their defaults, and every episode's robot radius must be the config's.
+    isolate : bool
+        Play in worker processes even with one worker, so that a signal handler that
+        raises in this process never lands inside the policy's or the compiler's code
+        (``pointnav eval`` does: see :mod:`pointnav_core.cli.datasets`).
+
+    Raises
+    ------
+    ValueError
+        For a bad argument, or an episode that does not suit its scene or robot (naming the
+        episode and the field); scene ids are checked before any episode is played.
+    EpisodeError
+        With ``on_error="stop"``, for the first episode whose policy raised, or a worker
+        process that died; its message names the episode.
+    KeyboardInterrupt
+        Passed on, after every worker process has ended.
+    """
+    episodes = select_episodes(episodes, limit, stride)
+    for name, value in (("workers", workers), ("max_steps", max_steps)):
+        if isinstance(value, bool) or not isinstance(value, int) or value < 1:
+            raise ArgumentError(f"{name} must be an integer >= 1, got {value!r}")
+    if on_error not in ON_ERROR:
+        raise ArgumentError(f"on_error must be one of {list(ON_ERROR)}, got {on_error!r}")
+    factory = make_policy(policy, sb3_algo, trust_policy_file) if isinstance(policy, str) else policy
+    if env_config is None:  # a checkpoint carries the config it was trained with
+        env_config = getattr(factory, "env_config", None)
+    if env_config is not None:
+        check_beside_config(env_config, backend=backend, max_steps=max_steps, drive=drive)
+        check_robot_radius(env_config, episodes)
+    check_scene_ids(episodes, scenes_root)
+    args = (policy, backend, max_steps, drive, scenes_root, sb3_algo, trust_policy_file, env_config)
+    results: list[EpisodeResult | None] = [None] * len(episodes)
+    from tqdm import tqdm
+
+    bar = tqdm(total=len(episodes), disable=not progress, desc="episodes", unit="ep")
+
+    def record(i: int, kind: str, payload: Any) -> None:
+        if kind == "input":
+            raise ArgumentError(payload)
+        if kind == "error":
+            if on_error == "stop":
+                raise EpisodeError(payload)
+            (on_failure or (lambda _ep, msg: warnings.warn(msg, RuntimeWarning, stacklevel=4)))(episodes[i], payload)
+        else:
+            results[i] = payload
+            if on_result is not None:
+                on_result(payload)
+        bar.update(1)
+
+    try:
+        n_workers = min(workers, len(episodes), usable_cores())
+        if n_workers <= 1 and not isolate:
+            runner = _Runner(*args)
+            for i, ep in enumerate(episodes):
+                record(i, *runner.outcome(ep))
+        elif episodes:
+            with WorkerPool(n_workers, _Runner, args, _play) as pool:
+                try:
+                    for i, (kind, payload) in pool.imap_unordered(enumerate(episodes)):
+                        record(i, kind, payload)  # type: ignore[arg-type]
+                except WorkerError as err:
+                    if err.key is None:
+                        raise EpisodeError(str(err)) from None
+                    ep = episodes[err.key]  # type: ignore[index]
+                    raise EpisodeError(
+                        f"episode {ep.episode_id!r} (scene {ep.scene_id!r}): {err.cause}"
+                    ) from None
+    finally:
+        bar.close()
+    return [r for r in results if r is not None]

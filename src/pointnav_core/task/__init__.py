@@ -1,0 +1,44 @@
+"""The point-goal navigation task: OmniGibson's ``PointNavigationTask`` as a state machine,
+with its lifecycle, configuration, terms (rewards, terminations, observations), metrics,
+episode sampling, markers and discrete actions.
+"""
+
+from pointnav_core.task.config import REWARD_TYPES, TaskConfig
+from pointnav_core.task.lifecycle import TaskState, TaskStateError
+from pointnav_core.task.metrics import soft_spl, spl
+from pointnav_core.task.observations import ObservationTerm
+from pointnav_core.task.rewards import (
+    CollisionReward,
+    PointGoalReward,
+    PotentialReward,
+    RewardFunction,
+)
+from pointnav_core.task.task import PointNavigationTask, TaskEnv
+from pointnav_core.task.terminations import (
+    Falling,
+    MaxCollision,
+    PointGoal,
+    TerminationCondition,
+    Timeout,
+)
+
+__all__ = [
+    "REWARD_TYPES",
+    "CollisionReward",
+    "Falling",
+    "MaxCollision",
+    "ObservationTerm",
+    "PointGoal",
+    "PointGoalReward",
+    "PointNavigationTask",
+    "PotentialReward",
+    "RewardFunction",
+    "TaskConfig",
+    "TaskEnv",
+    "TaskState",
+    "TaskStateError",
+    "TerminationCondition",
+    "Timeout",
+    "soft_spl",
+    "spl",
+]
