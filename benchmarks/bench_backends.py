@@ -33,7 +33,8 @@ from typing import Any
 
 import numpy as np
 
-from pointnav_core.backends.protocol import RobotSpec, available_backends, make_backend
+from pointnav_core.backends.protocol import available_backends, make_backend
+from pointnav_core.backends.robot_spec import RobotSpec
 from pointnav_core.envs.pointnav import PointNavEnv
 from pointnav_core.scenes import Scene, rooms
 

@@ -4,7 +4,7 @@
 Both ids are built exactly as users get them (``gymnasium.make`` and ``pettingzoo.make``
 with no arguments), so the episodes come from the default ``path_range`` the envs derive
 from the robot's reach (``_envcommon.fit_path_range``). The privileged shortest-path
-follower (:class:`pointnav_core.evaluation.policies.ShortestPathFollower`) drives ``--episodes``
+follower (:class:`pointnav_core.policies.oracle.ShortestPathFollower`) drives ``--episodes``
 robot-episodes of each; the target is a success rate of at least 99 %. To show why the
 range is what it is, each episode's *time ratio* is printed by geodesic band: the steps it
 took times the robot's full-speed step length (``max_linear_velocity / action_frequency``)
@@ -30,7 +30,7 @@ import numpy as np
 import pettingzoo
 
 import pointnav_core  # noqa: F401  (registers the ids)
-from pointnav_core.evaluation.policies import ShortestPathFollower
+from pointnav_core.policies.oracle import ShortestPathFollower
 
 BANDS = (0.0, 2.5, 5.0, 10.0, 15.0, np.inf)
 TARGET = 0.99

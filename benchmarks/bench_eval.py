@@ -4,7 +4,7 @@
 given), then played twice through :func:`pointnav_core.evaluation.run.evaluate` with one
 worker, the same code as ``pointnav eval --workers 1``:
 
-1. by the oracle (:class:`~pointnav_core.evaluation.policies.ShortestPathFollower`), whose actions are
+1. by the oracle (:class:`~pointnav_core.policies.oracle.ShortestPathFollower`), whose actions are
    recorded;
 2. by a policy that replays those actions: the same env builds, resets, steps and final
    distances, with no planning.
@@ -30,8 +30,9 @@ from typing import Any
 
 from pointnav_core.datasets.generator import generate_split
 from pointnav_core.datasets.scene_sets import scene_set
-from pointnav_core.evaluation.policies import ShortestPathFollower
-from pointnav_core.evaluation.run import evaluate, summarize
+from pointnav_core.evaluation.report import summarize
+from pointnav_core.evaluation.run import evaluate
+from pointnav_core.policies.oracle import ShortestPathFollower
 
 
 def _play(episodes: list[Any], recorded: list[list[Any]] | None) -> tuple[float, list[Any], list[list[Any]]]:

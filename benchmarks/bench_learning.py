@@ -11,7 +11,7 @@ at random from its own share of ``--train-houses`` generated ``rooms`` houses (s
 1, ...; :class:`HousePool`). Each policy is then evaluated deterministically on
 ``--eval-episodes`` episodes over ``--eval-houses`` held-out houses (seeds 1000, 1001, ...)
 that it never saw, with the shortest-path oracle
-(:class:`~pointnav_core.evaluation.policies.ShortestPathFollower`, continuous actions) driving the very
+(:class:`~pointnav_core.policies.oracle.ShortestPathFollower`, continuous actions) driving the very
 same episodes (same start, heading and goal) beside it. Printed: success, SPL and SoftSPL
 on the held-out houses, the training throughput (env steps per second of wall time, PPO
 updates and curve evaluations included), the wall time, and the learning curve (held-out
@@ -127,7 +127,7 @@ def evaluate(policy: Any, norm: Any, envs: Sequence[Any], episodes: int, seed: i
     With ``oracle_envs`` (continuous twins of ``envs``), the oracle plays instead, and each
     episode is checked to start where the policy's did (same goal vector at reset).
     """
-    from pointnav_core.evaluation.policies import ShortestPathFollower
+    from pointnav_core.policies.oracle import ShortestPathFollower
 
     results = []
     for k in range(episodes):

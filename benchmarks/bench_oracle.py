@@ -1,6 +1,6 @@
 """Oracle quality on every installed backend: success, SPL, SoftSPL, collisions, speed.
 
-The privileged shortest-path follower (:class:`pointnav_core.evaluation.policies.ShortestPathFollower`)
+The privileged shortest-path follower (:class:`pointnav_core.policies.oracle.ShortestPathFollower`)
 drives ``--episodes`` episodes over ``--houses`` generated ``rooms`` houses through
 :func:`pointnav_core.cli.run_demo`, the same code as ``pointnav demo``, once per backend.
 Start and goal come from the core's sampler, so every backend gets the same episodes (one

@@ -1,6 +1,6 @@
 """Oracle quality on real grid maps: the MovingAI ``den312d`` and ``maze-128-128-1`` maps.
 
-The privileged shortest-path follower (:class:`pointnav_core.evaluation.policies.ShortestPathFollower`)
+The privileged shortest-path follower (:class:`pointnav_core.policies.oracle.ShortestPathFollower`)
 drives ``--episodes`` episodes per map and per backend (kinematic and pymunk by default),
 the way :func:`pointnav_core.cli.run_demo` drives generated houses. Each map becomes a
 scene through ``Scene.from_movingai`` (``--resolution`` metres per character, default 0.5,
@@ -39,7 +39,7 @@ from benchkit import MOVINGAI_DIR, machine, movingai_maps
 
 from pointnav_core.backends.protocol import available_backends
 from pointnav_core.envs.pointnav import PointNavEnv
-from pointnav_core.evaluation.policies import ShortestPathFollower
+from pointnav_core.policies.oracle import ShortestPathFollower
 from pointnav_core.scenes import Scene
 
 #: The maps, as named in the MovingAI benchmark sets.

@@ -103,7 +103,7 @@ def time_frames(draw: Callable[[], np.ndarray], frames: int) -> tuple[float, flo
 def env_render_times(seed: int, frames: int, pixels_per_meter: float) -> tuple[float, float]:
     """Median and 90th percentile of ``env.render()`` (ms), one frame per oracle step."""
     from pointnav_core.envs.pointnav import PointNavEnv
-    from pointnav_core.evaluation.policies import ShortestPathFollower
+    from pointnav_core.policies.oracle import ShortestPathFollower
     from pointnav_core.scenes import rooms
 
     env = PointNavEnv(

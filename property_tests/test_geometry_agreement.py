@@ -24,8 +24,8 @@ from hypothesis import strategies as st
 from pointnav_core.backends.protocol import available_backends
 from pointnav_core.envs.pointnav import PointNavEnv
 from pointnav_core.errors import SamplingError
-from pointnav_core.evaluation.policies import ShortestPathFollower
 from pointnav_core.floor.maps import VOID
+from pointnav_core.policies.oracle import ShortestPathFollower
 from pointnav_core.testing.strategies import nav_scenes
 from pointnav_core.transforms import quat2yaw
 

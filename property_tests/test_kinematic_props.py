@@ -20,7 +20,7 @@ from hypothesis.stateful import RuleBasedStateMachine, initialize, invariant, ru
 from pointnav_kinematic import KinematicBackend
 from shapely import affinity
 
-from pointnav_core.backends.protocol import RobotSpec
+from pointnav_core.backends.robot_spec import RobotSpec
 from pointnav_core.floor.maps import FREE, OBSTACLE, VOID, TraversableMap
 from pointnav_core.scenes import Scene
 from pointnav_core.testing.conformance import obstacle_distance

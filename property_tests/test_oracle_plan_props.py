@@ -17,7 +17,7 @@ from hypothesis import strategies as st
 
 from pointnav_core import scenes
 from pointnav_core.envs.pointnav import PointNavEnv
-from pointnav_core.evaluation.policies import ShortestPathFollower
+from pointnav_core.policies.oracle import ShortestPathFollower
 
 
 def _checked(follower: ShortestPathFollower, tmap: Any, seen: list[int]) -> None:

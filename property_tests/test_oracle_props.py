@@ -13,7 +13,7 @@ import numpy as np
 from hypothesis import given
 from hypothesis import strategies as st
 
-from pointnav_core.evaluation.policies import _float32_move
+from pointnav_core.policies.oracle import _float32_move
 
 angles = st.one_of(
     st.floats(-math.pi, math.pi),

@@ -14,7 +14,7 @@ def raise_on_episode(env):
     """The oracle, except that it raises on the first step of the episode whose start and
     goal ``x, y`` are ``POINTNAV_TEST_RAISE`` (an environment variable, so that worker
     processes see it too: ``"sx,sy,gx,gy"``)."""
-    from pointnav_core.evaluation.policies import ShortestPathFollower
+    from pointnav_core.policies.oracle import ShortestPathFollower
 
     target = os.environ.get("POINTNAV_TEST_RAISE")
     here = [*env.task.get_current_pos(env)[:2], *env.task.get_goal_pos()[:2]]

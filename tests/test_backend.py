@@ -12,13 +12,13 @@ from pointnav_kinematic import KinematicBackend
 
 from pointnav_core.backends.protocol import (
     Backend,
-    RobotSpec,
     UnknownBackendError,
     available_backends,
     check_backend,
     get_backend,
     make_backend,
 )
+from pointnav_core.backends.robot_spec import RobotSpec
 from pointnav_core.errors import BackendError, PointNavError
 
 PROTOCOL_MEMBERS = {

@@ -18,7 +18,8 @@ from pointnav_core.backends.kit import (
     check_load,
     drive_arc,
 )
-from pointnav_core.backends.protocol import RobotSpec, check_backend, float_twin
+from pointnav_core.backends.protocol import check_backend, float_twin
+from pointnav_core.backends.robot_spec import RobotSpec
 from pointnav_core.scenes import Scene
 from pointnav_core.testing.conformance import run_checks
 

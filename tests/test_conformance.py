@@ -14,7 +14,6 @@ from pointnav_kinematic import KinematicBackend
 
 from pointnav_core.backends.protocol import (
     FLOAT_TWINS,
-    RobotSpec,
     UnknownBackendError,
     available_backends,
     check_backend,
@@ -22,6 +21,7 @@ from pointnav_core.backends.protocol import (
     get_backend,
     make_backend,
 )
+from pointnav_core.backends.robot_spec import RobotSpec
 from pointnav_core.errors import BackendError
 from pointnav_core.floor.maps import FREE, OBSTACLE, VOID, TraversableMap
 from pointnav_core.testing import strategies

@@ -12,7 +12,8 @@ import pytest
 from gymnasium.utils.env_checker import check_env
 from gymnasium.wrappers import FlattenObservation
 
-from pointnav_core.backends.protocol import RobotSpec, available_backends
+from pointnav_core.backends.protocol import available_backends
+from pointnav_core.backends.robot_spec import RobotSpec
 from pointnav_core.envs.pointnav import PointNavEnv
 from pointnav_core.envs.registration import ENV_IDS, register_envs
 from pointnav_core.floor.maps import FREE, OBSTACLE

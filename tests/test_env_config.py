@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 
 from pointnav_core import scenes
-from pointnav_core.backends.protocol import RobotSpec
+from pointnav_core.backends.robot_spec import RobotSpec
 from pointnav_core.datasets import PointNavEpisode
 from pointnav_core.envs.config import EnvConfig
 from pointnav_core.envs.multi_pointnav import parallel_env

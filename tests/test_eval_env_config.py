@@ -11,7 +11,8 @@ from pointnav_core.cli import main
 from pointnav_core.datasets import EpisodeDataset
 from pointnav_core.envs.config import EnvConfig
 from pointnav_core.envs.pointnav import PointNavEnv
-from pointnav_core.evaluation.run import evaluate, read_results, read_run
+from pointnav_core.evaluation.report import read_results, read_run
+from pointnav_core.evaluation.run import evaluate
 
 SCAN = EnvConfig(
     sensors={"scan": {"n_rays": 16}}, action_space="discrete", discrete_actions={"stop": False},

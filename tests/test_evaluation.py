@@ -17,16 +17,14 @@ from PIL import Image
 import pointnav_core
 from pointnav_core.cli import main
 from pointnav_core.datasets import EpisodeDataset
-from pointnav_core.evaluation.run import (
+from pointnav_core.evaluation.report import (
     bootstrap_interval,
-    evaluate,
-    make_policy,
     read_results,
     read_run,
-    select_episodes,
     summarize,
     write_results,
 )
+from pointnav_core.evaluation.run import evaluate, make_policy, select_episodes
 
 # 9 x 7 m at 0.5 m per character: two rooms joined by a door, and a pillar.
 MAP = """type octile

@@ -28,7 +28,7 @@ with warnings.catch_warnings():
     )
 
 from pointnav_core.envs.multi_pointnav import parallel_env  # noqa: E402
-from pointnav_core.task.lifecycle import TaskStateError  # noqa: E402
+from pointnav_core.errors import TaskStateError
 
 
 def test_frame_stacking_and_action_clipping_pass_the_parallel_api_test():

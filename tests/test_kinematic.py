@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 from pointnav_kinematic import KinematicBackend
 
-from pointnav_core.backends.protocol import RobotSpec
+from pointnav_core.backends.robot_spec import RobotSpec
 from pointnav_core.floor.maps import FREE, OBSTACLE, VOID, TraversableMap
 from pointnav_core.testing.conformance import obstacle_distance
 

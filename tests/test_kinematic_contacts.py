@@ -16,7 +16,7 @@ from pointnav_kinematic import KinematicBackend
 from shapely import affinity
 from shapely.geometry import Point
 
-from pointnav_core.backends.protocol import RobotSpec
+from pointnav_core.backends.robot_spec import RobotSpec
 from pointnav_core.floor.maps import FREE, OBSTACLE
 from pointnav_core.scenes import Scene
 

@@ -5,11 +5,11 @@ from pathlib import Path
 
 import pytest
 
+from pointnav_core.errors import TaskStateError
 from pointnav_core.task.lifecycle import (
     TRANSITIONS,
     Event,
     TaskState,
-    TaskStateError,
     allows,
     diagram,
     move,

@@ -16,7 +16,7 @@ from hypothesis import given
 from hypothesis import strategies as st
 
 import pointnav_core.task.markers as markers_module
-from pointnav_core.backends.protocol import RobotSpec
+from pointnav_core.backends.robot_spec import RobotSpec
 from pointnav_core.envs.pointnav import PointNavEnv
 from pointnav_core.floor.maps import FREE, OBSTACLE
 from pointnav_core.scenes import Scene

@@ -14,7 +14,7 @@ from pointnav_core import scenes
 from pointnav_core.backends.protocol import available_backends
 from pointnav_core.cli import run_demo
 from pointnav_core.envs.pointnav import PointNavEnv
-from pointnav_core.evaluation.policies import ShortestPathFollower
+from pointnav_core.policies.oracle import ShortestPathFollower
 from pointnav_core.scenes import Scene
 
 BACKENDS = available_backends()

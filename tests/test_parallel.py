@@ -14,7 +14,8 @@ from pettingzoo.utils.conversions import parallel_to_aec
 
 import pointnav_core  # noqa: F401  (registers the PettingZoo ids)
 from pointnav_core import scenes
-from pointnav_core.backends.protocol import RobotSpec, available_backends
+from pointnav_core.backends.protocol import available_backends
+from pointnav_core.backends.robot_spec import RobotSpec
 from pointnav_core.envs import multi_pointnav as parallel
 from pointnav_core.envs.multi_pointnav import MultiPointNavEnv
 from pointnav_core.envs.registration import AEC_ENV_IDS, PARALLEL_ENV_IDS, register_envs

@@ -24,7 +24,8 @@ from pointnav_pymunk.geometry import convex_pieces, floor_pieces, merge_cells
 from shapely.geometry import Point, Polygon, box
 
 from pointnav_core import floorplans, scenes
-from pointnav_core.backends.protocol import RobotSpec, get_backend, make_backend
+from pointnav_core.backends.protocol import get_backend, make_backend
+from pointnav_core.backends.robot_spec import RobotSpec
 from pointnav_core.floor.maps import OBSTACLE, VOID, TraversableMap
 from pointnav_core.scenes import Scene
 from pointnav_core.testing import strategies

@@ -19,7 +19,7 @@ from hypothesis import strategies as st
 from pointnav_pymunk import TOUCH_TOLERANCE, PymunkBackend
 from shapely.geometry import Point, box
 
-from pointnav_core.backends.protocol import RobotSpec
+from pointnav_core.backends.robot_spec import RobotSpec
 from pointnav_core.floor.maps import FREE, OBSTACLE, VOID, TraversableMap
 from pointnav_core.scenes import Scene
 

@@ -12,7 +12,8 @@ from test_floorplan_files import two_room_house
 
 from pointnav_core.cli import main
 from pointnav_core.datasets import EpisodeDataset, scene_set
-from pointnav_core.evaluation.run import evaluate, summarize
+from pointnav_core.evaluation.report import summarize
+from pointnav_core.evaluation.run import evaluate
 
 DATA = Path(__file__).parent / "data"
 FOREST = "type octile\nheight 12\nwidth 16\nmap\n" + "\n".join(

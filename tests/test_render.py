@@ -14,10 +14,11 @@ import numpy as np
 import pytest
 from PIL import Image
 
-from pointnav_core.backends.protocol import RobotSpec, make_backend
+from pointnav_core.backends.protocol import make_backend
+from pointnav_core.backends.robot_spec import RobotSpec
 from pointnav_core.envs.pointnav import PointNavEnv
-from pointnav_core.evaluation.policies import ShortestPathFollower
 from pointnav_core.floor.maps import FREE, OBSTACLE, VOID, TraversableMap
+from pointnav_core.policies.oracle import ShortestPathFollower
 from pointnav_core.render.recording import (
     record_episode,
     render_env,

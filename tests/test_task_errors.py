@@ -7,7 +7,8 @@ import math
 import numpy as np
 import pytest
 
-from pointnav_core.backends.protocol import RobotSpec, UnknownBackendError
+from pointnav_core.backends.protocol import UnknownBackendError
+from pointnav_core.backends.robot_spec import RobotSpec
 from pointnav_core.envs.pointnav import PointNavEnv
 from pointnav_core.errors import PointNavError, SamplingError
 from pointnav_core.floor.maps import FREE, OBSTACLE

@@ -20,7 +20,8 @@ import numpy as np
 import pytest
 
 from pointnav_core import scenes
-from pointnav_core.backends.protocol import RobotSpec, available_backends, get_backend
+from pointnav_core.backends.protocol import available_backends, get_backend
+from pointnav_core.backends.robot_spec import RobotSpec
 from pointnav_core.envs.pointnav import PointNavEnv
 from pointnav_core.floor.maps import FREE, OBSTACLE, VOID
 from pointnav_core.scenes import Scene

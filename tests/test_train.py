@@ -22,9 +22,10 @@ from map_data import PILLAR_ROOM
 
 from pointnav_core.cli import main
 from pointnav_core.envs.config import EnvConfig
-from pointnav_core.evaluation.run import evaluate, make_policy, read_results
-from pointnav_core.training.agent import ActorCritic, RunningNorm
-from pointnav_core.training.checkpoint import load_checkpoint, save_checkpoint
+from pointnav_core.evaluation.report import read_results
+from pointnav_core.evaluation.run import evaluate, make_policy
+from pointnav_core.policies.checkpoint import load_checkpoint, save_checkpoint
+from pointnav_core.policies.network import ActorCritic, RunningNorm
 
 SCAN = EnvConfig(sensors={"scan": {"n_rays": 8}}, action_space="discrete", discrete_actions={"stop": False},
                  task={"goal_in_polar": True, "reward_type": "geodesic"}, max_steps=30)
@@ -170,7 +171,7 @@ def _same_as_trainer(run, results_file) -> None:
 
 
 def test_train_then_eval_with_no_other_argument_scan_discrete(scan_run, room, monkeypatch, capsys) -> None:
-    from pointnav_core.evaluation.run import read_run
+    from pointnav_core.evaluation.report import read_run
     from pointnav_core.training.curve import read_curve
 
     rows = read_curve(scan_run / "curve.csv")

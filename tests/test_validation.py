@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 from pointnav_core import scenes
-from pointnav_core.backends.protocol import RobotSpec
+from pointnav_core.backends.robot_spec import RobotSpec
 from pointnav_core.envs.multi_pointnav import MultiPointNavEnv
 from pointnav_core.envs.pointnav import PointNavEnv
 from pointnav_core.floor.maps import FREE, OBSTACLE

@@ -17,7 +17,7 @@ from pointnav_core.backends.kit import (
     check_load,
     drive_arc,
 )
-from pointnav_core.backends.protocol import RobotSpec
+from pointnav_core.backends.robot_spec import RobotSpec
 from pointnav_core.errors import ArgumentError
 from pointnav_core.floor.maps import VOID
 from pointnav_pymunk.floor import (

@@ -52,9 +52,6 @@ Writing a backend
 :mod:`pointnav_core.backends.kit` is the author's kit: :class:`RobotStateBackend` (a base
 class that implements every method but ``load`` and ``step``, the twins included), the
 robot state, the exact drive motion, the floor grid and the argument checks, with a guide.
-The kit's names that used to live here (``RobotStateBackend``, ``check_index``,
-``check_load``, ``parse_position``, ``parse_orientation``, ``planar_quat``) can still be
-imported from this module.
 """
 
 from __future__ import annotations
@@ -68,28 +65,20 @@ from typing import TYPE_CHECKING, Any, Protocol, runtime_checkable
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from pointnav_core.backends.robot_spec import DRIVES, RobotSpec
+from pointnav_core.backends.robot_spec import RobotSpec
 from pointnav_core.errors import ArgumentError, BackendError
 
 __all__ = [
-    "DRIVES",
     "ENTRY_POINT_GROUP",
     "FLOAT_TWINS",
     "Backend",
     "FloatTwinBackend",
-    "RobotSpec",
-    "RobotStateBackend",
     "UnknownBackendError",
     "available_backends",
     "check_backend",
-    "check_index",
-    "check_load",
     "float_twin",
     "get_backend",
     "make_backend",
-    "parse_orientation",
-    "parse_position",
-    "planar_quat",
 ]
 
 #: Entry-point group under which backends register ``name = "module:Class"``.
@@ -436,14 +425,7 @@ _KIT_NAMES = frozenset(
 )
 
 if TYPE_CHECKING:
-    from pointnav_core.backends.kit import (
-        RobotStateBackend,
-        check_index,
-        check_load,
-        parse_orientation,
-        parse_position,
-        planar_quat,
-    )
+    pass
 
 
 def __getattr__(name: str) -> Any:

@@ -173,14 +173,13 @@ def _print_summary(args: argparse.Namespace, summary: dict[str, Any], of: int) -
 def _eval(args: argparse.Namespace) -> int:
     from pointnav_core.datasets import EpisodeDataset
     from pointnav_core.errors import PointNavError
+    from pointnav_core.evaluation.config import check_robot_radius
     from pointnav_core.evaluation.log import ResultsLog
-    from pointnav_core.evaluation.report import summary_path
+    from pointnav_core.evaluation.report import plot_results, summary_path
     from pointnav_core.evaluation.run import (
-        check_robot_radius,
         check_scene_ids,
         evaluate,
         make_policy,
-        plot_results,
         select_episodes,
     )
     from pointnav_core.utils.outputs import check_output

@@ -1,7 +1,7 @@
 """The ``pointnav`` command line.
 
 ``pointnav demo`` is the main job: it builds a generated house, drives the oracle
-(:class:`~pointnav_core.evaluation.policies.ShortestPathFollower`) to sampled goals on the default
+(:class:`~pointnav_core.policies.oracle.ShortestPathFollower`) to sampled goals on the default
 kinematic backend, and prints success, SPL, SoftSPL, path length, collisions and speed.
 
 ``pointnav demo --scene FILE`` drives on a scene file instead: a ROS map ``.yaml``, a ProcTHOR
@@ -28,7 +28,7 @@ from tqdm import tqdm
 from pointnav_core import scenes
 from pointnav_core.envs.pointnav import PointNavEnv
 from pointnav_core.errors import ArgumentError
-from pointnav_core.evaluation.policies import ShortestPathFollower
+from pointnav_core.policies.oracle import ShortestPathFollower
 
 __all__ = ["main", "run_demo"]
 

@@ -23,7 +23,7 @@ import numpy as np
 from gymnasium import spaces
 
 from pointnav_core import scenes
-from pointnav_core.backends.protocol import RobotSpec
+from pointnav_core.backends.robot_spec import RobotSpec
 from pointnav_core.errors import ArgumentError
 from pointnav_core.task import PointNavigationTask
 from pointnav_core.utils import validation

@@ -184,7 +184,8 @@ from pettingzoo import AECEnv, ParallelEnv
 from pettingzoo.utils.conversions import parallel_to_aec, parallel_to_aec_wrapper
 
 from pointnav_core import scenes
-from pointnav_core.backends.protocol import Backend, RobotSpec, make_backend
+from pointnav_core.backends.protocol import Backend, make_backend
+from pointnav_core.backends.robot_spec import RobotSpec
 from pointnav_core.envs import common as _envcommon
 from pointnav_core.envs._multi_actions import (
     check_actions,

@@ -10,7 +10,8 @@ import numpy as np
 from numpy.typing import NDArray
 
 from pointnav_core import scenes
-from pointnav_core.backends.protocol import Backend, RobotSpec, make_backend
+from pointnav_core.backends.protocol import Backend, make_backend
+from pointnav_core.backends.robot_spec import RobotSpec
 from pointnav_core.envs import common as _envcommon
 from pointnav_core.envs.config import EnvConfig, takes_config
 from pointnav_core.errors import ArgumentError

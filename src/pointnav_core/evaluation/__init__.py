@@ -1,9 +1,7 @@
 """Evaluating a policy on an episode dataset: the run (workers, resumable log), the env it
-plays from a saved config, per-episode results and their summary, and the reference policy
-(the privileged shortest-path follower).
+plays from a saved config, per-episode results and their summary.
 """
 
-from pointnav_core.evaluation.policies import ShortestPathFollower
 from pointnav_core.evaluation.report import (
     EpisodeResult,
     read_results,
@@ -14,7 +12,6 @@ from pointnav_core.evaluation.run import evaluate, make_policy
 
 __all__ = [
     "EpisodeResult",
-    "ShortestPathFollower",
     "evaluate",
     "make_policy",
     "read_results",

@@ -4,8 +4,8 @@
 env built from the :class:`~pointnav_core.envs.config.EnvConfig` a policy was trained with;
 the dataset still gives each episode's scene, floor, start, goal, goal radius and robot
 radius. A dataset made for another robot radius is refused (:func:`check_robot_radius`),
-as is a model whose spaces do not fit the env (:func:`check_spaces`), each naming what to
-change.
+as is a model whose spaces do not fit the env
+(:func:`pointnav_core.policies.spaces.check_spaces`), each naming what to change.
 """
 
 from __future__ import annotations
@@ -18,7 +18,7 @@ from pointnav_core.datasets.format import PointNavEpisode
 from pointnav_core.envs.config import EnvConfig
 from pointnav_core.errors import ArgumentError
 
-__all__ = ["RADIUS_TOLERANCE", "check_beside_config", "check_robot_radius", "check_spaces", "episode_config"]
+__all__ = ["RADIUS_TOLERANCE", "check_beside_config", "check_robot_radius", "episode_config"]
 
 def episode_config(config: EnvConfig, ep: PointNavEpisode) -> EnvConfig:
     """``config`` for playing ``ep``: the episode's floor and goal radius (when it records
@@ -45,34 +45,6 @@ def check_robot_radius(config: EnvConfig, episodes: Sequence[PointNavEpisode]) -
                 f"{ep.episode_id!r} (scene {ep.scene_id!r}) was made for a robot of radius "
                 f"{ep.robot_radius:g} m: evaluate on a dataset made for this robot "
                 f"(pointnav dataset generate --robot-radius {config.robot.radius:g})"
-            )
-
-
-def _shape_of(space: Any) -> Any:
-    """What must match between a model's space and an env's: a Box's shape, a Discrete's
-    ``n``, a Dict's keys and their shapes."""
-    from gymnasium import spaces
-
-    if isinstance(space, spaces.Dict):
-        return {key: _shape_of(sub) for key, sub in space.spaces.items()}
-    if isinstance(space, spaces.Discrete):
-        return f"Discrete({int(space.n)})"
-    return tuple(getattr(space, "shape", ()) or ())
-
-
-def check_spaces(name: str, model: Any, env: Any, advice: str | None = None) -> None:
-    """ValueError unless the observation and action spaces of ``model`` (anything with
-    ``observation_space`` and ``action_space``) have the shapes of ``env``'s; the message
-    names the env config to pass (``--env-config``, ``evaluate(env_config=...)``), or
-    says ``advice`` instead."""
-    for what in ("observation", "action"):
-        want = _shape_of(getattr(model, f"{what}_space"))
-        got = _shape_of(getattr(env, f"{what}_space"))
-        if want != got:
-            raise ArgumentError(
-                f"{name} takes {what}s of shape {want}, but the env built for it gives {got}: "
-                + (advice or "pass the env config the policy was trained with (pointnav eval "
-                   "--env-config FILE, evaluate(env_config=...); pointnav_core.envs.config.EnvConfig)")
             )
 
 

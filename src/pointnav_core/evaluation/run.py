@@ -11,13 +11,13 @@ the floor it records, for at most ``max_steps`` steps.
 
 Policies (``policy`` argument, or ``pointnav eval --policy``):
 
-- ``"oracle"``: :class:`~pointnav_core.evaluation.policies.ShortestPathFollower`;
+- ``"oracle"``: :class:`~pointnav_core.policies.oracle.ShortestPathFollower`;
 - ``"MODULE:CALLABLE"``: ``CALLABLE(env)`` is called after each reset and returns a
   function ``observation -> action``;
 - a path to a Stable-Baselines3 ``.zip``: the model (``sb3_algo``, PPO by default) acts
   deterministically; it gets the flat observation when its observation space is a ``Box``;
 - a path to a checkpoint ``.pt`` (``pointnav train``'s,
-  :mod:`pointnav_core.training.checkpoint`): its network acts deterministically (the most
+  :mod:`pointnav_core.policies.checkpoint`): its network acts deterministically (the most
   likely action, or the mean), in envs built from the env config it carries, unless
   ``env_config`` is given. Loading one runs no code, so it needs no trust flag.
 
@@ -48,46 +48,20 @@ from pointnav_core.datasets.playback import episode_seed
 from pointnav_core.datasets.scene_sets import load_scene, locate_scene
 from pointnav_core.envs.config import EnvConfig
 from pointnav_core.errors import ArgumentError, EpisodeError
+from pointnav_core.policies.spaces import check_spaces
 from pointnav_core.evaluation.config import (
     check_beside_config,
     check_robot_radius,
-    check_spaces,
     episode_config,
 )
 from pointnav_core.evaluation.report import (
     EpisodeResult,
-    bootstrap_interval,
-    plot_results,
-    read_results,
-    read_run,
-    result_line,
-    summarize,
-    summary_record,
-    write_results,
 )
 from pointnav_core.task import metrics
 from pointnav_core.utils.validation import integer
 from pointnav_core.utils.workers import WorkerError, WorkerPool, usable_cores
 
-__all__ = [
-    "POLICY_FORMS",
-    "EpisodeResult",
-    "bootstrap_interval",
-    "check_robot_radius",
-    "check_scene_ids",
-    "check_spaces",
-    "episode_config",
-    "evaluate",
-    "make_policy",
-    "plot_results",
-    "read_results",
-    "read_run",
-    "result_line",
-    "select_episodes",
-    "summarize",
-    "summary_record",
-    "write_results",
-]
+__all__ = ["POLICY_FORMS", "check_scene_ids", "evaluate", "make_policy", "select_episodes"]
 
 #: Default step limit: a 30 m geodesic at 0.5 m/s and 10 Hz takes 600 steps, plus turns.
 DEFAULT_MAX_STEPS = 1000
@@ -98,7 +72,7 @@ POLICY_FORMS = (
     "'oracle', MODULE:CALLABLE (a function env -> (observation -> action)), the path to "
     "a checkpoint .pt (pointnav train's) or the path to a Stable-Baselines3 .zip"
 )
-#: The suffix of a checkpoint (pointnav_core.training.checkpoint.CHECKPOINT_SUFFIX, which
+#: The suffix of a checkpoint (pointnav_core.policies.checkpoint.CHECKPOINT_SUFFIX, which
 #: imports torch).
 CHECKPOINT_SUFFIX = ".pt"
 
@@ -108,7 +82,7 @@ PolicyFactory = Callable[[Any], Policy]
 
 # ---------------------------------------------------------------------- policies
 def _oracle(env: Any) -> Policy:
-    from pointnav_core.evaluation.policies import ShortestPathFollower
+    from pointnav_core.policies.oracle import ShortestPathFollower
 
     follower = ShortestPathFollower(env)
     return lambda _obs: follower.act()
@@ -180,7 +154,7 @@ def make_policy(spec: str, sb3_algo: str = "PPO", trust_policy_file: bool = Fals
         if not os.path.isfile(spec):
             raise ArgumentError(f"policy {spec!r}: no such checkpoint file")
         try:
-            from pointnav_core.training.policy import CheckpointPolicy
+            from pointnav_core.policies.checkpoint_policy import CheckpointPolicy
         except ImportError:
             raise ArgumentError(f"policy {spec!r}: a checkpoint needs torch (pip install 'pointnav-core[vector]')") from None
         return CheckpointPolicy(spec)

@@ -263,7 +263,7 @@ def record_episode(
     Examples
     --------
     >>> from pointnav_core.envs.pointnav import PointNavEnv
-    >>> from pointnav_core.evaluation.policies import ShortestPathFollower
+    >>> from pointnav_core.policies.oracle import ShortestPathFollower
     >>> env = PointNavEnv(task={"visualize_goal": True, "visualize_path": True})
     >>> oracle = ShortestPathFollower(env)
     >>> frames = record_episode(env, lambda obs: oracle.act(), seed=0, every=10)

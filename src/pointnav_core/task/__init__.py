@@ -3,8 +3,9 @@ with its lifecycle, configuration, terms (rewards, terminations, observations), 
 episode sampling, markers and discrete actions.
 """
 
+from pointnav_core.errors import TaskStateError
 from pointnav_core.task.config import REWARD_TYPES, TaskConfig
-from pointnav_core.task.lifecycle import TaskState, TaskStateError
+from pointnav_core.task.lifecycle import TaskState
 from pointnav_core.task.metrics import soft_spl, spl
 from pointnav_core.task.observations import ObservationTerm
 from pointnav_core.task.rewards import (

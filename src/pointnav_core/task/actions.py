@@ -58,7 +58,6 @@ import numpy as np
 from numpy.typing import NDArray
 
 from pointnav_core.errors import ArgumentError
-from pointnav_core.sensors._checks import check_number
 from pointnav_core.task.terminations import TerminationCondition
 from pointnav_core.utils import validation
 
@@ -105,9 +104,9 @@ class DiscreteActions:
     def __init__(
         self, forward_step: float = 0.25, turn_angle: float = math.radians(10.0), stop: bool = True
     ) -> None:
-        self.forward_step = check_number("forward_step", forward_step, low=0.0, strict_low=True, unit="m")
-        self.turn_angle = check_number(
-            "turn_angle", turn_angle, low=0.0, strict_low=True, high=math.pi, unit="rad"
+        self.forward_step = validation.real("forward_step", forward_step, minimum=0.0, strict=True, unit="m")
+        self.turn_angle = validation.real(
+            "turn_angle", turn_angle, minimum=0.0, strict=True, maximum=math.pi, unit="rad"
         )
         if not isinstance(stop, (bool, np.bool_)):
             raise ArgumentError(f"stop must be True or False, got {stop!r}")

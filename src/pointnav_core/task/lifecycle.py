@@ -31,7 +31,7 @@ from types import MappingProxyType
 
 from pointnav_core.errors import TaskStateError
 
-__all__ = ["TaskState", "TaskStateError", "Event", "TRANSITIONS", "move", "allows", "diagram"]
+__all__ = ["TaskState", "Event", "TRANSITIONS", "move", "allows", "diagram"]
 
 
 class TaskState(enum.Enum):

@@ -21,13 +21,8 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from pointnav_core.task.lifecycle import (
-    ERROR,
-    IDLE,
-    ILLEGAL_HINT,
-    TaskState,
-    TaskStateError,
-)
+from pointnav_core.errors import TaskStateError
+from pointnav_core.task.lifecycle import ERROR, IDLE, ILLEGAL_HINT, TaskState
 from pointnav_core.task.terminations import Timeout
 from pointnav_core.utils import validation
 from pointnav_core.utils.frozen import FrozenMapping

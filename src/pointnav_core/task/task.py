@@ -45,7 +45,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from pointnav_core.backends.protocol import float_twin
-from pointnav_core.errors import ArgumentError
+from pointnav_core.errors import ArgumentError, TaskStateError
 from pointnav_core.task.config import (
     REWARD_TYPES,
     TaskConfig,
@@ -53,7 +53,7 @@ from pointnav_core.task.config import (
     merge_config,
 )
 from pointnav_core.task.episode_state import EpisodeState
-from pointnav_core.task.lifecycle import IDLE, TaskState, TaskStateError, allows, move
+from pointnav_core.task.lifecycle import IDLE, TaskState, allows, move
 from pointnav_core.task.lifecycle import Event as _Event
 from pointnav_core.task.markers import TaskMarkers
 from pointnav_core.task.observations import (
@@ -80,7 +80,8 @@ from pointnav_core.task.terminations import (
 from pointnav_core.utils.frozen import FrozenMapping
 
 if TYPE_CHECKING:
-    from pointnav_core.backends.protocol import Backend, RobotSpec
+    from pointnav_core.backends.protocol import Backend
+    from pointnav_core.backends.robot_spec import RobotSpec
     from pointnav_core.scenes import Scene
 
 __all__ = [

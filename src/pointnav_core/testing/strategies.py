@@ -156,7 +156,7 @@ def robot_specs(
     max_radius: float = 0.5,
     max_speed: float = 2.0,
 ) -> st.SearchStrategy:
-    """Valid :class:`~pointnav_core.backends.protocol.RobotSpec` values.
+    """Valid :class:`~pointnav_core.backends.robot_spec.RobotSpec` values.
 
     Radii lie in ``[0, max_radius]`` metres (shrinking to 0, a point robot), linear speed
     limits in ``[0.01, max_speed]`` m/s, yaw-rate limits in ``[0.01, 2 pi]`` rad/s, and the
@@ -171,10 +171,7 @@ def robot_specs(
     max_speed : float
         Largest ``max_linear_velocity`` in m/s, >= 0.01.
     """
-    from pointnav_core.backends.protocol import (  # this block was appended: import here
-        DRIVES,
-        RobotSpec,
-    )
+    from pointnav_core.backends.robot_spec import DRIVES, RobotSpec
 
     drives = tuple(drives)
     if not drives or any(d not in DRIVES for d in drives):
@@ -325,9 +322,7 @@ def nav_robot_specs() -> st.SearchStrategy:
 
     Shrinks towards a point robot with differential drive.
     """
-    from pointnav_core.backends.protocol import (
-        RobotSpec,  # this block was appended: import here
-    )
+    from pointnav_core.backends.robot_spec import RobotSpec
 
     return st.builds(
         RobotSpec,

@@ -1,8 +1,7 @@
-"""Training a policy on the batched engine, and its checkpoints (needs torch).
+"""Training a policy on the batched engine (needs torch); the network it trains and its
+checkpoint file live in :mod:`pointnav_core.policies`.
 
-- :mod:`~pointnav_core.training.agent`: the actor-critic MLP and the running statistics;
 - :mod:`~pointnav_core.training.ppo`: PPO on :class:`~pointnav_core.vector.VectorPointNavEnv`;
-- :mod:`~pointnav_core.training.checkpoint`: one checkpoint file, saved and loaded safely;
 - :mod:`~pointnav_core.training.config`: ``pointnav train``'s config file;
 - :mod:`~pointnav_core.training.trainer`: the training run (checkpoints, curve, held-out
   evaluation through :func:`pointnav_core.evaluation.run.evaluate`, resume);

@@ -24,7 +24,7 @@ import torch
 from torch import nn
 
 from pointnav_core.errors import ArgumentError
-from pointnav_core.training.agent import ActorCritic, RunningNorm, as_tensor
+from pointnav_core.policies.network import ActorCritic, RunningNorm, as_tensor
 from pointnav_core.utils import validation
 
 __all__ = ["PPO", "PPOSettings", "train"]

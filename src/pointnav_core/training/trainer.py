@@ -5,10 +5,10 @@ its scene set (each scene's floor as grid cells: the batched scan sees cells onl
 the benchmark trains so), and every ``eval_every`` env steps and at the end it
 
 1. saves ``latest.pt`` (the network, the observation statistics, the env config and the
-   optimiser: :mod:`pointnav_core.training.checkpoint`);
+   optimiser: :mod:`pointnav_core.policies.checkpoint`);
 2. plays the held-out episodes with that file through
    :func:`pointnav_core.evaluation.run.evaluate` and a
-   :class:`~pointnav_core.training.policy.CheckpointPolicy`, the code and policy
+   :class:`~pointnav_core.policies.checkpoint_policy.CheckpointPolicy`, the code and policy
    ``pointnav eval --policy latest.pt`` uses, so that its numbers are eval's to the
    episode; the per-episode results go to ``heldout/step_<N>.jsonl`` (eval's results file);
 3. copies the checkpoint to ``best.pt`` (without the optimiser: the file to share) when its
@@ -31,7 +31,7 @@ from collections.abc import Callable
 from typing import Any
 
 from pointnav_core.errors import ArgumentError
-from pointnav_core.training.checkpoint import load_checkpoint, save_checkpoint
+from pointnav_core.policies.checkpoint import load_checkpoint, save_checkpoint
 from pointnav_core.training.config import TrainConfig
 from pointnav_core.training.curve import plot_curve, read_curve, write_curve
 from pointnav_core.training.ppo import PPO
@@ -60,11 +60,8 @@ def heldout_episodes(config: TrainConfig) -> list[Any]:
     """The held-out episodes (``eval_limit`` and ``eval_stride`` applied), checked before
     any training: their scenes exist, and their robot radius is the config's."""
     from pointnav_core.datasets import EpisodeDataset
-    from pointnav_core.evaluation.run import (
-        check_robot_radius,
-        check_scene_ids,
-        select_episodes,
-    )
+    from pointnav_core.evaluation.config import check_robot_radius
+    from pointnav_core.evaluation.run import check_scene_ids, select_episodes
 
     episodes = select_episodes(EpisodeDataset.load(config.eval_dataset), config.eval_limit, config.eval_stride)
     check_robot_radius(config.policy_config(), episodes)
@@ -125,8 +122,9 @@ class _Run:
 
     def evaluate(self, wall: float) -> dict[str, Any]:
         """Save ``latest.pt``, play the held-out episodes with it, keep the row and the best."""
-        from pointnav_core.evaluation.run import evaluate, summary_record, write_results
-        from pointnav_core.training.policy import CheckpointPolicy
+        from pointnav_core.evaluation.report import summary_record, write_results
+        from pointnav_core.evaluation.run import evaluate
+        from pointnav_core.policies.checkpoint_policy import CheckpointPolicy
 
         self.save_latest()
         step = self.ppo.steps

@@ -10,7 +10,7 @@ import math
 
 from numpy.typing import ArrayLike
 
-from pointnav_core.backends.protocol import RobotSpec
+from pointnav_core.backends.robot_spec import RobotSpec
 
 __all__ = ["RobotState", "body_command", "drive_arc"]
 

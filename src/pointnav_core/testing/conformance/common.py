@@ -8,7 +8,7 @@ from typing import Any
 
 import numpy as np
 
-from pointnav_core.backends.protocol import RobotSpec
+from pointnav_core.backends.robot_spec import RobotSpec
 from pointnav_core.errors import BackendError
 from pointnav_core.floor.maps import OBSTACLE, TraversableMap
 from pointnav_core.scenes import Scene

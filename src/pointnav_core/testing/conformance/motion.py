@@ -7,7 +7,7 @@ from typing import Any
 
 import numpy as np
 
-from pointnav_core.backends.protocol import RobotSpec
+from pointnav_core.backends.robot_spec import RobotSpec
 from pointnav_core.floor.maps import OBSTACLE, VOID
 from pointnav_core.scenes import Scene
 from pointnav_core.testing.conformance.common import (

@@ -7,12 +7,8 @@ from typing import Any
 
 import numpy as np
 
-from pointnav_core.backends.protocol import (
-    FLOAT_TWINS,
-    RobotSpec,
-    check_backend,
-    float_twin,
-)
+from pointnav_core.backends.protocol import FLOAT_TWINS, check_backend, float_twin
+from pointnav_core.backends.robot_spec import RobotSpec
 from pointnav_core.errors import BackendError
 from pointnav_core.floor.maps import OBSTACLE, VOID
 from pointnav_core.scenes import Scene

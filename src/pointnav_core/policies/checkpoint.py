@@ -13,7 +13,7 @@ Examples
 --------
 >>> import tempfile, os
 >>> from pointnav_core.envs.config import EnvConfig
->>> from pointnav_core.training.agent import ActorCritic, RunningNorm
+>>> from pointnav_core.policies.network import ActorCritic, RunningNorm
 >>> agent, norm = ActorCritic(8, 3, 16), RunningNorm((8,))
 >>> path = os.path.join(tempfile.mkdtemp(), "policy.pt")
 >>> save_checkpoint(path, agent, norm, EnvConfig(action_space="discrete"), step=128)
@@ -34,7 +34,7 @@ import torch
 
 from pointnav_core.envs.config import EnvConfig
 from pointnav_core.errors import ArgumentError
-from pointnav_core.training.agent import ActorCritic, RunningNorm
+from pointnav_core.policies.network import ActorCritic, RunningNorm
 
 __all__ = ["CHECKPOINT_SUFFIX", "FORMAT", "FORMAT_VERSION", "Checkpoint", "load_checkpoint", "save_checkpoint"]
 

@@ -25,7 +25,7 @@ class CheckpointPolicy:
     Parameters
     ----------
     path : str
-        A checkpoint written by :func:`~pointnav_core.training.checkpoint.save_checkpoint`.
+        A checkpoint written by :func:`~pointnav_core.policies.checkpoint.save_checkpoint`.
 
     Raises
     ------
@@ -45,9 +45,9 @@ class CheckpointPolicy:
 
     @property
     def checkpoint(self) -> Any:
-        """The loaded :class:`~pointnav_core.training.checkpoint.Checkpoint`."""
+        """The loaded :class:`~pointnav_core.policies.checkpoint.Checkpoint`."""
         if self._checkpoint is None:
-            from pointnav_core.training.checkpoint import load_checkpoint
+            from pointnav_core.policies.checkpoint import load_checkpoint
 
             self._checkpoint = load_checkpoint(self.path)
         return self._checkpoint
@@ -71,7 +71,7 @@ class CheckpointPolicy:
 
     def check_env(self, env: Any) -> None:
         """ValueError unless ``env``'s spaces have the shapes the network was built for."""
-        from pointnav_core.evaluation.config import check_spaces
+        from pointnav_core.policies.spaces import check_spaces
 
         own = self.env_config.to_dict()
         check_spaces(
