@@ -46,7 +46,7 @@ def test_a_rebuilt_floor_reads_the_same_graph_back(folder) -> None:
     files = list(folder.glob("*.npz"))
     assert len(files) == 1 and not list(folder.glob("*.tmp"))
     second = Planner(_geo(), 0.18)
-    assert second._edges == first._edges  # every edge, before any search asks
+    assert second.edge_store == first.edge_store  # every edge, before any search asks
     np.testing.assert_array_equal(second.sights, first.sights)
     assert _distances(second) == _distances(first)
 

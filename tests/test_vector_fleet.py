@@ -229,7 +229,7 @@ def test_fields_without_labels_after_fields_with_labels() -> None:
     grid[15, 1:25] = OBSTACLE
     behind = Scene.from_array(grid, 0.1).goal_field(0, (0.5, 2.5), robot=0.18)
     open_floor = room(30, 30).goal_field(0, (2.0, 0.6), robot=0.18)
-    assert len(behind.field._search.node) > 0 and len(open_floor.field._search.node) == 0
+    assert len(behind.field.labels.node) > 0 and len(open_floor.field.labels.node) == 0
     tables = FieldTables([behind.field, open_floor.field], make_arrays("numpy"))
     x, y = np.array([0.5, 2.0]), np.array([0.6, 1.0])
     got = tables.distance(np.array([0, 1]), x, y)

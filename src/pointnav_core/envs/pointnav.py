@@ -365,7 +365,10 @@ class TaskStepLimit(gym.Wrapper[Any, np.ndarray, Any, np.ndarray], gym.utils.Rec
         inner: Any = env
         while isinstance(inner, gym.Wrapper):
             if isinstance(inner, gym.wrappers.TimeLimit):
-                limit, config = inner._max_episode_steps, getattr(env.unwrapped, "config", None)
+                # TimeLimit keeps its limit only privately: its spec shows the limit only
+                # when the env it wraps has a spec, which a directly built env has not.
+                limit = inner._max_episode_steps  # noqa: SLF001
+                config = getattr(env.unwrapped, "config", None)
                 if config is not None and limit != config.max_steps:
                     raise ArgumentError(
                         f"max_episode_steps={limit} given beside config, which sets "

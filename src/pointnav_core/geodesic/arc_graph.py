@@ -53,8 +53,8 @@ class ArcGraph:
         p = planner
         self.p = p
         p.build_all_edges()
-        keys = list(p._edges.keys())
-        vals = [p._edges[k] for k in keys]
+        keys = list(p.edge_store.keys())
+        vals = [p.edge_store[k] for k in keys]
         counts = np.fromiter((len(v[0]) for v in vals), dtype=np.int64, count=len(vals))
         n_e = int(counts.sum())
         a_node = np.repeat(np.fromiter((k[0] for k in keys), dtype=np.int64, count=len(keys)), counts)
@@ -100,10 +100,10 @@ class ArcGraph:
         """Whether the arc between vertices ``i`` and ``j`` (same arc, ``pos_i <= pos_j``) is clear."""
         p = self.p
         out = np.ones(len(i), dtype=bool)
-        has = np.fromiter((bool(p._blocked_ccw[n]) for n in self.node[i].tolist()), dtype=bool, count=len(i))
+        has = np.fromiter((bool(p.blocked_ccw[n]) for n in self.node[i].tolist()), dtype=bool, count=len(i))
         for q in np.flatnonzero(has).tolist():
             a, b = int(i[q]), int(j[q])
-            out[q] = p._arc_free(int(self.node[a]), int(self.side[a]), float(self.pos[a]), float(self.pos[b]))
+            out[q] = p.arc_free(int(self.node[a]), int(self.side[a]), float(self.pos[a]), float(self.pos[b]))
         return out
 
     def solve(self, links: list[tuple[int, int, float, float]]) -> FieldLabels:
@@ -128,7 +128,7 @@ class ArcGraph:
             gi = 2 * c + (s < 0)
             lo, hi = int(self.grp_start[gi]), int(self.grp_end[gi])
             j = lo + int(np.searchsorted(self.pos[lo:hi], q - ANG_TOL, side="left"))
-            if j < hi and p._arc_free(c, s, q, float(self.pos[j])):
+            if j < hi and p.arc_free(c, s, q, float(self.pos[j])):
                 x_to[k] = j
                 x_w[k] = p.radius * max(float(self.pos[j]) - q, 0.0) + _EPS_W
         kernel = _compiled.kernel("pointnav_core.geodesic._search_kernel", "seeded_dijkstra")

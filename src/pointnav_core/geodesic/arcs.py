@@ -62,11 +62,11 @@ def _drawn_arc(p: Planner, node: int, s: int, pos_from: float, pos_to: float) ->
     n = max(1, math.ceil(delta / ARC_PIECE))
     piece = delta / n
     reach = p.radius / math.cos(piece / 2)
-    cx, cy = p._cx[node], p._cy[node]
+    cx, cy = p.cx_list[node], p.cy_list[node]
     for k in range(n):
         pos = pos_from - piece * (k + 0.5)
-        ccw = pos if s > 0 else p._span[node] - pos
-        ang = p._phi0[node] + ccw
+        ccw = pos if s > 0 else p.span_list[node] - pos
+        ang = p.phi0_list[node] + ccw
         out.append(np.array([cx + reach * math.cos(ang), cy + reach * math.sin(ang)]))
     out.append(np.array(p.node_point(node, s, pos_to)))
     return out
@@ -77,7 +77,7 @@ def _pinch_position(p: Planner, node: int, s: int, vertex: NDArray[np.float64]) 
     ``vertex`` overlaps: towards the nearest such cell corner, or along the normal of the
     nearest such cell face (cells are axis-aligned). None if there is none on the grid."""
     geo, r = p.geo, p.radius
-    cx, cy = p._cx[node], p._cy[node]
+    cx, cy = p.cx_list[node], p.cy_list[node]
     res, (ox, oy) = geo.resolution, geo.origin
     col, row = math.floor((vertex[0] - ox) / res), math.floor((vertex[1] - oy) / res)
     k = math.ceil(r / res) + 1
@@ -101,5 +101,5 @@ def _pinch_position(p: Planner, node: int, s: int, vertex: NDArray[np.float64]) 
         ang = 0.0 if qx[i] > cx else math.pi
     else:
         ang = 0.5 * math.pi if qy[i] > cy else -0.5 * math.pi
-    ccw = (ang - p._phi0[node]) % TWO_PI
-    return ccw if s > 0 else p._span[node] - ccw
+    ccw = (ang - p.phi0_list[node]) % TWO_PI
+    return ccw if s > 0 else p.span_list[node] - ccw

@@ -34,7 +34,7 @@ def build_edges(p: Planner, nodes: NDArray[np.int64]) -> None:
     Candidates are the nodes within each node's sight bound; for each winding pair the
     common tangent must leave and arrive on the two arcs, and its segment must be clear
     for the robot's disc (one exact test for the whole batch). Stores, per ``(node, side)``,
-    the edges sorted by departure position in ``p._edges``.
+    the edges sorted by departure position in ``p.edge_store``.
     """
     nodes = np.asarray(nodes, dtype=np.int64)
     if not len(nodes):
@@ -43,7 +43,7 @@ def build_edges(p: Planner, nodes: NDArray[np.int64]) -> None:
     # An edge is a clear segment leaving both nodes' arcs, so the centres are at most either
     # node's sight plus two radii apart (geodesic.sight).
     pts = np.stack([p.cx[nodes], p.cy[nodes]], axis=1)
-    lists = p._tree.query_ball_point(pts, p.sights[nodes] + 2 * r)
+    lists = p.tree.query_ball_point(pts, p.sights[nodes] + 2 * r)
     counts = np.fromiter((len(v) for v in lists), dtype=np.int64, count=len(lists))
     src = np.repeat(nodes, counts)
     dst = np.fromiter((j for v in lists for j in v), dtype=np.int64, count=int(counts.sum()))
@@ -126,7 +126,7 @@ def build_edges(p: Planner, nodes: NDArray[np.int64]) -> None:
     sb_l = e_sb[order].tolist()
     arr_l = e_arr[order].tolist()
     len_l = e_len[order].tolist()
-    store = p._edges
+    store = p.edge_store
     empty: tuple[list[float], list[int], list[int], list[float], list[float]] = ([], [], [], [], [])
     for a in nodes.tolist():
         store.setdefault((a, 1), empty)

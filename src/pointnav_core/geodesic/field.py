@@ -99,10 +99,10 @@ class GoalField(ThawOnUnpickle):
         search = self._search
         for c, s, pos, length in p.point_links(x, y):
             side = -s
-            dep = p._span[c] - pos
+            dep = p.span_list[c] - pos
             for lab in search.on_arc(c, side):
                 lp = search.pos[lab]
-                if lp <= dep + ANG_TOL and p._arc_free(c, side, lp, dep):
+                if lp <= dep + ANG_TOL and p.arc_free(c, side, lp, dep):
                     total = search.cost[lab] + r * max(dep - lp, 0.0) + length
                     if total < best[0]:
                         best = (total, lab, dep)
@@ -207,23 +207,23 @@ class GoalField(ThawOnUnpickle):
         search = self._search
         c, side = int(search.node[lab]), int(search.side[lab])
         r = p.radius
-        dx = p._cx[c] - x
-        dy = p._cy[c] - y
+        dx = p.cx_list[c] - x
+        dy = p.cy_list[c] - y
         L = math.hypot(dx, dy)
         if L > r:
             # The tangent from (x, y) arriving winding -side is the one leaving the node.
             heading = math.atan2(dy, dx) + side * math.asin(r / L) if r > 0 else math.atan2(dy, dx)
-            ccw = (heading + side * (math.pi / 2) - p._phi0[c]) % TWO_PI
+            ccw = (heading + side * (math.pi / 2) - p.phi0_list[c]) % TWO_PI
             if ccw > TWO_PI - ANG_TOL:
                 ccw = 0.0
-            span = p._span[c]
+            span = p.span_list[c]
             if ccw <= span + ANG_TOL:
                 dep = min(ccw, span) if side > 0 else span - min(ccw, span)
                 lp = search.pos[lab]
                 if dep >= lp - ANG_TOL:
                     return search.cost[lab] + r * max(dep - lp, 0.0) + math.sqrt(L * L - r * r)
         qx, qy = p.node_point(c, side, search.pos[lab])
-        return search.cost[lab] + around_disc(x, y, p._cx[c], p._cy[c], r, qx, qy)
+        return search.cost[lab] + around_disc(x, y, p.cx_list[c], p.cy_list[c], r, qx, qy)
 
     def settle(self, cells: ArrayLike | None = None) -> tuple[NDArray[np.int8], NDArray[np.int32]]:
         """Settle the blocks of the root table that hold ``cells`` (default: every block).

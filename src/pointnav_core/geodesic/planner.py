@@ -125,7 +125,7 @@ class Planner(ThawOnUnpickle):
         started = time.perf_counter()
         self._build_nodes()
         # (node, side) -> departure positions, targets, target sides, arrivals, lengths.
-        self._edges: dict[tuple[int, int], tuple[list[float], list[int], list[int], list[float], list[float]]] = {}
+        self.edge_store: dict[tuple[int, int], tuple[list[float], list[int], list[int], list[float], list[float]]] = {}
         # The per-floor build from the disk cache, if an earlier process kept it (geodesic.cache).
         self._cache_key = cache.floor_key(collision, self.radius) if cache.cache_dir() is not None else None
         stored = cache.load(self._cache_key, self.n_nodes) if self._cache_key is not None else None
@@ -197,13 +197,16 @@ class Planner(ThawOnUnpickle):
         self.phi0, self.span = phi0_all[keep], span_all[keep]
         self.arc_clear = clear[keep]
         self.n_nodes = int(keep.sum())
-        self._cx, self._cy = self.cx.tolist(), self.cy.tolist()
-        self._phi0, self._span = self.phi0.tolist(), self.span.tolist()
+        # The same numbers as Python lists: the package's scalar loops (arcs, fields, point
+        # search) index them one node at a time, where a numpy scalar costs ten times more.
+        self.cx_list, self.cy_list = self.cx.tolist(), self.cy.tolist()
+        self.phi0_list, self.span_list = self.phi0.tolist(), self.span.tolist()
         # Blocked sample positions (ccw, rad) per node; empty for almost every node.
-        self._blocked_ccw: list[list[float]] = [[] for _ in range(self.n_nodes)]
+        self.blocked_ccw: list[list[float]] = [[] for _ in range(self.n_nodes)]
         for i, j in zip(*np.nonzero(~self.arc_clear)):
-            self._blocked_ccw[int(i)].append(float(self.span[i] * k[j]))
-        self._tree = cKDTree(np.stack([self.cx, self.cy], axis=1)) if self.n_nodes else None
+            self.blocked_ccw[int(i)].append(float(self.span[i] * k[j]))
+        # Node centres for nearest-node queries (edge building).
+        self.tree = cKDTree(np.stack([self.cx, self.cy], axis=1)) if self.n_nodes else None
         # Nodes grouped by tile, so that a lazy search builds a tile's edges in one batch.
         tcol = np.floor((self.cx - ox) / (res * _TILE)).astype(np.int64)
         trow = np.floor((self.cy - oy) / (res * _TILE)).astype(np.int64)
@@ -214,19 +217,19 @@ class Planner(ThawOnUnpickle):
 
     def node_point(self, node: int, s: int, pos: float) -> tuple[float, float]:
         """World point at arc position ``pos`` (rad, along winding ``s``) of ``node``."""
-        ccw = pos if s > 0 else self._span[node] - pos
-        a = self._phi0[node] + ccw
-        return (self._cx[node] + self.radius * math.cos(a), self._cy[node] + self.radius * math.sin(a))
+        ccw = pos if s > 0 else self.span_list[node] - pos
+        a = self.phi0_list[node] + ccw
+        return (self.cx_list[node] + self.radius * math.cos(a), self.cy_list[node] + self.radius * math.sin(a))
 
-    def _arc_free(self, node: int, s: int, p1: float, p2: float) -> bool:
+    def arc_free(self, node: int, s: int, p1: float, p2: float) -> bool:
         """Whether the arc of ``node`` between positions ``p1 <= p2`` (winding ``s``) is clear."""
-        blocked = self._blocked_ccw[node]
+        blocked = self.blocked_ccw[node]
         if not blocked:
             return True
         if s > 0:
             lo, hi = p1, p2
         else:
-            sp = self._span[node]
+            sp = self.span_list[node]
             lo, hi = sp - p2, sp - p1
         return not any(lo + ANG_TOL < b < hi - ANG_TOL for b in blocked)
 
@@ -234,17 +237,17 @@ class Planner(ThawOnUnpickle):
         """Each node's blocked arc samples (ccw positions, rad) as a row, NaN padded (NaN
         compares false), and which nodes have any; built once."""
         if getattr(self, "_blocked", None) is None:
-            widest = max((len(b) for b in self._blocked_ccw), default=0)
+            widest = max((len(b) for b in self.blocked_ccw), default=0)
             self._blocked = np.full((self.n_nodes, max(widest, 1)), np.nan)
-            for n, b in enumerate(self._blocked_ccw):
+            for n, b in enumerate(self.blocked_ccw):
                 self._blocked[n, : len(b)] = b
-            self._has_blocked = np.fromiter((bool(b) for b in self._blocked_ccw), dtype=bool, count=self.n_nodes)
+            self._has_blocked = np.fromiter((bool(b) for b in self.blocked_ccw), dtype=bool, count=self.n_nodes)
         return self._blocked, self._has_blocked
 
     def arcs_free(
         self, nodes: NDArray[np.int64], sides: NDArray[np.int64], p1: NDArray[np.float64], p2: NDArray[np.float64]
     ) -> NDArray[np.bool_]:
-        """Vectorised :meth:`_arc_free`, with its expressions (only nodes with a blocked arc
+        """Vectorised :meth:`arc_free`, with its expressions (only nodes with a blocked arc
         sample are looked at)."""
         blocked, has_blocked = self.blocked_arcs()
         out = np.ones(len(nodes), dtype=bool)
@@ -286,25 +289,25 @@ class Planner(ThawOnUnpickle):
         Returns the departure positions (rad) and a record array with fields ``to``,
         ``side``, ``arr`` (arrival position at ``to``), ``length`` (m).
         """
-        dep, to, side, arr, length = self._edge_lists(node, s)
+        dep, to, side, arr, length = self.edge_lists(node, s)
         rec = np.empty(len(dep), dtype=_EDGE_DTYPE)
         rec["to"], rec["side"], rec["arr"], rec["length"] = to, side, arr, length
         return list(dep), rec
 
-    def _edge_lists(self, node: int, s: int) -> tuple[list[float], list[int], list[int], list[float], list[float]]:
-        got = self._edges.get((node, s))
+    def edge_lists(self, node: int, s: int) -> tuple[list[float], list[int], list[int], list[float], list[float]]:
+        got = self.edge_store.get((node, s))
         if got is None:
             # Build the whole tile: the search will want the neighbours next.
             tile = self._tile_nodes[int(self._tile_of[node])]
-            todo = np.array([n for n in tile.tolist() if (n, 1) not in self._edges], dtype=np.int64)
+            todo = np.array([n for n in tile.tolist() if (n, 1) not in self.edge_store], dtype=np.int64)
             build_edges(self, todo)
-            got = self._edges[(node, s)]
+            got = self.edge_store[(node, s)]
         return got
 
     def build_all_edges(self) -> None:
         """Build the edges of every node (a goal field needs them all), and keep a slow build
         in the disk cache (:mod:`pointnav_core.geodesic.cache`)."""
-        todo = np.array([n for n in range(self.n_nodes) if (n, 1) not in self._edges], dtype=np.int64)
+        todo = np.array([n for n in range(self.n_nodes) if (n, 1) not in self.edge_store], dtype=np.int64)
         if not len(todo):
             return
         started = time.perf_counter()
@@ -327,7 +330,7 @@ class Planner(ThawOnUnpickle):
         """Approximate memory (bytes) of this floor's geometry for this radius: nodes, sight
         bounds, tangent edges, arc graph and cell links (the goal fields not included)."""
         arrays = sum(a.nbytes for a in (self.cx, self.cy, self.phi0, self.span, self.sights, self.sight_profile))
-        n_edges = sum(len(v[0]) for v in self._edges.values())
+        n_edges = sum(len(v[0]) for v in self.edge_store.values())
         links = self._cell_links.nbytes if isinstance(self._cell_links, CellLinks) else 0
         return int(arrays + n_edges * _EDGE_BYTES + links)
 
@@ -391,8 +394,8 @@ class Planner(ThawOnUnpickle):
 
     def _stored_edges(self) -> dict[str, NDArray[Any]]:
         """The sights and every edge as flat arrays (what the disk cache keeps)."""
-        keys = sorted(self._edges)
-        lists = [self._edges[k] for k in keys]
+        keys = sorted(self.edge_store)
+        lists = [self.edge_store[k] for k in keys]
         return {
             "sights": self.sights,
             "sight_profile": self.sight_profile,
@@ -412,7 +415,7 @@ class Planner(ThawOnUnpickle):
         starts = ends - stored["count"]
         cols = [stored[k].tolist() for k in ("dep", "to", "to_side", "arr", "length")]
         for node, side, i, j in zip(stored["node"].tolist(), stored["side"].tolist(), starts.tolist(), ends.tolist()):
-            self._edges[(node, side)] = tuple(c[i:j] for c in cols)  # type: ignore[assignment]
+            self.edge_store[(node, side)] = tuple(c[i:j] for c in cols)  # type: ignore[assignment]
 
     def arc_graph(self) -> ArcGraph:
         """The whole tangent graph as a plain digraph (built on first use, then cached)."""
@@ -462,7 +465,7 @@ class Planner(ThawOnUnpickle):
             clear = self.geo.segments_clear(np.array([x, y]), q, r)
             for i in idx[clear].tolist():
                 c = int(cand[i])
-                pos = float(ccw[i]) if s > 0 else self._span[c] - float(ccw[i])
+                pos = float(ccw[i]) if s > 0 else self.span_list[c] - float(ccw[i])
                 links.append((c, s, pos, float(length[i])))
         return links
 
@@ -527,7 +530,7 @@ class Planner(ThawOnUnpickle):
         # Links into the target, seen from the target: reversed, they leave a node.
         finish: dict[tuple[int, int], list[tuple[float, float]]] = {}
         for c, s, pos, length in self.point_links(tx, ty):
-            finish.setdefault((c, -s), []).append((self._span[c] - pos, length))
+            finish.setdefault((c, -s), []).append((self.span_list[c] - pos, length))
         search = PointSearch(self, heuristic_to=(tx, ty))
         for c, s, pos, length in self.point_links(sx, sy):
             search.push(length, c, s, pos, -1, 0.0)

@@ -57,7 +57,7 @@ class PointSearch:
         for lab in labels:
             lp = self.pos[lab]
             if lp <= pos + ANG_TOL and self.cost[lab] + r * max(pos - lp, 0.0) <= g + COST_TOL:
-                if self.p._arc_free(node, s, lp, pos):
+                if self.p.arc_free(node, s, lp, pos):
                     return True
         return False
 
@@ -88,18 +88,18 @@ class PointSearch:
             self.settled.setdefault((node, s), []).append(lab)
             if finish is not None:
                 for fdep, flen in finish.get((node, s), ()):
-                    if fdep >= pos - ANG_TOL and p._arc_free(node, s, pos, fdep):
+                    if fdep >= pos - ANG_TOL and p.arc_free(node, s, pos, fdep):
                         total = g + r * max(fdep - pos, 0.0) + flen
                         self.count += 1
                         heapq.heappush(heap, (total, total, self.count, -1, 0, 0.0, lab, fdep))
-            deps, to, side, arr, length = p._edge_lists(node, s)
+            deps, to, side, arr, length = p.edge_lists(node, s)
             start = bisect.bisect_left(deps, pos - ANG_TOL)
             if start >= len(deps):
                 continue
-            blocked = p._blocked_ccw[node]
+            blocked = p.blocked_ccw[node]
             for i in range(start, len(deps)):
                 d = deps[i]
-                if blocked and not p._arc_free(node, s, pos, d):
+                if blocked and not p.arc_free(node, s, pos, d):
                     break
                 self.push(g + r * max(d - pos, 0.0) + length[i], to[i], side[i], arr[i], lab, d)
         return None

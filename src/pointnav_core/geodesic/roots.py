@@ -393,7 +393,7 @@ def _link_values(
 ) -> tuple[NDArray[np.float64], NDArray[np.int64]]:
     """Each link's best total (inf if no label counts) and its first label of that total."""
     p = field.planner
-    search = field._search
+    search = field.labels
     group = 2 * node + (s > 0)  # the reverse path winds -s
     first = tables.start[group]
     count = tables.start[group + 1] - first
