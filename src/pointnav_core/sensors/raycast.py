@@ -92,16 +92,16 @@ class ScanGeometry:
         below[1:] |= pad[:-1]
         left = pad.copy()
         left[:, 1:] |= pad[:, :-1]
-        self._lookup = np.concatenate([pad.ravel(), below.ravel(), left.ravel()])
-        self._plane = pad.size
+        self.lookup = np.concatenate([pad.ravel(), below.ravel(), left.ravel()])
+        self.plane = pad.size
         hp, wp = pad.shape
         # Per crossing family (x, y), shaped to broadcast over (family, robots, rays, k).
         fam = (2, 1, 1, 1)
-        self._across_max = np.array([hp - 1.0, wp - 1.0]).reshape(fam)
-        self._along_max = np.array([wp - 1.0, hp - 1.0]).reshape(fam)
-        self._plane_of = np.array([pad.size, 2.0 * pad.size]).reshape(fam)
-        self._hi_stride = np.array([float(wp), 1.0]).reshape(fam)
-        self._entered_stride = np.array([1.0, float(wp)]).reshape(fam)
+        self.across_max = np.array([hp - 1.0, wp - 1.0]).reshape(fam)
+        self.along_max = np.array([wp - 1.0, hp - 1.0]).reshape(fam)
+        self.plane_of = np.array([pad.size, 2.0 * pad.size]).reshape(fam)
+        self.hi_stride = np.array([float(wp), 1.0]).reshape(fam)
+        self.entered_stride = np.array([1.0, float(wp)]).reshape(fam)
         polygons = tuple(tmap.collision.polygons)
         self.polygons = polygons
         starts: list[NDArray[np.float64]] = []
@@ -119,36 +119,36 @@ class ScanGeometry:
             self.edge_b = np.concatenate(ends)
         else:
             self.edge_a = self.edge_b = np.zeros((0, 2))
-        self._edge_vec = self.edge_b - self.edge_a
-        length = np.hypot(self._edge_vec[:, 0], self._edge_vec[:, 1])
+        self.edge_vec = self.edge_b - self.edge_a
+        length = np.hypot(self.edge_vec[:, 0], self.edge_vec[:, 1])
         # |u - 1/2| <= this: the edge's parameter u in [0, 1], widened by TOUCH_EPS metres.
-        self._edge_half_slack = 0.5 + TOUCH_EPS / np.maximum(length, TOUCH_EPS)
-        self._edge_lo = np.minimum(self.edge_a, self.edge_b)
-        self._edge_hi = np.maximum(self.edge_a, self.edge_b)
+        self.edge_half_slack = 0.5 + TOUCH_EPS / np.maximum(length, TOUCH_EPS)
+        self.edge_lo = np.minimum(self.edge_a, self.edge_b)
+        self.edge_hi = np.maximum(self.edge_a, self.edge_b)
         # Cells a polygon touches (padded grid): only an origin in one can be inside one.
         near = np.zeros(self.shape, dtype=bool)
-        self._poly_tree: Any = None
+        self.poly_tree: Any = None
         if polygons:
-            self._poly_tree = shapely.STRtree(list(polygons))
+            self.poly_tree = shapely.STRtree(list(polygons))
             res, (ox, oy) = self.resolution, self.origin
             rows, cols = np.indices(self.shape)
             boxes = shapely.box(
                 ox + (cols - 1) * res, oy + (rows - 1) * res, ox + cols * res, oy + rows * res
             ).ravel()
-            hit = self._poly_tree.query(boxes, predicate="intersects")[0]
+            hit = self.poly_tree.query(boxes, predicate="intersects")[0]
             near.ravel()[hit] = True
-        self._near_polygon = near.ravel()
+        self.near_polygon = near.ravel()
         # The compiled path's edge table, one row per edge: a, b - a, low corner, high
         # corner, the |u - 1/2| slack (raycast_jit).
         self._jit_edges = np.ascontiguousarray(np.column_stack(
-            [self.edge_a, self._edge_vec, self._edge_lo, self._edge_hi, self._edge_half_slack]
+            [self.edge_a, self.edge_vec, self.edge_lo, self.edge_hi, self.edge_half_slack]
         ).reshape(-1, 9))
         self._jit_base = (self.resolution, *self.origin)
         self._clearance_cells: NDArray[np.uint8] | None = None
         self._jit_params_of: dict[float, NDArray[np.float64]] = {}
 
     @property
-    def _clearance(self) -> NDArray[np.uint8]:
+    def clearance(self) -> NDArray[np.uint8]:
         """Per padded cell and quadrant, the free square ahead of it (cells).
 
         Flat, ``[cell * 4 + quadrant]`` (:func:`~pointnav_core.sensors.clearance.quadrant_clearance`
@@ -156,11 +156,11 @@ class ScanGeometry:
         a square (raycast_jit); built on first use.
         """
         if self._clearance_cells is None:
-            free = ~self._lookup[: self._plane].reshape(self.shape)
+            free = ~self.lookup[: self.plane].reshape(self.shape)
             self._clearance_cells = quadrant_clearance(free)
         return self._clearance_cells
 
-    def _jit_params(self, max_range: float) -> NDArray[np.float64]:
+    def jit_params(self, max_range: float) -> NDArray[np.float64]:
         """The compiled path's scalars: resolution, origin, max_range, padded shape."""
         params = self._jit_params_of.get(max_range)
         if params is None:  # a scan asks for the same max_range at every step
@@ -178,13 +178,13 @@ class ScanGeometry:
 
     def __getstate__(self) -> dict[str, Any]:
         state = self.__dict__.copy()
-        state["_poly_tree"] = None  # rebuilt, not shipped
+        state["poly_tree"] = None  # rebuilt, not shipped
         return state
 
     def __setstate__(self, state: dict[str, Any]) -> None:
         self.__dict__.update(state)
         if self.polygons:
-            self._poly_tree = shapely.STRtree(list(self.polygons))
+            self.poly_tree = shapely.STRtree(list(self.polygons))
 
     def __repr__(self) -> str:
         return f"ScanGeometry(shape={self.shape}, polygons={len(self.polygons)})"
@@ -322,7 +322,7 @@ def _grid_hits(
     reach = max_range * inv
     n_cross = int(min(math.ceil(reach) + 1, max(hp, wp) + 1))
     k = np.arange(n_cross, dtype=np.float64)[None, None, :]
-    lookup, plane = geo._lookup, geo._plane
+    lookup, plane = geo.lookup, geo.plane
 
     # Both families at once, stacked on a leading axis: [0] x-crossings (vertical lines),
     # [1] y-crossings (horizontal lines); "along" is the coordinate the lines cut.
@@ -347,13 +347,13 @@ def _grid_hits(
     # lo < hi: the crossing grazes the line between rows (columns) hi - 1 and hi.
     grazing = np.floor(across - e) < hi
     np.maximum(hi, 0.0, out=hi)
-    np.minimum(hi, geo._across_max, out=hi)
+    np.minimum(hi, geo.across_max, out=hi)
     entered = (base - ~pos)[..., None] + sgn[..., None] * k4
     np.maximum(entered, 0.0, out=entered)
-    np.minimum(entered, geo._along_max, out=entered)
+    np.minimum(entered, geo.along_max, out=entered)
     # x: column `entered`, row hi (and hi - 1 if grazing): plane 1 ORs the row below;
     # y: row `entered`, column hi (and hi - 1 if grazing): plane 2 ORs the column left.
-    idx = grazing * geo._plane_of + hi * geo._hi_stride + entered * geo._entered_stride
+    idx = grazing * geo.plane_of + hi * geo.hi_stride + entered * geo.entered_stride
     hit = lookup[idx.astype(np.intp)]
     # Crossings come in order along the ray: the first blocked one is the nearest.
     first = hit.argmax(axis=3)
@@ -388,13 +388,13 @@ def polygon_hits(
     n, r = c.shape
     best = np.full((n, r), np.inf)
     # Candidate edges: those whose bounding box is within max_range of the origin.
-    lo, hi = geo._edge_lo, geo._edge_hi
+    lo, hi = geo.edge_lo, geo.edge_hi
     near = (
         (hi[None, :, 0] >= p[:, 0, None] - max_range) & (lo[None, :, 0] <= p[:, 0, None] + max_range)
         & (hi[None, :, 1] >= p[:, 1, None] - max_range) & (lo[None, :, 1] <= p[:, 1, None] + max_range)
     )
     robot, edge = np.nonzero(near)
-    e = geo._edge_vec[edge]
+    e = geo.edge_vec[edge]
     f = geo.edge_a[edge] - p[robot]
     # Back faces: an origin on the material's side of an edge's line cannot first meet it
     # (an origin inside a polygon reads 0 below).
@@ -412,7 +412,7 @@ def polygon_hits(
             t = (fx * ey - fy * ex) * inv
             u = (fx * dy - fy * dx) * inv
             # Touching an end counts: u within TOUCH_EPS metres of [0, 1].
-            hit = (t >= 0.0) & (np.abs(u - 0.5) <= geo._edge_half_slack[edge, None])
+            hit = (t >= 0.0) & (np.abs(u - 0.5) <= geo.edge_half_slack[edge, None])
         t = np.where(hit, t, np.inf)
         if n == 1:
             best[0] = t.min(axis=0)
@@ -431,9 +431,9 @@ def inside_polygon(geo: ScanGeometry, p: NDArray[np.float64]) -> NDArray[np.intp
     inv = 1.0 / geo.resolution
     col = np.minimum(np.maximum(np.floor((p[:, 0] - geo.origin[0]) * inv) + 1, 0), wp - 1).astype(np.intp)
     row = np.minimum(np.maximum(np.floor((p[:, 1] - geo.origin[1]) * inv) + 1, 0), hp - 1).astype(np.intp)
-    check = np.flatnonzero(geo._near_polygon[row * wp + col])
+    check = np.flatnonzero(geo.near_polygon[row * wp + col])
     if len(check):
-        return check[geo._poly_tree.query(shapely.points(p[check]), predicate="intersects")[0]]
+        return check[geo.poly_tree.query(shapely.points(p[check]), predicate="intersects")[0]]
     return check
 
 

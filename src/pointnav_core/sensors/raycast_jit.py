@@ -74,7 +74,7 @@ def cast_rays_compiled(
     """
     out = np.empty((len(cy), len(ca)), dtype=np.float64)
     near = kernel()(
-        p, cy, sy, ca, sa, geometry._jit_params(max_range), geometry._lookup, geometry._clearance,
-        geometry._near_polygon, geometry.edge_table, discs, own, out,
+        p, cy, sy, ca, sa, geometry.jit_params(max_range), geometry.lookup, geometry.clearance,
+        geometry.near_polygon, geometry.edge_table, discs, own, out,
     )
     return out, near

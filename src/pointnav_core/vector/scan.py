@@ -76,15 +76,15 @@ class ScanTables:
         self.geometries = [ScanGeometry(scene.floors[floor]) for scene in scenes]
         for geo in self.geometries:
             hp, wp = geo.shape
-            lookups.append(geo._lookup)
-            clears.append(geo._clearance)
+            lookups.append(geo.lookup)
+            clears.append(geo.clearance)
             edges.append(geo.edge_table)
             n_edges = len(geo.edge_table)
             # lookup offset, clearance offset, padded rows, padded columns, cell size, origin,
             # first polygon edge, number of edges
             meta.append((lo, co, hp, wp, geo.resolution, geo.origin[0], geo.origin[1], eo, n_edges))
-            lo += geo._lookup.size
-            co += geo._clearance.size
+            lo += geo.lookup.size
+            co += geo.clearance.size
             eo += n_edges
         #: Per scene: lookup offset, clearance offset, hp, wp, resolution, ox, oy, first
         #: edge, edges (float64).
