@@ -18,7 +18,8 @@ from shapely.geometry import box
 
 from pointnav_core.floor.collision import FloorCollision
 from pointnav_core.floor.maps import TraversableMap
-from pointnav_core.geodesic.planner import Planner, path_length, planner_for
+from pointnav_core.geodesic.paths import path_length
+from pointnav_core.geodesic.planner import Planner, planner_for
 
 
 def test_radius_below_half_a_cell_is_not_ignored():

@@ -48,7 +48,6 @@ from pointnav_core.datasets.playback import episode_seed
 from pointnav_core.datasets.scene_sets import load_scene, locate_scene
 from pointnav_core.envs.config import EnvConfig
 from pointnav_core.errors import ArgumentError, EpisodeError
-from pointnav_core.policies.spaces import check_spaces
 from pointnav_core.evaluation.config import (
     check_beside_config,
     check_robot_radius,
@@ -57,6 +56,7 @@ from pointnav_core.evaluation.config import (
 from pointnav_core.evaluation.report import (
     EpisodeResult,
 )
+from pointnav_core.policies.spaces import check_spaces
 from pointnav_core.task import metrics
 from pointnav_core.utils.validation import integer
 from pointnav_core.utils.workers import WorkerError, WorkerPool, usable_cores

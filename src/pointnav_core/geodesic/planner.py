@@ -53,7 +53,6 @@ from pointnav_core.geodesic.arc_graph import ArcGraph
 from pointnav_core.geodesic.cell_links import CellLinks
 from pointnav_core.geodesic.edges import build_edges
 from pointnav_core.geodesic.field import GoalField
-from pointnav_core.geodesic.paths import path_length, resample_path
 from pointnav_core.geodesic.point_search import PointSearch
 from pointnav_core.geodesic.roots import compiled
 from pointnav_core.geodesic.sight import NodeBalls, node_sights
@@ -63,7 +62,7 @@ from pointnav_core.utils.frozen import ThawOnUnpickle
 if TYPE_CHECKING:
     from pointnav_core.floor.maps import TraversableMap
 
-__all__ = ["Planner", "planner_for", "resample_path", "path_length"]
+__all__ = ["Planner", "planner_for"]
 
 #: Nodes whose tangent edges are found together by build_all_edges.
 _EDGE_BATCH = 256
