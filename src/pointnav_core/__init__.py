@@ -7,8 +7,6 @@ first use, and the ids ``pointnav_core/PointNav-v0`` (Gymnasium) and
 library as soon as both it and this package are imported (see ``registration``).
 """
 
-from typing import Any
-
 from pointnav_core.envs.registration import register_envs, register_when_imported
 from pointnav_core.errors import (
     ArgumentError,
@@ -21,6 +19,7 @@ from pointnav_core.floor.maps import FREE, OBSTACLE, VOID, TraversableMap
 from pointnav_core.scenes import Scene
 from pointnav_core.task import PointNavigationTask, TaskState, TaskStateError
 from pointnav_core.task.metrics import soft_spl, spl
+from pointnav_core.utils.lazy import lazy_exports
 
 __version__ = "0.1.0"
 
@@ -49,25 +48,14 @@ __all__ = [
 
 #: Exports that load Gymnasium or PettingZoo (EnvConfig checks its fields with the envs' own
 #: code), imported on first access.
-_LAZY = {
-    "PointNavEnv": "pointnav_core.envs.pointnav",
-    "MultiPointNavEnv": "pointnav_core.envs.multi_pointnav",
-    "EnvConfig": "pointnav_core.envs.config",
-}
-
-
-def __getattr__(name: str) -> Any:
-    if name in _LAZY:
-        import importlib
-
-        value = getattr(importlib.import_module(_LAZY[name]), name)
-        globals()[name] = value
-        return value
-    raise AttributeError(f"module 'pointnav_core' has no attribute {name!r}")
-
-
-def __dir__() -> list[str]:
-    return sorted(set(globals()) | set(_LAZY))
-
+__getattr__, __dir__ = lazy_exports(
+    "pointnav_core",
+    {
+        "PointNavEnv": "pointnav_core.envs.pointnav",
+        "MultiPointNavEnv": "pointnav_core.envs.multi_pointnav",
+        "EnvConfig": "pointnav_core.envs.config",
+    },
+    globals(),
+)
 
 register_when_imported()

@@ -5,7 +5,7 @@ wrappers, and registration with both libraries.
 The names load Gymnasium or PettingZoo, so they are imported on first access.
 """
 
-from typing import Any
+from pointnav_core.utils.lazy import lazy_exports
 
 __all__ = [
     "DatasetEpisodes",
@@ -20,29 +20,19 @@ __all__ = [
     "register_envs",
 ]
 
-_LAZY = {
-    "PointNavEnv": "pointnav_core.envs.pointnav",
-    "TaskStepLimit": "pointnav_core.envs.pointnav",
-    "MultiPointNavEnv": "pointnav_core.envs.multi_pointnav",
-    "parallel_env": "pointnav_core.envs.multi_pointnav",
-    "env": "pointnav_core.envs.multi_pointnav",
-    "raw_env": "pointnav_core.envs.multi_pointnav",
-    "EnvConfig": "pointnav_core.envs.config",
-    "DatasetEpisodes": "pointnav_core.envs.dataset_wrappers",
-    "ParallelDatasetEpisodes": "pointnav_core.envs.dataset_wrappers",
-    "register_envs": "pointnav_core.envs.registration",
-}
-
-
-def __getattr__(name: str) -> Any:
-    if name in _LAZY:
-        import importlib
-
-        value = getattr(importlib.import_module(_LAZY[name]), name)
-        globals()[name] = value
-        return value
-    raise AttributeError(f"module 'pointnav_core.envs' has no attribute {name!r}")
-
-
-def __dir__() -> list[str]:
-    return sorted(set(globals()) | set(_LAZY))
+__getattr__, __dir__ = lazy_exports(
+    "pointnav_core.envs",
+    {
+        "PointNavEnv": "pointnav_core.envs.pointnav",
+        "TaskStepLimit": "pointnav_core.envs.pointnav",
+        "MultiPointNavEnv": "pointnav_core.envs.multi_pointnav",
+        "parallel_env": "pointnav_core.envs.multi_pointnav",
+        "env": "pointnav_core.envs.multi_pointnav",
+        "raw_env": "pointnav_core.envs.multi_pointnav",
+        "EnvConfig": "pointnav_core.envs.config",
+        "DatasetEpisodes": "pointnav_core.envs.dataset_wrappers",
+        "ParallelDatasetEpisodes": "pointnav_core.envs.dataset_wrappers",
+        "register_envs": "pointnav_core.envs.registration",
+    },
+    globals(),
+)

@@ -3,13 +3,14 @@ environments onto disk (PNG, GIF). Imports Pillow only to write files.
 """
 
 from pointnav_core.render.top_down import TopDownRenderer
+from pointnav_core.utils.lazy import lazy_exports
 
 __all__ = ["TopDownRenderer", "record_episode", "render_env", "save_gif", "save_png"]
 
 
-def __getattr__(name: str):
-    if name in {"record_episode", "render_env", "save_gif", "save_png"}:
-        from pointnav_core.render import recording
-
-        return getattr(recording, name)
-    raise AttributeError(f"module 'pointnav_core.render' has no attribute {name!r}")
+# The recording functions load Pillow, so they are imported on first access.
+__getattr__, __dir__ = lazy_exports(
+    "pointnav_core.render",
+    {name: "pointnav_core.render.recording" for name in ("record_episode", "render_env", "save_gif", "save_png")},
+    globals(),
+)
