@@ -29,7 +29,7 @@ import tempfile
 import warnings
 import zipfile
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from numpy.typing import NDArray
@@ -39,7 +39,7 @@ from pointnav_core.errors import ArgumentError
 if TYPE_CHECKING:
     from pointnav_core.floor.collision import FloorCollision
 
-__all__ = ["ENV_VAR", "MIN_SECONDS", "cache_dir", "floor_key", "load", "save"]
+__all__ = ["ENV_VAR", "MIN_SECONDS", "cache_dir", "edge_arrays", "edges_from_arrays", "floor_key", "load", "save"]
 
 ENV_VAR = "POINTNAV_CACHE_DIR"
 #: Builds (s) shorter than this are not written to the cache.
@@ -123,3 +123,31 @@ def save(key: str, arrays: dict[str, NDArray]) -> Path | None:
         Path(tmp).unlink(missing_ok=True)
         return None
     return path
+
+
+def edge_arrays(store: dict[tuple[int, int], tuple[list[Any], ...]]) -> dict[str, NDArray[Any]]:
+    """A planner's edges, ``(node, side) -> (departures, targets, target sides, arrivals,
+    lengths)``, as the flat arrays an entry keeps."""
+    keys = sorted(store)
+    lists = [store[k] for k in keys]
+    return {
+        "node": np.array([k[0] for k in keys], dtype=np.int64),
+        "side": np.array([k[1] for k in keys], dtype=np.int8),
+        "count": np.array([len(v[0]) for v in lists], dtype=np.int64),
+        "dep": np.array([x for v in lists for x in v[0]], dtype=np.float64),
+        "to": np.array([x for v in lists for x in v[1]], dtype=np.int64),
+        "to_side": np.array([x for v in lists for x in v[2]], dtype=np.int8),
+        "arr": np.array([x for v in lists for x in v[3]], dtype=np.float64),
+        "length": np.array([x for v in lists for x in v[4]], dtype=np.float64),
+    }
+
+
+def edges_from_arrays(stored: dict[str, NDArray[Any]]) -> dict[tuple[int, int], tuple[list[Any], ...]]:
+    """The edges :func:`edge_arrays` flattened, as lists again."""
+    ends = np.cumsum(stored["count"])
+    starts = ends - stored["count"]
+    cols = [stored[k].tolist() for k in ("dep", "to", "to_side", "arr", "length")]
+    return {
+        (node, side): tuple(c[i:j] for c in cols)
+        for node, side, i, j in zip(stored["node"].tolist(), stored["side"].tolist(), starts.tolist(), ends.tolist())
+    }

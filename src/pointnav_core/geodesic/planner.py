@@ -43,20 +43,22 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy import ndimage
 from scipy.spatial import cKDTree
-from shapely.geometry.polygon import orient
 from tqdm.auto import tqdm
 
 from pointnav_core.errors import ArgumentError
-from pointnav_core.floor.collision import TOUCH_TOL, FloorCollision, convex_corners
+from pointnav_core.floor.collision import FloorCollision
 from pointnav_core.geodesic import cache
 from pointnav_core.geodesic.arc_graph import ArcGraph
+from pointnav_core.geodesic.cache import edge_arrays, edges_from_arrays
 from pointnav_core.geodesic.cell_links import CellLinks
 from pointnav_core.geodesic.edges import build_edges
 from pointnav_core.geodesic.field import GoalField
+from pointnav_core.geodesic.links import point_links
+from pointnav_core.geodesic.nodes import corner_arcs
 from pointnav_core.geodesic.point_search import PointSearch
-from pointnav_core.geodesic.roots import compiled
 from pointnav_core.geodesic.sight import NodeBalls, node_sights
-from pointnav_core.geodesic.tangents import ANG_TOL, TWO_PI, ccw_pos, tangent_from_point
+from pointnav_core.geodesic.tangents import ANG_TOL
+from pointnav_core.geodesic.usable import nearest_usable, usable_cells
 from pointnav_core.utils.frozen import ThawOnUnpickle
 
 if TYPE_CHECKING:
@@ -67,8 +69,6 @@ __all__ = ["Planner", "planner_for"]
 #: Nodes whose tangent edges are found together by build_all_edges.
 _EDGE_BATCH = 256
 
-#: Samples along a node's arc used to find the parts of it within ``r`` of something else.
-_ARC_SAMPLES = 9
 #: Nodes whose edges a build finds before it shows a progress bar (about 2 s of work).
 _PROGRESS_NODES = 20_000
 #: Side (cells) of the square tiles whose nodes get their edges built together.
@@ -137,7 +137,7 @@ class Planner(ThawOnUnpickle):
         if stored is not None:
             self.sights = stored["sights"].astype(np.float64)
             self.sight_profile = stored["sight_profile"].astype(np.float32)
-            self._restore_edges(stored)
+            self.edge_store.update(edges_from_arrays(stored))
             self._check_geometry_bytes()
             self._cell_links = CellLinks.stored(stored, collision.shape[0] * collision.shape[1], self.n_nodes)
         else:
@@ -158,44 +158,11 @@ class Planner(ThawOnUnpickle):
 
     # ------------------------------------------------------------------ nodes
     def _build_nodes(self) -> None:
-        geo, r = self.geo, self.radius
+        geo = self.geo
         res = geo.resolution
         ox, oy = geo.origin
-        rows, cols, quad = convex_corners(geo.blocked, geo.outside_blocked)
-        xs = [ox + cols * res]
-        ys = [oy + rows * res]
-        phi0 = [quad * (math.pi / 2)]
-        span = [np.full(len(rows), math.pi / 2)]
-        for poly in geo.polygons:
-            for ring in _rings(poly):
-                pts = np.asarray(ring.coords)[:-1]
-                if len(pts) < 3:
-                    continue
-                e1 = pts - np.roll(pts, 1, axis=0)
-                e2 = np.roll(pts, -1, axis=0) - pts
-                cross = e1[:, 0] * e2[:, 1] - e1[:, 1] * e2[:, 0]
-                dot = (e1 * e2).sum(axis=1)
-                convex = cross > 1e-12
-                a1 = np.arctan2(-e1[:, 0], e1[:, 1])  # outward normal of the edge before
-                turn = np.arctan2(cross, dot)
-                xs.append(pts[convex, 0])
-                ys.append(pts[convex, 1])
-                phi0.append(a1[convex])
-                span.append(turn[convex])
-        cx = np.concatenate(xs).astype(np.float64)
-        cy = np.concatenate(ys).astype(np.float64)
-        phi0_all = np.mod(np.concatenate(phi0).astype(np.float64), TWO_PI)
-        span_all = np.concatenate(span).astype(np.float64)
-        # Which samples of each arc are clear of everything else.
-        k = np.linspace(0.0, 1.0, _ARC_SAMPLES)
-        ang = phi0_all[:, None] + span_all[:, None] * k[None, :]
-        pts = np.stack([cx[:, None] + r * np.cos(ang), cy[:, None] + r * np.sin(ang)], axis=-1)
-        clear = geo.points_clear(pts, r) if len(cx) else np.zeros((0, _ARC_SAMPLES), bool)
-        keep = clear.any(axis=1)
-        self.cx, self.cy = cx[keep], cy[keep]
-        self.phi0, self.span = phi0_all[keep], span_all[keep]
-        self.arc_clear = clear[keep]
-        self.n_nodes = int(keep.sum())
+        self.cx, self.cy, self.phi0, self.span, self.arc_clear, k = corner_arcs(geo, self.radius)
+        self.n_nodes = len(self.cx)
         # The same numbers as Python lists: the package's scalar loops (arcs, fields, point
         # search) index them one node at a time, where a numpy scalar costs ten times more.
         self.cx_list, self.cy_list = self.cx.tolist(), self.cy.tolist()
@@ -322,7 +289,7 @@ class Planner(ThawOnUnpickle):
         self._build_seconds += time.perf_counter() - started
         if self._cache_key is not None and self._build_seconds >= cache.MIN_SECONDS:
             links = self._cell_links.arrays() if isinstance(self._cell_links, CellLinks) else {}
-            self._in_cache = cache.save(self._cache_key, {**self._stored_edges(), **links}) is not None
+            self._in_cache = cache.save(self._cache_key, {**self._edge_arrays(), **links}) is not None
 
     @property
     def geometry_nbytes(self) -> int:
@@ -370,7 +337,7 @@ class Planner(ThawOnUnpickle):
                 if self.geometry_nbytes > self.geometry_bytes:
                     self._cell_links = False  # optional: not kept past the budget
                 if self._cache_key is not None and self._build_seconds >= cache.MIN_SECONDS:
-                    arrays = {**self._stored_edges(), **self._cell_links.arrays()}
+                    arrays = {**self._edge_arrays(), **self._cell_links.arrays()}
                     self._in_cache = cache.save(self._cache_key, arrays) is not None
         return self._cell_links or None
 
@@ -391,30 +358,9 @@ class Planner(ThawOnUnpickle):
         """Whether this floor's build is in the disk cache (read from it, or written to it)."""
         return self._in_cache
 
-    def _stored_edges(self) -> dict[str, NDArray[Any]]:
+    def _edge_arrays(self) -> dict[str, NDArray[Any]]:
         """The sights and every edge as flat arrays (what the disk cache keeps)."""
-        keys = sorted(self.edge_store)
-        lists = [self.edge_store[k] for k in keys]
-        return {
-            "sights": self.sights,
-            "sight_profile": self.sight_profile,
-            "node": np.array([k[0] for k in keys], dtype=np.int64),
-            "side": np.array([k[1] for k in keys], dtype=np.int8),
-            "count": np.array([len(v[0]) for v in lists], dtype=np.int64),
-            "dep": np.array([x for v in lists for x in v[0]], dtype=np.float64),
-            "to": np.array([x for v in lists for x in v[1]], dtype=np.int64),
-            "to_side": np.array([x for v in lists for x in v[2]], dtype=np.int8),
-            "arr": np.array([x for v in lists for x in v[3]], dtype=np.float64),
-            "length": np.array([x for v in lists for x in v[4]], dtype=np.float64),
-        }
-
-    def _restore_edges(self, stored: dict[str, NDArray[Any]]) -> None:
-        """Fill the edges from :meth:`_stored_edges`' arrays."""
-        ends = np.cumsum(stored["count"])
-        starts = ends - stored["count"]
-        cols = [stored[k].tolist() for k in ("dep", "to", "to_side", "arr", "length")]
-        for node, side, i, j in zip(stored["node"].tolist(), stored["side"].tolist(), starts.tolist(), ends.tolist()):
-            self.edge_store[(node, side)] = tuple(c[i:j] for c in cols)  # type: ignore[assignment]
+        return {"sights": self.sights, "sight_profile": self.sight_profile, **edge_arrays(self.edge_store)}
 
     def arc_graph(self) -> ArcGraph:
         """The whole tangent graph as a plain digraph (built on first use, then cached)."""
@@ -438,35 +384,7 @@ class Planner(ThawOnUnpickle):
         ``side`` is the winding of a path that leaves the point and wraps the node; the
         reverse path (node to point) winds ``-side`` and leaves at ``span - arrival``.
         """
-        if not self.n_nodes:
-            return []
-        r = self.radius
-        cand = self.nodes_seeing(np.array([x]), np.array([y]))[1]
-        links: list[tuple[int, int, float, float]] = []
-        if not len(cand):
-            return links
-        kernel = compiled(self, "point_links")
-        if kernel is not None:
-            # The same tangents in compiled code (the sight profile first rules out hidden ones).
-            node, side = np.empty(2 * len(cand), np.int64), np.empty(2 * len(cand), np.int64)
-            pos, length = np.empty(2 * len(cand)), np.empty(2 * len(cand))
-            n = kernel(float(x), float(y), cand, self.cx, self.cy, self.phi0, self.span, r, ANG_TOL, TOUCH_TOL,
-                       self.sight_profile, *self.geo.kernel_geometry(), node, side, pos, length)
-            return list(zip(node[:n].tolist(), (1 - 2 * side[:n]).tolist(), pos[:n].tolist(), length[:n].tolist()))
-        for s in (1, -1):
-            ang, length, _, ok = tangent_from_point(x, y, self.cx[cand], self.cy[cand], r, s)
-            ccw, ok_arc = ccw_pos(ang, self.phi0[cand], self.span[cand])
-            ok &= ok_arc
-            idx = np.flatnonzero(ok)
-            if not len(idx):
-                continue
-            q = np.stack([self.cx[cand[idx]] + r * np.cos(ang[idx]), self.cy[cand[idx]] + r * np.sin(ang[idx])], axis=1)
-            clear = self.geo.segments_clear(np.array([x, y]), q, r)
-            for i in idx[clear].tolist():
-                c = int(cand[i])
-                pos = float(ccw[i]) if s > 0 else self.span_list[c] - float(ccw[i])
-                links.append((c, s, pos, float(length[i])))
-        return links
+        return point_links(self, x, y)
 
     # ------------------------------------------------------------------ queries
     def is_clear(self, x: float, y: float) -> bool:
@@ -546,32 +464,14 @@ class Planner(ThawOnUnpickle):
     def usable(self) -> NDArray[np.bool_]:
         """Cells whose centre the robot's disc fits at (read-only)."""
         if self._usable is None:
-            geo = self.geo
-            h, w = geo.shape
-            rows, cols = np.mgrid[0:h, 0:w]
-            centres = np.stack(
-                [geo.origin[0] + (cols + 0.5) * geo.resolution, geo.origin[1] + (rows + 0.5) * geo.resolution],
-                axis=-1,
-            )
-            mask = ~geo.blocked
-            sub = geo.points_clear(centres[mask], self.radius)
-            usable = np.zeros((h, w), dtype=bool)
-            usable[mask] = sub
-            usable.flags.writeable = False
-            self._usable = usable
+            self._usable = usable_cells(self.geo, self.radius)
         return self._usable
 
     @property
     def near_usable(self) -> NDArray[np.int32]:
         """Flat index of each cell's nearest usable cell (-1 where none is), int32."""
         if self._near is None:
-            usable = self.usable
-            h, w = usable.shape
-            if usable.any():
-                _, (nr, nc) = ndimage.distance_transform_edt(~usable, return_indices=True)
-                self._near = (nr * w + nc).ravel().astype(np.int32)
-            else:
-                self._near = np.full(h * w, -1, dtype=np.int32)
+            self._near = nearest_usable(self.usable)
         return self._near
 
 
@@ -587,7 +487,3 @@ def _runs(sorted_keys: NDArray[np.int64]) -> list[tuple[int, int, int]]:
     ends = np.concatenate([cut, [len(sorted_keys)]])
     return list(zip(sorted_keys[starts].tolist(), starts.tolist(), ends.tolist()))
 
-
-def _rings(poly: Any) -> list[Any]:
-    """Exterior rings of a polygon's parts, counter-clockwise (the blocked side on the left)."""
-    return [orient(part, 1.0).exterior for part in getattr(poly, "geoms", [poly])]
