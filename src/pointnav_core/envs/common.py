@@ -13,7 +13,6 @@ import copy
 import dataclasses
 import inspect
 import math
-import sys
 import warnings
 from collections import OrderedDict
 from collections.abc import Mapping
@@ -262,7 +261,8 @@ def fit_path_range(
 def _stacklevel_outside_package() -> int:
     """The ``stacklevel`` that points a warning at the first caller outside this package
     and the env libraries (``gymnasium.make`` may sit in between)."""
-    frame, level = sys._getframe(1), 1
+    here = inspect.currentframe()
+    frame, level = (here.f_back if here is not None else None), 1
     while frame is not None and frame.f_globals.get("__name__", "").partition(".")[0] in _SKIPPED:
         frame, level = frame.f_back, level + 1
     return level

@@ -364,7 +364,9 @@ class TaskStepLimit(gym.Wrapper[Any, np.ndarray, Any, np.ndarray], gym.utils.Rec
         inner: Any = env
         while isinstance(inner, gym.Wrapper):
             if isinstance(inner, gym.wrappers.TimeLimit):
-                limit, config = inner._max_episode_steps, getattr(env.unwrapped, "config", None)
+                # gymnasium 1.x keeps the limit only in this attribute (its spec may be None)
+                limit = inner._max_episode_steps  # noqa: SLF001
+                config = getattr(env.unwrapped, "config", None)
                 if config is not None and limit != config.max_steps:
                     raise ArgumentError(
                         f"max_episode_steps={limit} given beside config, which sets "
