@@ -184,6 +184,13 @@ def render_env(
     floor = tasks[0].floor if tasks else 0
     renderer = _renderer_for(env.scene.floors[floor], ppm, renderers)
 
+    markers = _marker_glyphs(tasks, floor)
+    robots = _robot_glyphs(env, tasks, floor)
+    return renderer.draw(robots, markers, _scan_glyphs(env.backend, tasks, floor))
+
+
+def _marker_glyphs(tasks: list[Any], floor: int) -> list[Marker]:
+    """The visible markers of the tasks on ``floor``, coloured by kind."""
     markers = []
     for task in tasks:
         if task.floor != floor:
@@ -194,6 +201,11 @@ def render_env(
                     Marker(position_xy=marker.position[:2], radius=marker.radius, color=MARKER_COLORS[marker.kind])
                 )
 
+    return markers
+
+
+def _robot_glyphs(env: Any, tasks: list[Any], floor: int) -> list[RobotGlyph]:
+    """The placed robots present on ``floor``, coloured by id."""
     backend = env.backend
     # A robot whose task has never been reset has not been placed (it stands at the origin).
     unplaced = {task.robot_idn for task in tasks if task.state is TaskState.IDLE}
@@ -210,6 +222,11 @@ def render_env(
                 color=ROBOT_PALETTE[idn % len(ROBOT_PALETTE)],
             )
         )
+    return robots
+
+
+def _scan_glyphs(backend: Any, tasks: list[Any], floor: int) -> list[ScanGlyph]:
+    """The last range scan of each task on ``floor`` with a ``"scan"`` term and a robot present."""
     scans = []
     for task in tasks:
         term = task.observation_terms.get("scan")
@@ -222,7 +239,7 @@ def render_env(
         bearings = yaw + term.angles
         ends = np.stack([x + readings * np.cos(bearings), y + readings * np.sin(bearings)], axis=1)
         scans.append(ScanGlyph(origin_xy=(x, y), ends_xy=ends, hit=readings < term.max_range))
-    return renderer.draw(robots, markers, scans)
+    return scans
 
 
 def record_episode(
