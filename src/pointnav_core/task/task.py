@@ -506,23 +506,9 @@ class PointNavigationTask(OmniGibsonTaskAPI):
             ep = self._ep
             ep.advance(x, y, z, quat, contact)
 
-            # Each condition's result, and the same as info["termination_conditions"].
-            results: dict[str, tuple[bool, bool]] = {}
-            conditions: dict[str, dict[str, bool]] = {}
-            done = success = terminated = truncated = False
-            for name, condition in self._termination_items:
-                result = condition.step(self, env, action)
-                results[name] = result
-                is_done, is_success = result
-                conditions[name] = {"done": is_done, "success": is_success}
-                if is_done:
-                    done = True
-                    if is_success:
-                        success = True
-                    if condition.is_truncation:
-                        truncated = True
-                    else:
-                        terminated = True
+            results, conditions, done, success, terminated, truncated = _terminations(
+                self._termination_items, self, env, action
+            )
             ep.results = results
             ep.success = success
 
@@ -553,3 +539,34 @@ class PointNavigationTask(OmniGibsonTaskAPI):
             f"PointNavigationTask(robot_idn={self._idn}, floor={self._config.floor}, "
             f"reward_type={self._config.reward_type!r}, state={self._state.name})"
         )
+
+
+def _terminations(
+    items: tuple[tuple[str, TerminationCondition], ...],
+    task: PointNavigationTask,
+    env: TaskEnv,
+    action: Any,
+) -> tuple[dict[str, tuple[bool, bool]], dict[str, dict[str, bool]], bool, bool, bool, bool]:
+    """Evaluate every termination condition in ``items``, none short-circuiting.
+
+    Returns ``(results, conditions, done, success, terminated, truncated)``: each
+    condition's ``(done, success)``, the same as ``info["termination_conditions"]``, and
+    the step's flags.
+    """
+    results: dict[str, tuple[bool, bool]] = {}
+    conditions: dict[str, dict[str, bool]] = {}
+    done = success = terminated = truncated = False
+    for name, condition in items:
+        result = condition.step(task, env, action)
+        results[name] = result
+        is_done, is_success = result
+        conditions[name] = {"done": is_done, "success": is_success}
+        if is_done:
+            done = True
+            if is_success:
+                success = True
+            if condition.is_truncation:
+                truncated = True
+            else:
+                terminated = True
+    return results, conditions, done, success, terminated, truncated
