@@ -13,16 +13,18 @@ from PIL import Image
 
 from pointnav_core.errors import ArgumentError
 from pointnav_core.floor.maps import BoundedCache, TraversableMap
-from pointnav_core.render.top_down import (
-    DEFAULT_PIXELS_PER_METER,
+from pointnav_core.render.glyphs import (
     MARKER_COLORS,
-    ROBOT_PALETTE,
     Marker,
-    PathArg,
     RobotGlyph,
     ScanGlyph,
+    check_number,
+)
+from pointnav_core.render.top_down import (
+    DEFAULT_PIXELS_PER_METER,
+    ROBOT_PALETTE,
+    PathArg,
     TopDownRenderer,
-    _check_number,
 )
 from pointnav_core.task import TaskState
 from pointnav_core.transforms import quat2yaw
@@ -80,7 +82,7 @@ def save_gif(frames: Iterable[ArrayLike], path: PathArg, fps: float = 10) -> Non
         When there is no frame, a frame is not a uint8 (H, W, 3) array, the frames differ in
         shape, or ``fps`` is not a finite number > 0.
     """
-    rate = _check_number(fps, "fps", " (frames/s)", low=0.0, strict=True)
+    rate = check_number(fps, "fps", " (frames/s)", low=0.0, strict=True)
     images = []
     first_shape: tuple[int, ...] | None = None
     for i, frame in enumerate(frames):
@@ -179,7 +181,7 @@ def render_env(
         pixels_per_meter = getattr(env, "render_pixels_per_meter", None)
         if pixels_per_meter is None:
             pixels_per_meter = DEFAULT_PIXELS_PER_METER
-    ppm = _check_number(pixels_per_meter, "pixels_per_meter", " (px/m)", low=0.0, strict=True)
+    ppm = check_number(pixels_per_meter, "pixels_per_meter", " (px/m)", low=0.0, strict=True)
     tasks = _env_tasks(env)
     floor = tasks[0].floor if tasks else 0
     renderer = _renderer_for(env.scene.floors[floor], ppm, renderers)
