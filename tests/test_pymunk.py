@@ -19,8 +19,8 @@ from hypothesis import given
 from hypothesis import strategies as st
 from pointnav_kinematic import KinematicBackend
 from pointnav_pymunk import OVERLAP_TOLERANCE, TOUCH_TOLERANCE, PymunkBackend
-from pointnav_pymunk.backend import _project
 from pointnav_pymunk.geometry import convex_pieces, floor_pieces, merge_cells
+from pointnav_pymunk.velocity import closest_feasible
 from shapely.geometry import Point, Polygon, box
 
 from pointnav_core import floorplans, scenes
@@ -480,7 +480,7 @@ def test_no_pymunk_noise_when_a_backend_lives_until_interpreter_exit(tmp_path):
 )
 def test_projection_is_feasible_and_no_worse_than_stopping(u, limits):
     constraints = [(math.cos(a), math.sin(a), c) for a, c in limits]
-    vx, vy = _project(u[0], u[1], constraints)
+    vx, vy = closest_feasible(u[0], u[1], constraints)
     for nx, ny, c in constraints:
         assert nx * vx + ny * vy >= c - 1e-9
     assert (vx - u[0]) ** 2 + (vy - u[1]) ** 2 <= u[0] ** 2 + u[1] ** 2 + 1e-12

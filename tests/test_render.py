@@ -19,6 +19,13 @@ from pointnav_core.backends.robot_spec import RobotSpec
 from pointnav_core.envs.pointnav import PointNavEnv
 from pointnav_core.floor.maps import FREE, OBSTACLE, VOID, TraversableMap
 from pointnav_core.policies.oracle import ShortestPathFollower
+from pointnav_core.render.glyphs import (
+    GOAL_COLOR,
+    START_COLOR,
+    WAYPOINT_COLOR,
+    Marker,
+    RobotGlyph,
+)
 from pointnav_core.render.recording import (
     record_episode,
     render_env,
@@ -27,12 +34,7 @@ from pointnav_core.render.recording import (
 )
 from pointnav_core.render.top_down import (
     FLOOR_COLORS,
-    GOAL_COLOR,
     ROBOT_PALETTE,
-    START_COLOR,
-    WAYPOINT_COLOR,
-    Marker,
-    RobotGlyph,
     TopDownRenderer,
     contrast_color,
 )

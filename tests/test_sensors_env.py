@@ -374,7 +374,7 @@ def test_robots_cast_together_exactly_as_each_alone():
 
 
 def test_render_draws_the_scan_rays_and_hits():
-    from pointnav_core.render.top_down import SCAN_HIT_COLOR, SCAN_RAY_COLOR, ScanGlyph
+    from pointnav_core.render.glyphs import SCAN_HIT_COLOR, SCAN_RAY_COLOR, ScanGlyph
 
     def colours(frame, colour):
         return int((frame == np.array(colour, np.uint8)).all(axis=2).sum())
@@ -392,7 +392,7 @@ def test_render_draws_the_scan_rays_and_hits():
 
 
 def test_multi_robot_render_draws_every_robots_scan():
-    from pointnav_core.render.top_down import SCAN_HIT_COLOR
+    from pointnav_core.render.glyphs import SCAN_HIT_COLOR
 
     penv = parallel.parallel_env(scene=small_scene(), n_robots=2, sensors={"scan": {"n_rays": 8}}, render_mode="rgb_array")
     penv.reset(seed=0)

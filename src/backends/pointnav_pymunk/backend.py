@@ -27,6 +27,7 @@ from pointnav_pymunk.floor import (
     TOUCH_TOLERANCE,
     _Floor,
 )
+from pointnav_pymunk.velocity import closest_feasible
 
 __all__ = ["CONTACT_SLOP", "OVERLAP_TOLERANCE", "TOUCH_TOLERANCE", "PymunkBackend"]
 
@@ -99,41 +100,6 @@ def _empty_spaces(spaces: list[pymunk.Space]) -> None:
 def _depth(arbiter: pymunk.Arbiter) -> float:
     """How deep (m) the two shapes of ``arbiter`` overlap; 0 when they only touch."""
     return max((-p.distance for p in arbiter.contact_point_set.points), default=0.0)
-
-
-def _project(
-    ux: float, uy: float, limits: list[tuple[float, float, float]]
-) -> tuple[float, float]:
-    """The velocity closest to (ux, uy) with ``n . u >= c`` for every (nx, ny, c), c <= 0.
-
-    A 2D quadratic programme solved by enumerating active sets (one or two constraints);
-    zero is always feasible, since every c <= 0.
-    """
-
-    def feasible(vx: float, vy: float) -> bool:
-        return all(nx * vx + ny * vy >= c - 1e-12 for nx, ny, c in limits)
-
-    if feasible(ux, uy):
-        return ux, uy
-    best, best_d = (0.0, 0.0), ux * ux + uy * uy
-    for nx, ny, c in limits:
-        gap = c - (nx * ux + ny * uy)
-        if gap > 0.0:
-            vx, vy = ux + gap * nx, uy + gap * ny
-            d = gap * gap
-            if d < best_d and feasible(vx, vy):
-                best, best_d = (vx, vy), d
-    for i, (ax, ay, ac) in enumerate(limits):
-        for bx, by, bc in limits[i + 1 :]:
-            det = ax * by - ay * bx
-            if abs(det) < 1e-12:
-                continue
-            vx = (ac * by - ay * bc) / det
-            vy = (ax * bc - ac * bx) / det
-            d = (vx - ux) ** 2 + (vy - uy) ** 2
-            if d < best_d and feasible(vx, vy):
-                best, best_d = (vx, vy), d
-    return best
 
 
 class PymunkBackend(RobotStateBackend):
@@ -469,7 +435,7 @@ class PymunkBackend(RobotStateBackend):
                 ov = other.control.velocity
                 c = min(0.0, nx * ov.x + ny * ov.y)
             limits.append((nx, ny, c))
-        return _project(u[0], u[1], limits)
+        return closest_feasible(u[0], u[1], limits)
 
     def _settle(self, moving: list[_Robot], spaces: list[pymunk.Space], h: float) -> None:
         """Resolve overlaps left by the last sub-step, with nothing else moving."""

@@ -336,6 +336,12 @@ def _number(text: str) -> float:
 
 def add_commands(sub: Any, positive_int: Callable[[str], int]) -> None:
     """Add ``dataset generate`` and ``eval`` to the ``pointnav`` sub-command parser."""
+    _add_generate(sub, positive_int)
+    _add_eval(sub, positive_int)
+
+
+def _add_generate(sub: Any, positive_int: Callable[[str], int]) -> None:
+    """Add ``dataset generate``."""
     dataset = sub.add_parser("dataset", help="episode datasets")
     dsub = dataset.add_subparsers(dest="dataset_command", required=True)
     gen = dsub.add_parser("generate", help="generate an episode dataset with Habitat's rules")
@@ -371,6 +377,9 @@ def add_commands(sub: Any, positive_int: Callable[[str], int]) -> None:
     gen.add_argument("--quiet", action="store_true", help="no progress bar")
     gen.set_defaults(func=reporting("dataset generate", _dataset_generate))
 
+
+def _add_eval(sub: Any, positive_int: Callable[[str], int]) -> None:
+    """Add ``eval``."""
     ev = sub.add_parser("eval", help="evaluate a policy on an episode dataset")
     ev.add_argument("--dataset", required=True, metavar="FILE")
     ev.add_argument(

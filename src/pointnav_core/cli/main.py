@@ -92,6 +92,38 @@ def run_demo(
         raise ArgumentError(f"houses must be >= 1, got {houses}")
     if every < 1:
         raise ArgumentError(f"every must be >= 1, got {every}")
+    envs = _demo_envs(seed, houses, max_steps, backend, drive, frames, pixels_per_meter, scene)
+    houses = len(envs)
+    results: dict[str, list[float]] = {k: [] for k in ("success", "spl", "soft_spl", "path_length", "collisions")}
+    steps = 0
+    elapsed = 0.0
+    for episode in tqdm(range(episodes), disable=not progress, desc="episodes", unit="ep"):
+        env = envs[episode % houses]
+        _, info = env.reset(seed=seed * 100_003 + episode)
+        info, episode_steps, seconds = _play_oracle(env, frames if episode == 0 else None, every)
+        steps += episode_steps
+        elapsed += seconds
+        for key in results:
+            results[key].append(float(info[key]))
+    for env in envs:
+        env.close()
+    summary = {key: float(np.mean(values)) for key, values in results.items()}
+    summary.update(episodes=float(episodes), steps=float(steps), steps_per_second=steps / elapsed)
+    return summary
+
+
+def _demo_envs(
+    seed: int,
+    houses: int,
+    max_steps: int,
+    backend: str,
+    drive: str,
+    frames: list | None,
+    pixels_per_meter: float | None,
+    scene: str | None,
+) -> list[PointNavEnv]:
+    """One env per house of :func:`run_demo` (one for a ``scene`` file), rendering when
+    ``frames`` is given."""
     task: dict = {"termination_config": {"max_steps": max_steps}}
     if frames is not None:
         task.update(visualize_goal=True, visualize_path=True)
@@ -114,34 +146,30 @@ def run_demo(
     if pixels_per_meter is not None:
         for env in envs:
             env.render_pixels_per_meter = pixels_per_meter  # read by render_env
-    results: dict[str, list[float]] = {k: [] for k in ("success", "spl", "soft_spl", "path_length", "collisions")}
-    steps = 0
-    elapsed = 0.0
-    for episode in tqdm(range(episodes), disable=not progress, desc="episodes", unit="ep"):
-        env = envs[episode % houses]
-        _, info = env.reset(seed=seed * 100_003 + episode)
-        oracle = ShortestPathFollower(env)
-        record = frames is not None and episode == 0
-        if record:
+    return envs
+
+
+def _play_oracle(env: PointNavEnv, frames: list | None, every: int) -> tuple[dict, int, float]:
+    """Play the just-reset ``env``'s episode with the oracle.
+
+    Returns the last ``info``, the step count and the seconds spent stepping (oracle and
+    first frame not counted). With ``frames``, its frames are appended: after reset, every
+    ``every``-th step, and the last.
+    """
+    oracle = ShortestPathFollower(env)
+    if frames is not None:
+        frames.append(env.render())
+    done = False
+    episode_steps = 0
+    info: dict = {}
+    start = time.perf_counter()
+    while not done:
+        _, _, terminated, truncated, info = env.step(oracle.act())
+        episode_steps += 1
+        done = terminated or truncated
+        if frames is not None and (done or episode_steps % every == 0):
             frames.append(env.render())
-        done = False
-        episode_steps = 0
-        start = time.perf_counter()
-        while not done:
-            _, _, terminated, truncated, info = env.step(oracle.act())
-            steps += 1
-            episode_steps += 1
-            done = terminated or truncated
-            if record and (done or episode_steps % every == 0):
-                frames.append(env.render())
-        elapsed += time.perf_counter() - start
-        for key in results:
-            results[key].append(float(info[key]))
-    for env in envs:
-        env.close()
-    summary = {key: float(np.mean(values)) for key, values in results.items()}
-    summary.update(episodes=float(episodes), steps=float(steps), steps_per_second=steps / elapsed)
-    return summary
+    return info, episode_steps, time.perf_counter() - start
 
 
 def _demo(args: argparse.Namespace) -> int:

@@ -211,83 +211,125 @@ def generate_episodes(
         raise ArgumentError(f"n_episodes must be an integer >= 0, got {n_episodes!r}")
     rng = np.random.default_rng(seed)
     radius = config.robot_radius
-    near, far = config.geodesic_range
-    areas = np.array([f.usable(radius).sum() for f in scene.floors], dtype=np.float64)
-    if not areas.sum():
-        raise SamplingError(
-            f"scene {scene_id!r} has no usable cell for a robot of radius {radius} m"
-        )
-    floor_p = areas / areas.sum()
+    floor_p = _floor_weights(scene, scene_id, radius)
     episodes: list[PointNavEpisode] = []
     stats = {} if stats is None else stats
     total: dict[str, int] = stats.setdefault("rejected", {})
     trials: list[tuple[float, bool]] = stats.setdefault("ratio_trials", [])
     while len(episodes) < n_episodes:
-        rejected = {
-            "goal on a small island": 0,
-            "no path": 0,
-            "geodesic out of range": 0,
-            "ratio filter": 0,
-            "start on a small island": 0,
-        }
-        episode = None
-        for _ in range(config.max_goals_per_episode):
-            floor = int(rng.choice(len(areas), p=floor_p))
-            tmap = scene.floors[floor]
-            goal = _pick_cell(tmap, radius, rng)
-            if island_radius(scene, floor, goal, radius) < config.island_radius_limit:
-                rejected["goal on a small island"] += 1
-                continue
-            episode = None
-            for _ in range(config.retries_per_goal):
-                start = _pick_cell(tmap, radius, rng)
-                euclid = math.hypot(*(goal - start))
-                if euclid > far:  # the geodesic is at least as long
-                    rejected["geodesic out of range"] += 1
-                    continue
-                geodesic = scene.geodesic_distance(floor, start, goal, robot=radius)
-                if geodesic == math.inf:
-                    rejected["no path"] += 1
-                    continue
-                if not near <= geodesic <= far:
-                    rejected["geodesic out of range"] += 1
-                    continue
-                ratio = geodesic / euclid
-                if ratio < config.ratio_threshold:
-                    kept = not rng.random() > ratio_keep_probability(ratio)
-                    trials.append((ratio, kept))
-                    if not kept:
-                        rejected["ratio filter"] += 1
-                        continue
-                if island_radius(scene, floor, start, radius) < config.island_radius_limit:
-                    rejected["start on a small island"] += 1
-                    continue
-                yaw = float(rng.uniform(0.0, 2.0 * math.pi))
-                z = tmap.height
-                episode = PointNavEpisode(
-                    episode_id=f"{id_prefix}{first_id + len(episodes)}",
-                    scene_id=scene_id,
-                    floor=floor,
-                    start_position=(float(start[0]), float(start[1]), z),
-                    start_rotation=(0.0, 0.0, math.sin(0.5 * yaw), math.cos(0.5 * yaw)),
-                    goal_position=(float(goal[0]), float(goal[1]), z),
-                    goal_radius=config.goal_radius,
-                    geodesic_distance=float(geodesic),
-                    robot_radius=radius,
-                )
-                break
-            if episode is not None:
-                episodes.append(episode)
-                break
+        rejected = dict.fromkeys(_RULES, 0)
+        pair = _draw_pair(scene, rng, config, floor_p, rejected, trials)
         for rule, count in rejected.items():
             total[rule] = total.get(rule, 0) + count
-        if episode is None:
+        if pair is None:
             detail = ", ".join(f"{k}: {v}" for k, v in rejected.items())
             raise SamplingError(
                 f"could not generate episode {len(episodes)} on scene {scene_id!r}: no acceptable "
                 f"start for {config.max_goals_per_episode} goals in a row ({detail})"
             )
+        floor, goal, start, geodesic = pair
+        yaw = float(rng.uniform(0.0, 2.0 * math.pi))
+        z = scene.floors[floor].height
+        episodes.append(
+            PointNavEpisode(
+                episode_id=f"{id_prefix}{first_id + len(episodes)}",
+                scene_id=scene_id,
+                floor=floor,
+                start_position=(float(start[0]), float(start[1]), z),
+                start_rotation=(0.0, 0.0, math.sin(0.5 * yaw), math.cos(0.5 * yaw)),
+                goal_position=(float(goal[0]), float(goal[1]), z),
+                goal_radius=config.goal_radius,
+                geodesic_distance=float(geodesic),
+                robot_radius=radius,
+            )
+        )
     return episodes
+
+
+def _floor_weights(scene: Scene, scene_id: str, radius: float) -> NDArray[np.float64]:
+    """Each floor's probability of holding an episode: its share of usable cells for a robot
+    of ``radius`` m."""
+    areas = np.array([f.usable(radius).sum() for f in scene.floors], dtype=np.float64)
+    if not areas.sum():
+        raise SamplingError(
+            f"scene {scene_id!r} has no usable cell for a robot of radius {radius} m"
+        )
+    return areas / areas.sum()
+
+
+# The rejection rules, in the order the counts are reported.
+_RULES = (
+    "goal on a small island",
+    "no path",
+    "geodesic out of range",
+    "ratio filter",
+    "start on a small island",
+)
+
+
+def _draw_pair(
+    scene: Scene,
+    rng: np.random.Generator,
+    config: GeneratorConfig,
+    floor_p: NDArray[np.float64],
+    rejected: dict[str, int],
+    trials: list[tuple[float, bool]],
+) -> tuple[int, NDArray[np.float64], NDArray[np.float64], float] | None:
+    """Draw goals until one has an acceptable start: ``(floor, goal, start, geodesic)``
+    (positions in m), or None after ``max_goals_per_episode`` goals. Rejections are counted
+    in ``rejected`` by rule."""
+    radius = config.robot_radius
+    for _ in range(config.max_goals_per_episode):
+        floor = int(rng.choice(len(floor_p), p=floor_p))
+        goal = _pick_cell(scene.floors[floor], radius, rng)
+        if island_radius(scene, floor, goal, radius) < config.island_radius_limit:
+            rejected["goal on a small island"] += 1
+            continue
+        found = _draw_start(scene, floor, goal, rng, config, rejected, trials)
+        if found is not None:
+            return floor, goal, found[0], found[1]
+    return None
+
+
+def _draw_start(
+    scene: Scene,
+    floor: int,
+    goal: NDArray[np.float64],
+    rng: np.random.Generator,
+    config: GeneratorConfig,
+    rejected: dict[str, int],
+    trials: list[tuple[float, bool]],
+) -> tuple[NDArray[np.float64], float] | None:
+    """Draw starts for ``goal`` until one passes every rule: ``(start, geodesic)`` (m), or
+    None after ``retries_per_goal`` tries."""
+    radius = config.robot_radius
+    near, far = config.geodesic_range
+    tmap = scene.floors[floor]
+    for _ in range(config.retries_per_goal):
+        start = _pick_cell(tmap, radius, rng)
+        euclid = math.hypot(*(goal - start))
+        if euclid > far:  # the geodesic is at least as long
+            rejected["geodesic out of range"] += 1
+            continue
+        geodesic = scene.geodesic_distance(floor, start, goal, robot=radius)
+        if geodesic == math.inf:
+            rejected["no path"] += 1
+            continue
+        if not near <= geodesic <= far:
+            rejected["geodesic out of range"] += 1
+            continue
+        ratio = geodesic / euclid
+        if ratio < config.ratio_threshold:
+            kept = not rng.random() > ratio_keep_probability(ratio)
+            trials.append((ratio, kept))
+            if not kept:
+                rejected["ratio filter"] += 1
+                continue
+        if island_radius(scene, floor, start, radius) < config.island_radius_limit:
+            rejected["start on a small island"] += 1
+            continue
+        return start, geodesic
+    return None
 
 
 def scene_seed(seed: int, scene_id: str) -> np.random.SeedSequence:

@@ -5,7 +5,8 @@ checks them all before anything moves, so a rejected step changes nothing; its e
 the agent (a missing action, one for an agent whose episode ended or for an unknown agent,
 one of the wrong shape). Finiteness of continuous actions is left to the backend's step,
 which moves nothing when it refuses one; :func:`named_action_error` then names the agent.
-:func:`no_agents_error` says why a step with no alive agent is refused.
+:func:`no_agents_error` says why a step with no alive agent is refused, and
+:func:`step_discrete` runs one step of discrete actions.
 """
 
 from __future__ import annotations
@@ -20,7 +21,13 @@ from pointnav_core.errors import ArgumentError
 from pointnav_core.task import TaskStateError
 from pointnav_core.task.actions import check_discrete_action
 
-__all__ = ["bad_keys_error", "check_actions", "named_action_error", "no_agents_error"]
+__all__ = [
+    "bad_keys_error",
+    "check_actions",
+    "named_action_error",
+    "no_agents_error",
+    "step_discrete",
+]
 
 #: Per agent: robot index, action shape, drive, the task's step and its observation function.
 Slot = tuple[int, tuple[int], str, Callable[..., Any], Callable[..., Any]]
@@ -165,3 +172,20 @@ def named_action_error(err: ValueError, todo: Sequence[Todo]) -> ValueError:
         if not np.isfinite(action).all():
             return ArgumentError(f"{agent}: {err}")
     return err
+
+
+def step_discrete(
+    backend: Any, plans: Sequence[Any], actions: dict[int, int]
+) -> dict[int, bool]:
+    """Run each robot's discrete action for its control steps, all robots together; a
+    robot's action ends at its first contact. ``plans[i][a]`` is robot ``i``'s command and
+    control steps for action ``a``. Returns whether each robot touched something
+    (:mod:`pointnav_core.task.actions`)."""
+    todo = {i: plans[i][a] for i, a in actions.items()}
+    contacts = dict.fromkeys(todo, False)
+    for k in range(max(steps for _, steps in todo.values())):
+        backend.step({i: cmd for i, (cmd, steps) in todo.items() if k < steps and not contacts[i]})
+        for i in todo:
+            if not contacts[i] and backend.in_contact(i):
+                contacts[i] = True
+    return contacts

@@ -191,6 +191,7 @@ from pointnav_core.envs._multi_actions import (
     check_actions,
     named_action_error,
     no_agents_error,
+    step_discrete,
 )
 from pointnav_core.envs._multi_state import STATE_FIELDS, global_state, state_space
 from pointnav_core.envs.config import EnvConfig, multi_robot_arguments, takes_config
@@ -332,7 +333,19 @@ class MultiPointNavEnv(ParallelEnv[str, Any, np.ndarray]):
         # Robots with a fixed start are placed first, so no sampled start can take it.
         self._reset_order = sorted(range(n), key=lambda i: tasks[i].initial_pos is None)
 
-        self.possible_agents = [f"robot_{i}" for i in range(n)]
+        self._set_agents(tasks, frequency)
+        self._active = [False] * n
+        self._cycles = 0
+        self._np_random: np.random.Generator | None = None
+        self._np_random_seed: int | None = None
+        # True until a reset completes, and after a step or reset that failed half-way.
+        self._void = True
+        self._started = False  # whether reset() was ever called
+
+    def _set_agents(self, tasks: list[Any], frequency: float) -> None:
+        """Name the agents, build their spaces and the state space, and cache the per-agent
+        values the step loop reads (``frequency`` in Hz)."""
+        self.possible_agents = [f"robot_{i}" for i in range(len(tasks))]
         self.agents: list[str] = []
         self._index = {agent: i for i, agent in enumerate(self.possible_agents)}
         self.action_spaces = {
@@ -348,7 +361,7 @@ class MultiPointNavEnv(ParallelEnv[str, Any, np.ndarray]):
             agent: _envcommon.observation_space(t, self.flatten_obs)
             for agent, t in zip(self.possible_agents, tasks)
         }
-        self.state_space = state_space(scene, n)
+        self.state_space = state_space(self.scene, len(tasks))
         self._state_low = self.state_space.low.astype(np.float64)
         self._state_high = self.state_space.high.astype(np.float64)
 
@@ -359,13 +372,6 @@ class MultiPointNavEnv(ParallelEnv[str, Any, np.ndarray]):
             agent: (i, (rb.action_dim,), rb.drive, t.step, self._observe[i])
             for i, (agent, rb, t) in enumerate(zip(self.possible_agents, self.robots, tasks))
         }
-        self._active = [False] * n
-        self._cycles = 0
-        self._np_random: np.random.Generator | None = None
-        self._np_random_seed: int | None = None
-        # True until a reset completes, and after a step or reset that failed half-way.
-        self._void = True
-        self._started = False  # whether reset() was ever called
 
     # ------------------------------------------------------------------ PettingZoo API
     def observation_space(self, agent: str) -> spaces.Space[Any]:
@@ -485,7 +491,7 @@ class MultiPointNavEnv(ParallelEnv[str, Any, np.ndarray]):
             contacts = None
         try:
             if plans is not None:
-                contacts = self._step_discrete(commands)
+                contacts = step_discrete(self.backend, plans, commands)
             self._cycles += 1
             cut = self._cycles >= self.max_cycles
             alive = []
@@ -514,20 +520,6 @@ class MultiPointNavEnv(ParallelEnv[str, Any, np.ndarray]):
             self._void = True
             raise
         return observations, rewards, terminations, truncations, infos
-
-    def _step_discrete(self, actions: dict[int, int]) -> dict[int, bool]:
-        """Run each robot's discrete action for its control steps, all robots together; a
-        robot's action ends at its first contact. Returns whether each robot touched
-        something (:mod:`pointnav_core.task.actions`)."""
-        plans, backend = self._plans, self.backend
-        todo = {i: plans[i][a] for i, a in actions.items()}  # type: ignore[index]
-        contacts = dict.fromkeys(todo, False)
-        for k in range(max(steps for _, steps in todo.values())):
-            backend.step({i: cmd for i, (cmd, steps) in todo.items() if k < steps and not contacts[i]})
-            for i in todo:
-                if not contacts[i] and backend.in_contact(i):
-                    contacts[i] = True
-        return contacts
 
     def _finish(self, i: int) -> None:
         self._active[i] = False

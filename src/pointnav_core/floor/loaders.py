@@ -7,6 +7,11 @@ Scene constructors wrap the arrays into maps; nothing here keeps state.
 
 A missing file raises :class:`FileNotFoundError`, as :func:`open` does; a file that exists but
 is not what the reader expects raises :class:`ValueError` naming the parameter at fault.
+
+On :func:`read_trav_png`'s geometry: OmniGibson itself resizes with bilinear interpolation and then
+keeps only cells equal to 255, and looks cells up with ``round(xy / res + N / 2)``, which puts its
+cell centres half a cell away from the pixel geometry. Here a cell covers exactly the square its
+pixels cover, so world positions agree with the image to within one source pixel.
 """
 
 from __future__ import annotations
@@ -98,13 +103,6 @@ def read_trav_png(
     --------
     pointnav_core.floor.maps.TraversableMap : wraps ``codes``, ``resolution`` and ``origin``.
 
-    Notes
-    -----
-    OmniGibson itself resizes with bilinear interpolation and then keeps only cells equal to
-    255, and looks cells up with ``round(xy / res + N / 2)``, which puts its cell centres half
-    a cell away from the pixel geometry. Here a cell covers exactly the square its pixels
-    cover, so world positions agree with the image to within one source pixel.
-
     Examples
     --------
     >>> import tempfile, pathlib
@@ -128,6 +126,14 @@ def read_trav_png(
     """
     resolution = _check_resolution(resolution, "resolution")
     source_resolution = _check_resolution(source_resolution, "source_resolution")
+    factor = resolution / source_resolution  # source pixels per cell, along one axis
+    codes = _resampled(_blocked_pixels(path), factor)
+    half = codes.shape[0] * resolution / 2.0
+    return codes, (-half, -half)
+
+
+def _blocked_pixels(path: str | os.PathLike[str]) -> NDArray[np.bool_]:
+    """The pixels below 255 of an 8-bit greyscale square image; raises as :func:`read_trav_png`."""
     where = f"path {os.fspath(path)!r}"
     from PIL import UnidentifiedImageError  # only this reader needs Pillow
 
@@ -156,9 +162,15 @@ def read_trav_png(
     if np.isin(_ROS_SHADES, pixels).all():
         # map_saver's free (254) and unknown (205) would all read as blocked here.
         raise ArgumentError(f"{where} holds ROS map_saver's free (254) and unknown (205) shades: {_ROS_HINT}")
-    blocked = pixels < 255
+    return pixels < 255
+
+
+def _resampled(blocked: NDArray[np.bool_], factor: float) -> NDArray[np.uint8]:
+    """Cell codes of the square pixel mask ``blocked`` at ``factor`` pixels a cell, centred.
+
+    A cell is FREE only when no pixel it overlaps is blocked and it lies inside the image.
+    """
     n_pixels = blocked.shape[0]
-    factor = resolution / source_resolution  # source pixels per cell, along one axis
     n_cells = max(1, math.ceil(n_pixels / factor - _EDGE_TOL))
     # Pixel coordinate of the grid's outer edge: <= 0, half the padding when not divisible.
     offset = (n_pixels - n_cells * factor) / 2.0
@@ -168,9 +180,7 @@ def read_trav_png(
     any_cells = _any_in_spans(any_rows, starts, stops, axis=1)
     outside = (starts < 0) | (stops > n_pixels)  # a cell reaching past the image edge
     any_cells |= outside[:, None] | outside[None, :]
-    codes = np.where(any_cells, OBSTACLE, FREE).astype(np.uint8)
-    half = n_cells * resolution / 2.0
-    return codes, (-half, -half)
+    return np.where(any_cells, OBSTACLE, FREE).astype(np.uint8)
 
 
 def open_image(path: str | os.PathLike[str], where: str):  # -> PIL.Image.Image

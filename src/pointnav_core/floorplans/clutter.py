@@ -86,14 +86,7 @@ def clutter(
     """
     rng = rng_from(seed)
     width, height = check_pair(size, "size", "(width, height) in metres")
-    if n_obstacles is None:
-        n_obstacles = round(width * height / 8.0)
-    if (
-        isinstance(n_obstacles, bool)
-        or not isinstance(n_obstacles, (int, np.integer))
-        or n_obstacles < 0
-    ):
-        raise ArgumentError(f"n_obstacles must be an integer >= 0 or None, got {n_obstacles!r}")
+    n_obstacles = _check_count(n_obstacles, width, height)
     size_lo, size_hi = check_range(obstacle_size, "obstacle_size")
     discs = check_probability(discs, "discs")
     grouped = check_probability(grouped, "grouped")
@@ -107,56 +100,50 @@ def clutter(
             f"obstacle_size[1] + 2 * (wall + gap) = {size_hi + 2 * (wall + gap)} m a side, got {size!r}"
         )
     outline, ring = walled_box(width, height, wall)
+    groups = _place_groups(rng, n_obstacles, hall, (size_lo, size_hi), discs, grouped, gap)
+    return FloorPlan(outline=outline, obstacles=(ring, *groups))
 
-    # Each group is one obstacle polygon: a single shape, or the closed union of several.
+
+def _check_count(n_obstacles: int | None, width: float, height: float) -> int:
+    """``n_obstacles``, or one per 8 m² of the ``width x height`` m floor when None."""
+    if n_obstacles is None:
+        n_obstacles = round(width * height / 8.0)
+    if (
+        isinstance(n_obstacles, bool)
+        or not isinstance(n_obstacles, (int, np.integer))
+        or n_obstacles < 0
+    ):
+        raise ArgumentError(f"n_obstacles must be an integer >= 0 or None, got {n_obstacles!r}")
+    return n_obstacles
+
+
+def _place_groups(
+    rng: np.random.Generator,
+    n_obstacles: int,
+    hall: tuple[float, float, float, float],
+    extents: tuple[float, float],
+    discs: float,
+    grouped: float,
+    gap: float,
+) -> list[Polygon]:
+    """Place up to ``n_obstacles`` shapes in ``hall`` (m), in up to 20 tries each.
+
+    Returns one polygon per group: a single shape, or the closed union of several.
+    """
     groups: list[Polygon] = []
     anchors: list[tuple[float, float]] = []  # the point every shape of a group contains
     placed = 0
     for _ in range(20 * int(n_obstacles)):
         if placed == n_obstacles:
             break
-        join = groups and rng.random() < grouped
-        is_disc = rng.random() < discs
-        extent, other = rng.uniform(size_lo, size_hi, size=2)
-        angle = rng.uniform(0.0, math.pi)
-        if join:
-            g = int(rng.integers(len(groups)))
-            # Put the anchor at a random point well inside the new shape (in its own frame).
-            u, v = rng.uniform(-0.8, 0.8, size=2)
-            if is_disc:
-                v = 0.0  # a point on the diameter at ``angle``
-            du, dv = u * extent / 2, v * other / 2
-            ax, ay = anchors[g]
-            cx = ax - (du * math.cos(angle) - dv * math.sin(angle))
-            cy = ay - (du * math.sin(angle) + dv * math.cos(angle))
-        else:
-            g = -1
-            cx, cy = rng.uniform(hall[0], hall[2]), rng.uniform(hall[1], hall[3])
-        if is_disc:
-            shape = Point(cx, cy).buffer(extent / 2, quad_segs=8)
-        else:
-            shape = affinity.rotate(
-                box(cx - extent / 2, cy - other / 2, cx + extent / 2, cy + other / 2),
-                angle,
-                origin=(cx, cy),
-                use_radians=True,
-            )
+        g, shape, centre = _draw_shape(rng, groups, anchors, hall, extents, discs, grouped)
         xmin, ymin, xmax, ymax = shape.bounds
         if xmin < hall[0] or ymin < hall[1] or xmax > hall[2] or ymax > hall[3]:
             continue
         if g >= 0:
-            if not shape.contains(Point(anchors[g])):
+            candidate = _joined(groups[g], anchors[g], shape, gap)
+            if candidate is None:
                 continue
-            if shape.difference(groups[g]).area < 0.5 * shape.area:  # mostly new, not a pile
-                continue
-            # Close the union with a disc of radius gap / 2: this fills the narrow wedges
-            # between shapes, whose tips a robot could enter but not turn round in (on a grid
-            # they leave isolated usable cells). The closing stays in the convex hull.
-            union = shapely.union(groups[g], shape)
-            closed = union.buffer(gap / 2, quad_segs=8).buffer(-gap / 2, quad_segs=8)
-            # Rounding in the buffers can leave specks beside the body, or pinholes in it.
-            body = max(shapely.get_parts(shapely.union(closed, union)), key=lambda p: p.area)
-            candidate = Polygon(body.exterior)
         else:
             candidate = shape
         others = [group for k, group in enumerate(groups) if k != g]
@@ -167,5 +154,66 @@ def clutter(
             groups[g] = candidate
         else:
             groups.append(candidate)
-            anchors.append((cx, cy))
-    return FloorPlan(outline=outline, obstacles=(ring, *groups))
+            anchors.append(centre)
+    return groups
+
+
+def _draw_shape(
+    rng: np.random.Generator,
+    groups: list[Polygon],
+    anchors: list[tuple[float, float]],
+    hall: tuple[float, float, float, float],
+    extents: tuple[float, float],
+    discs: float,
+    grouped: float,
+) -> tuple[int, Polygon, tuple[float, float]]:
+    """Draw one shape: ``(group, shape, centre)``, group -1 for a shape standing alone.
+
+    A shape laid across group ``g`` contains that group's anchor.
+    """
+    join = groups and rng.random() < grouped
+    is_disc = rng.random() < discs
+    extent, other = rng.uniform(extents[0], extents[1], size=2)
+    angle = rng.uniform(0.0, math.pi)
+    if join:
+        g = int(rng.integers(len(groups)))
+        # Put the anchor at a random point well inside the new shape (in its own frame).
+        u, v = rng.uniform(-0.8, 0.8, size=2)
+        if is_disc:
+            v = 0.0  # a point on the diameter at ``angle``
+        du, dv = u * extent / 2, v * other / 2
+        ax, ay = anchors[g]
+        cx = ax - (du * math.cos(angle) - dv * math.sin(angle))
+        cy = ay - (du * math.sin(angle) + dv * math.cos(angle))
+    else:
+        g = -1
+        cx, cy = rng.uniform(hall[0], hall[2]), rng.uniform(hall[1], hall[3])
+    if is_disc:
+        shape = Point(cx, cy).buffer(extent / 2, quad_segs=8)
+    else:
+        shape = affinity.rotate(
+            box(cx - extent / 2, cy - other / 2, cx + extent / 2, cy + other / 2),
+            angle,
+            origin=(cx, cy),
+            use_radians=True,
+        )
+    return g, shape, (cx, cy)
+
+
+def _joined(
+    group: Polygon, anchor: tuple[float, float], shape: Polygon, gap: float
+) -> Polygon | None:
+    """The group with ``shape`` laid across it, or None when the shape does not hold the
+    group's anchor or is mostly inside the group (a pile, not a new part)."""
+    if not shape.contains(Point(anchor)):
+        return None
+    if shape.difference(group).area < 0.5 * shape.area:  # mostly new, not a pile
+        return None
+    # Close the union with a disc of radius gap / 2: this fills the narrow wedges
+    # between shapes, whose tips a robot could enter but not turn round in (on a grid
+    # they leave isolated usable cells). The closing stays in the convex hull.
+    union = shapely.union(group, shape)
+    closed = union.buffer(gap / 2, quad_segs=8).buffer(-gap / 2, quad_segs=8)
+    # Rounding in the buffers can leave specks beside the body, or pinholes in it.
+    body = max(shapely.get_parts(shapely.union(closed, union)), key=lambda p: p.area)
+    return Polygon(body.exterior)

@@ -84,7 +84,20 @@ def maze(
     xs = x0 + px * np.arange(nx + 1)  # left edge of each vertical wall line
     ys = y0 + py * np.arange(ny + 1)  # bottom edge of each horizontal wall line
 
-    # Recursive backtracker; open_x[j, i]: passage between cells (j, i) and (j, i + 1).
+    open_x, open_y = _spanning_tree(rng, nx, ny)
+    walls = _interior_walls(xs, ys, wall, (-x0, -y0), open_x, open_y)
+    outline, ring = walled_box(width, height, wall)
+    return FloorPlan(outline=outline, obstacles=(ring, *walls))
+
+
+def _spanning_tree(
+    rng: np.random.Generator, nx: int, ny: int
+) -> tuple[NDArray[np.bool_], NDArray[np.bool_]]:
+    """A random spanning tree of the ``ny x nx`` cell grid, by recursive backtracking.
+
+    Returns ``(open_x, open_y)``: ``open_x[j, i]`` when cells ``(j, i)`` and ``(j, i + 1)``
+    are joined, ``open_y[j, i]`` when ``(j, i)`` and ``(j + 1, i)`` are.
+    """
     open_x = np.zeros((ny, nx - 1), dtype=bool)
     open_y = np.zeros((ny - 1, nx), dtype=bool)
     visited = np.zeros((ny, nx), dtype=bool)
@@ -108,9 +121,24 @@ def maze(
             open_y[min(j, j + dj), i] = True
         visited[j + dj, i + di] = True
         stack.append((j + dj, i + di))
+    return open_x, open_y
 
+
+def _interior_walls(
+    xs: NDArray[np.float64],
+    ys: NDArray[np.float64],
+    wall: float,
+    far: tuple[float, float],
+    open_x: NDArray[np.bool_],
+    open_y: NDArray[np.bool_],
+) -> list[Polygon]:
+    """The interior walls (m) where cells are not joined, merged along straight runs.
+
+    ``xs``, ``ys``: near edges of the wall lines; ``far``: the outer wall's far faces.
+    """
+    nx, ny = len(xs) - 1, len(ys) - 1
     # Far edge of each wall line; clipped, as x0 + px * nx + wall can round past -x0.
-    xe, ye = np.minimum(xs + wall, -x0), np.minimum(ys + wall, -y0)
+    xe, ye = np.minimum(xs + wall, far[0]), np.minimum(ys + wall, far[1])
     walls: list[Polygon] = []
     # Vertical wall line k (1 .. nx-1) between columns k-1 and k: closed where not open.
     for k in range(1, nx):
@@ -119,8 +147,7 @@ def maze(
     for k in range(1, ny):
         for i0, i1 in _runs(~open_y[k - 1, :]):
             walls.append(box(xs[i0], ys[k], xe[i1], ye[k]))
-    outline, ring = walled_box(width, height, wall)
-    return FloorPlan(outline=outline, obstacles=(ring, *walls))
+    return walls
 
 
 def _runs(closed: NDArray[np.bool_]) -> list[tuple[int, int]]:

@@ -157,7 +157,18 @@ def rasterize(
         check_polygon(obstacle, f"obstacles[{i}]")
     resolution = check_positive(resolution, "resolution", "m/cell")
 
-    xmin, ymin, xmax, ymax = outline.bounds
+    origin, height, width = _grid(outline.bounds, resolution)
+    return _cell_codes(outline, obstacles, origin, resolution, (height, width)), origin
+
+
+def _grid(
+    bounds: tuple[float, float, float, float], resolution: float
+) -> tuple[tuple[float, float], int, int]:
+    """``(origin, height, width)`` of the grid over ``bounds`` (m), snapped outward.
+
+    Raises ``ArgumentError`` when the grid would exceed the cell budget.
+    """
+    xmin, ymin, xmax, ymax = bounds
     col0 = math.floor(xmin / resolution + SNAP_TOL)
     row0 = math.floor(ymin / resolution + SNAP_TOL)
     width = max(1, math.ceil(xmax / resolution - SNAP_TOL) - col0)
@@ -169,7 +180,18 @@ def rasterize(
             f"resolution {resolution} m/cell is too fine for an outline of "
             f"{xmax - xmin:.3g} x {ymax - ymin:.3g} m: {err}"
         ) from None
-    origin = (col0 * resolution, row0 * resolution)
+    return (col0 * resolution, row0 * resolution), height, width
+
+
+def _cell_codes(
+    outline: Polygon,
+    obstacles: tuple[Polygon, ...],
+    origin: tuple[float, float],
+    resolution: float,
+    shape: tuple[int, int],
+) -> NDArray[np.uint8]:
+    """The code of each cell of the grid at ``origin`` (m), by the class of its centre."""
+    height, width = shape
     xs = origin[0] + (np.arange(width) + 0.5) * resolution
     ys = origin[1] + (np.arange(height) + 0.5) * resolution
     cx, cy = np.meshgrid(xs, ys)
@@ -186,7 +208,7 @@ def rasterize(
         hit = shapely.intersects_xy(blocked, cx[inside], cy[inside])
         rows, cols = np.nonzero(inside)
         codes[rows[hit], cols[hit]] = OBSTACLE
-    return codes, origin
+    return codes
 
 
 def walled_box(width: float, height: float, wall: float) -> tuple[Polygon, Polygon]:

@@ -116,42 +116,148 @@ def rooms(
     True
     """
     rng = rng_from(seed)
-    width, height = check_pair(size, "size", "(width, height) in metres")
-    wall = check_positive(wall, "wall")
-    outer_wall = check_positive(outer_wall, "outer_wall")
-    door_lo, door_hi = check_range(door_width, "door_width")
-    min_room = check_positive(min_room, "min_room")
-    if min_room < door_hi + 2 * _DOOR_MARGIN:
-        raise ArgumentError(
-            f"min_room must be at least the widest door plus {2 * _DOOR_MARGIN} m "
-            f"({door_hi + 2 * _DOOR_MARGIN} m), got {min_room}"
-        )
-    max_room = check_positive(max_room, "max_room")
-    if max_room < min_room:
-        raise ArgumentError(f"max_room must be >= min_room ({min_room} m), got {max_room}")
-    l_shape = check_probability(l_shape, "l_shape")
-    furniture = float(furniture)
-    if not (math.isfinite(furniture) and furniture >= 0.0):
-        raise ArgumentError(
-            f"furniture must be a finite number >= 0 (pieces per room), got {furniture!r}"
-        )
-    clearance = check_positive(clearance, "clearance")
-    if min(width, height) < min_room + 2 * outer_wall:
-        raise ArgumentError(
-            f"size must be at least min_room + 2 * outer_wall = {min_room + 2 * outer_wall} m "
-            f"on each side, got {size!r}"
-        )
+    args = _Params.checked(
+        size, min_room, max_room, wall, outer_wall, door_width, l_shape, furniture, clearance
+    )
+    outline, ring, walls, keepouts, todo = _house(rng, args)
+    leaves = _split_rooms(rng, todo, walls, keepouts, args)
+    pieces = _furnish(rng, leaves, keepouts, args)
+    return _mirrored(rng, outline, [ring, *walls, *pieces])
 
+
+def _mirrored(rng: np.random.Generator, outline: Polygon, geoms: list[Polygon]) -> FloorPlan:
+    """The plan, mirrored in x and/or y at random (the house was built in one orientation)."""
+    sx, sy = rng.choice([-1.0, 1.0], size=2)
+    if sx != 1.0 or sy != 1.0:
+        outline = affinity.scale(outline, sx, sy, origin=(0, 0))
+        geoms = [affinity.scale(g, sx, sy, origin=(0, 0)) for g in geoms]
+    return FloorPlan(outline=outline, obstacles=tuple(geoms))
+
+
+@dataclass(frozen=True)
+class _Params:
+    """The checked arguments of :func:`rooms` (lengths in metres)."""
+
+    width: float
+    height: float
+    min_room: float
+    max_room: float
+    wall: float
+    outer_wall: float
+    door_lo: float
+    door_hi: float
+    l_shape: float
+    furniture: float
+    clearance: float
+
+    @classmethod
+    def checked(
+        cls,
+        size: tuple[float, float],
+        min_room: float,
+        max_room: float,
+        wall: float,
+        outer_wall: float,
+        door_width: tuple[float, float],
+        l_shape: float,
+        furniture: float,
+        clearance: float,
+    ) -> _Params:
+        """Check :func:`rooms`'s arguments, in its order; raise ``ArgumentError`` naming one."""
+        width, height = check_pair(size, "size", "(width, height) in metres")
+        wall = check_positive(wall, "wall")
+        outer_wall = check_positive(outer_wall, "outer_wall")
+        door_lo, door_hi = check_range(door_width, "door_width")
+        min_room = check_positive(min_room, "min_room")
+        if min_room < door_hi + 2 * _DOOR_MARGIN:
+            raise ArgumentError(
+                f"min_room must be at least the widest door plus {2 * _DOOR_MARGIN} m "
+                f"({door_hi + 2 * _DOOR_MARGIN} m), got {min_room}"
+            )
+        max_room = check_positive(max_room, "max_room")
+        if max_room < min_room:
+            raise ArgumentError(f"max_room must be >= min_room ({min_room} m), got {max_room}")
+        l_shape = check_probability(l_shape, "l_shape")
+        furniture = float(furniture)
+        if not (math.isfinite(furniture) and furniture >= 0.0):
+            raise ArgumentError(
+                f"furniture must be a finite number >= 0 (pieces per room), got {furniture!r}"
+            )
+        clearance = check_positive(clearance, "clearance")
+        if min(width, height) < min_room + 2 * outer_wall:
+            raise ArgumentError(
+                f"size must be at least min_room + 2 * outer_wall = "
+                f"{min_room + 2 * outer_wall} m on each side, got {size!r}"
+            )
+        return cls(
+            width, height, min_room, max_room, wall, outer_wall, door_lo, door_hi, l_shape,
+            furniture, clearance,
+        )  # fmt: skip
+
+
+def _split_rooms(
+    rng: np.random.Generator,
+    todo: list[_Room],
+    walls: list[Polygon],
+    keepouts: list[Polygon],
+    args: _Params,
+) -> list[_Room]:
+    """Split the rooms in ``todo`` until none can be; returns the rooms left.
+
+    The walls and door approach zones of the splits are appended to ``walls`` and
+    ``keepouts``; ``todo`` is emptied.
+    """
+    leaves: list[_Room] = []
+    while todo:
+        room = todo.pop()
+        split = _split_room(
+            rng, room, args.min_room, args.max_room, args.wall, args.door_lo, args.door_hi,
+            args.clearance,
+        )  # fmt: skip
+        if split is None:
+            leaves.append(room)
+            continue
+        children, new_walls, keepout = split
+        walls.extend(new_walls)
+        keepouts.append(keepout)
+        todo.extend(children)
+    return leaves
+
+
+def _furnish(
+    rng: np.random.Generator, leaves: list[_Room], keepouts: list[Polygon], args: _Params
+) -> list[Polygon]:
+    """Furniture for each room: a Poisson number of pieces tried, those that fit kept."""
+    keepout_array = np.array(keepouts, dtype=object)
+    pieces: list[Polygon] = []
+    for room in leaves:
+        for _ in range(rng.poisson(args.furniture)):
+            piece = _place_furniture(rng, room, pieces, keepout_array, args.clearance)
+            if piece is not None:
+                pieces.append(piece)
+    return pieces
+
+
+def _house(
+    rng: np.random.Generator, args: _Params
+) -> tuple[Polygon, Polygon, list[Polygon], list[Polygon], list[_Room]]:
+    """The house's outline, its outer wall ring, and its first rooms.
+
+    A rectangle, or with probability ``l_shape`` an L whose two parts are split by a wall
+    with a door. Returns ``(outline, ring, walls, keepouts, rooms)``: the interior walls and
+    door approach zones made so far, and the rooms still to split.
+    """
+    width, height, t, wall = args.width, args.height, args.outer_wall, args.wall
+    door_lo, door_hi, clearance = args.door_lo, args.door_hi, args.clearance
     x0, y0, x1, y1 = -width / 2, -height / 2, width / 2, height / 2
-    t = outer_wall
     # Canonical orientation: the notch of an L is the top-right corner; mirrored at the end.
     notch_w = rng.uniform(0.3, 0.5) * width
     notch_h = rng.uniform(0.3, 0.5) * height
-    use_l = rng.random() < l_shape
+    use_l = rng.random() < args.l_shape
     strip_h = height - notch_h - 2 * t  # inner height of the full-width strip
     block_w = width - notch_w - 2 * t  # inner width of the block above it
     block_h = notch_h - wall  # inner height of the block above the dividing wall
-    if use_l and min(strip_h, block_w, block_h) >= min_room:
+    if use_l and min(strip_h, block_w, block_h) >= args.min_room:
         outline = Polygon(
             [
                 (x0, y0),
@@ -195,33 +301,7 @@ def rooms(
         walls, keepouts = [], []
         todo = [_Room(x0 + t, y0 + t, x1 - t, y1 - t)]
     ring = Polygon(outline.exterior.coords, [inner.exterior.coords])
-
-    leaves: list[_Room] = []
-    while todo:
-        room = todo.pop()
-        split = _split_room(rng, room, min_room, max_room, wall, door_lo, door_hi, clearance)
-        if split is None:
-            leaves.append(room)
-            continue
-        children, new_walls, keepout = split
-        walls.extend(new_walls)
-        keepouts.append(keepout)
-        todo.extend(children)
-
-    keepout_array = np.array(keepouts, dtype=object)
-    pieces: list[Polygon] = []
-    for room in leaves:
-        for _ in range(rng.poisson(furniture)):
-            piece = _place_furniture(rng, room, pieces, keepout_array, clearance)
-            if piece is not None:
-                pieces.append(piece)
-
-    sx, sy = rng.choice([-1.0, 1.0], size=2)
-    geoms = [ring, *walls, *pieces]
-    if sx != 1.0 or sy != 1.0:
-        outline = affinity.scale(outline, sx, sy, origin=(0, 0))
-        geoms = [affinity.scale(g, sx, sy, origin=(0, 0)) for g in geoms]
-    return FloorPlan(outline=outline, obstacles=tuple(geoms))
+    return outline, ring, walls, keepouts, todo
 
 
 def _door_interval(
@@ -303,7 +383,10 @@ def _split_room(
                 second.doors[side] = [d for d in room.doors[side] if d[0] >= c]
             walls = _wall_with_door(a, room.y0, b, room.y1, door, axis=1)
             keepout = box(
-                a - _DOOR_APPROACH, door[0] - clearance, b + _DOOR_APPROACH, door[1] + clearance
+                a - _DOOR_APPROACH,
+                door[0] - clearance,
+                b + _DOOR_APPROACH,
+                door[1] + clearance,
             )
         else:
             door = _door_interval(rng, room.x0, room.x1, door_lo, door_hi)
@@ -318,7 +401,10 @@ def _split_room(
                 second.doors[side] = [d for d in room.doors[side] if d[0] >= c]
             walls = _wall_with_door(room.x0, a, room.x1, b, door, axis=0)
             keepout = box(
-                door[0] - clearance, a - _DOOR_APPROACH, door[1] + clearance, b + _DOOR_APPROACH
+                door[0] - clearance,
+                a - _DOOR_APPROACH,
+                door[1] + clearance,
+                b + _DOOR_APPROACH,
             )
         return [first, second], walls, keepout
     return None

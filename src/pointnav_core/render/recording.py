@@ -13,16 +13,18 @@ from PIL import Image
 
 from pointnav_core.errors import ArgumentError
 from pointnav_core.floor.maps import BoundedCache, TraversableMap
-from pointnav_core.render.top_down import (
-    DEFAULT_PIXELS_PER_METER,
+from pointnav_core.render.glyphs import (
     MARKER_COLORS,
-    ROBOT_PALETTE,
     Marker,
-    PathArg,
     RobotGlyph,
     ScanGlyph,
+    check_number,
+)
+from pointnav_core.render.top_down import (
+    DEFAULT_PIXELS_PER_METER,
+    ROBOT_PALETTE,
+    PathArg,
     TopDownRenderer,
-    _check_number,
 )
 from pointnav_core.task import TaskState
 from pointnav_core.transforms import quat2yaw
@@ -80,7 +82,7 @@ def save_gif(frames: Iterable[ArrayLike], path: PathArg, fps: float = 10) -> Non
         When there is no frame, a frame is not a uint8 (H, W, 3) array, the frames differ in
         shape, or ``fps`` is not a finite number > 0.
     """
-    rate = _check_number(fps, "fps", " (frames/s)", low=0.0, strict=True)
+    rate = check_number(fps, "fps", " (frames/s)", low=0.0, strict=True)
     images = []
     first_shape: tuple[int, ...] | None = None
     for i, frame in enumerate(frames):
@@ -179,11 +181,18 @@ def render_env(
         pixels_per_meter = getattr(env, "render_pixels_per_meter", None)
         if pixels_per_meter is None:
             pixels_per_meter = DEFAULT_PIXELS_PER_METER
-    ppm = _check_number(pixels_per_meter, "pixels_per_meter", " (px/m)", low=0.0, strict=True)
+    ppm = check_number(pixels_per_meter, "pixels_per_meter", " (px/m)", low=0.0, strict=True)
     tasks = _env_tasks(env)
     floor = tasks[0].floor if tasks else 0
     renderer = _renderer_for(env.scene.floors[floor], ppm, renderers)
 
+    markers = _marker_glyphs(tasks, floor)
+    robots = _robot_glyphs(env, tasks, floor)
+    return renderer.draw(robots, markers, _scan_glyphs(env.backend, tasks, floor))
+
+
+def _marker_glyphs(tasks: list[Any], floor: int) -> list[Marker]:
+    """The visible markers of the tasks on ``floor``, coloured by kind."""
     markers = []
     for task in tasks:
         if task.floor != floor:
@@ -194,6 +203,11 @@ def render_env(
                     Marker(position_xy=marker.position[:2], radius=marker.radius, color=MARKER_COLORS[marker.kind])
                 )
 
+    return markers
+
+
+def _robot_glyphs(env: Any, tasks: list[Any], floor: int) -> list[RobotGlyph]:
+    """The placed robots present on ``floor``, coloured by id."""
     backend = env.backend
     # A robot whose task has never been reset has not been placed (it stands at the origin).
     unplaced = {task.robot_idn for task in tasks if task.state is TaskState.IDLE}
@@ -210,6 +224,11 @@ def render_env(
                 color=ROBOT_PALETTE[idn % len(ROBOT_PALETTE)],
             )
         )
+    return robots
+
+
+def _scan_glyphs(backend: Any, tasks: list[Any], floor: int) -> list[ScanGlyph]:
+    """The last range scan of each task on ``floor`` with a ``"scan"`` term and a robot present."""
     scans = []
     for task in tasks:
         term = task.observation_terms.get("scan")
@@ -222,7 +241,7 @@ def render_env(
         bearings = yaw + term.angles
         ends = np.stack([x + readings * np.cos(bearings), y + readings * np.sin(bearings)], axis=1)
         scans.append(ScanGlyph(origin_xy=(x, y), ends_xy=ends, hit=readings < term.max_range))
-    return renderer.draw(robots, markers, scans)
+    return scans
 
 
 def record_episode(

@@ -3,6 +3,7 @@ the generated scenes (``rooms``, ``maze``, ``clutter``) datasets name.
 """
 
 from pointnav_core.scenes.generated import clutter, maze, rooms
-from pointnav_core.scenes.scene import FloorGoalField, Scene, robot_radius
+from pointnav_core.scenes.goal_field import FloorGoalField
+from pointnav_core.scenes.scene import Scene, robot_radius
 
 __all__ = ["FloorGoalField", "Scene", "clutter", "maze", "robot_radius", "rooms"]

@@ -39,11 +39,12 @@ from pointnav_core.errors import ArgumentError, SamplingError
 from pointnav_core.floor import loaders, reachability
 from pointnav_core.floor.maps import OBSTACLE, TraversableMap
 from pointnav_core.floorplans import FloorPlan
-from pointnav_core.geodesic import GoalField, Planner, planner_for
+from pointnav_core.geodesic import Planner, planner_for
 from pointnav_core.geodesic.paths import resample_path
+from pointnav_core.scenes.goal_field import FloorGoalField, as_xy
 from pointnav_core.utils import validation
 
-__all__ = ["Scene", "FloorGoalField", "robot_radius", "rooms", "maze", "clutter"]
+__all__ = ["Scene", "robot_radius", "rooms", "maze", "clutter"]
 
 
 def robot_radius(robot: Any) -> float:
@@ -58,54 +59,10 @@ def robot_radius(robot: Any) -> float:
     return validation.real("robot radius", radius, minimum=0.0)
 
 
-def _as_xy(value: ArrayLike, name: str) -> NDArray[np.float64]:
-    try:
-        return validation.vector(name, value, sizes=(2, 3))[:2]
-    except ValueError:
-        raise ArgumentError(f"{name} must be a finite (x, y) or (x, y, z) point in metres, got {value!r}") from None
-
-
 def _as_rng(rng: np.random.Generator | int | None) -> np.random.Generator:
     if isinstance(rng, np.random.Generator):
         return rng
     return np.random.default_rng(rng)
-
-
-class FloorGoalField:
-    """Geodesic distance to one goal on one floor, in metres (a cached view of a GoalField).
-
-    ``distance(x, y)`` is the per-step query: a table lookup plus one tangent (the table is
-    built on the first call). ``exact_distance`` and ``path`` are exact for the given point.
-    """
-
-    def __init__(self, tmap: TraversableMap, field: GoalField) -> None:
-        self.tmap = tmap
-        self.field = field
-
-    def distance(self, x: float, y: float) -> float:
-        """Geodesic distance (m) from world point (x, y) to the goal; ``inf`` if unreachable."""
-        return float(self.field.distance(x, y))
-
-    @property
-    def goal_usable(self) -> bool:
-        """Whether the robot fits at the goal (if not, nothing reaches it)."""
-        return self.field.reachable_from_anywhere
-
-    def exact_distance(self, source_xy: ArrayLike) -> float:
-        """Geodesic distance (m) from the exact point ``source_xy`` (``inf`` if none)."""
-        return float(self.field.point_distance(_as_xy(source_xy, "source_xy")))
-
-    def path(
-        self, source_xy: ArrayLike, exact: bool = True, max_length: float = math.inf
-    ) -> tuple[NDArray[np.float64] | None, float]:
-        """Shortest path (N, 2) in world metres from ``source_xy`` to the goal, and its length
-        (``(None, inf)`` when unreachable). ``exact`` is accepted for compatibility: every path
-        is exact. A finite ``max_length`` (m) draws only the path's beginning, to its first
-        vertex at least that far along; the length is still the whole path's."""
-        points, length = self.field.path(_as_xy(source_xy, "source_xy"), max_length=max_length)
-        if points is None:
-            return None, math.inf
-        return points, float(length)
 
 
 class Scene:
@@ -337,7 +294,7 @@ class Scene:
 
     def is_usable(self, floor: int, xy: ArrayLike, robot: Any = None) -> bool:
         """Whether the robot's centre can stand at world point ``xy`` on ``floor``."""
-        return bool(self._floor(floor).is_usable(_as_xy(xy, "xy"), robot_radius(robot)))
+        return bool(self._floor(floor).is_usable(as_xy(xy, "xy"), robot_radius(robot)))
 
     # ---------------------------------------------------------------- sampling
     def get_random_point(
@@ -394,7 +351,7 @@ class Scene:
         if reference_point is None:
             cells = np.flatnonzero(tmap.usable(radius))
         else:
-            ref = _as_xy(reference_point, "reference_point")
+            ref = as_xy(reference_point, "reference_point")
             label = int(tmap.component_at(ref, radius))
             if label == 0:
                 raise ArgumentError(
@@ -415,7 +372,7 @@ class Scene:
     def goal_field(self, floor: int, goal_xy: ArrayLike, robot: Any = None) -> FloorGoalField:
         """Cached geodesic distance field to ``goal_xy`` on ``floor`` (see FloorGoalField)."""
         planner = planner_for(self._floor(floor), robot_radius(robot))
-        return FloorGoalField(self._floor(floor), planner.goal_field(_as_xy(goal_xy, "goal_xy")))
+        return FloorGoalField(self._floor(floor), planner.goal_field(as_xy(goal_xy, "goal_xy")))
 
     def geodesic_distance(
         self, floor: int, source_xy: ArrayLike, target_xy: ArrayLike, robot: Any = None
@@ -431,7 +388,7 @@ class Scene:
         self, floor: int, source_xy: ArrayLike, target_xy: ArrayLike, robot: Any
     ) -> tuple[NDArray[np.float64] | None, float]:
         tmap, radius = self._floor(floor), robot_radius(robot)
-        src, tgt = _as_xy(source_xy, "source_xy"), _as_xy(target_xy, "target_xy")
+        src, tgt = as_xy(source_xy, "source_xy"), as_xy(target_xy, "target_xy")
         if reachability.disconnected(tmap, radius, src, tgt):  # proven in O(1), no search
             return None, math.inf
         planner = planner_for(tmap, radius)

@@ -14,7 +14,8 @@ from pointnav_core.task.rewards import (
     PotentialReward,
     RewardFunction,
 )
-from pointnav_core.task.task import PointNavigationTask, TaskEnv
+from pointnav_core.task.task import PointNavigationTask
+from pointnav_core.task.task_env import TaskEnv
 from pointnav_core.task.terminations import (
     Falling,
     MaxCollision,

@@ -19,6 +19,7 @@ module                                 part
 :mod:`~pointnav_core.task.observations`     observation terms, their frame and layout
 :mod:`~pointnav_core.task.markers`          the start, goal and waypoint markers
 :mod:`~pointnav_core.task.omnigibson_api`         the OmniGibson-compatible properties and queries
+:mod:`~pointnav_core.task.task_env`         what the task reads of the env; the termination pass
 =====================================  ==================================================
 
 Lifecycle
@@ -39,9 +40,8 @@ from __future__ import annotations
 
 import dataclasses
 from collections.abc import Mapping, Sequence
-from typing import TYPE_CHECKING, Any, ClassVar, Protocol
+from typing import Any, ClassVar
 
-import numpy as np
 from numpy.typing import ArrayLike
 
 from pointnav_core.backends.protocol import float_twin
@@ -70,6 +70,7 @@ from pointnav_core.task.rewards import (
     RewardFunction,
 )
 from pointnav_core.task.sampling import GoalConstraint, sample_task_episode
+from pointnav_core.task.task_env import TaskEnv, check_fits, evaluate_terminations
 from pointnav_core.task.terminations import (
     Falling,
     MaxCollision,
@@ -79,11 +80,6 @@ from pointnav_core.task.terminations import (
 )
 from pointnav_core.utils.frozen import FrozenMapping
 
-if TYPE_CHECKING:
-    from pointnav_core.backends.protocol import Backend
-    from pointnav_core.backends.robot_spec import RobotSpec
-    from pointnav_core.scenes import Scene
-
 __all__ = [
     "REWARD_TYPES",
     "PointNavigationTask",
@@ -92,33 +88,6 @@ __all__ = [
     "TaskState",
     "TaskStateError",
 ]
-
-
-class TaskEnv(Protocol):
-    """What the task needs from the environment it runs in.
-
-    A ``PointNavEnv`` provides these, and so must any multi-robot environment.
-    """
-
-    @property
-    def scene(self) -> Scene:
-        """The floors, their sampling and geodesic queries."""
-        ...
-
-    @property
-    def backend(self) -> Backend:
-        """The world: poses, velocities, contacts of every robot."""
-        ...
-
-    @property
-    def robots(self) -> Sequence[RobotSpec]:
-        """One spec per robot; the index is ``robot_idn``."""
-        ...
-
-    @property
-    def np_random(self) -> np.random.Generator:
-        """The only source of randomness the task uses (seeded by the env's reset)."""
-        ...
 
 
 class PointNavigationTask(OmniGibsonTaskAPI):
@@ -354,26 +323,9 @@ class PointNavigationTask(OmniGibsonTaskAPI):
         ValueError
             Naming ``robot_idn``, ``floor``, ``initial_pos`` or ``goal_pos``.
         """
-        cfg, robots, scene = self._config, env.robots, env.scene
-        idn, floor = cfg.robot_idn, cfg.floor
-        if idn >= len(robots):
-            raise ArgumentError(
-                f"robot_idn must be in [0, {len(robots)}) for an environment with "
-                f"{len(robots)} robot(s), got {idn}"
-            )
-        if floor >= scene.n_floors:
-            raise ArgumentError(
-                f"floor must be in [0, {scene.n_floors}) for a scene with {scene.n_floors} "
-                f"floor(s), got {floor}"
-            )
-        spec = robots[idn]
-        for name, xy in (("initial_pos", cfg.initial_pos), ("goal_pos", cfg.goal_pos)):
-            if xy is not None and not scene.is_usable(floor, xy, spec):
-                raise ArgumentError(
-                    f"{name} {list(xy)} is not usable on floor {floor} by robot "
-                    f"{idn} (radius {spec.radius} m): it is off the map, on an "
-                    f"obstacle or void, or closer than the radius to one"
-                )
+        scene = env.scene
+        spec = check_fits(self._config, env)
+        floor = self._config.floor
         self._spec = spec
         self._floor_height = self._marks.floor_height = float(scene.get_floor_height(floor))
         self._marks.spacing = float(scene.waypoint_spacing)
@@ -507,23 +459,9 @@ class PointNavigationTask(OmniGibsonTaskAPI):
             ep = self._ep
             ep.advance(x, y, z, quat, contact)
 
-            # Each condition's result, and the same as info["termination_conditions"].
-            results: dict[str, tuple[bool, bool]] = {}
-            conditions: dict[str, dict[str, bool]] = {}
-            done = success = terminated = truncated = False
-            for name, condition in self._termination_items:
-                result = condition.step(self, env, action)
-                results[name] = result
-                is_done, is_success = result
-                conditions[name] = {"done": is_done, "success": is_success}
-                if is_done:
-                    done = True
-                    if is_success:
-                        success = True
-                    if condition.is_truncation:
-                        truncated = True
-                    else:
-                        terminated = True
+            results, conditions, done, success, terminated, truncated = evaluate_terminations(
+                self._termination_items, self, env, action
+            )
             ep.results = results
             ep.success = success
 
@@ -554,3 +492,4 @@ class PointNavigationTask(OmniGibsonTaskAPI):
             f"PointNavigationTask(robot_idn={self._idn}, floor={self._config.floor}, "
             f"reward_type={self._config.reward_type!r}, state={self._state.name})"
         )
+

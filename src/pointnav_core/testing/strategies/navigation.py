@@ -1,7 +1,5 @@
-"""Hypothesis strategies for pointnav-core values, exported for users' own property tests.
-
-Strategies build valid values directly (rather than filtering) and put the simplest choice
-first, so that failures shrink to something readable.
+"""Hypothesis strategies for scenes and what runs in them: navigation scenes, robots, task
+arguments, valid poses, robot placements, action sequences and cluttered rooms.
 """
 
 from __future__ import annotations
@@ -12,265 +10,22 @@ import numpy as np
 from hypothesis import note
 from hypothesis import strategies as st
 
-from pointnav_core import floorplans
 from pointnav_core.errors import ArgumentError
-from pointnav_core.floor.maps import FREE, OBSTACLE, VOID, TraversableMap
-from pointnav_core.floorplans import FloorPlan
+from pointnav_core.floor.maps import FREE, OBSTACLE, VOID
+from pointnav_core.testing.strategies.geometry import yaws
+from pointnav_core.testing.strategies.maps import code_grids
+from pointnav_core.testing.strategies.robots import robot_actions
 
-__all__: list[str] = [
-    "code_grids",
-    "traversable_maps",
-    "maps_with_points",
-    "floor_plans",
-    "unit_quaternions",
-    "yaws",
-    "euler_angles",
-    "finite_vectors",
+__all__ = [
+    "nav_scenes",
+    "nav_robot_specs",
+    "nav_task_kwargs",
+    "scenes",
+    "valid_poses",
+    "robot_placements",
+    "action_sequences",
+    "cluttered_rooms",
 ]
-
-
-def floor_plans(
-    kinds: tuple[str, ...] = ("rooms", "maze", "clutter"),
-) -> st.SearchStrategy[FloorPlan]:
-    """Procedurally generated :class:`~pointnav_core.floorplans.FloorPlan` values.
-
-    Draws a generator from ``kinds`` (``"rooms"``, ``"maze"``, ``"clutter"``), a seed and a
-    modest size (8 to 20 m a side), keeping every other parameter at its default, so that the
-    plans' connectivity guarantee holds: one connected free region for robots narrower than
-    the 0.8 m clearance, less grid slack (a 0.2 m radius on a 0.1 m grid is safe). The call
-    that rebuilds a failing plan is printed with the falsifying example. Shrinks towards the
-    first kind, seed 0 and the smallest size.
-
-    Parameters
-    ----------
-    kinds : tuple of str
-        A non-empty subset of ``("rooms", "maze", "clutter")``.
-    """
-    valid = ("rooms", "maze", "clutter")
-    kinds = tuple(kinds)
-    unknown = [k for k in kinds if k not in valid]
-    if not kinds or unknown:
-        raise ArgumentError(f"kinds must be a non-empty subset of {valid}, got {kinds!r}")
-    return _floor_plans(kinds)
-
-
-@st.composite
-def _floor_plans(draw: st.DrawFn, kinds: tuple[str, ...]) -> FloorPlan:
-    kind = draw(st.sampled_from(kinds))
-    seed = draw(st.integers(0, 2**32 - 1))
-    width = draw(st.floats(8.0, 20.0))
-    height = draw(st.floats(8.0, 20.0))
-    note(f"pointnav_core.floorplans.{kind}({seed}, size=({width!r}, {height!r}))")
-    return getattr(floorplans, kind)(seed, size=(width, height))
-
-
-# ----------------------------------------------------------------------- transforms
-
-
-@st.composite
-def unit_quaternions(draw: st.DrawFn) -> np.ndarray:
-    """Unit quaternions ``(x, y, z, w)`` as float64 arrays of shape (4,), covering all rotations.
-
-    Built without filtering: one component, the lead, gets a magnitude in [0.5, 1] and the
-    others lie in [-1, 1], so the norm is at least 0.5 before normalising. Every unit
-    quaternion is reachable (its largest component is at least 0.5), both signs included.
-    Shrinks towards the identity ``(0, 0, 0, 1)``.
-    """
-    lead = draw(st.sampled_from((3, 0, 1, 2)))  # w first: shrinks to the identity
-    magnitude = draw(st.floats(0.5, 1.0))
-    sign = draw(st.sampled_from((1.0, -1.0)))
-    q = [draw(st.floats(-1.0, 1.0)) if i != lead else sign * magnitude for i in range(4)]
-    arr = np.array(q, dtype=np.float64)
-    return arr / np.linalg.norm(arr)
-
-
-def yaws(
-    min_value: float = -math.pi, max_value: float = math.pi
-) -> st.SearchStrategy[float]:
-    """Headings in radians in ``[min_value, max_value]`` (default ``[-pi, pi]``).
-
-    Shrinks towards 0 when it is in range. Pass a wider range (e.g. ``-4 * pi`` to ``4 * pi``)
-    to test wrapping.
-
-    Parameters
-    ----------
-    min_value, max_value : float
-        Bounds in radians, finite, ``min_value <= max_value``.
-    """
-    if not (math.isfinite(min_value) and math.isfinite(max_value) and min_value <= max_value):
-        raise ArgumentError(
-            f"min_value and max_value must be finite with min_value <= max_value, "
-            f"got {min_value!r} and {max_value!r}"
-        )
-    return st.floats(min_value, max_value)
-
-
-def euler_angles(gimbal_margin: float = 0.0) -> st.SearchStrategy[np.ndarray]:
-    """Euler angles ``(roll, pitch, yaw)`` in canonical ranges, as float64 arrays of shape (3,).
-
-    Roll and yaw lie in (-pi, pi] and pitch in ``[-pi/2 + gimbal_margin, pi/2 - gimbal_margin]``;
-    a positive ``gimbal_margin`` (radians) keeps away from gimbal lock, where roll and yaw
-    are not unique. Shrinks towards ``(0, 0, 0)``.
-
-    Parameters
-    ----------
-    gimbal_margin : float
-        Distance in radians to keep from pitch = +-pi/2, in [0, pi/2).
-    """
-    if not 0.0 <= gimbal_margin < math.pi / 2:
-        raise ArgumentError(f"gimbal_margin must be in [0, pi/2) radians, got {gimbal_margin!r}")
-    half_turn = st.floats(-math.pi, math.pi, exclude_min=True)
-    limit = math.pi / 2 - gimbal_margin
-    return st.tuples(half_turn, st.floats(-limit, limit), half_turn).map(
-        lambda angles: np.array(angles, dtype=np.float64)
-    )
-
-
-def finite_vectors(n: int, max_abs: float = 1e3) -> st.SearchStrategy[np.ndarray]:
-    """Float64 arrays of shape ``(n,)`` with entries in ``[-max_abs, max_abs]``.
-
-    The default bound (1 km for positions in metres) keeps sums and squares far from
-    overflow, so tolerances in properties stay meaningful. Shrinks towards the zero vector.
-
-    Parameters
-    ----------
-    n : int
-        Length of the vectors, >= 1.
-    max_abs : float
-        Largest absolute value of an entry, finite and > 0.
-    """
-    if not (isinstance(n, int) and n >= 1):
-        raise ArgumentError(f"n must be an int >= 1, got {n!r}")
-    if not (math.isfinite(max_abs) and max_abs > 0):
-        raise ArgumentError(f"max_abs must be a finite number > 0, got {max_abs!r}")
-    return st.lists(st.floats(-max_abs, max_abs), min_size=n, max_size=n).map(
-        lambda values: np.array(values, dtype=np.float64)
-    )
-
-
-# ----------------------------------------------------------------------- robots and actions
-
-
-def robot_specs(
-    drives: tuple[str, ...] = ("differential", "holonomic"),
-    max_radius: float = 0.5,
-    max_speed: float = 2.0,
-) -> st.SearchStrategy:
-    """Valid :class:`~pointnav_core.backends.robot_spec.RobotSpec` values.
-
-    Radii lie in ``[0, max_radius]`` metres (shrinking to 0, a point robot), linear speed
-    limits in ``[0.01, max_speed]`` m/s, yaw-rate limits in ``[0.01, 2 pi]`` rad/s, and the
-    drive is drawn from ``drives`` (shrinking to the first).
-
-    Parameters
-    ----------
-    drives : tuple of str
-        A non-empty subset of ``("differential", "holonomic")``.
-    max_radius : float
-        Largest radius in metres, >= 0.
-    max_speed : float
-        Largest ``max_linear_velocity`` in m/s, >= 0.01.
-    """
-    from pointnav_core.backends.robot_spec import DRIVES, RobotSpec
-
-    drives = tuple(drives)
-    if not drives or any(d not in DRIVES for d in drives):
-        raise ArgumentError(f"drives must be a non-empty subset of {tuple(DRIVES)}, got {drives!r}")
-    if not (math.isfinite(max_radius) and max_radius >= 0.0):
-        raise ArgumentError(f"max_radius must be a finite number >= 0 (metres), got {max_radius!r}")
-    if not (math.isfinite(max_speed) and max_speed >= 0.01):
-        raise ArgumentError(f"max_speed must be a finite number >= 0.01 (m/s), got {max_speed!r}")
-    return st.builds(
-        RobotSpec,
-        radius=st.floats(0.0, max_radius),
-        max_linear_velocity=st.floats(0.01, max_speed),
-        max_angular_velocity=st.floats(0.01, 2 * math.pi),
-        drive=st.sampled_from(drives),
-    )
-
-
-def robot_actions(spec: object, overshoot: float = 0.0) -> st.SearchStrategy[np.ndarray]:
-    """Actions for a robot of ``spec``: float64 arrays of shape ``(spec.action_dim,)``.
-
-    Components lie in ``[-1 - overshoot, 1 + overshoot]``; a positive ``overshoot`` also
-    exercises clipping. Shrinks towards the zero action (standing still).
-
-    Parameters
-    ----------
-    spec : RobotSpec
-        The robot the actions are for.
-    overshoot : float
-        How far beyond ``[-1, 1]`` components may go, >= 0.
-    """
-    if not (math.isfinite(overshoot) and overshoot >= 0.0):
-        raise ArgumentError(f"overshoot must be a finite number >= 0, got {overshoot!r}")
-    bound = 1.0 + overshoot
-    n = int(spec.action_dim)  # type: ignore[attr-defined]
-    return st.lists(st.floats(-bound, bound), min_size=n, max_size=n).map(
-        lambda values: np.array(values, dtype=np.float64)
-    )
-
-
-__all__ += ["robot_specs", "robot_actions"]
-
-
-# ----------------------------------------------------------------------- maps
-
-
-@st.composite
-def code_grids(draw: st.DrawFn, min_side: int = 2, max_side: int = 24) -> np.ndarray:
-    """Cell-code grids (uint8, FREE/OBSTACLE/VOID) made of a free floor and a few rectangles.
-
-    At least one cell is FREE. Shrinks towards a small, all-free grid.
-    """
-    h = draw(st.integers(min_side, max_side))
-    w = draw(st.integers(min_side, max_side))
-    grid = np.full((h, w), FREE, dtype=np.uint8)
-    for _ in range(draw(st.integers(0, 6))):
-        r0, c0 = draw(st.integers(0, h - 1)), draw(st.integers(0, w - 1))
-        r1, c1 = draw(st.integers(r0, h - 1)), draw(st.integers(c0, w - 1))
-        grid[r0 : r1 + 1, c0 : c1 + 1] = draw(st.sampled_from((OBSTACLE, VOID)))
-    if not (grid == FREE).any():
-        grid[draw(st.integers(0, h - 1)), draw(st.integers(0, w - 1))] = FREE
-    return grid
-
-
-@st.composite
-def traversable_maps(draw: st.DrawFn, max_side: int = 24) -> TraversableMap:
-    """Small :class:`~pointnav_core.floor.maps.TraversableMap` values with a random origin."""
-    grid = draw(code_grids(max_side=max_side))
-    resolution = draw(st.sampled_from((0.1, 0.05, 0.25, 1.0)))
-    origin = (draw(st.floats(-50.0, 50.0)), draw(st.floats(-50.0, 50.0)))
-    height = draw(st.floats(-5.0, 5.0))
-    return TraversableMap(grid, resolution, origin, height)
-
-
-@st.composite
-def maps_with_points(
-    draw: st.DrawFn, n_points: int = 2, max_side: int = 24, max_radius_cells: float = 2.5
-) -> tuple[TraversableMap, float, np.ndarray]:
-    """A map, a robot radius (m) and ``n_points`` usable world points (n, 2) on it.
-
-    The radius is chosen so that some cell is usable; points lie anywhere inside usable
-    cells (not only at centres) where the disc fits, else at the cell's centre.
-    """
-    tmap = draw(traversable_maps(max_side=max_side))
-    radius = draw(st.floats(0.0, max_radius_cells)) * tmap.resolution
-    if not tmap.usable(radius).any():
-        radius = 0.0
-    cells = np.argwhere(tmap.usable(radius))
-    points = []
-    for _ in range(n_points):
-        r, c = cells[draw(st.integers(0, len(cells) - 1))]
-        fr, fc = draw(st.floats(0.05, 0.95)), draw(st.floats(0.05, 0.95))
-        point = tmap.grid_to_world(np.array([r + fr, c + fc]))
-        if not tmap.is_usable(point, radius):
-            point = tmap.cell_to_world(np.array([r, c]))
-        points.append(point)
-    return tmap, radius, np.array(points)
-
-
-# ----------------------------------------------------------------------- navigation episodes
 
 
 @st.composite
@@ -322,7 +77,9 @@ def nav_robot_specs() -> st.SearchStrategy:
 
     Shrinks towards a point robot with differential drive.
     """
-    from pointnav_core.backends.robot_spec import RobotSpec
+    from pointnav_core.backends.protocol import (
+        RobotSpec,  # this block was appended: import here
+    )
 
     return st.builds(
         RobotSpec,
@@ -364,7 +121,6 @@ def nav_task_kwargs(draw: st.DrawFn, max_steps: int = 60) -> dict:
     }
 
 
-__all__ += ["nav_scenes", "nav_robot_specs", "nav_task_kwargs"]
 
 
 # ----------------------------------------------------------------------- scenes and backends
@@ -555,9 +311,6 @@ def action_sequences(
     )
 
 
-__all__ += ["scenes", "valid_poses", "robot_placements", "action_sequences"]
-
-
 @st.composite
 def cluttered_rooms(draw: st.DrawFn, max_clutter: float = 0.12, min_side: int = 12, patch: int = 6) -> object:
     """A walled room of 0.1 m cells, ``min_side`` to 30 cells a side: random OBSTACLE cells
@@ -577,6 +330,3 @@ def cluttered_rooms(draw: st.DrawFn, max_clutter: float = 0.12, min_side: int = 
     r, c = draw(st.integers(1, rows - 1 - patch)), draw(st.integers(1, cols - 1 - patch))
     grid[r : r + patch, c : c + patch] = FREE
     return Scene.from_array(grid, 0.1)
-
-
-__all__ += ["cluttered_rooms"]
