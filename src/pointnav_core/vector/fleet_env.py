@@ -18,6 +18,7 @@ robot at the sum of their radii, and is a disc of its radius in the scans and ma
 
 from __future__ import annotations
 
+import dataclasses
 from collections.abc import Mapping, Sequence
 from typing import Any
 
@@ -34,7 +35,7 @@ from pointnav_core.vector.accounting import task_step
 from pointnav_core.vector.arguments import as_scene_list, check_real_actions
 from pointnav_core.vector.contacts import advance
 from pointnav_core.vector.contacts_jit import advance_compiled
-from pointnav_core.vector.discrete import MOVED, DiscretePlan
+from pointnav_core.vector.discrete import DiscretePlan
 from pointnav_core.vector.drive import (
     arc,
     body_command,
@@ -55,6 +56,7 @@ from pointnav_core.vector.per_robot import (
 from pointnav_core.vector.pool_build import pool_options
 from pointnav_core.vector.robots import advance_robots, robot_walls
 from pointnav_core.vector.scan import requested_scan
+from pointnav_core.vector.state import Motion
 from pointnav_core.vector.xp import make_arrays
 
 __all__ = ["FINISHED_MODES", "VectorFleetEnv"]
@@ -171,7 +173,7 @@ class VectorFleetEnv(VectorPointNavEnv):
             self.action_space = batch(batch(self.single_action_space, self.n_robots), self.num_envs)
         self._rng = np.random.default_rng(seed)
         n, r = self.num_envs, self.n_robots
-        self._world_scene = a.asarray(np.arange(n) % len(scene_list), a.i64)
+        self.world_scene = a.asarray(np.arange(n) % len(scene_list), a.i64)
         self._robot_scene = a.asarray(np.repeat(np.arange(n) % len(scene_list), r).reshape(n, r), a.i64)
         self._robot_ids = a.asarray(np.arange(r), a.i64).reshape(1, r)
         self.pool: FleetPool | None = None  # type: ignore[assignment]
@@ -234,23 +236,23 @@ class VectorFleetEnv(VectorPointNavEnv):
         if self._discrete is not None:
             return self._account(*self._discrete.run(self, act, acting=self._active))
         # Robots that are not agents any more get no command (the backend's _NO_COMMAND).
-        moved, contact = self._drive(self.arrays.xp.where(self._active[..., None], act, 0.0 * act), self._state)
+        moved, contact = self.drive(self.arrays.xp.where(self._active[..., None], act, 0.0 * act), self.state)
         return self._account(moved, contact, None)
 
-    def _drive(self, act: Any, state: Mapping[str, Any]) -> tuple[dict[str, Any], Any]:
+    def drive(self, act: Any, state: Motion) -> tuple[Motion, Any]:
         """One control step of every world from ``state`` under commands ``act``
         ``(num_envs, n_robots, action_dim)`` in ``[-1, 1]`` units, not committed: the new pose,
-        height, velocities and fall speed (keys ``MOVED``) and the contacts. A falling robot
+        height, velocities and fall speed, and the contacts. A falling robot
         present in the world drops (:func:`~pointnav_core.vector.falls.apply_falls`); it
         neither drives nor blocks. A robot out of the world stays as it is."""
         a, xp = self.arrays, self.arrays.xp
         dt, radius = self.dt, self._radius  # (1, R): each robot's radius
-        falling = state["fs"] > 0.0
+        falling = state.fall_speed > 0.0
         present = self._present & ~falling
         vmax, wmax = self._vmax, self._wmax  # (1, R): each robot's speed limits
         vx, vy, w = body_command(xp, act, vmax, wmax, self.holonomic)
         zero = xp.zeros_like(vx)
-        x0, y0, yaw0 = state["x"], state["y"], state["yaw"]
+        x0, y0, yaw0 = state.x, state.y, state.yaw
         dx, dy = arc(xp, yaw0, vx, vy, w, dt)
         length = travel(xp, vx, vy, dt)
         # The backend's fast path: clearance beyond the step and no other free robot within reach.
@@ -283,20 +285,21 @@ class VectorFleetEnv(VectorPointNavEnv):
         vel_y = xp.where(fast, dy / dt, (y - y0) / dt)
         vel_w = xp.where(fast, w, (yaw - yaw0) / dt)
         vel_x, vel_y, vel_w = (xp.where(present, v, zero) for v in (vel_x, vel_y, vel_w))
-        moved = apply_falls(xp, state, {"x": x, "y": y, "yaw": yaw, "vx": vel_x, "vy": vel_y, "w": vel_w}, began, dt)
+        moved = apply_falls(xp, state, {"x": x, "y": y, "yaw": yaw, "vx": vel_x, "vy": vel_y, "yaw_rate": vel_w}, began, dt)
         # A robot out of the world (removed, or fallen and gone) is not moved by the backend.
         out = ~self._present
-        moved = {key: xp.where(out, state[key], value) if key in ("z", "fs") else value for key, value in moved.items()}
-        moved["vz"] = xp.where(out, zero, moved["vz"])
+        moved = dataclasses.replace(moved, z=xp.where(out, state.z, moved.z),
+                                    fall_speed=xp.where(out, state.fall_speed, moved.fall_speed),
+                                    vz=xp.where(out, zero, moved.vz))
         return moved, contact & ~falling
 
-    def _account(self, moved: Mapping[str, Any], contact: Any, stopped: Any) -> tuple[Any, Any, Any, Any, dict[str, Any]]:
+    def _account(self, moved: Motion, contact: Any, stopped: Any) -> tuple[Any, Any, Any, Any, dict[str, Any]]:
         """Each active robot's task step (``PointNavigationTask.step``, masked by the robots
         still acting) over the moves from the committed state, then the commit and the
         next-step autoresets. ``stopped``: the robots that called STOP (None without STOP)."""
-        a, xp, st = self.arrays, self.arrays.xp, self._state
+        a, xp, st = self.arrays, self.arrays.xp, self.state
         acting, present = self._active, self._present
-        zero = xp.zeros_like(st["x"])
+        zero = xp.zeros_like(st.x)
         t = task_step(self, moved, contact, stopped, acting)  # each acting robot's task step
         cycles = self._cycles + 1
         reward, terminated, success, fell = t.reward, t.terminated, t.success, t.fell
@@ -306,8 +309,9 @@ class VectorFleetEnv(VectorPointNavEnv):
         active = acting & ~ended
         # A robot that fell leaves its floor; with "remove" every finished robot leaves.
         gone = (ended & fell) if self.finished == "park" else ended
-        st.update({key: moved[key] for key in MOVED}, path=t.path, dist=t.dist, pot=xp.where(acting, t.pot, st["pot"]))
-        self._steps, self._collisions, self._cycles = t.steps, t.collisions, cycles
+        self.state = st.moved(moved, path_length=t.path, goal_distance=t.dist, potential=xp.where(acting, t.pot, st.potential),
+                              steps=t.steps, collisions=t.collisions)
+        self._cycles = cycles
         self._active, self._present = active, present & ~gone
         # The multi-robot env observes every robot before its finished robots leave the world.
         self._seen = present
@@ -369,15 +373,15 @@ class VectorFleetEnv(VectorPointNavEnv):
     def _scan_ranges(self, c: Any, s: Any) -> Any:
         """Every robot's scan readings (m), ``(num_envs, n_robots, n_rays)``; robots outside
         ``_seen`` neither see nor are seen (their rows are hidden by ``_observe``)."""
-        xp, st = self.arrays.xp, self._state
+        xp, st = self.arrays.xp, self.state
         yaw = xp.arctan2(s, c)  # the heading as the multi-robot env's frame gives it
-        return self.scan.readings(self._world_scene, st["x"], st["y"], yaw, self._seen, self._radius, self._steps)
+        return self.scan.readings(self.world_scene, st.x, st.y, yaw, self._seen, self._radius, st.steps)
 
     def _map_values(self) -> Any:
         """Every robot's local map, ``(num_envs, n_robots, cells * cells)``, with the discs of
         the robots in ``_seen`` (the scan's rule); rows outside it are hidden by ``_observe``."""
-        st = self._state
-        return self.local_map.values(self._world_scene, st["x"], st["y"], st["yaw"], self._seen, self._radius)
+        st = self.state
+        return self.local_map.values(self.world_scene, st.x, st.y, st.yaw, self._seen, self._radius)
 
     def _observe(self, shown: Any) -> Any:
         """The robots' ``low_dim`` observations, zero where ``shown`` is False."""
