@@ -246,10 +246,10 @@ class VectorFleetEnv(VectorPointNavEnv):
         present in the world drops (:func:`~pointnav_core.vector.falls.apply_falls`); it
         neither drives nor blocks. A robot out of the world stays as it is."""
         a, xp = self.arrays, self.arrays.xp
-        dt, radius = self.dt, self._radius  # (1, R): each robot's radius
+        dt, radius = self.dt, self.radius  # (1, R): each robot's radius
         falling = state.fall_speed > 0.0
         present = self._present & ~falling
-        vmax, wmax = self._vmax, self._wmax  # (1, R): each robot's speed limits
+        vmax, wmax = self.vmax, self.wmax  # (1, R): each robot's speed limits
         vx, vy, w = body_command(xp, act, vmax, wmax, self.holonomic)
         zero = xp.zeros_like(vx)
         x0, y0, yaw0 = state.x, state.y, state.yaw
@@ -338,7 +338,7 @@ class VectorFleetEnv(VectorPointNavEnv):
         the others where they are: ``x``, ``y`` and the contact flags, ``(num_envs, n_robots)``."""
         a = self.arrays
         if contacts_jit.available(self.floors):  # every world in one compiled loop
-            sx, sy, c = advance_compiled(self.floors, self._robot_scene, x0, y0, dx, dy, slow, self._radius,
+            sx, sy, c = advance_compiled(self.floors, self._robot_scene, x0, y0, dx, dy, slow, self.radius,
                                          self._max_travel)
             return a.asarray(sx), a.asarray(sy), a.asarray(c, a.boolean)
         x, y, contact = x0 + 0.0, y0 + 0.0, a.xp.zeros_like(slow)
@@ -349,7 +349,7 @@ class VectorFleetEnv(VectorPointNavEnv):
         """The array path of the slow robots' contacts: writes their ends into ``x``, ``y``
         and their flags into ``contact`` (in place)."""
         a, xp, scene = self.arrays, self.arrays.xp, self._robot_scene
-        radius = xp.zeros_like(x0) + self._radius  # (W, R)
+        radius = xp.zeros_like(x0) + self.radius  # (W, R)
         n_slow = slow.sum(-1)
         # A world with one slow robot is the one-robot resolver's case (the backend's
         # advance with a single robot): cheaper, and most busy worlds are such.
@@ -375,13 +375,13 @@ class VectorFleetEnv(VectorPointNavEnv):
         ``_seen`` neither see nor are seen (their rows are hidden by ``_observe``)."""
         xp, st = self.arrays.xp, self.state
         yaw = xp.arctan2(s, c)  # the heading as the multi-robot env's frame gives it
-        return self.scan.readings(self.world_scene, st.x, st.y, yaw, self._seen, self._radius, st.steps)
+        return self.scan.readings(self.world_scene, st.x, st.y, yaw, self._seen, self.radius, st.steps)
 
     def _map_values(self) -> Any:
         """Every robot's local map, ``(num_envs, n_robots, cells * cells)``, with the discs of
         the robots in ``_seen`` (the scan's rule); rows outside it are hidden by ``_observe``."""
         st = self.state
-        return self.local_map.values(self.world_scene, st.x, st.y, st.yaw, self._seen, self._radius)
+        return self.local_map.values(self.world_scene, st.x, st.y, st.yaw, self._seen, self.radius)
 
     def _observe(self, shown: Any) -> Any:
         """The robots' ``low_dim`` observations, zero where ``shown`` is False."""

@@ -120,8 +120,8 @@ class VectorLocalMap:
         self.floors = floors
         a = self.arrays = floors.arrays
         # The single term's cell centres in the robot frame (forward u, left v), row by row.
-        self._u = a.asarray(term._u)
-        self._v = a.asarray(term._v)
+        self._u = a.asarray(term.u)
+        self._v = a.asarray(term.v)
         # The floors' codes as local map codes, once (one gather per cell, not two).
         self._codes = a.asarray(_LUT[a.numpy(floors.codes)], a.i64)
         # Float copies of the grids' shapes, to index in float until one cast.
