@@ -22,7 +22,6 @@ from pointnav_core import scenes
 from pointnav_core.envs import common as _envcommon
 from pointnav_core.envs.config import EnvConfig, takes_config, vector_arguments
 from pointnav_core.errors import ArgumentError, TaskStateError
-from pointnav_core.task.metrics import soft_spl_values, spl_values
 from pointnav_core.utils import validation
 from pointnav_core.vector import contacts_jit
 from pointnav_core.vector.accounting import custom_rewards, task_step
@@ -31,24 +30,17 @@ from pointnav_core.vector.arguments import (
     check_real_actions,
     task_arguments,
 )
-from pointnav_core.vector.contacts import advance
 from pointnav_core.vector.discrete import DiscretePlan
-from pointnav_core.vector.drive import (
-    arc,
-    body_command,
-    sub_steps,
-    substep_drive,
-    travel,
-)
+from pointnav_core.vector.drive_step import drive_worlds
 from pointnav_core.vector.episodes import EpisodePool, fixed_pose
-from pointnav_core.vector.falls import apply_falls
 from pointnav_core.vector.floors import FloorTables
 from pointnav_core.vector.local_map import VectorLocalMap, local_map_term
+from pointnav_core.vector.observe import low_dim, step_info
 from pointnav_core.vector.pool_build import build_parts, pool_options
 from pointnav_core.vector.refresh import PoolRefreshing
 from pointnav_core.vector.scan import ScanTables, VectorScan, requested_scan
 from pointnav_core.vector.state import Motion, WorldState
-from pointnav_core.vector.xp import make_arrays
+from pointnav_core.vector.xp import as_dtype, cat, copy, make_arrays
 
 __all__ = ["VectorPointNavEnv"]
 
@@ -325,7 +317,7 @@ class VectorPointNavEnv(PoolRefreshing, VectorEnv):
         # A chord is never longer than its arc (a holonomic one: the diagonal of its two
         # top speeds); the margin covers rounding.
         top = spec.max_linear_velocity * (math.sqrt(2.0) if self.holonomic else 1.0)
-        self._max_travel = top * self.dt * (1.0 + 1e-9) + 1e-12
+        self.max_travel = top * self.dt * (1.0 + 1e-9) + 1e-12
 
     # ------------------------------------------------------------------ pools
     @property
@@ -336,7 +328,7 @@ class VectorPointNavEnv(PoolRefreshing, VectorEnv):
         Goal fields keep only the cells within it of their starts (``FieldTables``)."""
         steps = self.max_steps if isinstance(self.max_steps, int) else int(self.arrays.numpy(self.max_steps).max())
         steps = min(steps, getattr(self, "max_cycles", steps))
-        per_step = self._max_travel * (1 if self._discrete is None else self._discrete.max_steps)
+        per_step = self.max_travel * (1 if self._discrete is None else self._discrete.max_steps)
         return steps * per_step
 
     def _build_pool(self, fixed: Sequence[tuple[Any, float, Any, int]]) -> None:
@@ -401,27 +393,9 @@ class VectorPointNavEnv(PoolRefreshing, VectorEnv):
         else:
             k = a.asarray(self._rng.integers(self.pool.pool_size, size=n), a.i64)
             ep = self.world_scene * self.pool.pool_size + k
-        p = self.pool
         idx = a.nonzero(mask)
-        e = ep[idx]
-        # In place: the state's arrays are this engine's own (info hands out copies).
-        for array, src in ((st.x, p.sx), (st.y, p.sy), (st.yaw, p.syaw), (st.goal_x, p.gx), (st.goal_y, p.gy),
-                           (st.start_distance, p.d0)):
-            array[idx] = src[e]
         height = self.floors.height[self.world_scene[idx]]  # (k,); each robot of a fleet's world
-        st.z[idx] = height if st.z.ndim == 1 else height[:, None] + 0.0 * st.x[idx]
-        for array in (st.vx, st.vy, st.vz, st.yaw_rate, st.fall_speed, st.path_length):
-            array[idx] = 0.0
-        st.goal_field[idx] = p.field[e]
-        st.steps[idx] = st.collisions[idx] = 0
-        d0 = st.start_distance[idx]
-        geo = self.geodesic_reward & (d0 < math.inf)
-        st.geodesic_metric[idx] = geo
-        x, y = st.x[idx], st.y[idx]
-        dist = p.fields.distance(p.field[e], x, y)
-        st.goal_distance[idx] = dist
-        l2 = xp.sqrt((st.goal_x[idx] - x) ** 2 + (st.goal_y[idx] - y) ** 2)
-        st.potential[idx] = xp.where(geo, xp.where(dist < math.inf, dist, d0), l2)
+        st.start_episodes(xp, idx, self.pool, ep[idx], height, self.geodesic_reward)
         self._needs_reset[idx] = False
         if self.scan is not None:  # the worlds' episode counts key the scan's noise
             self.scan.begin(mask, n)
@@ -468,50 +442,7 @@ class VectorPointNavEnv(PoolRefreshing, VectorEnv):
         ``(num_envs, action_dim)``, not committed: the new pose, height, velocities and fall
         speed, and the contacts. A falling robot ignores its command and drops
         (:func:`~pointnav_core.vector.falls.apply_falls`)."""
-        a, xp = self.arrays, self.arrays.xp
-        spec, dt = self.robot, self.dt
-        vx, vy, w = body_command(xp, act, spec.max_linear_velocity, spec.max_angular_velocity, self.holonomic)
-        x0, y0, yaw0 = state.x, state.y, state.yaw
-        dx, dy = arc(xp, yaw0, vx, vy, w, dt)  # the exact arc over the step (drive_arc)
-        length = travel(xp, vx, vy, dt)
-        scene = self.world_scene
-        row, col, inside = self.floors.cells(scene, x0, y0)
-        budget = self.floors.fast[self.floors.flat_index(scene, row, col, inside)]
-        standing = ~(state.fall_speed > 0.0)
-        fast = inside & (budget > length)
-        x, y, yaw = x0 + dx, y0 + dy, yaw0 + w * dt
-        vel_x, vel_y, vel_w = dx / dt, dy / dt, w
-        contact = xp.zeros_like(x) > 1.0
-        began = contact
-        slow = a.nonzero(~fast & standing)
-        if slow.shape[0]:
-            sc = scene[slow]
-            resolver = contacts_jit.advance_one if contacts_jit.available(self.floors) else advance
-
-            def move(px: Any, py: Any, mx: Any, my: Any, part: Any) -> tuple[Any, Any, Any]:
-                # The worlds of ``part`` by their chords; a later sub-step has fewer of them.
-                if bool(part.all()):
-                    return resolver(self.floors, sc, px, py, mx, my, spec.radius, self._max_travel)
-                idx = a.nonzero(part)
-                ix, iy, ic = resolver(self.floors, sc[idx], px[idx], py[idx], mx[idx], my[idx], spec.radius, self._max_travel)
-                nx, ny, c = px + 0.0, py + 0.0, xp.zeros_like(part)
-                nx[idx], ny[idx], c[idx] = ix, iy, ic
-                return nx, ny, c
-
-            n_sub = sub_steps(xp, length[slow], w[slow], dt, self.floors.res[sc])
-            sx, sy, syaw, fall, c = substep_drive(
-                xp, (x0[slow], y0[slow], yaw0[slow]), (vx[slow], vy[slow], w[slow]), n_sub, dt, move,
-                lambda px, py: self.floors.is_void(sc, px, py), (dx[slow], dy[slow]),
-            )
-            x[slow], y[slow], yaw[slow] = sx, sy, syaw
-            vel_x[slow] = (sx - x0[slow]) / dt
-            vel_y[slow] = (sy - y0[slow]) / dt
-            vel_w = xp.where(fast, vel_w, (yaw - yaw0) / dt)
-            began = began.clone() if a.is_torch else began.copy()
-            began[slow] = fall
-            contact[slow] = c
-        moved = apply_falls(xp, state, {"x": x, "y": y, "yaw": yaw, "vx": vel_x, "vy": vel_y, "yaw_rate": vel_w}, began, dt)
-        return moved, contact
+        return drive_worlds(self, act, state)  # a method: the fleet has its own, the discrete plan calls either
 
     def _account(self, moved: Motion, contact: Any, stopped: Any) -> tuple[Any, Any, Any, Any, dict[str, Any]]:
         """The task's step over the worlds' moves from the committed state: rewards, ends, info,
@@ -523,7 +454,7 @@ class VectorPointNavEnv(PoolRefreshing, VectorEnv):
         # Commit, then reset the worlds that ended on the previous step (next-step autoreset).
         self.state = self.state.moved(moved, path_length=t.path, goal_distance=t.dist, potential=t.pot, steps=t.steps,
                                       collisions=t.collisions)
-        resetting = self._needs_reset.clone() if a.is_torch else self._needs_reset.copy()
+        resetting = copy(xp, self._needs_reset)
         if a.any(resetting):
             self._reset_worlds(resetting)
             keep = ~resetting
@@ -534,31 +465,20 @@ class VectorPointNavEnv(PoolRefreshing, VectorEnv):
         self._needs_reset = terminated | truncated
         info = self._info(success, r_pot, r_col, r_goal, contact, resetting)
         for name, r in r_custom.items():  # fresh arrays, as _info's
-            info[f"reward_{name}"] = r.clone() if a.is_torch else r.copy()
+            info[f"reward_{name}"] = copy(xp, r)
         return self._observe(), reward, terminated, truncated, info
 
     # ------------------------------------------------------------------ observation and info
     def _observe(self) -> Any:
-        a, xp, st = self.arrays, self.arrays.xp, self.state
-        c, s = xp.cos(st.yaw), xp.sin(st.yaw)
-        dx, dy = st.goal_x - st.x, st.goal_y - st.y
-        lx, ly = c * dx + s * dy, c * dy - s * dx
-        polar = self.goal_in_polar  # a bool, or a (1, R) mask when robots' tasks differ
-        if polar is not False:
-            rho = xp.sqrt(lx * lx + ly * ly)
-            phi = xp.where(rho > 0.0, xp.arctan2(ly, lx), 0.0)
-            phi = xp.where(phi == -math.pi, math.pi, phi)
-            lx, ly = (rho, phi) if polar is True else (xp.where(polar, rho, lx), xp.where(polar, phi, ly))
-        vx, vy = st.vx, st.vy
-        zero = xp.zeros_like(vx)
-        obs = xp.stack([lx, ly, c * vx + s * vy, c * vy - s * vx, st.vz, zero, zero, st.yaw_rate], -1)
+        xp = self.arrays.xp
+        obs, c, s = low_dim(xp, self.state, self.goal_in_polar)
         if self.scan is not None:
-            obs = (xp.cat if a.is_torch else xp.concatenate)([obs, self._scan_ranges(c, s)], -1)
+            obs = cat(xp, [obs, self._scan_ranges(c, s)], -1)
         sc, width = self.world_scene, obs.shape[-1]
         obs = xp.minimum(xp.maximum(obs, self._low[..., :width][sc]), self._high[..., :width][sc])
-        obs = obs.to(xp.float32) if a.is_torch else obs.astype(np.float32)
+        obs = as_dtype(xp, obs, xp.float32)
         if self.local_map is not None:  # after the scan (the single env's order); codes within their bounds
-            obs = (xp.cat if a.is_torch else xp.concatenate)([obs, self._map_values()], -1)
+            obs = cat(xp, [obs, self._map_values()], -1)
         return obs
 
     def _scan_ranges(self, c: Any, s: Any) -> Any:
@@ -576,16 +496,4 @@ class VectorPointNavEnv(PoolRefreshing, VectorEnv):
                                      self.robot.radius)[:, 0]
 
     def _info(self, success: Any, r_pot: Any, r_col: Any, r_goal: Any, contact: Any, resetting: Any) -> dict[str, Any]:
-        xp, st = self.arrays.xp, self.state
-        d0, length, d_t = st.start_distance, st.path_length, st.goal_distance
-        spl = spl_values(success, d0, length, xp.where)  # the single env's definition
-        soft = soft_spl_values(d_t, d0, length, xp.where)
-        info = {
-            "success": success, "spl": spl, "soft_spl": soft, "path_length": length, "geodesic_dist": d0,
-            "distance_to_goal": d_t, "collisions": st.collisions, "episode_length": st.steps,
-            "in_contact": contact, "reward_potential": r_pot, "reward_collision": r_col,
-            "reward_pointgoal": r_goal, "autoreset": resetting,
-        }
-        # Fresh arrays: the engine's state arrays are written in place at the next autoreset.
-        copy = (lambda v: v.clone()) if self.arrays.is_torch else (lambda v: v.copy())
-        return {key: copy(value) for key, value in info.items()}
+        return step_info(self.arrays.xp, self.state, success, r_pot, r_col, r_goal, contact, resetting)

@@ -57,7 +57,7 @@ from pointnav_core.vector.pool_build import pool_options
 from pointnav_core.vector.robots import advance_robots, robot_walls
 from pointnav_core.vector.scan import requested_scan
 from pointnav_core.vector.state import Motion
-from pointnav_core.vector.xp import make_arrays
+from pointnav_core.vector.xp import amax, as_dtype, copy, make_arrays
 
 __all__ = ["FINISHED_MODES", "VectorFleetEnv"]
 
@@ -158,6 +158,23 @@ class VectorFleetEnv(VectorPointNavEnv):
         self.floors = FloorTables(scene_list, t.floor, spec.radius, a, shared)
         # Each robot's clearance table, of its own radius: (R, all cells).
         self._fast = a.xp.stack([self.floors.fast_for(s.radius) for s in self.robots])
+        self._make_spaces(first)
+        self._rng = np.random.default_rng(seed)
+        n, r = self.num_envs, self.n_robots
+        self.world_scene = a.asarray(np.arange(n) % len(scene_list), a.i64)
+        self._robot_scene = a.asarray(np.repeat(np.arange(n) % len(scene_list), r).reshape(n, r), a.i64)
+        self._robot_ids = a.asarray(np.arange(r), a.i64).reshape(1, r)
+        self.pool: FleetPool | None = None  # type: ignore[assignment]
+        self._allocate((n, r), scan_term, sensors)
+        self._active = a.zeros((n, r), a.boolean)
+        self._present = a.zeros((n, r), a.boolean)
+        self._seen = self._present  # the robots the scans see at the next observation
+        self._cycles = a.zeros(n, a.i64)
+
+    def _make_spaces(self, first: Any) -> None:
+        """The observation bounds of every (scene, robot) and the batched spaces, from the
+        multi-robot envs (``first`` gives the action space)."""
+        a = self.arrays
         bounds = [[t.observation_bounds for t in env.tasks] for env in self._samplers]  # (scene, robot)
         lows, highs = (np.array([[b[k] for b in row] for row in bounds], np.float64) for k in (0, 1))
         self._low, self._high = a.asarray(lows), a.asarray(highs)
@@ -171,17 +188,6 @@ class VectorFleetEnv(VectorPointNavEnv):
             self.action_space = gym.spaces.MultiDiscrete(nvec)
         else:
             self.action_space = batch(batch(self.single_action_space, self.n_robots), self.num_envs)
-        self._rng = np.random.default_rng(seed)
-        n, r = self.num_envs, self.n_robots
-        self.world_scene = a.asarray(np.arange(n) % len(scene_list), a.i64)
-        self._robot_scene = a.asarray(np.repeat(np.arange(n) % len(scene_list), r).reshape(n, r), a.i64)
-        self._robot_ids = a.asarray(np.arange(r), a.i64).reshape(1, r)
-        self.pool: FleetPool | None = None  # type: ignore[assignment]
-        self._allocate((n, r), scan_term, sensors)
-        self._active = a.zeros((n, r), a.boolean)
-        self._present = a.zeros((n, r), a.boolean)
-        self._seen = self._present  # the robots the scans see at the next observation
-        self._cycles = a.zeros(n, a.i64)
 
     # ------------------------------------------------------------------ pools
     def reset(self, *, seed: int | None = None, options: dict[str, Any] | None = None) -> tuple[Any, dict[str, Any]]:
@@ -196,7 +202,7 @@ class VectorFleetEnv(VectorPointNavEnv):
             self._seen = self._present
             self._started = True
             zero, no = a.zeros((self.num_envs, self.n_robots)), a.zeros((self.num_envs, self.n_robots), a.boolean)
-            shown = self._active.clone() if a.is_torch else self._active.copy()
+            shown = copy(a.xp, self._active)
             return self._observe(shown), self._info(no, zero, zero, zero, no, shown, no)
 
     def _fixed_episode(self, i: int, episode: Any, s: int) -> Any:
@@ -273,7 +279,7 @@ class VectorFleetEnv(VectorPointNavEnv):
         if a.any(slow):
             # Every slow robot of a world takes the world's sub-steps (the backend's _slow_step).
             n_sub = sub_steps(xp, length, w, dt, self.floors.res[scene])
-            n_sub = xp.where(slow, n_sub, zero).amax(-1) if a.is_torch else xp.where(slow, n_sub, zero).max(-1)
+            n_sub = amax(xp, xp.where(slow, n_sub, zero), -1)
             n_sub = xp.where(slow, n_sub[:, None], zero)
             sx, sy, syaw, fall, contact = substep_drive(
                 xp, (x0, y0, yaw0), (vx, vy, w), n_sub, dt, self._move_slow,
@@ -316,7 +322,7 @@ class VectorFleetEnv(VectorPointNavEnv):
         # The multi-robot env observes every robot before its finished robots leave the world.
         self._seen = present
         shown = acting
-        resetting = self._needs_reset.clone() if a.is_torch else self._needs_reset.copy()
+        resetting = copy(xp, self._needs_reset)
         if a.any(resetting):
             # Next-step autoreset: every robot of a world with no agent left starts again.
             self._reset_worlds(resetting)
@@ -339,7 +345,7 @@ class VectorFleetEnv(VectorPointNavEnv):
         a = self.arrays
         if contacts_jit.available(self.floors):  # every world in one compiled loop
             sx, sy, c = advance_compiled(self.floors, self._robot_scene, x0, y0, dx, dy, slow, self.radius,
-                                         self._max_travel)
+                                         self.max_travel)
             return a.asarray(sx), a.asarray(sy), a.asarray(c, a.boolean)
         x, y, contact = x0 + 0.0, y0 + 0.0, a.xp.zeros_like(slow)
         self._advance_slow(x0, y0, dx, dy, slow, x, y, contact)
@@ -356,13 +362,13 @@ class VectorFleetEnv(VectorPointNavEnv):
         alone = a.nonzero((slow & (n_slow == 1)[:, None]).reshape(-1))
         if alone.shape[0]:
             flat = [v.reshape(-1)[alone] for v in (scene, x0, y0, dx, dy, radius)]
-            nx, ny, c = advance(self.floors, *flat, self._max_travel)
+            nx, ny, c = advance(self.floors, *flat, self.max_travel)
             x.reshape(-1)[alone], y.reshape(-1)[alone], contact.reshape(-1)[alone] = nx, ny, c
         busy = a.nonzero(n_slow > 1)
         if busy.shape[0]:
             bx, by, bdx, bdy = x0[busy], y0[busy], dx[busy], dy[busy]
             brad = radius[busy]
-            walls = robot_walls(self.floors, scene[busy], bx, by, bdx, bdy, brad, self._max_travel)
+            walls = robot_walls(self.floors, scene[busy], bx, by, bdx, bdy, brad, self.max_travel)
             nx, ny, c = advance_robots(a, bx, by, bdx, bdy, brad, present=slow[busy], walls=walls)
             bslow = slow[busy]
             x[busy] = xp.where(bslow, nx, x[busy])
@@ -386,7 +392,7 @@ class VectorFleetEnv(VectorPointNavEnv):
     def _observe(self, shown: Any) -> Any:
         """The robots' ``low_dim`` observations, zero where ``shown`` is False."""
         obs = super()._observe()
-        return obs * (shown[..., None].to(obs.dtype) if self.arrays.is_torch else shown[..., None])
+        return obs * as_dtype(self.arrays.xp, shown[..., None], obs.dtype)
 
     def _info(self, success: Any, r_pot: Any, r_col: Any, r_goal: Any, contact: Any, shown: Any, resetting: Any) -> dict[str, Any]:
         xp = self.arrays.xp
@@ -394,5 +400,5 @@ class VectorFleetEnv(VectorPointNavEnv):
         for key, value in info.items():
             if key != "autoreset":
                 info[key] = value & shown if value.dtype == self.arrays.boolean else xp.where(shown, value, xp.zeros_like(value))
-        info["active"] = self._active.clone() if self.arrays.is_torch else self._active.copy()
+        info["active"] = copy(self.arrays.xp, self._active)
         return info

@@ -18,6 +18,7 @@ Examples
 from __future__ import annotations
 
 import dataclasses
+import math
 from dataclasses import dataclass
 from typing import Any
 
@@ -118,3 +119,41 @@ class WorldState(Motion):
     def moved(self, motion: Motion, **changes: Any) -> WorldState:
         """This state with ``motion``'s fields and ``changes`` in place of its own."""
         return dataclasses.replace(self, **{name: getattr(motion, name) for name in MOTION_FIELDS}, **changes)
+
+    def start_episodes(self, xp: Any, idx: Any, pool: Any, episode: Any, height: Any, geodesic_reward: Any) -> None:
+        """Begin pool episodes ``episode`` in entries ``idx``, in place (the arrays are the
+        engine's own; ``info`` hands out copies).
+
+        Parameters
+        ----------
+        xp : module
+            ``numpy`` or ``torch``.
+        idx : array of int, shape (k,)
+            The worlds to reset.
+        pool : EpisodePool or FleetPool
+            Its start ``sx``, ``sy`` (m), ``syaw`` (rad), goal ``gx``, ``gy`` (m), ``d0`` (m),
+            goal ``field`` and ``fields`` (distances) are read at ``episode``.
+        episode : array of int, shape (k,)
+            Each reset world's episode in ``pool``.
+        height : array of float64, shape (k,)
+            Each world's floor height (m); a fleet's robots all stand on it.
+        geodesic_reward : bool or bool array
+            Whether the potential is geodesic where the start's distance is finite.
+        """
+        e, p = episode, pool
+        for array, src in ((self.x, p.sx), (self.y, p.sy), (self.yaw, p.syaw), (self.goal_x, p.gx),
+                           (self.goal_y, p.gy), (self.start_distance, p.d0)):
+            array[idx] = src[e]
+        self.z[idx] = height if self.z.ndim == 1 else height[:, None] + 0.0 * self.x[idx]
+        for array in (self.vx, self.vy, self.vz, self.yaw_rate, self.fall_speed, self.path_length):
+            array[idx] = 0.0
+        self.goal_field[idx] = p.field[e]
+        self.steps[idx] = self.collisions[idx] = 0
+        d0 = self.start_distance[idx]
+        geo = geodesic_reward & (d0 < math.inf)
+        self.geodesic_metric[idx] = geo
+        x, y = self.x[idx], self.y[idx]
+        dist = p.fields.distance(p.field[e], x, y)
+        self.goal_distance[idx] = dist
+        l2 = xp.sqrt((self.goal_x[idx] - x) ** 2 + (self.goal_y[idx] - y) ** 2)
+        self.potential[idx] = xp.where(geo, xp.where(dist < math.inf, dist, d0), l2)
