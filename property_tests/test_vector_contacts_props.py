@@ -239,7 +239,7 @@ def test_engines_step_alike_on_the_compiled_and_array_contact_paths(
             for act in actions:
                 obs, reward, terminated, truncated, info = env.step(act)
                 out.append([to_np(v) for v in (obs, reward, terminated, truncated, info["in_contact"],
-                                               env._state["x"], env._state["y"], env._state["yaw"])])
+                                               env.state.x, env.state.y, env.state.yaw)])
         runs.append(out)
     for t, (got, want) in enumerate(zip(*runs)):
         for g, w in zip(got, want):

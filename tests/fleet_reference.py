@@ -123,7 +123,7 @@ def compare_fleet(
                 stats["falling_steps"] += not term[a] and env.backend.get_pose(k)[0][2] < env.tasks[k].floor_height
             # Every robot's height, falls over several steps included (parked falling robots too).
             z = np.array([env.backend.get_pose(k)[0][2] for k in range(r)])
-            np.testing.assert_allclose(to_np(venv._state["z"])[i], z, rtol=0, atol=1e-9, err_msg=f"z {where}")
+            np.testing.assert_allclose(to_np(venv.state.z)[i], z, rtol=0, atol=1e-9, err_msg=f"z {where}")
     return stats
 
 

@@ -65,7 +65,7 @@ def play(kind: str, env, ep: PointNavEpisode, other: PointNavEpisode):
     _, info = env.reset(options={"episodes": episodes})
     d0 = np.asarray(info["geodesic_dist"]).reshape(-1)[0]
     assert d0 == pytest.approx(math.dist(ep.start_xy, ep.goal_xy), abs=1e-6)  # open floor: a straight line
-    return float(env.arrays.numpy(env._state["x"]).reshape(-1)[0]), float(env.arrays.numpy(env._state["y"]).reshape(-1)[0])
+    return float(env.arrays.numpy(env.state.x).reshape(-1)[0]), float(env.arrays.numpy(env.state.y).reshape(-1)[0])
 
 
 @pytest.mark.parametrize("kind", ["single", "parallel", "vector", "fleet"])
@@ -159,12 +159,12 @@ def test_actions_that_are_not_real_numbers_are_refused_by_every_engine(name: str
     ]
     for env, actions in batched:
         env.reset(seed=0)
-        before = env.arrays.numpy(env._state["x"]).copy()
+        before = env.arrays.numpy(env.state.x).copy()
         # As a list, and as an array (but a list of bools and floats makes a float array).
         for given in (actions, np.array(actions)) if name != "bool item" else (actions,):
             with pytest.raises(ValueError, match=r"^actions must be real numbers in \[-1, 1\]"):
                 env.step(given)
-        np.testing.assert_array_equal(env.arrays.numpy(env._state["x"]), before)  # nothing moved
+        np.testing.assert_array_equal(env.arrays.numpy(env.state.x), before)  # nothing moved
         env.step(np.zeros(np.shape(np.array(actions)), np.int64))  # integers are real numbers
 
 

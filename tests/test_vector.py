@@ -59,7 +59,7 @@ def test_wall_contact_slides_and_costs(device: str) -> None:
     for _ in range(20):
         _, _, _, _, info = env.step(np.array([[1.0, 0.0]]))
         contacts += bool(env.arrays.numpy(info["in_contact"])[0])
-    y = float(env.arrays.numpy(env._state["y"])[0])
+    y = float(env.arrays.numpy(env.state.y)[0])
     assert contacts > 0
     assert abs(y - (0.1 + 0.18)) < 1e-6  # resting on the wall
     assert float(env.arrays.numpy(info["collisions"])[0]) == contacts
@@ -85,9 +85,9 @@ def test_pool_episodes_have_exact_geodesics() -> None:
     scene = room()
     env = VectorPointNavEnv(4, scene=scene, seed=3, pool_size=3)
     _, info = env.reset()
-    st = env._state
+    st = env.state
     for i in range(4):
-        start, goal = (st["x"][i], st["y"][i]), (st["gx"][i], st["gy"][i])
+        start, goal = (st.x[i], st.y[i]), (st.goal_x[i], st.goal_y[i])
         # An empty room: the geodesic is the straight line.
         assert info["geodesic_dist"][i] == pytest.approx(math.dist(start, goal), abs=1e-9)
         assert 1.0 < info["geodesic_dist"][i] < 10.0  # the single env's derived path_range
@@ -128,11 +128,11 @@ def test_a_fall_goes_on_over_three_steps_by_hand(device: str, n_robots: int) -> 
     assert float(env.single_observation_space.low[4]) > -1.4905  # so the clip below is seen
     for step in range(1, 7):
         obs, reward, terminated, _, info = env.step(np.array([[[1.0, 0.0]] * n_robots] if n_robots > 1 else [[1.0, 0.0]]))
-        z = float(to_np(env._state["z"]).reshape(-1)[0])
+        z = float(to_np(env.state.z).reshape(-1)[0])
         o, r = to_np(obs).reshape(n_robots, -1)[0], float(to_np(reward).reshape(-1)[0])
         assert z == pytest.approx(want_z.get(step, 0.0), abs=1e-12), f"step {step}"
         assert bool(to_np(terminated).reshape(-1)[0]) == (step == 6), f"step {step}"
-        x = float(to_np(env._state["x"]).reshape(-1)[0])
+        x = float(to_np(env.state.x).reshape(-1)[0])
         assert x == pytest.approx(min(0.92 + 0.05 * step, 1.12), abs=1e-12)
         # Driving at 0.5 m/s until the fall's first step; then no planar motion, no reward.
         assert o[2] == pytest.approx(0.5 if step <= 4 else 0.0, abs=1e-6)
@@ -165,10 +165,10 @@ def test_cuda_without_cuda_is_refused(monkeypatch: pytest.MonkeyPatch) -> None:
 def test_bad_actions_are_refused(device: str, actions: np.ndarray) -> None:
     env = VectorPointNavEnv(2, scene=room(), device=device, pool_size=1)
     env.reset(seed=0)
-    before = env.arrays.numpy(env._state["x"])
+    before = env.arrays.numpy(env.state.x)
     with pytest.raises(ValueError, match="actions"):
         env.step(actions)
-    np.testing.assert_array_equal(env.arrays.numpy(env._state["x"]), before)
+    np.testing.assert_array_equal(env.arrays.numpy(env.state.x), before)
 
 
 @pytest.mark.parametrize(("kwargs", "name"), [({"n_robots": 0}, "n_robots"), ({"sensors": {"lidar": {}}}, "sensors"),

@@ -58,7 +58,7 @@ def test_forward_moves_then_stop_at_the_goal_by_hand(device: str) -> None:
     assert to_np(info["episode_length"]).tolist() == [8, 8]
     np.testing.assert_allclose(to_np(obs)[1, 1], -math.radians(10.0), atol=1e-6)  # the goal swung right
     np.testing.assert_allclose(to_np(info["path_length"])[1], 1.75, atol=1e-12)
-    np.testing.assert_allclose(env.arrays.numpy(env._state["x"])[1], 2.75, atol=1e-12)
+    np.testing.assert_allclose(env.arrays.numpy(env.state.x)[1], 2.75, atol=1e-12)
 
 
 @pytest.mark.parametrize("device", DEVICES)
@@ -78,7 +78,7 @@ def test_a_move_into_a_wall_ends_at_the_contact(device: str) -> None:
     to_np = env.arrays.numpy
     env.reset(options={"episodes": [((0.4, 1.5), math.pi, (3.0, 1.5))]})
     obs, reward, _, _, info = env.step(np.array([FORWARD]))
-    np.testing.assert_allclose(to_np(env._state["x"]), [0.28], atol=1e-9)
+    np.testing.assert_allclose(to_np(env.state.x), [0.28], atol=1e-9)
     assert to_np(info["collisions"]).tolist() == [1] and to_np(info["in_contact"]).tolist() == [True]
     np.testing.assert_allclose(to_np(info["path_length"]), [0.12], atol=1e-9)
     np.testing.assert_allclose(to_np(obs)[0, 2], 0.2, atol=1e-6)  # the last control step: 0.02 m in 0.1 s
@@ -94,10 +94,10 @@ def test_a_move_into_a_wall_ends_at_the_contact(device: str) -> None:
 def test_bad_discrete_actions_are_refused(device: str, actions: object) -> None:
     env = make(2, device, stop=False)
     env.reset(options={"episodes": [((1.0, 1.5), 0.0, (3.0, 1.5))] * 2})
-    before = env.arrays.numpy(env._state["x"])
+    before = env.arrays.numpy(env.state.x)
     with pytest.raises(ValueError, match="actions"):
         env.step(actions)
-    np.testing.assert_array_equal(env.arrays.numpy(env._state["x"]), before)
+    np.testing.assert_array_equal(env.arrays.numpy(env.state.x), before)
 
 
 def test_discrete_actions_need_the_discrete_space() -> None:
@@ -167,8 +167,9 @@ def test_a_refreshed_pool_keeps_each_episode_on_its_goal_field(device: str) -> N
         if t in (1, 4):
             env.refresh_pool(wait=True)
         _, _, _, _, info = env.step(np.full(4, FORWARD))
-        st = {k: to_np(env._state[k]) for k in ("x", "y", "gx", "gy")}
-        np.testing.assert_allclose(to_np(info["distance_to_goal"]), np.hypot(st["gx"] - st["x"], st["gy"] - st["y"]), atol=1e-9)
+        st = env.state
+        x, y, gx, gy = (to_np(v) for v in (st.x, st.y, st.goal_x, st.goal_y))
+        np.testing.assert_allclose(to_np(info["distance_to_goal"]), np.hypot(gx - x, gy - y), atol=1e-9)
     assert env.pool.pool_size == 3  # the refreshed pool holds three starts per goal too
 
 
@@ -191,8 +192,8 @@ def test_fleet_robots_run_together_for_the_longest_action_by_hand(device: str) -
     env.reset(options={"episodes": [[((1.0, 1.5), 0.0, (2.5, 1.5)), ((1.0, 2.5), 0.0, (1.0, 2.5))]]})
     obs, reward, terminated, _, info = env.step(np.array([[FORWARD, LEFT]]))
     obs = to_np(obs)
-    np.testing.assert_allclose(to_np(env._state["x"])[0], [1.25, 1.0], atol=1e-12)
-    np.testing.assert_allclose(to_np(env._state["yaw"])[0], [0.0, math.radians(10.0)], atol=1e-12)
+    np.testing.assert_allclose(to_np(env.state.x)[0], [1.25, 1.0], atol=1e-12)
+    np.testing.assert_allclose(to_np(env.state.yaw)[0], [0.0, math.radians(10.0)], atol=1e-12)
     np.testing.assert_allclose(obs[0, 0, [2, 7]], [0.5, 0.0], atol=1e-6)  # 0.05 m in the last 0.1 s
     np.testing.assert_allclose(obs[0, 1, 2:], 0.0, atol=1e-7)  # stood still in the last control steps
     np.testing.assert_allclose(to_np(reward)[0], [0.25, 0.0], atol=1e-9)
@@ -205,7 +206,7 @@ def test_fleet_robots_run_together_for_the_longest_action_by_hand(device: str) -
     obs, reward, terminated, _, info = env.step(np.array([[STOP, FORWARD]]))  # robot 1's is ignored
     assert to_np(info["active"]).tolist() == [[False, False]]
     assert to_np(terminated).tolist() == [[True, False]] and to_np(info["success"]).tolist() == [[False, False]]
-    np.testing.assert_allclose(to_np(env._state["x"])[0], [1.25, 1.0], atol=1e-12)
+    np.testing.assert_allclose(to_np(env.state.x)[0], [1.25, 1.0], atol=1e-12)
 
 
 @pytest.mark.parametrize("device", DEVICES)
@@ -218,7 +219,7 @@ def test_fleet_move_into_a_parked_robot_ends_at_the_contact_by_hand(device: str)
     env.step(np.array([[RIGHT, STOP]]))
     env.step(np.array([[LEFT, FORWARD]]))
     info = env.step(np.array([[FORWARD, FORWARD]]))[4]
-    np.testing.assert_allclose(to_np(env._state["x"])[0], [1.24, 1.6], atol=1e-9)
+    np.testing.assert_allclose(to_np(env.state.x)[0], [1.24, 1.6], atol=1e-9)
     assert to_np(info["in_contact"]).tolist() == [[True, False]]
     assert to_np(info["collisions"]).tolist() == [[1, 0]]
     np.testing.assert_allclose(to_np(info["path_length"])[0, 0], 0.24, atol=1e-9)
@@ -234,10 +235,10 @@ def test_fleet_move_into_a_parked_robot_ends_at_the_contact_by_hand(device: str)
 def test_fleet_bad_discrete_actions_are_refused(device: str, actions: object) -> None:
     env = make_fleet(2, device, stop=False)
     env.reset()
-    before = env.arrays.numpy(env._state["x"])
+    before = env.arrays.numpy(env.state.x)
     with pytest.raises(ValueError, match="actions"):
         env.step(actions)
-    np.testing.assert_array_equal(env.arrays.numpy(env._state["x"]), before)
+    np.testing.assert_array_equal(env.arrays.numpy(env.state.x), before)
 
 
 @pytest.mark.parametrize("device", DEVICES)

@@ -73,7 +73,7 @@ def test_a_parked_robot_blocks_until_the_world_resets(device: str) -> None:
         assert to_np(terminated)[0].tolist() == [step == 7, False]
         assert to_np(info["active"])[0].tolist() == [step < 7, True]
     assert to_np(info["success"])[0].tolist() == [True, False]
-    assert abs(float(to_np(env._state["x"])[0, 0]) - 1.35) < 1e-9
+    assert abs(float(to_np(env.state.x)[0, 0]) - 1.35) < 1e-9
     # Robot 0 is no agent any more: its action is ignored and its entries are zero.
     for step in range(8, 21):
         obs, reward, terminated, truncated, info = env.step(np.array([drive]) + [[1.0, 1.0], [0.0, 0.0]])
@@ -81,7 +81,7 @@ def test_a_parked_robot_blocks_until_the_world_resets(device: str) -> None:
         assert not to_np(info["active"])[0, 0] and to_np(info["episode_length"])[0, 0] == 0
         # Robot 1 closes 0.85 m to 0.36 m (two radii) in 9.8 steps, then rests on robot 0.
         assert bool(to_np(info["in_contact"])[0, 1]) == (step >= 17)
-    x1 = float(to_np(env._state["x"])[0, 1])
+    x1 = float(to_np(env.state.x)[0, 1])
     assert abs(x1 - (1.35 + 0.36)) < 1e-8
     assert to_np(info["collisions"])[0, 1] == 4
     # max_cycles = 20: robot 1 is truncated, no robot is left, the next step resets the world.
@@ -102,7 +102,7 @@ def test_a_removed_robot_lets_the_others_pass(device: str) -> None:
     for _ in range(13):
         _, _, _, _, info = env.step(np.array([[[0.0, 0.0], [1.0, 0.0]]]))
         assert not to_np(info["in_contact"]).any()
-    assert abs(float(to_np(env._state["x"])[0, 1]) - (2.2 - 13 * 0.05)) < 1e-9  # through robot 0's place
+    assert abs(float(to_np(env.state.x)[0, 1]) - (2.2 - 13 * 0.05)) < 1e-9  # through robot 0's place
 
 
 SCAN = {"scan": {"n_rays": 4, "fov": 2 * math.pi, "max_range": 5.6}}  # bearings -pi, -pi/2, 0, pi/2
@@ -190,10 +190,10 @@ def test_crowded_worlds_match_parallel_envs(device: str, sensors: dict | None) -
 def test_bad_actions_are_refused(device: str, actions: np.ndarray) -> None:
     env = VectorPointNavEnv(2, n_robots=2, scene=room(), task=TASK, device=device, pool_size=1, seed=0)
     env.reset()
-    before = env.arrays.numpy(env._state["x"])
+    before = env.arrays.numpy(env.state.x)
     with pytest.raises(ValueError, match="actions"):
         env.step(actions)
-    np.testing.assert_array_equal(env.arrays.numpy(env._state["x"]), before)
+    np.testing.assert_array_equal(env.arrays.numpy(env.state.x), before)
 
 
 @pytest.mark.parametrize(("kwargs", "name"), [
@@ -274,8 +274,9 @@ def test_starts_per_goal_episodes_play_on_their_goal_fields(device: str) -> None
         if t in (1, 4):
             env.refresh_pool(wait=True)
         _, _, _, _, info = env.step(np.tile([1.0, 0.3], (4, 2, 1)))
-        st = {k: to_np(env._state[k]) for k in ("x", "y", "gx", "gy")}
+        st = env.state
+        x, y, gx, gy = (to_np(v) for v in (st.x, st.y, st.goal_x, st.goal_y))
         active = to_np(info["active"]) | to_np(info["autoreset"])
-        want = np.hypot(st["gx"] - st["x"], st["gy"] - st["y"])
+        want = np.hypot(gx - x, gy - y)
         np.testing.assert_allclose(to_np(info["distance_to_goal"])[active], want[active], atol=1e-9)
     assert env.pool.pool_size == 3  # the refreshed pool holds three sets of starts per goal set too

@@ -39,7 +39,7 @@ def one_step(device: str, start: tuple[float, float], yaw: float, action: list[f
     act[0, 0] = action
     obs, _, _, _, info = env.step(act if n_robots > 1 else act[:, 0])
     to_np = env.arrays.numpy
-    pose = [float(to_np(env._state[k]).reshape(-1)[0]) for k in ("x", "y", "yaw")]
+    pose = [float(to_np(getattr(env.state, k)).reshape(-1)[0]) for k in ("x", "y", "yaw")]
     return pose, to_np(obs).reshape(-1, obs.shape[-1])[0], bool(to_np(info["in_contact"]).reshape(-1)[0])
 
 
@@ -98,11 +98,11 @@ def test_discrete_forward_moves_a_holonomic_robot_ahead(device: str) -> None:
     env.reset(options={"episodes": [((1.0, 0.6), math.pi / 2, FAR_GOAL)]})
     env.step(np.array([0]))
     to_np = env.arrays.numpy
-    assert float(to_np(env._state["x"])[0]) == pytest.approx(1.0, abs=1e-12)
-    assert float(to_np(env._state["y"])[0]) == pytest.approx(0.85, abs=1e-12)
+    assert float(to_np(env.state.x)[0]) == pytest.approx(1.0, abs=1e-12)
+    assert float(to_np(env.state.y)[0]) == pytest.approx(0.85, abs=1e-12)
     env.step(np.array([1]))
-    assert float(to_np(env._state["yaw"])[0]) == pytest.approx(math.pi / 2 + math.radians(10.0), abs=1e-12)
-    assert float(to_np(env._state["y"])[0]) == pytest.approx(0.85, abs=1e-12)
+    assert float(to_np(env.state.yaw)[0]) == pytest.approx(math.pi / 2 + math.radians(10.0), abs=1e-12)
+    assert float(to_np(env.state.y)[0]) == pytest.approx(0.85, abs=1e-12)
 
 
 def test_spaces_equal_the_single_envs() -> None:
@@ -125,10 +125,10 @@ def test_actions_of_the_wrong_shape_are_named(n_robots: int, bad: tuple, words: 
     env = VectorPointNavEnv(2, n_robots=n_robots, scene=room(), robot=HOLO, pool_size=1, seed=0,
                             task={"path_range": (0.5, 1.5)})
     env.reset()
-    before = env.arrays.numpy(env._state["x"])
+    before = env.arrays.numpy(env.state.x)
     with pytest.raises(ValueError, match=words):
         env.step(np.zeros(bad))
-    np.testing.assert_array_equal(env.arrays.numpy(env._state["x"]), before)
+    np.testing.assert_array_equal(env.arrays.numpy(env.state.x), before)
 
 
 def test_a_differential_engine_names_its_own_shape() -> None:

@@ -168,7 +168,7 @@ def test_robots_of_radii_01_and_03_touch_at_04_m(device: str, path: str, monkeyp
     drive = np.array([[[1.0, 0.0], [0.0, 0.0]]])
     for step in range(1, 8):
         obs, _, _, _, info = env.step(drive)
-        x = np_(env._state["x"])[0]
+        x = np_(env.state.x)[0]
         contact = np_(info["in_contact"])[0].tolist()
         if step < 7:
             np.testing.assert_allclose(x, [0.5 + 0.05 * step, 1.22], atol=1e-12)
@@ -211,15 +211,15 @@ def test_discrete_actions_of_robots_of_different_speeds_by_hand(device: str) -> 
     # Both forward: the world runs 10 control steps; robot 0 drives in the first 5 and then
     # stands (zero velocity at the end), robot 1 drives in all 10. Both end 0.25 m ahead.
     obs, _, _, _, info = env.step(np.array([[0, 0]]))
-    np.testing.assert_allclose(to_np(env._state["x"])[0], [0.75, 0.75], atol=1e-12)
+    np.testing.assert_allclose(to_np(env.state.x)[0], [0.75, 0.75], atol=1e-12)
     np.testing.assert_allclose(to_np(obs)[0, :, 2], [0.0, 0.25], atol=1e-6)  # forward speed (m/s)
     assert to_np(info["episode_length"]).tolist() == [[1, 1]]
     np.testing.assert_allclose(to_np(info["path_length"])[0], [0.25, 0.25], atol=1e-12)
     # Robot 0 forward (5 steps) while robot 1 turns left (4 steps): robot 0 drives to the end of
     # the world's 5 steps, robot 1 turns 10 deg at 0.436 rad/s and stands in the 5th.
     obs, _, _, _, _ = env.step(np.array([[0, 1]]))
-    np.testing.assert_allclose(to_np(env._state["x"])[0], [1.0, 0.75], atol=1e-12)
-    np.testing.assert_allclose(to_np(env._state["yaw"])[0], [0.0, math.radians(10.0)], atol=1e-12)
+    np.testing.assert_allclose(to_np(env.state.x)[0], [1.0, 0.75], atol=1e-12)
+    np.testing.assert_allclose(to_np(env.state.yaw)[0], [0.0, math.radians(10.0)], atol=1e-12)
     np.testing.assert_allclose(to_np(obs)[0, :, 2], [0.5, 0.0], atol=1e-6)
     np.testing.assert_allclose(to_np(obs)[0, :, 7], [0.0, 0.0], atol=1e-6)  # yaw rate (rad/s)
 

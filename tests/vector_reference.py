@@ -84,7 +84,7 @@ def compare(
             sobs[i] = obs
             # The robot's height, falls over several steps included (the engine's state).
             z = float(env.backend.get_pose(0)[0][2])
-            assert abs(z - float(to_np(venv._state["z"])[i])) <= 1e-9, f"z world {i}, step {t}"
+            assert abs(z - float(to_np(venv.state.z)[i])) <= 1e-9, f"z world {i}, step {t}"
             stats["falling_steps"] += info is not None and z < env.task.floor_height and not term
             ties[i] = obs_ties(env, 0, sensors, dim)
             where = f"world {i}, step {t}"

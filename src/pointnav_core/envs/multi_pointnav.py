@@ -328,10 +328,12 @@ class MultiPointNavEnv(ParallelEnv[str, Any, np.ndarray]):
                 raise prefixed(f"task[{i}]", err) from None
         #: One task per robot, indexed by ``robot_idn`` (read it, don't replace entries).
         self.tasks = tasks
-        self._separation = goal_separation(scene, tasks, self.robots)
-        check_fixed_positions(tasks, self.robots, self._separation)
+        #: m, how far apart two robots' goals must be (read by the batched fleet's pools).
+        self.separation = goal_separation(scene, tasks, self.robots)
+        check_fixed_positions(tasks, self.robots, self.separation)
         # Robots with a fixed start are placed first, so no sampled start can take it.
-        self._reset_order = sorted(range(n), key=lambda i: tasks[i].initial_pos is None)
+        #: Robot indices in the order a reset places them.
+        self.reset_order = sorted(range(n), key=lambda i: tasks[i].initial_pos is None)
 
         self._set_agents(tasks, frequency)
         self._active = [False] * n
@@ -420,7 +422,7 @@ class MultiPointNavEnv(ParallelEnv[str, Any, np.ndarray]):
         self.backend.reset()
         infos: list[dict[str, Any]] = [{}] * len(self.tasks)
         placed: list[int] = []
-        for i in self._reset_order:
+        for i in self.reset_order:
             infos[i] = self._reset_robot(i, placed, given[i])
             placed.append(i)
         self._active = [True] * len(self.tasks)
@@ -448,7 +450,7 @@ class MultiPointNavEnv(ParallelEnv[str, Any, np.ndarray]):
 
     def _reset_robot(self, i: int, placed: list[int], episode: Any = None) -> dict[str, Any]:
         """Reset task ``i`` with its goal kept apart from the goals decided so far."""
-        constraint = goals_apart(self.tasks, i, placed, self._separation)
+        constraint = goals_apart(self.tasks, i, placed, self.separation)
         return self.tasks[i].reset(self, goal_constraint=constraint, episode=episode)
 
     def step(

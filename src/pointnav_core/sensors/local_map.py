@@ -107,8 +107,8 @@ class LocalMap(ObservationTerm):
         # Cell centres in the robot frame: forward u (row 0 ahead), left v (column 0 left).
         half = self.cells / 2.0
         idx = np.arange(self.cells, dtype=np.float64)
-        self._u = np.repeat((half - idx - 0.5) * self.cell_size, self.cells)
-        self._v = np.tile((half - idx - 0.5) * self.cell_size, self.cells)
+        self.u = np.repeat((half - idx - 0.5) * self.cell_size, self.cells)
+        self.v = np.tile((half - idx - 0.5) * self.cell_size, self.cells)
 
     @property
     def doc_rows(self) -> tuple[tuple[str, str, str], ...]:  # type: ignore[override]
@@ -124,14 +124,14 @@ class LocalMap(ObservationTerm):
     def cell_centres(self, x: float, y: float, yaw: float) -> NDArray[np.float64]:
         """World ``(x, y)`` of every cell centre, row by row, shape ``(cells * cells, 2)``."""
         c, s = math.cos(yaw), math.sin(yaw)
-        return np.stack([x + c * self._u - s * self._v, y + s * self._u + c * self._v], axis=1)
+        return np.stack([x + c * self.u - s * self.v, y + s * self.u + c * self.v], axis=1)
 
     def grid(self, frame: Frame) -> NDArray[np.uint8]:
         """The local map at the frame's pose, ``(cells, cells)`` uint8 codes."""
         task, env = frame.task, frame.env
         tmap = env.scene.floors[task.floor]
         c, s = frame.cos_yaw, frame.sin_yaw
-        u, v = self._u, self._v
+        u, v = self.u, self.v
         wx = frame.x + c * u - s * v
         wy = frame.y + s * u + c * v
         inv = 1.0 / tmap.resolution

@@ -280,7 +280,7 @@ class OmniGibsonTaskAPI:
         return self._ep.success
 
     @property
-    def _goal_field(self) -> Any:
+    def goal_field(self) -> Any:
         """This episode's goal field (None before the first reset)."""
         return self._ep.field
 

@@ -13,11 +13,11 @@ same within an ulp).
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping
 from typing import Any, NamedTuple
 
 from pointnav_core.task.rewards import CollisionReward, PointGoalReward, PotentialReward
 from pointnav_core.task.terminations import Falling, MaxCollision, Timeout
+from pointnav_core.vector.state import Motion
 
 __all__ = ["BatchedTask", "TaskStep", "custom_rewards", "task_step"]
 
@@ -61,15 +61,15 @@ class TaskStep(NamedTuple):
     reward: Any  #: their sum, as the task adds them
 
 
-def task_step(engine: Any, moved: Mapping[str, Any], contact: Any, stopped: Any, acting: Any = None) -> TaskStep:
+def task_step(engine: Any, moved: Motion, contact: Any, stopped: Any, acting: Any = None) -> TaskStep:
     """The task's step over the robots' moves from the engine's committed state.
 
     Parameters
     ----------
     engine : VectorPointNavEnv
-        Its committed state (``_state``, ``_steps``, ``_collisions``), goal fields and task
+        Its committed ``state`` (:class:`~.state.WorldState`), goal fields and task
         constants (floats, or ``(1, n_robots)`` arrays when the robots' tasks differ).
-    moved : mapping
+    moved : Motion
         The moved state (``x``, ``y``, ``z``: m).
     contact : bool array
         Robots that touched a wall or another robot this step.
@@ -82,27 +82,27 @@ def task_step(engine: Any, moved: Mapping[str, Any], contact: Any, stopped: Any,
     -------
     TaskStep
     """
-    a, xp, st = engine.arrays, engine.arrays.xp, engine._state
-    x0, y0 = st["x"], st["y"]
-    x, y, z = moved["x"], moved["y"], moved["z"]
+    a, xp, st = engine.arrays, engine.arrays.xp, engine.state
+    x0, y0 = st.x, st.y
+    x, y, z = moved.x, moved.y, moved.z
     zero = xp.zeros_like(x)  # torch.where of two numbers would give float32
     moved_by = xp.sqrt((x - x0) ** 2 + (y - y0) ** 2)
-    height = engine.floors.height[engine._world_scene]
+    height = engine.floors.height[engine.world_scene]
     if acting is None:
-        path = st["path"] + moved_by
-        steps = engine._steps + 1
+        path = st.path_length + moved_by
+        steps = st.steps + 1
         touched = contact
     else:
-        path = st["path"] + xp.where(acting, moved_by, zero)
-        steps = engine._steps + a.to_int(acting)
+        path = st.path_length + xp.where(acting, moved_by, zero)
+        steps = st.steps + a.to_int(acting)
         touched = contact & acting
         height = height[:, None]
-    collisions = engine._collisions + a.to_int(touched)
+    collisions = st.collisions + a.to_int(touched)
     # The task's terms, each the single task's own definition on arrays (rewards, terminations).
-    dist = engine.pool.fields.distance(engine._field, x, y)
-    gx, gy = st["gx"], st["gy"]
+    dist = engine.pool.fields.distance(st.goal_field, x, y)
+    gx, gy = st.goal_x, st.goal_y
     l2 = xp.sqrt((gx - x) ** 2 + (gy - y) ** 2)
-    pot = xp.where(engine._geo_metric, xp.where(dist < math.inf, dist, st["pot"]), l2)
+    pot = xp.where(st.geodesic_metric, xp.where(dist < math.inf, dist, st.potential), l2)
     success = l2 < engine.goal_tolerance
     fell = Falling.value(z, height, engine.fall_height)
     truncated = Timeout.value(steps, engine.max_steps)
@@ -113,7 +113,7 @@ def task_step(engine: Any, moved: Mapping[str, Any], contact: Any, stopped: Any,
     terminated = MaxCollision.value(collisions, engine.max_collisions) | fell | success
     if stopped is not None:
         terminated = terminated | stopped
-    r_pot = PotentialReward.value(engine.r_potential, st["pot"], pot)
+    r_pot = PotentialReward.value(engine.r_potential, st.potential, pot)
     if acting is not None:
         terminated = acting & terminated
         r_pot = xp.where(acting, r_pot, zero)

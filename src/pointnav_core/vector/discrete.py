@@ -38,13 +38,10 @@ import numpy as np
 
 from pointnav_core.errors import ArgumentError
 from pointnav_core.task.actions import STOP, DiscreteActions
+from pointnav_core.vector.state import Motion, motion_where
 from pointnav_core.vector.xp import Arrays
 
 __all__ = ["DiscretePlan"]
-
-# The state a control step changes: pose, height, the backend's velocities and the fall
-# speed (m/s, 0 while standing; vector.falls).
-MOVED = ("x", "y", "yaw", "z", "vx", "vy", "w", "vz", "fs")
 
 
 class DiscretePlan:
@@ -136,7 +133,7 @@ class DiscretePlan:
         Parameters
         ----------
         env : VectorPointNavEnv
-            The engine; its ``_drive(commands, state)`` advances every world one control
+            The engine; its ``drive(commands, state)`` advances every world one control
             step from ``state`` without committing it (commands in ``[-1, 1]`` units, one
             per world, or per robot with several robots per world).
         index : array of int, shape (num_envs,) or (num_envs, n_robots)
@@ -150,8 +147,8 @@ class DiscretePlan:
 
         Returns
         -------
-        state : dict of arrays
-            The worlds' (robots') pose, height and velocities after their actions (keys ``MOVED``).
+        state : Motion
+            The worlds' (robots') pose, height and velocities after their actions.
         contact : array of bool
             Whether any of a world's (robot's) control steps touched something.
         stopped : array of bool or None
@@ -162,7 +159,7 @@ class DiscretePlan:
             command, steps = self.commands[index], self.steps[index]
         else:  # one plan per robot: (robot, action) pairs
             command, steps = self.commands[self._robots, index], self.steps[self._robots, index]
-        state = {key: env._state[key] for key in MOVED}
+        state: Motion = env.state
         contact = xp.zeros_like(index) > 0
         for k in range(self.max_steps):
             lasts = steps > k
@@ -176,9 +173,9 @@ class DiscretePlan:
                 active = lasts.any(-1)[:, None]
             if not a.any(active):
                 break
-            # A falling robot ignores its command and drops, faster each step (env._drive, vector.falls).
-            moved, touched = env._drive(xp.where(running[..., None], command, 0.0 * command), state)
-            state = {key: xp.where(active, moved[key], state[key]) for key in MOVED}
+            # A falling robot ignores its command and drops, faster each step (env.drive, vector.falls).
+            moved, touched = env.drive(xp.where(running[..., None], command, 0.0 * command), state)
+            state = motion_where(xp, active, moved, state)
             contact = contact | (active & touched)
         stopped = None if self.stop is None else index == self.stop
         return state, contact, stopped

@@ -22,7 +22,6 @@ from pointnav_core import scenes
 from pointnav_core.envs import common as _envcommon
 from pointnav_core.envs.config import EnvConfig, takes_config, vector_arguments
 from pointnav_core.errors import ArgumentError, TaskStateError
-from pointnav_core.task.metrics import soft_spl_values, spl_values
 from pointnav_core.utils import validation
 from pointnav_core.vector import contacts_jit
 from pointnav_core.vector.accounting import custom_rewards, task_step
@@ -31,23 +30,17 @@ from pointnav_core.vector.arguments import (
     check_real_actions,
     task_arguments,
 )
-from pointnav_core.vector.contacts import advance
-from pointnav_core.vector.discrete import MOVED, DiscretePlan
-from pointnav_core.vector.drive import (
-    arc,
-    body_command,
-    sub_steps,
-    substep_drive,
-    travel,
-)
+from pointnav_core.vector.discrete import DiscretePlan
+from pointnav_core.vector.drive_step import drive_worlds
 from pointnav_core.vector.episodes import EpisodePool, fixed_pose
-from pointnav_core.vector.falls import apply_falls
 from pointnav_core.vector.floors import FloorTables
 from pointnav_core.vector.local_map import VectorLocalMap, local_map_term
+from pointnav_core.vector.observe import low_dim, step_info
 from pointnav_core.vector.pool_build import build_parts, pool_options
 from pointnav_core.vector.refresh import PoolRefreshing
 from pointnav_core.vector.scan import ScanTables, VectorScan, requested_scan
-from pointnav_core.vector.xp import make_arrays
+from pointnav_core.vector.state import Motion, WorldState
+from pointnav_core.vector.xp import as_dtype, cat, copy, make_arrays
 
 __all__ = ["VectorPointNavEnv"]
 
@@ -285,7 +278,7 @@ class VectorPointNavEnv(PoolRefreshing, VectorEnv):
         self.observation_space = gym.vector.utils.batch_space(self.single_observation_space, self.num_envs)
         self.action_space = gym.vector.utils.batch_space(self.single_action_space, self.num_envs)
         self._rng = np.random.default_rng(seed)
-        self._world_scene = a.asarray(np.arange(self.num_envs) % len(scene_list), a.i64)
+        self.world_scene = a.asarray(np.arange(self.num_envs) % len(scene_list), a.i64)
         self.pool: EpisodePool | None = None  # sampled at the first reset that needs it
         self._allocate((self.num_envs,), scan_term, sensors)
 
@@ -295,13 +288,8 @@ class VectorPointNavEnv(PoolRefreshing, VectorEnv):
         a = self.arrays
         contacts_jit.prepare(self.floors)  # not in the first step that meets a wall
         self._fixed: Any = None
-        # "fs": the fall speed (m/s), 0 while the robot stands (vector.falls).
-        keys = ("x", "y", "yaw", "z", "vx", "vy", "vz", "w", "fs", "gx", "gy", "d0", "pot", "path", "dist")
-        self._state = {k: a.zeros(shape) for k in keys}
-        self._field = a.zeros(shape, a.i64)
-        self._geo_metric = a.zeros(shape, a.boolean)
-        self._steps = a.zeros(shape, a.i64)
-        self._collisions = a.zeros(shape, a.i64)
+        #: The committed state of every world (robot); a step replaces it (vector.state).
+        self.state = WorldState.zeros(a, shape)
         self._needs_reset = a.zeros(self.num_envs, a.boolean)
         self._started = False
         tables = None if scan_term is None else ScanTables(self.scenes, self.task.floor, a)
@@ -329,7 +317,7 @@ class VectorPointNavEnv(PoolRefreshing, VectorEnv):
         # A chord is never longer than its arc (a holonomic one: the diagonal of its two
         # top speeds); the margin covers rounding.
         top = spec.max_linear_velocity * (math.sqrt(2.0) if self.holonomic else 1.0)
-        self._max_travel = top * self.dt * (1.0 + 1e-9) + 1e-12
+        self.max_travel = top * self.dt * (1.0 + 1e-9) + 1e-12
 
     # ------------------------------------------------------------------ pools
     @property
@@ -340,7 +328,7 @@ class VectorPointNavEnv(PoolRefreshing, VectorEnv):
         Goal fields keep only the cells within it of their starts (``FieldTables``)."""
         steps = self.max_steps if isinstance(self.max_steps, int) else int(self.arrays.numpy(self.max_steps).max())
         steps = min(steps, getattr(self, "max_cycles", steps))
-        per_step = self._max_travel * (1 if self._discrete is None else self._discrete.max_steps)
+        per_step = self.max_travel * (1 if self._discrete is None else self._discrete.max_steps)
         return steps * per_step
 
     def _build_pool(self, fixed: Sequence[tuple[Any, float, Any, int]]) -> None:
@@ -384,7 +372,7 @@ class VectorPointNavEnv(PoolRefreshing, VectorEnv):
         if episodes is not None:
             if len(episodes) != self.num_envs:
                 raise ArgumentError(f"options['episodes'] must hold one episode per world ({self.num_envs}), got {len(episodes)}")
-            scene_of = a.numpy(self._world_scene)
+            scene_of = a.numpy(self.world_scene)
             fixed = [self._fixed_episode(i, episode, int(scene_of[i])) for i, episode in enumerate(episodes)]
             self._build_pool(fixed)
             self._fixed = a.asarray(self.pool.n_sampled + np.arange(self.num_envs), a.i64)
@@ -398,32 +386,16 @@ class VectorPointNavEnv(PoolRefreshing, VectorEnv):
         return (*fixed_pose(f"options['episodes'][{i}]", episode, env.scene, env.task.floor, self.robot), s)
 
     def _reset_worlds(self, mask: Any) -> None:
-        a, xp, st = self.arrays, self.arrays.xp, self._state
+        a, xp, st = self.arrays, self.arrays.xp, self.state
         n = self.num_envs
         if self._fixed is not None:
             ep = self._fixed
         else:
             k = a.asarray(self._rng.integers(self.pool.pool_size, size=n), a.i64)
-            ep = self._world_scene * self.pool.pool_size + k
-        p = self.pool
+            ep = self.world_scene * self.pool.pool_size + k
         idx = a.nonzero(mask)
-        e = ep[idx]
-        for key, src in (("x", p.sx), ("y", p.sy), ("yaw", p.syaw), ("gx", p.gx), ("gy", p.gy), ("d0", p.d0)):
-            st[key][idx] = src[e]
-        height = self.floors.height[self._world_scene[idx]]  # (k,); each robot of a fleet's world
-        st["z"][idx] = height if st["z"].ndim == 1 else height[:, None] + 0.0 * st["x"][idx]
-        for key in ("vx", "vy", "vz", "w", "fs", "path"):
-            st[key][idx] = 0.0
-        self._field[idx] = p.field[e]
-        self._steps[idx] = self._collisions[idx] = 0
-        d0 = st["d0"][idx]
-        geo = self.geodesic_reward & (d0 < math.inf)
-        self._geo_metric[idx] = geo
-        x, y = st["x"][idx], st["y"][idx]
-        dist = p.fields.distance(p.field[e], x, y)
-        st["dist"][idx] = dist
-        l2 = xp.sqrt((st["gx"][idx] - x) ** 2 + (st["gy"][idx] - y) ** 2)
-        st["pot"][idx] = xp.where(geo, xp.where(dist < math.inf, dist, d0), l2)
+        height = self.floors.height[self.world_scene[idx]]  # (k,); each robot of a fleet's world
+        st.start_episodes(xp, idx, self.pool, ep[idx], height, self.geodesic_reward)
         self._needs_reset[idx] = False
         if self.scan is not None:  # the worlds' episode counts key the scan's noise
             self.scan.begin(mask, n)
@@ -457,76 +429,32 @@ class VectorPointNavEnv(PoolRefreshing, VectorEnv):
     def _step(self, actions: Any) -> tuple[Any, Any, Any, Any, dict[str, Any]]:
         if not self._started:
             raise TaskStateError("call reset() before step()")
-        st = self._state
         act = self.check_actions(actions)
         if self._discrete is None:
-            moved, contact = self._drive(act, st)
+            moved, contact = self.drive(act, self.state)
             stopped = None
         else:
             moved, contact, stopped = self._discrete.run(self, act)
         return self._account(moved, contact, stopped)
 
-    def _drive(self, act: Any, state: Mapping[str, Any]) -> tuple[dict[str, Any], Any]:
+    def drive(self, act: Any, state: Motion) -> tuple[Motion, Any]:
         """One control step of every world from ``state`` under commands ``act``
         ``(num_envs, action_dim)``, not committed: the new pose, height, velocities and fall
-        speed (keys ``MOVED``) and the contacts. A falling robot ignores its command and drops
+        speed, and the contacts. A falling robot ignores its command and drops
         (:func:`~pointnav_core.vector.falls.apply_falls`)."""
-        a, xp = self.arrays, self.arrays.xp
-        spec, dt = self.robot, self.dt
-        vx, vy, w = body_command(xp, act, spec.max_linear_velocity, spec.max_angular_velocity, self.holonomic)
-        x0, y0, yaw0 = state["x"], state["y"], state["yaw"]
-        dx, dy = arc(xp, yaw0, vx, vy, w, dt)  # the exact arc over the step (drive_arc)
-        length = travel(xp, vx, vy, dt)
-        scene = self._world_scene
-        row, col, inside = self.floors.cells(scene, x0, y0)
-        budget = self.floors.fast[self.floors.flat_index(scene, row, col, inside)]
-        standing = ~(state["fs"] > 0.0)
-        fast = inside & (budget > length)
-        x, y, yaw = x0 + dx, y0 + dy, yaw0 + w * dt
-        vel_x, vel_y, vel_w = dx / dt, dy / dt, w
-        contact = xp.zeros_like(x) > 1.0
-        began = contact
-        slow = a.nonzero(~fast & standing)
-        if slow.shape[0]:
-            sc = scene[slow]
-            resolver = contacts_jit.advance_one if contacts_jit.available(self.floors) else advance
+        return drive_worlds(self, act, state)  # a method: the fleet has its own, the discrete plan calls either
 
-            def move(px: Any, py: Any, mx: Any, my: Any, part: Any) -> tuple[Any, Any, Any]:
-                # The worlds of ``part`` by their chords; a later sub-step has fewer of them.
-                if bool(part.all()):
-                    return resolver(self.floors, sc, px, py, mx, my, spec.radius, self._max_travel)
-                idx = a.nonzero(part)
-                ix, iy, ic = resolver(self.floors, sc[idx], px[idx], py[idx], mx[idx], my[idx], spec.radius, self._max_travel)
-                nx, ny, c = px + 0.0, py + 0.0, xp.zeros_like(part)
-                nx[idx], ny[idx], c[idx] = ix, iy, ic
-                return nx, ny, c
-
-            n_sub = sub_steps(xp, length[slow], w[slow], dt, self.floors.res[sc])
-            sx, sy, syaw, fall, c = substep_drive(
-                xp, (x0[slow], y0[slow], yaw0[slow]), (vx[slow], vy[slow], w[slow]), n_sub, dt, move,
-                lambda px, py: self.floors.is_void(sc, px, py), (dx[slow], dy[slow]),
-            )
-            x[slow], y[slow], yaw[slow] = sx, sy, syaw
-            vel_x[slow] = (sx - x0[slow]) / dt
-            vel_y[slow] = (sy - y0[slow]) / dt
-            vel_w = xp.where(fast, vel_w, (yaw - yaw0) / dt)
-            began = began.clone() if a.is_torch else began.copy()
-            began[slow] = fall
-            contact[slow] = c
-        moved = apply_falls(xp, state, {"x": x, "y": y, "yaw": yaw, "vx": vel_x, "vy": vel_y, "w": vel_w}, began, dt)
-        return moved, contact
-
-    def _account(self, moved: Mapping[str, Any], contact: Any, stopped: Any) -> tuple[Any, Any, Any, Any, dict[str, Any]]:
+    def _account(self, moved: Motion, contact: Any, stopped: Any) -> tuple[Any, Any, Any, Any, dict[str, Any]]:
         """The task's step over the worlds' moves from the committed state: rewards, ends, info,
         then the commit and the next-step autoresets. ``stopped``: the worlds that called STOP."""
-        a, xp, st = self.arrays, self.arrays.xp, self._state
+        a, xp = self.arrays, self.arrays.xp
         t = task_step(self, moved, contact, stopped)  # PointNavigationTask.step's accounting
         reward, terminated, truncated, success = t.reward, t.terminated, t.truncated, t.success
         r_pot, r_col, r_goal, r_custom = t.r_pot, t.r_col, t.r_goal, t.r_custom
         # Commit, then reset the worlds that ended on the previous step (next-step autoreset).
-        st.update({key: moved[key] for key in MOVED}, path=t.path, dist=t.dist, pot=t.pot)
-        self._steps, self._collisions = t.steps, t.collisions
-        resetting = self._needs_reset.clone() if a.is_torch else self._needs_reset.copy()
+        self.state = self.state.moved(moved, path_length=t.path, goal_distance=t.dist, potential=t.pot, steps=t.steps,
+                                      collisions=t.collisions)
+        resetting = copy(xp, self._needs_reset)
         if a.any(resetting):
             self._reset_worlds(resetting)
             keep = ~resetting
@@ -537,57 +465,35 @@ class VectorPointNavEnv(PoolRefreshing, VectorEnv):
         self._needs_reset = terminated | truncated
         info = self._info(success, r_pot, r_col, r_goal, contact, resetting)
         for name, r in r_custom.items():  # fresh arrays, as _info's
-            info[f"reward_{name}"] = r.clone() if a.is_torch else r.copy()
+            info[f"reward_{name}"] = copy(xp, r)
         return self._observe(), reward, terminated, truncated, info
 
     # ------------------------------------------------------------------ observation and info
     def _observe(self) -> Any:
-        a, xp, st = self.arrays, self.arrays.xp, self._state
-        c, s = xp.cos(st["yaw"]), xp.sin(st["yaw"])
-        dx, dy = st["gx"] - st["x"], st["gy"] - st["y"]
-        lx, ly = c * dx + s * dy, c * dy - s * dx
-        polar = self.goal_in_polar  # a bool, or a (1, R) mask when robots' tasks differ
-        if polar is not False:
-            rho = xp.sqrt(lx * lx + ly * ly)
-            phi = xp.where(rho > 0.0, xp.arctan2(ly, lx), 0.0)
-            phi = xp.where(phi == -math.pi, math.pi, phi)
-            lx, ly = (rho, phi) if polar is True else (xp.where(polar, rho, lx), xp.where(polar, phi, ly))
-        vx, vy = st["vx"], st["vy"]
-        zero = xp.zeros_like(vx)
-        obs = xp.stack([lx, ly, c * vx + s * vy, c * vy - s * vx, st["vz"], zero, zero, st["w"]], -1)
+        xp = self.arrays.xp
+        obs, c, s = low_dim(xp, self.state, self.goal_in_polar)
         if self.scan is not None:
-            obs = (xp.cat if a.is_torch else xp.concatenate)([obs, self._scan_ranges(c, s)], -1)
-        sc, width = self._world_scene, obs.shape[-1]
+            obs = cat(xp, [obs, self._scan_ranges(c, s)], -1)
+        sc, width = self.world_scene, obs.shape[-1]
         obs = xp.minimum(xp.maximum(obs, self._low[..., :width][sc]), self._high[..., :width][sc])
-        obs = obs.to(xp.float32) if a.is_torch else obs.astype(np.float32)
+        obs = as_dtype(xp, obs, xp.float32)
         if self.local_map is not None:  # after the scan (the single env's order); codes within their bounds
-            obs = (xp.cat if a.is_torch else xp.concatenate)([obs, self._map_values()], -1)
+            obs = cat(xp, [obs, self._map_values()], -1)
         return obs
 
     def _scan_ranges(self, c: Any, s: Any) -> Any:
         """The scan's readings (m), ``(num_envs, n_rays)``, at the headings' cosines ``c`` and sines ``s``."""
-        xp, st = self.arrays.xp, self._state
+        xp, st = self.arrays.xp, self.state
         yaw, one = xp.arctan2(s, c)[:, None], xp.ones_like(c)[:, None] > 0.0  # the single env's frame heading
-        return self.scan.readings(self._world_scene, st["x"][:, None], st["y"][:, None], yaw, one, self.robot.radius, self._steps[:, None])[:, 0]
+        return self.scan.readings(self.world_scene, st.x[:, None], st.y[:, None], yaw, one, self.robot.radius,
+                                  st.steps[:, None])[:, 0]
 
     def _map_values(self) -> Any:
         """The local map's codes, ``(num_envs, cells * cells)`` float32 (one robot: no discs)."""
-        st = self._state
-        one = self.arrays.xp.ones_like(st["x"])[:, None] > 0.0
-        return self.local_map.values(self._world_scene, st["x"][:, None], st["y"][:, None], st["yaw"][:, None], one,
+        st = self.state
+        one = self.arrays.xp.ones_like(st.x)[:, None] > 0.0
+        return self.local_map.values(self.world_scene, st.x[:, None], st.y[:, None], st.yaw[:, None], one,
                                      self.robot.radius)[:, 0]
 
     def _info(self, success: Any, r_pot: Any, r_col: Any, r_goal: Any, contact: Any, resetting: Any) -> dict[str, Any]:
-        xp, st = self.arrays.xp, self._state
-        d0, length, d_t = st["d0"], st["path"], st["dist"]
-        spl = spl_values(success, d0, length, xp.where)  # the single env's definition
-        soft = soft_spl_values(d_t, d0, length, xp.where)
-        info = {
-            "success": success, "spl": spl, "soft_spl": soft, "path_length": length, "geodesic_dist": d0,
-            "distance_to_goal": d_t, "collisions": self._collisions, "episode_length": self._steps,
-            "in_contact": contact, "reward_potential": r_pot, "reward_collision": r_col,
-            "reward_pointgoal": r_goal, "autoreset": resetting,
-        }
-        # Fresh arrays: the engine's state arrays are written in place at the next autoreset.
-        copy = (lambda v: v.clone()) if self.arrays.is_torch else (lambda v: v.copy())
-        return {key: copy(value) for key, value in info.items()}
+        return step_info(self.arrays.xp, self.state, success, r_pot, r_col, r_goal, contact, resetting)

@@ -191,22 +191,22 @@ class EpisodePool:
         for seed in seeds:
             env.reset(seed=int(seed))
             task = env.task
-            x, y, yaw = env.backend._pose(env.backend._robots[task.robot_idn])
+            x, y, yaw = env.backend.planar_pose(task.robot_idn)
             gx, gy = task.goal_xy
             rows.append((x, y, yaw, gx, gy, task.geodesic_dist, s))
             field_of.append(len(fields))
-            cfg = task._config
+            cfg = task.config
             for _ in range(starts - 1):
                 ep = sample_episode(
                     env, robot_idn=cfg.robot_idn, floor=cfg.floor, spec=env.robot,
-                    floor_height=task._floor_height, initial_pos=None, initial_quat=None,
+                    floor_height=task.floor_height, initial_pos=None, initial_quat=None,
                     goal_pos=(gx, gy), goal_tolerance=cfg.goal_tolerance, path_range=cfg.path_range,
                     max_trials=task.max_trials,
                 )
                 qz, qw = ep.start_quat[2], ep.start_quat[3]
                 rows.append((ep.start_xy[0], ep.start_xy[1], 2.0 * np.arctan2(qz, qw), gx, gy, ep.geodesic, s))
                 field_of.append(len(fields))
-            fields.append(task._goal_field.field)
+            fields.append(task.goal_field.field)
         table = np.array(rows, dtype=np.float64).reshape(-1, 7)
         return settle_part(table, np.asarray(field_of, dtype=np.int64), fields, reach, cells_before, goals_before)
 

@@ -8,19 +8,21 @@ drop's ``vz``. From then on it no longer drives or blocks: every control step it
 zero planar velocities (``RobotStateBackend._fall``). Nothing stops a fall; the task ends
 the episode once ``z < floor height - fall_height``, however many steps that takes.
 
-The engines keep each robot's fall speed in their state (key ``"fs"``, m/s; 0 while it
-stands). :func:`apply_falls` turns one control step of the standing robots into the step
-of all of them, as arrays of any shape (numpy or torch).
+The engines keep each robot's fall speed in their state (``WorldState.fall_speed``, m/s;
+0 while it stands). :func:`apply_falls` turns one control step of the standing robots into
+the step of all of them, as arrays of any shape (numpy or torch).
 
 Examples
 --------
 >>> import numpy as np
->>> start = {"x": np.zeros(3), "y": np.zeros(3), "yaw": np.zeros(3), "z": np.zeros(3), "fs": np.array([0.0, 0.0, 1.0])}
->>> standing = {"x": np.array([0.1, 0.1, 0.5]), "y": np.zeros(3), "yaw": np.zeros(3),
-...             "vx": np.ones(3), "vy": np.zeros(3), "w": np.zeros(3)}
+>>> from pointnav_core.vector.state import Motion
+>>> zero = np.zeros(3)
+>>> start = Motion(zero, zero, zero, zero, zero, zero, zero, zero, np.array([0.0, 0.0, 1.0]))
+>>> standing = {"x": np.array([0.1, 0.1, 0.5]), "y": zero, "yaw": zero,
+...             "vx": np.ones(3), "vy": zero, "yaw_rate": zero}
 >>> began = np.array([False, True, False])  # robot 1 went over VOID, robot 2 was falling
 >>> out = apply_falls(np, start, standing, began, 0.1)
->>> out["z"].round(5).tolist(), out["x"].tolist(), out["fs"].round(3).tolist()
+>>> out.z.round(5).tolist(), out.x.tolist(), out.fall_speed.round(3).tolist()
 ([0.0, -0.14905, -0.14905], [0.1, 0.1, 0.0], [0.0, 1.981, 1.981])
 """
 
@@ -30,6 +32,7 @@ from collections.abc import Mapping
 from typing import Any
 
 from pointnav_core.backends.kit.base import _GRAVITY, _MIN_FIRST_DROP
+from pointnav_core.vector.state import Motion
 
 __all__ = ["FALL_SPEED", "GRAVITY", "MIN_FIRST_DROP", "apply_falls", "first_drop"]
 
@@ -53,19 +56,20 @@ def first_drop(dt: float) -> float:
     return max(FALL_SPEED * dt + 0.5 * GRAVITY * dt * dt, MIN_FIRST_DROP)
 
 
-def apply_falls(xp: Any, start: Mapping[str, Any], standing: Mapping[str, Any], began: Any, dt: float) -> dict[str, Any]:
+def apply_falls(xp: Any, start: Motion, standing: Mapping[str, Any], began: Any, dt: float) -> Motion:
     """One control step of every robot, falls included, from the standing robots' step.
 
     Parameters
     ----------
     xp : module
         ``numpy`` or ``torch``.
-    start : dict of arrays
-        The state before the step: ``x``, ``y`` (m), ``yaw`` (rad), ``z`` (m) and ``fs``,
-        the fall speed (m/s, > 0 for a robot already falling, 0 otherwise).
+    start : Motion
+        The state before the step (a :class:`~.state.WorldState` will do): its ``x``, ``y``
+        (m), ``yaw`` (rad), ``z`` (m) and ``fall_speed`` (m/s, > 0 for a robot already
+        falling, 0 otherwise) are read.
     standing : dict of arrays
         The step as the drive and contacts give it: ``x``, ``y``, ``yaw``, ``vx``, ``vy``
-        (m/s) and ``w`` (rad/s); entries of falling robots are ignored.
+        (m/s) and ``yaw_rate`` (rad/s); entries of falling robots are ignored.
     began : array of bool
         The robots that were standing and whose centre ended this step over VOID.
     dt : float
@@ -73,20 +77,25 @@ def apply_falls(xp: Any, start: Mapping[str, Any], standing: Mapping[str, Any], 
 
     Returns
     -------
-    dict of arrays
-        ``x``, ``y``, ``yaw``, ``vx``, ``vy``, ``w``: the standing step, except that a robot
-        already falling keeps its pose and has zero planar velocities; ``z`` (m), ``vz``
-        (m/s, the drop over ``dt``, negative) and ``fs`` (m/s) after the step.
+    Motion
+        ``x``, ``y``, ``yaw``, ``vx``, ``vy``, ``yaw_rate``: the standing step, except that
+        a robot already falling keeps its pose and has zero planar velocities; ``z`` (m),
+        ``vz`` (m/s, the drop over ``dt``, negative) and ``fall_speed`` (m/s) after the step.
     """
-    fs0, z0 = start["fs"], start["z"]
+    fs0, z0 = start.fall_speed, start.z
     falling = fs0 > 0.0
     zero = xp.zeros_like(z0)
     # The backend's _fall, in its own expression order: drop = v dt + g dt^2 / 2.
     drop = fs0 * dt + 0.5 * GRAVITY * dt * dt
     first = first_drop(dt)
-    out = {key: xp.where(falling, start[key], standing[key]) for key in ("x", "y", "yaw")}
-    out.update({key: xp.where(falling, zero, standing[key]) for key in ("vx", "vy", "w")})
-    out["z"] = xp.where(falling, z0 - drop, xp.where(began, z0 - first, z0))
-    out["vz"] = xp.where(falling, -drop / dt, xp.where(began, zero - first / dt, zero))
-    out["fs"] = xp.where(falling, fs0 + GRAVITY * dt, xp.where(began, zero + (FALL_SPEED + GRAVITY * dt), zero))
-    return out
+    return Motion(
+        x=xp.where(falling, start.x, standing["x"]),
+        y=xp.where(falling, start.y, standing["y"]),
+        yaw=xp.where(falling, start.yaw, standing["yaw"]),
+        z=xp.where(falling, z0 - drop, xp.where(began, z0 - first, z0)),
+        vx=xp.where(falling, zero, standing["vx"]),
+        vy=xp.where(falling, zero, standing["vy"]),
+        yaw_rate=xp.where(falling, zero, standing["yaw_rate"]),
+        vz=xp.where(falling, -drop / dt, xp.where(began, zero - first / dt, zero)),
+        fall_speed=xp.where(falling, fs0 + GRAVITY * dt, xp.where(began, zero + (FALL_SPEED + GRAVITY * dt), zero)),
+    )

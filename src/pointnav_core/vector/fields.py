@@ -167,7 +167,7 @@ class FieldTables:
         """The tables of fields settled apart (:func:`field_part`, in worker processes, say),
         in order: the same arrays as the tables of those fields built here."""
         tables = cls.__new__(cls)
-        tables._assemble(parts, arrays)
+        cls._assemble(tables, parts, arrays)  # the class's own builder, on an instance without __init__
         return tables
 
     def _assemble(self, parts: Sequence[FieldPart], arrays: Arrays) -> None:

@@ -18,6 +18,7 @@ robot at the sum of their radii, and is a disc of its radius in the scans and ma
 
 from __future__ import annotations
 
+import dataclasses
 from collections.abc import Mapping, Sequence
 from typing import Any
 
@@ -34,7 +35,7 @@ from pointnav_core.vector.accounting import task_step
 from pointnav_core.vector.arguments import as_scene_list, check_real_actions
 from pointnav_core.vector.contacts import advance
 from pointnav_core.vector.contacts_jit import advance_compiled
-from pointnav_core.vector.discrete import MOVED, DiscretePlan
+from pointnav_core.vector.discrete import DiscretePlan
 from pointnav_core.vector.drive import (
     arc,
     body_command,
@@ -55,7 +56,8 @@ from pointnav_core.vector.per_robot import (
 from pointnav_core.vector.pool_build import pool_options
 from pointnav_core.vector.robots import advance_robots, robot_walls
 from pointnav_core.vector.scan import requested_scan
-from pointnav_core.vector.xp import make_arrays
+from pointnav_core.vector.state import Motion
+from pointnav_core.vector.xp import amax, as_dtype, copy, make_arrays
 
 __all__ = ["FINISHED_MODES", "VectorFleetEnv"]
 
@@ -156,6 +158,23 @@ class VectorFleetEnv(VectorPointNavEnv):
         self.floors = FloorTables(scene_list, t.floor, spec.radius, a, shared)
         # Each robot's clearance table, of its own radius: (R, all cells).
         self._fast = a.xp.stack([self.floors.fast_for(s.radius) for s in self.robots])
+        self._make_spaces(first)
+        self._rng = np.random.default_rng(seed)
+        n, r = self.num_envs, self.n_robots
+        self.world_scene = a.asarray(np.arange(n) % len(scene_list), a.i64)
+        self._robot_scene = a.asarray(np.repeat(np.arange(n) % len(scene_list), r).reshape(n, r), a.i64)
+        self._robot_ids = a.asarray(np.arange(r), a.i64).reshape(1, r)
+        self.pool: FleetPool | None = None  # type: ignore[assignment]
+        self._allocate((n, r), scan_term, sensors)
+        self._active = a.zeros((n, r), a.boolean)
+        self._present = a.zeros((n, r), a.boolean)
+        self._seen = self._present  # the robots the scans see at the next observation
+        self._cycles = a.zeros(n, a.i64)
+
+    def _make_spaces(self, first: Any) -> None:
+        """The observation bounds of every (scene, robot) and the batched spaces, from the
+        multi-robot envs (``first`` gives the action space)."""
+        a = self.arrays
         bounds = [[t.observation_bounds for t in env.tasks] for env in self._samplers]  # (scene, robot)
         lows, highs = (np.array([[b[k] for b in row] for row in bounds], np.float64) for k in (0, 1))
         self._low, self._high = a.asarray(lows), a.asarray(highs)
@@ -169,17 +188,6 @@ class VectorFleetEnv(VectorPointNavEnv):
             self.action_space = gym.spaces.MultiDiscrete(nvec)
         else:
             self.action_space = batch(batch(self.single_action_space, self.n_robots), self.num_envs)
-        self._rng = np.random.default_rng(seed)
-        n, r = self.num_envs, self.n_robots
-        self._world_scene = a.asarray(np.arange(n) % len(scene_list), a.i64)
-        self._robot_scene = a.asarray(np.repeat(np.arange(n) % len(scene_list), r).reshape(n, r), a.i64)
-        self._robot_ids = a.asarray(np.arange(r), a.i64).reshape(1, r)
-        self.pool: FleetPool | None = None  # type: ignore[assignment]
-        self._allocate((n, r), scan_term, sensors)
-        self._active = a.zeros((n, r), a.boolean)
-        self._present = a.zeros((n, r), a.boolean)
-        self._seen = self._present  # the robots the scans see at the next observation
-        self._cycles = a.zeros(n, a.i64)
 
     # ------------------------------------------------------------------ pools
     def reset(self, *, seed: int | None = None, options: dict[str, Any] | None = None) -> tuple[Any, dict[str, Any]]:
@@ -194,7 +202,7 @@ class VectorFleetEnv(VectorPointNavEnv):
             self._seen = self._present
             self._started = True
             zero, no = a.zeros((self.num_envs, self.n_robots)), a.zeros((self.num_envs, self.n_robots), a.boolean)
-            shown = self._active.clone() if a.is_torch else self._active.copy()
+            shown = copy(a.xp, self._active)
             return self._observe(shown), self._info(no, zero, zero, zero, no, shown, no)
 
     def _fixed_episode(self, i: int, episode: Any, s: int) -> Any:
@@ -234,23 +242,23 @@ class VectorFleetEnv(VectorPointNavEnv):
         if self._discrete is not None:
             return self._account(*self._discrete.run(self, act, acting=self._active))
         # Robots that are not agents any more get no command (the backend's _NO_COMMAND).
-        moved, contact = self._drive(self.arrays.xp.where(self._active[..., None], act, 0.0 * act), self._state)
+        moved, contact = self.drive(self.arrays.xp.where(self._active[..., None], act, 0.0 * act), self.state)
         return self._account(moved, contact, None)
 
-    def _drive(self, act: Any, state: Mapping[str, Any]) -> tuple[dict[str, Any], Any]:
+    def drive(self, act: Any, state: Motion) -> tuple[Motion, Any]:
         """One control step of every world from ``state`` under commands ``act``
         ``(num_envs, n_robots, action_dim)`` in ``[-1, 1]`` units, not committed: the new pose,
-        height, velocities and fall speed (keys ``MOVED``) and the contacts. A falling robot
+        height, velocities and fall speed, and the contacts. A falling robot
         present in the world drops (:func:`~pointnav_core.vector.falls.apply_falls`); it
         neither drives nor blocks. A robot out of the world stays as it is."""
         a, xp = self.arrays, self.arrays.xp
-        dt, radius = self.dt, self._radius  # (1, R): each robot's radius
-        falling = state["fs"] > 0.0
+        dt, radius = self.dt, self.radius  # (1, R): each robot's radius
+        falling = state.fall_speed > 0.0
         present = self._present & ~falling
-        vmax, wmax = self._vmax, self._wmax  # (1, R): each robot's speed limits
+        vmax, wmax = self.vmax, self.wmax  # (1, R): each robot's speed limits
         vx, vy, w = body_command(xp, act, vmax, wmax, self.holonomic)
         zero = xp.zeros_like(vx)
-        x0, y0, yaw0 = state["x"], state["y"], state["yaw"]
+        x0, y0, yaw0 = state.x, state.y, state.yaw
         dx, dy = arc(xp, yaw0, vx, vy, w, dt)
         length = travel(xp, vx, vy, dt)
         # The backend's fast path: clearance beyond the step and no other free robot within reach.
@@ -271,7 +279,7 @@ class VectorFleetEnv(VectorPointNavEnv):
         if a.any(slow):
             # Every slow robot of a world takes the world's sub-steps (the backend's _slow_step).
             n_sub = sub_steps(xp, length, w, dt, self.floors.res[scene])
-            n_sub = xp.where(slow, n_sub, zero).amax(-1) if a.is_torch else xp.where(slow, n_sub, zero).max(-1)
+            n_sub = amax(xp, xp.where(slow, n_sub, zero), -1)
             n_sub = xp.where(slow, n_sub[:, None], zero)
             sx, sy, syaw, fall, contact = substep_drive(
                 xp, (x0, y0, yaw0), (vx, vy, w), n_sub, dt, self._move_slow,
@@ -283,20 +291,21 @@ class VectorFleetEnv(VectorPointNavEnv):
         vel_y = xp.where(fast, dy / dt, (y - y0) / dt)
         vel_w = xp.where(fast, w, (yaw - yaw0) / dt)
         vel_x, vel_y, vel_w = (xp.where(present, v, zero) for v in (vel_x, vel_y, vel_w))
-        moved = apply_falls(xp, state, {"x": x, "y": y, "yaw": yaw, "vx": vel_x, "vy": vel_y, "w": vel_w}, began, dt)
+        moved = apply_falls(xp, state, {"x": x, "y": y, "yaw": yaw, "vx": vel_x, "vy": vel_y, "yaw_rate": vel_w}, began, dt)
         # A robot out of the world (removed, or fallen and gone) is not moved by the backend.
         out = ~self._present
-        moved = {key: xp.where(out, state[key], value) if key in ("z", "fs") else value for key, value in moved.items()}
-        moved["vz"] = xp.where(out, zero, moved["vz"])
+        moved = dataclasses.replace(moved, z=xp.where(out, state.z, moved.z),
+                                    fall_speed=xp.where(out, state.fall_speed, moved.fall_speed),
+                                    vz=xp.where(out, zero, moved.vz))
         return moved, contact & ~falling
 
-    def _account(self, moved: Mapping[str, Any], contact: Any, stopped: Any) -> tuple[Any, Any, Any, Any, dict[str, Any]]:
+    def _account(self, moved: Motion, contact: Any, stopped: Any) -> tuple[Any, Any, Any, Any, dict[str, Any]]:
         """Each active robot's task step (``PointNavigationTask.step``, masked by the robots
         still acting) over the moves from the committed state, then the commit and the
         next-step autoresets. ``stopped``: the robots that called STOP (None without STOP)."""
-        a, xp, st = self.arrays, self.arrays.xp, self._state
+        a, xp, st = self.arrays, self.arrays.xp, self.state
         acting, present = self._active, self._present
-        zero = xp.zeros_like(st["x"])
+        zero = xp.zeros_like(st.x)
         t = task_step(self, moved, contact, stopped, acting)  # each acting robot's task step
         cycles = self._cycles + 1
         reward, terminated, success, fell = t.reward, t.terminated, t.success, t.fell
@@ -306,13 +315,14 @@ class VectorFleetEnv(VectorPointNavEnv):
         active = acting & ~ended
         # A robot that fell leaves its floor; with "remove" every finished robot leaves.
         gone = (ended & fell) if self.finished == "park" else ended
-        st.update({key: moved[key] for key in MOVED}, path=t.path, dist=t.dist, pot=xp.where(acting, t.pot, st["pot"]))
-        self._steps, self._collisions, self._cycles = t.steps, t.collisions, cycles
+        self.state = st.moved(moved, path_length=t.path, goal_distance=t.dist, potential=xp.where(acting, t.pot, st.potential),
+                              steps=t.steps, collisions=t.collisions)
+        self._cycles = cycles
         self._active, self._present = active, present & ~gone
         # The multi-robot env observes every robot before its finished robots leave the world.
         self._seen = present
         shown = acting
-        resetting = self._needs_reset.clone() if a.is_torch else self._needs_reset.copy()
+        resetting = copy(xp, self._needs_reset)
         if a.any(resetting):
             # Next-step autoreset: every robot of a world with no agent left starts again.
             self._reset_worlds(resetting)
@@ -334,8 +344,8 @@ class VectorFleetEnv(VectorPointNavEnv):
         the others where they are: ``x``, ``y`` and the contact flags, ``(num_envs, n_robots)``."""
         a = self.arrays
         if contacts_jit.available(self.floors):  # every world in one compiled loop
-            sx, sy, c = advance_compiled(self.floors, self._robot_scene, x0, y0, dx, dy, slow, self._radius,
-                                         self._max_travel)
+            sx, sy, c = advance_compiled(self.floors, self._robot_scene, x0, y0, dx, dy, slow, self.radius,
+                                         self.max_travel)
             return a.asarray(sx), a.asarray(sy), a.asarray(c, a.boolean)
         x, y, contact = x0 + 0.0, y0 + 0.0, a.xp.zeros_like(slow)
         self._advance_slow(x0, y0, dx, dy, slow, x, y, contact)
@@ -345,20 +355,20 @@ class VectorFleetEnv(VectorPointNavEnv):
         """The array path of the slow robots' contacts: writes their ends into ``x``, ``y``
         and their flags into ``contact`` (in place)."""
         a, xp, scene = self.arrays, self.arrays.xp, self._robot_scene
-        radius = xp.zeros_like(x0) + self._radius  # (W, R)
+        radius = xp.zeros_like(x0) + self.radius  # (W, R)
         n_slow = slow.sum(-1)
         # A world with one slow robot is the one-robot resolver's case (the backend's
         # advance with a single robot): cheaper, and most busy worlds are such.
         alone = a.nonzero((slow & (n_slow == 1)[:, None]).reshape(-1))
         if alone.shape[0]:
             flat = [v.reshape(-1)[alone] for v in (scene, x0, y0, dx, dy, radius)]
-            nx, ny, c = advance(self.floors, *flat, self._max_travel)
+            nx, ny, c = advance(self.floors, *flat, self.max_travel)
             x.reshape(-1)[alone], y.reshape(-1)[alone], contact.reshape(-1)[alone] = nx, ny, c
         busy = a.nonzero(n_slow > 1)
         if busy.shape[0]:
             bx, by, bdx, bdy = x0[busy], y0[busy], dx[busy], dy[busy]
             brad = radius[busy]
-            walls = robot_walls(self.floors, scene[busy], bx, by, bdx, bdy, brad, self._max_travel)
+            walls = robot_walls(self.floors, scene[busy], bx, by, bdx, bdy, brad, self.max_travel)
             nx, ny, c = advance_robots(a, bx, by, bdx, bdy, brad, present=slow[busy], walls=walls)
             bslow = slow[busy]
             x[busy] = xp.where(bslow, nx, x[busy])
@@ -369,20 +379,20 @@ class VectorFleetEnv(VectorPointNavEnv):
     def _scan_ranges(self, c: Any, s: Any) -> Any:
         """Every robot's scan readings (m), ``(num_envs, n_robots, n_rays)``; robots outside
         ``_seen`` neither see nor are seen (their rows are hidden by ``_observe``)."""
-        xp, st = self.arrays.xp, self._state
+        xp, st = self.arrays.xp, self.state
         yaw = xp.arctan2(s, c)  # the heading as the multi-robot env's frame gives it
-        return self.scan.readings(self._world_scene, st["x"], st["y"], yaw, self._seen, self._radius, self._steps)
+        return self.scan.readings(self.world_scene, st.x, st.y, yaw, self._seen, self.radius, st.steps)
 
     def _map_values(self) -> Any:
         """Every robot's local map, ``(num_envs, n_robots, cells * cells)``, with the discs of
         the robots in ``_seen`` (the scan's rule); rows outside it are hidden by ``_observe``."""
-        st = self._state
-        return self.local_map.values(self._world_scene, st["x"], st["y"], st["yaw"], self._seen, self._radius)
+        st = self.state
+        return self.local_map.values(self.world_scene, st.x, st.y, st.yaw, self._seen, self.radius)
 
     def _observe(self, shown: Any) -> Any:
         """The robots' ``low_dim`` observations, zero where ``shown`` is False."""
         obs = super()._observe()
-        return obs * (shown[..., None].to(obs.dtype) if self.arrays.is_torch else shown[..., None])
+        return obs * as_dtype(self.arrays.xp, shown[..., None], obs.dtype)
 
     def _info(self, success: Any, r_pot: Any, r_col: Any, r_goal: Any, contact: Any, shown: Any, resetting: Any) -> dict[str, Any]:
         xp = self.arrays.xp
@@ -390,5 +400,5 @@ class VectorFleetEnv(VectorPointNavEnv):
         for key, value in info.items():
             if key != "autoreset":
                 info[key] = value & shown if value.dtype == self.arrays.boolean else xp.where(shown, value, xp.zeros_like(value))
-        info["active"] = self._active.clone() if self.arrays.is_torch else self._active.copy()
+        info["active"] = copy(self.arrays.xp, self._active)
         return info

@@ -52,7 +52,7 @@ def check_fixed_episode(sampler: Any, episode: Sequence[FleetEpisode], where: st
         raise ArgumentError(f"{where} must hold one (start_xy, yaw, goal_xy) per robot ({n}), got {len(entries)}")
     scene, floor, specs = sampler.scene, sampler.tasks[0].floor, sampler.robots
     robots = [fixed_pose(f"{where}[{r}]", entry, scene, floor, specs[r]) for r, entry in enumerate(entries)]
-    sep = sampler._separation
+    sep = sampler.separation
     for i in range(n):
         for j in range(i + 1, n):
             (si, _, gi), (sj, _, gj) = robots[i], robots[j]
@@ -130,10 +130,10 @@ class FleetPool:
             episode = []
             field_of.extend([[len(fields) + i for i in range(len(env.tasks))]] * starts)
             for i, task in enumerate(env.tasks):
-                x, y, yaw = backend._pose(backend._robots[i])
+                x, y, yaw = backend.planar_pose(i)
                 gx, gy = task.goal_xy
                 episode.append((x, y, yaw, gx, gy, task.geodesic_dist))
-                fields.append(task._goal_field.field)
+                fields.append(task.goal_field.field)
             rows.append(episode)
             rows.extend(_more_starts(env, [row[3:5] for row in episode]) for _ in range(starts - 1))
         n_robots = len(env.tasks)
@@ -152,12 +152,12 @@ def _more_starts(env: Any, goals: Sequence[tuple[float, float]]) -> list[tuple[f
 
     env.backend.reset()  # every robot unplaced: none blocks until it lands
     rows: dict[int, tuple[float, ...]] = {}
-    for i in env._reset_order:
+    for i in env.reset_order:
         task = env.tasks[i]
-        cfg = task._config
+        cfg = task.config
         gx, gy = goals[i]
         ep = sample_episode(
-            env, robot_idn=cfg.robot_idn, floor=cfg.floor, spec=env.robots[i], floor_height=task._floor_height,
+            env, robot_idn=cfg.robot_idn, floor=cfg.floor, spec=env.robots[i], floor_height=task.floor_height,
             initial_pos=None, initial_quat=None, goal_pos=(gx, gy), goal_tolerance=cfg.goal_tolerance,
             path_range=cfg.path_range, max_trials=task.max_trials,
         )

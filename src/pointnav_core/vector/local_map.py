@@ -52,6 +52,7 @@ import numpy as np
 from pointnav_core.errors import ArgumentError
 from pointnav_core.sensors.local_map import _LUT, LOCAL_ROBOT, LOCAL_VOID, LocalMap
 from pointnav_core.vector.floors import FloorTables
+from pointnav_core.vector.xp import as_dtype, cat
 
 __all__ = ["CPU_BLOCK", "VectorLocalMap", "frame_heading", "local_map_term"]
 
@@ -120,8 +121,8 @@ class VectorLocalMap:
         self.floors = floors
         a = self.arrays = floors.arrays
         # The single term's cell centres in the robot frame (forward u, left v), row by row.
-        self._u = a.asarray(term._u)
-        self._v = a.asarray(term._v)
+        self._u = a.asarray(term.u)
+        self._v = a.asarray(term.v)
         # The floors' codes as local map codes, once (one gather per cell, not two).
         self._codes = a.asarray(_LUT[a.numpy(floors.codes)], a.i64)
         # Float copies of the grids' shapes, to index in float until one cast.
@@ -156,13 +157,13 @@ class VectorLocalMap:
         w, n = x.shape
         radius = xp.zeros_like(x) + radius  # (W, R)
         block = max(1, CPU_BLOCK // (n * self.size))
-        if w <= block or (a.is_torch and a.device != "cpu"):
+        if w <= block or a.on_gpu:
             return self._values(scene, x, y, yaw, present, radius)
         # On a CPU, blocks of worlds whose temporaries stay in cache (about twice as fast
         # at 1,024 x 4 robots with 32 x 32 maps as one call); a GPU takes the whole batch.
         parts = [self._values(scene[i : i + block], x[i : i + block], y[i : i + block], yaw[i : i + block],
                               present[i : i + block], radius[i : i + block]) for i in range(0, w, block)]
-        return (xp.cat if a.is_torch else xp.concatenate)(parts)
+        return cat(xp, parts)
 
     def _values(self, scene: Any, x: Any, y: Any, yaw: Any, present: Any, radius: Any) -> Any:
         """:meth:`values` of one block of worlds."""
@@ -184,7 +185,7 @@ class VectorLocalMap:
         out = xp.where(inside, code, xp.full_like(code, LOCAL_VOID))
         if x.shape[1] > 1:
             out = self._draw_discs(out, x, y, c0, s0, present, radius)
-        return out.to(xp.float32) if a.is_torch else out.astype(np.float32)
+        return as_dtype(xp, out, xp.float32)
 
     def _draw_discs(self, out: Any, x: Any, y: Any, c: Any, s: Any, present: Any, radius: Any) -> Any:
         """``out`` with code 3 where another present robot's disc (of its own ``radius``,

@@ -97,7 +97,8 @@ def read_tasks(env: Any, tasks: Sequence[Any], specs: Sequence[RobotSpec], array
     """Set the engine's per-robot settings from the robots' built ``tasks`` and ``specs``.
 
     The reward weights, tolerances, step and collision limits, fall height, speed limits
-    and radii become ``(1, R)`` arrays on the engine's device; ``goal_in_polar`` stays a bool when all
+    (``vmax``: m/s, ``wmax``: rad/s) and radii (``radius``: m) become ``(1, R)`` arrays on
+    the engine's device, public attributes that its step reads; ``goal_in_polar`` stays a bool when all
     robots agree, else it is a ``(1, R)`` mask. ValueError naming ``task`` if the robots'
     floors differ.
     """
@@ -118,6 +119,6 @@ def read_tasks(env: Any, tasks: Sequence[Any], specs: Sequence[RobotSpec], array
     env.geodesic_reward = row([t.reward_type == "geodesic" for t in tasks], arrays.boolean)
     polar = [bool(t.goal_in_polar) for t in tasks]
     env.goal_in_polar = polar[0] if len(set(polar)) == 1 else row(polar, arrays.boolean)
-    env._vmax = row([s.max_linear_velocity for s in specs])
-    env._wmax = row([s.max_angular_velocity for s in specs])
-    env._radius = row([s.radius for s in specs])
+    env.vmax = row([s.max_linear_velocity for s in specs])
+    env.wmax = row([s.max_angular_velocity for s in specs])
+    env.radius = row([s.radius for s in specs])

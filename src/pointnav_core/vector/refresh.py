@@ -19,6 +19,7 @@ died. Copies and pickles of the env leave the worker, and a pending refresh, beh
 from __future__ import annotations
 
 import copy
+import dataclasses
 import functools
 import warnings
 from collections.abc import Sequence
@@ -226,13 +227,13 @@ class PoolRefreshing:
         self._old_from = len(new.fields)
         self.pool = join_pools(new, self.pool)
         self._fresh = new
-        self._field = self._field + self._old_from
+        self.state = dataclasses.replace(self.state, goal_field=self.state.goal_field + self._old_from)
 
     def _poll_pool(self) -> None:
         """At a step's start: swap in a finished refresh; drop old episodes no world is in."""
         if self._refresh is not None and self._refresh.done():
             self._take_refresh()
-        if self._old_from is not None and not bool((self._field >= self._old_from).any()):
+        if self._old_from is not None and not bool((self.state.goal_field >= self._old_from).any()):
             self.pool, self._fresh, self._old_from = self._fresh, None, None
 
     def _stop_worker(self) -> None:

@@ -19,12 +19,10 @@ from __future__ import annotations
 import math
 from typing import Any
 
-from pointnav_core.vector.contacts import _nearest as nearest
-from pointnav_core.vector.contacts import _take as take_along
-from pointnav_core.vector.contacts import window
+from pointnav_core.vector.contacts import nearest, window
 from pointnav_core.vector.floors import FloorTables
 from pointnav_core.vector.sweep import enter_disc, enter_rounded_square, square_distance
-from pointnav_core.vector.xp import Arrays
+from pointnav_core.vector.xp import Arrays, cat, swap_last_two, take_along
 
 __all__ = ["advance_robots", "robot_walls"]
 
@@ -97,7 +95,7 @@ def advance_robots(
         upper & present[:, :, None] & present[:, None, :]
         & (moving[:, :, None] | moving[:, None, :]) & (gap2 < reach * reach)
     )
-    pair = pair | (pair.transpose(1, 2) if a.is_torch else xp.swapaxes(pair, 1, 2))
+    pair = pair | swap_last_two(xp, pair)
     hit_w = _hit_radius(rad)
     hit_r = _hit_radius(rsum)
     left = xp.ones_like(x[:, 0])
@@ -107,7 +105,7 @@ def advance_robots(
     wk = a.arange(n_walls)
 
     def take(v: Any, idx: Any) -> Any:
-        return (xp.gather(v, -1, idx) if a.is_torch else xp.take_along_axis(v, idx, -1))[..., 0]
+        return take_along(xp, v, idx)[..., 0]
 
     def resolve(
         x: Any, y: Any, mx: Any, my: Any, forced_p: Any, forced_w: Any, left: Any, active: Any, geo: tuple[Any, ...]
@@ -126,11 +124,10 @@ def advance_robots(
         dist = xp.sqrt(ex * ex + ey * ey)
         ptouch = pair & (dist <= rsum + _ACTIVE)
         safe = xp.where(dist > 0.0, dist, 1.0)
-        nx = xp.cat([wnx, xp.where(dist > 0.0, ex / safe, 1.0)], -1) if a.is_torch else xp.concatenate([wnx, xp.where(dist > 0.0, ex / safe, 1.0)], -1)
-        ny = xp.cat([wny, xp.where(dist > 0.0, ey / safe, 0.0)], -1) if a.is_torch else xp.concatenate([wny, xp.where(dist > 0.0, ey / safe, 0.0)], -1)
-        cat = xp.cat if a.is_torch else xp.concatenate
-        touching = cat([wtouch, ptouch], -1)
-        forced = cat([forced_w, forced_p], -1)
+        nx = cat(xp, [wnx, xp.where(dist > 0.0, ex / safe, 1.0)], -1)
+        ny = cat(xp, [wny, xp.where(dist > 0.0, ey / safe, 0.0)], -1)
+        touching = cat(xp, [wtouch, ptouch], -1)
+        forced = cat(xp, [forced_w, forced_p], -1)
         px, py = x[:, :, None, None], y[:, :, None, None]
 
         def blocks(tx: Any, ty: Any) -> Any:
@@ -142,7 +139,7 @@ def advance_robots(
             )
             tr = enter_disc(xp, px, py, tx[..., None], ty[..., None], x[:, None, None, :], y[:, None, None, :],
                             hit_r[:, :, None, :])
-            t = cat([tw, tr], -1)
+            t = cat(xp, [tw, tr], -1)
             return touching[:, :, None, :] & into & (forced[:, :, None, :] | (t <= left[:, None, None, None]))
 
         go = ((mx != 0.0) | (my != 0.0)) & active[:, None]
@@ -194,8 +191,7 @@ def advance_robots(
         tp = enter_disc(xp, sx[:, :, None], sy[:, :, None], vx, vy, sx[:, None, :], sy[:, None, :], ghit_r)
         apart = (sx[:, :, None] - sx[:, None, :]) * vx + (sy[:, :, None] - sy[:, None, :]) * vy >= 0.0
         tp = xp.where(gpair & upper & ((vx != 0.0) | (vy != 0.0)) & ~((tp == 0.0) & apart), tp, inf)
-        cat = xp.cat if a.is_torch else xp.concatenate
-        flat = cat([tw.reshape(n, -1), tp.reshape(n, -1)], -1)
+        flat = cat(xp, [tw.reshape(n, -1), tp.reshape(n, -1)], -1)
         first = xp.argmin(flat, -1)
         t_first = take(flat, first[:, None])
         event = t_first < sleft

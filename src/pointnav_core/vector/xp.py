@@ -2,8 +2,18 @@
 
 The step is written once against the handful of functions numpy and torch share
 (``where``, ``minimum``, ``sqrt``, fancy indexing ...). What they spell differently lives
-here, in :class:`Arrays`: casts, constructors on the right device and the way back to
-numpy. torch is imported only when a torch device is asked for.
+here and only here: constructors on the right device and the way back to numpy in
+:class:`Arrays`; copies, joins, gathers, reductions, casts and sorts in the small functions
+below, each given the array module ``xp`` (``numpy`` or ``torch``) and doing the same
+arithmetic on both. torch is imported only when a torch device is asked for.
+
+Examples
+--------
+>>> a = np.array([[3.0, 1.0, 2.0]])
+>>> take_along(np, a, np.array([[2, 0]])).tolist(), amax(np, a, -1).tolist()
+([[2.0, 3.0]], [3.0])
+>>> cat(np, [a, a], -1).shape, stable_argsort(np, np.array([1.0, 0.0, 1.0])).tolist()
+((1, 6), [1, 0, 2])
 """
 
 from __future__ import annotations
@@ -14,7 +24,8 @@ import numpy as np
 
 from pointnav_core.errors import ArgumentError
 
-__all__ = ["Arrays", "make_arrays"]
+__all__ = ["Arrays", "amax", "as_dtype", "cat", "copy", "make_arrays", "sort", "stable_argsort", "swap_last_two",
+           "take_along"]
 
 
 class Arrays:
@@ -26,12 +37,15 @@ class Arrays:
         ``numpy`` or ``torch``.
     device : str
         ``"numpy"``, ``"cpu"`` (torch on the CPU) or a CUDA device such as ``"cuda:0"``.
+    on_gpu : bool
+        Whether the arrays live on a GPU (work is then batched whole, not in cache-sized blocks).
     """
 
     def __init__(self, xp: Any, device: str) -> None:
         self.xp = xp
         self.device = device
         self.is_torch = xp is not np
+        self.on_gpu = self.is_torch and device != "cpu"
         if self.is_torch:
             self.f64, self.i64, self.boolean = xp.float64, xp.int64, xp.bool
         else:
@@ -85,6 +99,47 @@ class Arrays:
         if self.is_torch:
             return a.detach().cpu().numpy()
         return np.array(a)
+
+
+def copy(xp: Any, a: Any) -> Any:
+    """A fresh copy of ``a`` (``clone`` in torch)."""
+    return a.copy() if xp is np else a.clone()
+
+
+def cat(xp: Any, parts: Any, axis: int = 0) -> Any:
+    """``parts`` joined along ``axis`` (``concatenate``; ``cat`` in torch)."""
+    return np.concatenate(parts, axis) if xp is np else xp.cat(parts, axis)
+
+
+def take_along(xp: Any, a: Any, idx: Any) -> Any:
+    """``a``'s entries at the integer indices ``idx`` along the last axis (``gather`` in torch)."""
+    return np.take_along_axis(a, idx, -1) if xp is np else xp.gather(a, -1, idx)
+
+
+def amax(xp: Any, a: Any, axis: int) -> Any:
+    """The maximum of ``a`` along ``axis`` (values only; ``amax`` in torch)."""
+    return a.max(axis) if xp is np else a.amax(axis)
+
+
+def swap_last_two(xp: Any, a: Any) -> Any:
+    """``a`` with its last two axes swapped (a view)."""
+    return np.swapaxes(a, -1, -2) if xp is np else a.transpose(-1, -2)
+
+
+def as_dtype(xp: Any, a: Any, dtype: Any) -> Any:
+    """``a`` cast to ``dtype`` (``xp.float32`` ...; ``to`` in torch)."""
+    return a.astype(dtype) if xp is np else a.to(dtype)
+
+
+def stable_argsort(xp: Any, a: Any) -> Any:
+    """Indices that sort ``a`` along its last axis, equal values in their original order
+    (torch's default sort is not stable)."""
+    return np.argsort(a, -1, kind="stable") if xp is np else xp.argsort(a, dim=-1, stable=True)
+
+
+def sort(xp: Any, a: Any) -> Any:
+    """``a`` sorted along its last axis (values only; torch also returns the indices)."""
+    return np.sort(a, -1) if xp is np else xp.sort(a, -1)[0]
 
 
 def make_arrays(device: Any) -> Arrays:

@@ -230,6 +230,11 @@ class RobotStateBackend:
         x, y, yaw = self._pose(rb)
         return np.array((x, y, rb.z)), planar_quat(yaw)
 
+    def planar_pose(self, idn: int) -> tuple[float, float, float]:
+        """Robot ``idn``'s planar pose ``(x, y, yaw)`` (m, m, rad) as the backend holds it,
+        without the quaternion round trip of :meth:`get_pose` (the batched engine's pools)."""
+        return self._pose(self._robot(idn))
+
     def get_pose_floats(self, idn: int) -> tuple[float, ...]:
         """Return :meth:`get_pose`'s seven numbers as a tuple of floats, without arrays.
 
