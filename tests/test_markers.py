@@ -313,7 +313,7 @@ def test_waypoints_hide_when_the_robot_loses_its_path_and_come_back_with_it(monk
     env.reset(seed=0)
     assert any(m.visible for m in env.task.markers)
     before = env.task.markers
-    field = env.task._goal_field  # the field the task holds: make it find no path once
+    field = env.task.goal_field  # the field the task holds: make it find no path once
     real_path = field.path
     monkeypatch.setattr(field, "path", lambda xy, exact=True: (None, math.inf))
     env.step(FORWARD)

@@ -36,10 +36,7 @@ def robot_specs(
     max_speed : float
         Largest ``max_linear_velocity`` in m/s, >= 0.01.
     """
-    from pointnav_core.backends.protocol import (  # this block was appended: import here
-        DRIVES,
-        RobotSpec,
-    )
+    from pointnav_core.backends.robot_spec import DRIVES, RobotSpec
 
     drives = tuple(drives)
     if not drives or any(d not in DRIVES for d in drives):
