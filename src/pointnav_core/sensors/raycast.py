@@ -248,17 +248,7 @@ def cast_rays(
     cy, sy = np.cos(yaw), np.sin(yaw)
     ca, sa = np.cos(ang), np.sin(ang)
     if method != "numpy" and raycast_jit.available():
-        d = _NO_DISCS if discs is None else np.asarray(discs, dtype=np.float64).reshape(-1, 3)
-        if own_disc is None:
-            own = _no_own(len(p))
-        else:
-            own = np.ascontiguousarray(own_disc, dtype=np.int64).reshape(-1)
-        best, near = raycast_jit.cast_rays_compiled(
-            geometry, np.ascontiguousarray(p), cy, sy, ca, sa, float(max_range), np.ascontiguousarray(d), own
-        )
-        if near:  # an origin in a cell a polygon touches: shapely decides if it is inside
-            best[inside_polygon(geometry, p)] = 0.0
-        return best
+        return _cast_compiled(geometry, p, (cy, sy, ca, sa), float(max_range), discs, own_disc)
     if method == "numba":
         raise ArgumentError('method="numba" needs numba: pip install "pointnav-core[fast]"')
     c = cy[:, None] * ca[None, :] - sy[:, None] * sa[None, :]
@@ -273,6 +263,26 @@ def cast_rays(
         if len(d):
             own = None if own_disc is None else np.asarray(own_disc, dtype=np.int64).reshape(-1)
             np.minimum(best, _disc_hits(p, c, s, d, own), out=best)
+    return best
+
+
+def _cast_compiled(
+    geometry: ScanGeometry,
+    p: NDArray[np.float64],
+    trig: tuple[NDArray[np.float64], ...],
+    max_range: float,
+    discs: ArrayLike | None,
+    own_disc: ArrayLike | None,
+) -> NDArray[np.float64]:
+    """:func:`cast_rays`' compiled path: ``trig`` is the headings' and bearings' cosines and
+    sines ``(cy, sy, ca, sa)``."""
+    d = _NO_DISCS if discs is None else np.asarray(discs, dtype=np.float64).reshape(-1, 3)
+    own = _no_own(len(p)) if own_disc is None else np.ascontiguousarray(own_disc, dtype=np.int64).reshape(-1)
+    best, near = raycast_jit.cast_rays_compiled(
+        geometry, np.ascontiguousarray(p), *trig, max_range, np.ascontiguousarray(d), own
+    )
+    if near:  # an origin in a cell a polygon touches: shapely decides if it is inside
+        best[inside_polygon(geometry, p)] = 0.0
     return best
 
 

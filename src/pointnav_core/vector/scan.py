@@ -201,27 +201,36 @@ def cast_batch(
     angles = a.asarray(angles)
     radius = a.xp.zeros_like(x) + radius  # (W, R)
     if method != "array" and on_cpu and compiled_available():
-        from pointnav_core.vector._scan_kernel import cast_worlds
-
-        # torch CPU tensors are read through numpy views of their memory (no copies).
-        view = (lambda v: v.numpy()) if a.is_torch else (lambda v: v)
-        x, y, yaw, angles = view(x), view(y), view(yaw), view(angles)
-        w, r = x.shape
-        out = np.empty((w, r, angles.shape[0]))
-        cast_worlds(
-            np.ascontiguousarray(view(scene), dtype=np.int64), np.ascontiguousarray(x, dtype=np.float64),
-            np.ascontiguousarray(y, dtype=np.float64), np.cos(yaw), np.sin(yaw), np.cos(angles), np.sin(angles),
-            np.ascontiguousarray(view(present), dtype=np.bool_), np.ascontiguousarray(view(radius), dtype=np.float64),
-            float(max_range),
-            tables.meta, tables.lookup, tables.clearance, tables.edges, out,
-        )
-        _zero_inside(tables, view(scene), x, y, view(present), out)
-        return a.asarray(out) if a.is_torch else out
+        return _cast_compiled(tables, scene, x, y, yaw, angles, present, radius, float(max_range))
     c, s = directions(a, yaw, angles)
     best = _grid_ranges(tables, scene, x, y, c, s, float(max_range))
     best = a.xp.minimum(best, _disc_ranges(a, x, y, c, s, present, radius))
     best = _polygon_ranges(tables, scene, x, y, c, s, float(max_range), best)
     return a.xp.where(present[..., None], best, a.xp.full_like(best, float(max_range)))
+
+
+def _cast_compiled(
+    tables: ScanTables, scene: Any, x: Any, y: Any, yaw: Any, angles: Any, present: Any, radius: Any,
+    max_range: float,
+) -> Any:
+    """:func:`cast_batch`'s compiled path, on numpy arrays or torch CPU tensors."""
+    from pointnav_core.vector._scan_kernel import cast_worlds
+
+    a = tables.arrays
+    # torch CPU tensors are read through numpy views of their memory (no copies).
+    view = (lambda v: v.numpy()) if a.is_torch else (lambda v: v)
+    x, y, yaw, angles = view(x), view(y), view(yaw), view(angles)
+    w, r = x.shape
+    out = np.empty((w, r, angles.shape[0]))
+    cast_worlds(
+        np.ascontiguousarray(view(scene), dtype=np.int64), np.ascontiguousarray(x, dtype=np.float64),
+        np.ascontiguousarray(y, dtype=np.float64), np.cos(yaw), np.sin(yaw), np.cos(angles), np.sin(angles),
+        np.ascontiguousarray(view(present), dtype=np.bool_), np.ascontiguousarray(view(radius), dtype=np.float64),
+        max_range,
+        tables.meta, tables.lookup, tables.clearance, tables.edges, out,
+    )
+    _zero_inside(tables, view(scene), x, y, view(present), out)
+    return a.asarray(out) if a.is_torch else out
 
 
 def _polygon_ranges(tables: ScanTables, scene: Any, x: Any, y: Any, c: Any, s: Any, max_range: float, best: Any) -> Any:
