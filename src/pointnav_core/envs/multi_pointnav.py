@@ -187,12 +187,7 @@ from pointnav_core import scenes
 from pointnav_core.backends.protocol import Backend, make_backend
 from pointnav_core.backends.robot_spec import RobotSpec
 from pointnav_core.envs import common as _envcommon
-from pointnav_core.envs._multi_actions import (
-    check_actions,
-    named_action_error,
-    no_agents_error,
-    step_discrete,
-)
+from pointnav_core.envs._multi_actions import check_actions, named_action_error, no_agents_error, step_discrete
 from pointnav_core.envs._multi_state import STATE_FIELDS, global_state, state_space
 from pointnav_core.envs.config import EnvConfig, multi_robot_arguments, takes_config
 from pointnav_core.envs.fleet import (
