@@ -85,17 +85,25 @@ def test_a_multi_robot_reset_that_cannot_separate_goals_tries_max_trials_pairs_a
 
 
 @pytest.mark.parametrize("resolution", [0.1, 0.05, 0.3])
-def test_points_within_max_distance_are_exactly_those_math_hypot_keeps(resolution):
+@pytest.mark.parametrize("walls", [False, True])
+def test_points_within_max_distance_are_exactly_those_math_hypot_keeps(resolution, walls):
     # Cell centres at exact distances (3-4-5 triangles on the grid) sit on the bound: the
-    # fast squared test must keep exactly the cells that math.hypot keeps.
-    scene = Scene.from_array(np.zeros((41, 41), np.uint8), resolution=resolution)
+    # draw must be among exactly the cells that math.hypot keeps, listed row-major, and
+    # pick the one a list of them would (the same random number).
+    grid = np.zeros((41, 41), np.uint8)
+    if walls:  # rows split into several runs of the component
+        grid[::4, 3::5] = 1
+        grid[10, 5:35] = 1
+    scene = Scene.from_array(grid, resolution=resolution)
     tmap = scene.floors[0]
-    ref = tmap.cell_to_world(np.array([20, 20]))
-    label = int(tmap.component_at(ref, 0.0))
-    flat, xy = tmap.component_cells(0.0, label)
-    for cells in (5, 10, 12.5, 15):
-        bound = cells * resolution
-        want = [i for i, (x, y) in zip(flat.tolist(), xy.tolist()) if math.hypot(x - ref[0], y - ref[1]) <= bound]
-        from pointnav_core.scenes.scene import _cells_of
+    from pointnav_core.scenes.scene import _pick_cell
 
-        assert _cells_of(tmap, 0.0, label, ref, bound).tolist() == want
+    for ref in (tmap.cell_to_world(np.array([20, 20])), tmap.cell_to_world(np.array([20, 21])) + 0.3 * resolution):
+        label = int(tmap.component_at(ref, 0.0))
+        flat, xy = tmap.component_cells(0.0, label)
+        for cells in (0.2, 5, 10, 12.5, 15, 60):
+            bound = cells * resolution
+            want = [i for i, (x, y) in zip(flat.tolist(), xy.tolist()) if math.hypot(x - ref[0], y - ref[1]) <= bound]
+            for seed in range(20):
+                got = _pick_cell(tmap, 0.0, label, ref, bound, np.random.default_rng(seed))
+                assert got == (want[int(np.random.default_rng(seed).integers(len(want)))] if want else None)

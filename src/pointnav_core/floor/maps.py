@@ -376,15 +376,19 @@ class TraversableMap:
         flat = pts.reshape(-1, 2)
         labels = self.components(radius)
         out = np.zeros(len(flat), dtype=np.int32)
-        clear = self.is_usable(flat, radius)
-        # A usable point on a labelled cell's centre (every sampled point) is that cell's:
-        # the nearest candidate, at distance 0, which the loop below would find first.
+        # A point on a labelled cell's centre (every sampled point) is that cell's: the
+        # nearest candidate, at distance 0, which the loop below would find first. The
+        # labelled cells are the usable ones, exact at their centres, so such a point
+        # needs no disc test of its own.
         cells = self.world_to_cell(flat)
         inside = self.in_bounds(cells)
         rows, cols = np.where(inside, cells[:, 0], 0), np.where(inside, cells[:, 1], 0)
         own = labels[rows, cols]
-        centred = clear & inside & (own > 0) & (self.cell_to_world(cells) == flat).all(axis=1)
+        centred = inside & (own > 0) & (self.cell_to_world(cells) == flat).all(axis=1)
         out[centred] = own[centred]
+        clear = np.zeros(len(flat), dtype=bool)
+        if not centred.all():
+            clear[~centred] = self.is_usable(flat[~centred], radius)
         span = np.arange(-2, 3)
         for i in np.flatnonzero(clear & ~centred):
             cell = self.world_to_cell(flat[i])

@@ -350,6 +350,7 @@ class Scene:
         # backend collides with, so every backend accepts the point.
         if reference_point is None:
             cells = np.flatnonzero(tmap.usable(radius))
+            index = int(cells[int(rng.integers(len(cells)))]) if len(cells) else None
         else:
             ref = as_xy(reference_point, "reference_point")
             label = int(tmap.component_at(ref, radius))
@@ -358,13 +359,13 @@ class Scene:
                     f"reference_point {ref.tolist()} is not usable on floor {floor} for a robot "
                     f"of radius {radius} m (blocked, too close to an obstacle, or off the map)"
                 )
-            cells = _cells_of(tmap, radius, label, ref, max_distance)
-        if len(cells) == 0:
+            index = _pick_cell(tmap, radius, label, ref, max_distance, rng)
+        if index is None:
             within = "" if max_distance is None else f" within {max_distance} m of the reference point"
             raise SamplingError(
                 f"floor {floor} has no usable cell{within} for a robot of radius {radius} m"
             )
-        cell = np.unravel_index(cells[int(rng.integers(len(cells)))], tmap.shape)
+        cell = np.unravel_index(index, tmap.shape)
         x, y = tmap.cell_to_world(np.array(cell))
         return int(floor), np.array([x, y, tmap.height])
 
@@ -373,6 +374,19 @@ class Scene:
         """Cached geodesic distance field to ``goal_xy`` on ``floor`` (see FloorGoalField)."""
         planner = planner_for(self._floor(floor), robot_radius(robot))
         return FloorGoalField(self._floor(floor), planner.goal_field(as_xy(goal_xy, "goal_xy")))
+
+    def geodesic_bounds(
+        self, floor: int, source_xy: ArrayLike, target_xy: ArrayLike, robot: Any = None
+    ) -> tuple[float, float]:
+        """Lower and upper bounds (m) on :meth:`geodesic_distance`, at a fraction of its cost.
+
+        From a few landmarks' exact distances (``geodesic.landmarks``): a sampler rejects a
+        goal out of its range without building the goal's field. ``(0, inf)`` where nothing
+        is known cheaply (numba is not installed).
+        """
+        src, tgt = as_xy(source_xy, "source_xy"), as_xy(target_xy, "target_xy")
+        landmarks = planner_for(self._floor(floor), robot_radius(robot)).landmarks()
+        return landmarks.bounds((float(src[0]), float(src[1])), (float(tgt[0]), float(tgt[1])))
 
     def geodesic_distance(
         self, floor: int, source_xy: ArrayLike, target_xy: ArrayLike, robot: Any = None
@@ -441,25 +455,51 @@ class Scene:
         return f"Scene(n_floors={self.n_floors}, floors={self.floors!r})"
 
 
-def _cells_of(tmap: TraversableMap, radius: float, label: int, ref: NDArray[np.float64], max_distance: float | None) -> NDArray[np.intp]:
-    """Flat indices (row-major) of the cells of component ``label``, with centres within
-    ``max_distance`` (m) of ``ref`` if given."""
-    flat, xy = tmap.component_cells(radius, label)
+def _pick_cell(
+    tmap: TraversableMap, radius: float, label: int, ref: NDArray[np.float64], max_distance: float | None,
+    rng: np.random.Generator,
+) -> int | None:
+    """A uniformly drawn cell (flat row-major index) of component ``label`` whose centre is
+    within ``max_distance`` (m, ``hypot``) of ``ref`` if given; None when there is none.
+
+    The cells within reach are counted row by row, each row's an interval of columns found
+    by bisection in the component's sorted cells, so a draw costs O(rows), not a distance
+    per cell. The one random number drawn, and so the cell, is the same as when the cells
+    within reach are listed in row-major order and one of them is picked.
+    """
+    flat, _ = tmap.component_cells(radius, label)
     if max_distance is None or not math.isfinite(max_distance):
-        return flat
+        return int(flat[int(rng.integers(len(flat)))]) if len(flat) else None
+    h, w = tmap.shape
+    res, (ox, oy) = tmap.resolution, tmap.origin
     rx, ry = float(ref[0]), float(ref[1])
-    d2 = xy[:, 0] - rx
-    d2 *= d2
-    dy = xy[:, 1] - ry
-    dy *= dy
-    d2 += dy
-    # The squared test decides all but a thin shell around the bound, where it could round
-    # the other way; there ``hypot`` decides, so the cells are exactly those with
-    # ``hypot <= max_distance`` (at a fifth of its cost).
-    near = d2 <= (max_distance * (1 - 1e-9)) ** 2
-    shell = np.flatnonzero((d2 <= (max_distance * (1 + 1e-9)) ** 2) != near)
-    near[shell] = np.hypot(xy[shell, 0] - rx, xy[shell, 1] - ry) <= max_distance
-    return flat[near]
+    # Rows whose centres may be within reach (one row of slack each way).
+    first = max(0, math.floor((ry - max_distance - oy) / res - 0.5) - 1)
+    rows = np.arange(first, max(first, min(h, math.ceil((ry + max_distance - oy) / res - 0.5) + 2)))
+    dy = (oy + (rows + 0.5) * res) - ry
+
+    def reaches(col: NDArray[np.float64]) -> NDArray[np.bool_]:
+        # The same centre and test as listing every cell: cell_to_world, then hypot.
+        return np.hypot((ox + (col + 0.5) * res) - rx, dy) <= max_distance
+
+    half = np.sqrt(np.maximum(max_distance * max_distance - dy * dy, 0.0))
+    # Each row's interval of columns from the square root; rounding moves an end by at most
+    # one column, which the exact test then settles.
+    lo = np.ceil((rx - half - ox) / res - 0.5)
+    hi = np.floor((rx + half - ox) / res - 0.5)
+    before, first_in, last_in, after = reaches(np.stack([lo - 1, lo, hi, hi + 1]))
+    lo = np.where(before, lo - 1, np.where(first_in, lo, lo + 1))
+    hi = np.where(after, hi + 1, np.where(last_in, hi, hi - 1))
+    lo, hi = np.maximum(lo, 0).astype(np.int64), np.minimum(hi, w - 1).astype(np.int64)
+    start = np.searchsorted(flat, rows * w + lo)
+    counts = np.where(lo <= hi, np.searchsorted(flat, rows * w + hi, side="right") - start, 0)
+    total = int(counts.sum())
+    if total == 0:
+        return None
+    k = int(rng.integers(total))
+    ends = np.cumsum(counts)
+    row = int(np.searchsorted(ends, k, side="right"))
+    return int(flat[start[row] + k - (ends[row] - counts[row])])
 
 
 # The generators name their scenes as datasets do (a module of their own, imported last:
