@@ -96,7 +96,7 @@ def test_points_within_max_distance_are_exactly_those_math_hypot_keeps(resolutio
         grid[10, 5:35] = 1
     scene = Scene.from_array(grid, resolution=resolution)
     tmap = scene.floors[0]
-    from pointnav_core.scenes.scene import _pick_cell
+    from pointnav_core.floor import draw_cell
 
     for ref in (tmap.cell_to_world(np.array([20, 20])), tmap.cell_to_world(np.array([20, 21])) + 0.3 * resolution):
         label = int(tmap.component_at(ref, 0.0))
@@ -105,5 +105,5 @@ def test_points_within_max_distance_are_exactly_those_math_hypot_keeps(resolutio
             bound = cells * resolution
             want = [i for i, (x, y) in zip(flat.tolist(), xy.tolist()) if math.hypot(x - ref[0], y - ref[1]) <= bound]
             for seed in range(20):
-                got = _pick_cell(tmap, 0.0, label, ref, bound, np.random.default_rng(seed))
+                got = draw_cell(tmap, 0.0, label, ref, bound, np.random.default_rng(seed))
                 assert got == (want[int(np.random.default_rng(seed).integers(len(want)))] if want else None)

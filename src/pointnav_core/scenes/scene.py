@@ -37,6 +37,7 @@ from numpy.typing import ArrayLike, NDArray
 from pointnav_core import floorplans
 from pointnav_core.errors import ArgumentError, SamplingError
 from pointnav_core.floor import loaders, reachability
+from pointnav_core.floor.draw import draw_cell
 from pointnav_core.floor.maps import OBSTACLE, TraversableMap
 from pointnav_core.floorplans import FloorPlan
 from pointnav_core.geodesic import Planner, planner_for
@@ -359,7 +360,7 @@ class Scene:
                     f"reference_point {ref.tolist()} is not usable on floor {floor} for a robot "
                     f"of radius {radius} m (blocked, too close to an obstacle, or off the map)"
                 )
-            index = _pick_cell(tmap, radius, label, ref, max_distance, rng)
+            index = draw_cell(tmap, radius, label, ref, max_distance, rng)
         if index is None:
             within = "" if max_distance is None else f" within {max_distance} m of the reference point"
             raise SamplingError(
@@ -453,53 +454,6 @@ class Scene:
 
     def __repr__(self) -> str:
         return f"Scene(n_floors={self.n_floors}, floors={self.floors!r})"
-
-
-def _pick_cell(
-    tmap: TraversableMap, radius: float, label: int, ref: NDArray[np.float64], max_distance: float | None,
-    rng: np.random.Generator,
-) -> int | None:
-    """A uniformly drawn cell (flat row-major index) of component ``label`` whose centre is
-    within ``max_distance`` (m, ``hypot``) of ``ref`` if given; None when there is none.
-
-    The cells within reach are counted row by row, each row's an interval of columns found
-    by bisection in the component's sorted cells, so a draw costs O(rows), not a distance
-    per cell. The one random number drawn, and so the cell, is the same as when the cells
-    within reach are listed in row-major order and one of them is picked.
-    """
-    flat, _ = tmap.component_cells(radius, label)
-    if max_distance is None or not math.isfinite(max_distance):
-        return int(flat[int(rng.integers(len(flat)))]) if len(flat) else None
-    h, w = tmap.shape
-    res, (ox, oy) = tmap.resolution, tmap.origin
-    rx, ry = float(ref[0]), float(ref[1])
-    # Rows whose centres may be within reach (one row of slack each way).
-    first = max(0, math.floor((ry - max_distance - oy) / res - 0.5) - 1)
-    rows = np.arange(first, max(first, min(h, math.ceil((ry + max_distance - oy) / res - 0.5) + 2)))
-    dy = (oy + (rows + 0.5) * res) - ry
-
-    def reaches(col: NDArray[np.float64]) -> NDArray[np.bool_]:
-        # The same centre and test as listing every cell: cell_to_world, then hypot.
-        return np.hypot((ox + (col + 0.5) * res) - rx, dy) <= max_distance
-
-    half = np.sqrt(np.maximum(max_distance * max_distance - dy * dy, 0.0))
-    # Each row's interval of columns from the square root; rounding moves an end by at most
-    # one column, which the exact test then settles.
-    lo = np.ceil((rx - half - ox) / res - 0.5)
-    hi = np.floor((rx + half - ox) / res - 0.5)
-    before, first_in, last_in, after = reaches(np.stack([lo - 1, lo, hi, hi + 1]))
-    lo = np.where(before, lo - 1, np.where(first_in, lo, lo + 1))
-    hi = np.where(after, hi + 1, np.where(last_in, hi, hi - 1))
-    lo, hi = np.maximum(lo, 0).astype(np.int64), np.minimum(hi, w - 1).astype(np.int64)
-    start = np.searchsorted(flat, rows * w + lo)
-    counts = np.where(lo <= hi, np.searchsorted(flat, rows * w + hi, side="right") - start, 0)
-    total = int(counts.sum())
-    if total == 0:
-        return None
-    k = int(rng.integers(total))
-    ends = np.cumsum(counts)
-    row = int(np.searchsorted(ends, k, side="right"))
-    return int(flat[start[row] + k - (ends[row] - counts[row])])
 
 
 # The generators name their scenes as datasets do (a module of their own, imported last:

@@ -1,0 +1,80 @@
+"""Uniform draws of a floor's usable cells within reach of a point, without a distance per cell."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numpy.typing import NDArray
+
+from pointnav_core.floor.maps import TraversableMap
+
+__all__ = ["draw_cell"]
+
+
+def draw_cell(
+    tmap: TraversableMap, radius: float, label: int, ref: NDArray[np.float64], max_distance: float | None,
+    rng: np.random.Generator,
+) -> int | None:
+    """A uniformly drawn cell of one component, within reach of a point.
+
+    The cells within reach are counted row by row, each row an interval of columns settled
+    by the exact test at its two ends, then found by bisection in the component's sorted
+    cells: a draw costs O(rows), not a distance per cell. The one random number drawn, and so
+    the cell, is the one that picks from the list of every cell within reach in row-major
+    order.
+
+    Parameters
+    ----------
+    tmap : TraversableMap
+    radius : float
+        Robot radius (m) whose components (:meth:`TraversableMap.components`) are drawn from.
+    label : int
+        The component.
+    ref : ndarray, shape (2,)
+        World point (m) the reach is measured from.
+    max_distance : float or None
+        Reach (m): only cells whose centre has ``np.hypot(centre - ref) <= max_distance``;
+        None or inf for the whole component.
+    rng : numpy.random.Generator
+        Draws one integer.
+
+    Returns
+    -------
+    int or None
+        Flat row-major index of the cell drawn; None when no cell is within reach (nothing
+        is drawn then).
+    """
+    flat, _ = tmap.component_cells(radius, label)
+    if max_distance is None or not math.isfinite(max_distance):
+        return int(flat[int(rng.integers(len(flat)))]) if len(flat) else None
+    h, w = tmap.shape
+    res, (ox, oy) = tmap.resolution, tmap.origin
+    rx, ry = float(ref[0]), float(ref[1])
+    # Rows whose centres may be within reach (one row of slack each way).
+    first = max(0, math.floor((ry - max_distance - oy) / res - 0.5) - 1)
+    rows = np.arange(first, max(first, min(h, math.ceil((ry + max_distance - oy) / res - 0.5) + 2)))
+    dy = (oy + (rows + 0.5) * res) - ry
+
+    def reaches(col: NDArray[np.float64]) -> NDArray[np.bool_]:
+        # The same centre and test as listing every cell: cell_to_world, then hypot.
+        return np.hypot((ox + (col + 0.5) * res) - rx, dy) <= max_distance
+
+    half = np.sqrt(np.maximum(max_distance * max_distance - dy * dy, 0.0))
+    # Each row's interval of columns from the square root; rounding moves an end by at most
+    # one column, which the exact test then settles.
+    lo = np.ceil((rx - half - ox) / res - 0.5)
+    hi = np.floor((rx + half - ox) / res - 0.5)
+    before, first_in, last_in, after = reaches(np.stack([lo - 1, lo, hi, hi + 1]))
+    lo = np.where(before, lo - 1, np.where(first_in, lo, lo + 1))
+    hi = np.where(after, hi + 1, np.where(last_in, hi, hi - 1))
+    lo, hi = np.maximum(lo, 0).astype(np.int64), np.minimum(hi, w - 1).astype(np.int64)
+    start = np.searchsorted(flat, rows * w + lo)
+    counts = np.where(lo <= hi, np.searchsorted(flat, rows * w + hi, side="right") - start, 0)
+    total = int(counts.sum())
+    if total == 0:
+        return None
+    k = int(rng.integers(total))
+    ends = np.cumsum(counts)
+    row = int(np.searchsorted(ends, k, side="right"))
+    return int(flat[start[row] + k - (ends[row] - counts[row])])
