@@ -108,7 +108,7 @@ def test_scans_that_graze_the_jumps_far_sides_equal_the_numpy_path(case):
     pytest.importorskip("numba", reason="the compiled path is the `fast` extra")
     tmap, origins, yaws, angles, max_range = case
     geo = ScanGeometry(tmap)
-    general = cast_rays(geo, origins, yaws, angles, max_range, method="numpy")
+    general = cast_rays(geo, origins, yaws, angles, max_range, method="array")
     np.testing.assert_array_equal(cast_rays(geo, origins, yaws, angles, max_range, method="numba"), general)
     # The batched kernel, one robot per world (no discs), on the same floor.
     scene = Scene.from_array(np.asarray(tmap.codes), tmap.resolution, origin=tuple(tmap.origin))

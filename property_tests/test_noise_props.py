@@ -33,7 +33,7 @@ def test_compiled_noise_equals_numpy(
     robot = np.arange(robots)[None, :, None]
     step = rng.integers(0, 10_000, (worlds, robots, 1))
     args = (episode, robot, step, n_rays, noise_std, dropout)
-    want, got = scan_noise(*args, method="numpy"), scan_noise(*args, method="numba")
+    want, got = scan_noise(*args, method="array"), scan_noise(*args, method="numba")
     for w, g in zip(want, got, strict=True):
         assert (w is None) == (g is None)
         if w is not None:

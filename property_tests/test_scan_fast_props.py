@@ -36,7 +36,7 @@ pytest.importorskip("numba", reason="the compiled path is the `fast` extra")
 
 def _both(geo, origins, yaws, angles, max_range, discs=None, own=None):
     fast = cast_rays(geo, origins, yaws, angles, max_range, discs=discs, own_disc=own, method="numba")
-    general = cast_rays(geo, origins, yaws, angles, max_range, discs=discs, own_disc=own, method="numpy")
+    general = cast_rays(geo, origins, yaws, angles, max_range, discs=discs, own_disc=own, method="array")
     np.testing.assert_array_equal(fast, general)
     return fast
 
@@ -55,7 +55,7 @@ def test_the_scans_one_pose_path_gives_equal_ranges(case):
     heading = np.concatenate([np.cos(yaws), np.sin(yaws)])
     directions = (np.cos(np.asarray(angles, dtype=np.float64)), np.sin(np.asarray(angles, dtype=np.float64)))
     got = cast_pose_compiled(geo, np.array([origin], dtype=np.float64), heading, directions, max_range)
-    np.testing.assert_array_equal(got, cast_rays(geo, [origin], [yaw], angles, max_range, method="numpy")[0])
+    np.testing.assert_array_equal(got, cast_rays(geo, [origin], [yaw], angles, max_range, method="array")[0])
 
 
 @st.composite
