@@ -12,7 +12,7 @@ over several rounds (the best round of each kept, since the machines are shared)
 
 each with ``method="numba"`` (the ``fast`` extra) and ``method="array"``; the last column
 is the numpy time over the compiled one. The two paths give equal ranges
-(``property_tests/test_scan_fast_props.py``).
+(``property_tests/test_compiled_paths.py``, checks in ``tests/pairs_scan.py``).
 
 Run: ``python benchmarks/bench_scan.py [--poses 500] [--rounds 5]``
 """

@@ -7,8 +7,8 @@ for every robot of the batch as whole arrays: about a hundred array calls a step
 resolve nothing. On the CPU this module does the same arithmetic one world, robot and wall
 at a time in a numba kernel (:mod:`~pointnav_core.vector._contact_kernel`), stopping where
 each world stops, with the same expressions in the same order, so both paths give the same
-positions and contact flags; ``property_tests/test_vector_contacts_props.py`` checks that
-they are equal.
+positions and contact flags; ``property_tests/test_compiled_paths.py`` checks that they
+are equal (``tests/pairs_vector.py``).
 
 numba is optional (the ``fast`` extra): without it (or inside
 :func:`~pointnav_core.utils.compiled.numpy_paths`), or for arrays on a GPU, the engines

@@ -13,7 +13,7 @@ VOID is not seen; touching counts (within :data:`~pointnav_core.sensors.TOUCH_EP
 origin touching a blocked cell reads 0. Absent robots neither see nor are seen; their rows
 read ``max_range``.
 
-Two paths give the same ranges (``property_tests/test_vector_scan_props.py``):
+Two paths give the same ranges (``property_tests/test_compiled_paths.py``, ``tests/pairs_vector.py``):
 
 - the array path (numpy, or torch on any device, through
   :class:`~pointnav_core.vector.xp.Arrays`): the single env's crossing formulas
