@@ -40,6 +40,7 @@ METHODS = ("auto", "array", "numba")
 
 _LOADED: dict[tuple[str, str], Any] = {}
 _OFF: list[bool] = []
+_UNSEEN = object()  # not looked up yet (None: looked up, no numba)
 
 
 def _cannot_cache(error: RuntimeError) -> bool:
@@ -97,11 +98,11 @@ def kernel(module: str, name: str) -> Any:
     inside :func:`numpy_paths`). Looked up once: later calls read a dict (hot paths call it)."""
     if _OFF:
         return None
-    key = (module, name)
-    if key not in _LOADED:
+    fn = _LOADED.get((module, name), _UNSEEN)
+    if fn is _UNSEEN:
         loaded = kernel_module(module)
-        _LOADED[key] = None if loaded is None else getattr(loaded, name)
-    return _LOADED[key]
+        fn = _LOADED[module, name] = None if loaded is None else getattr(loaded, name)
+    return fn
 
 
 def check_method(method: str) -> None:
