@@ -394,6 +394,7 @@ class VectorScan:
     def __init__(self, term: RangeScan, tables: ScanTables, method: str = "auto") -> None:
         if not isinstance(term, RangeScan):
             raise ArgumentError(f"term must be a RangeScan, got {term!r}")
+        check_method(method)  # refused now, not at the first reading
         self.term = term
         self.tables = tables
         self.method = method
