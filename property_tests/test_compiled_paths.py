@@ -164,8 +164,10 @@ def test_only_the_loader_imports_kernel_modules() -> None:
     bad = []
     for module, text in callers.items():
         for node in ast.walk(ast.parse(text)):
-            names = [node.module or ""] if isinstance(node, ast.ImportFrom) else (
-                [a.name for a in node.names] if isinstance(node, ast.Import) else [])
+            if isinstance(node, ast.ImportFrom):  # "from pkg import _x_kernel" names it too
+                names = [node.module or ""] + [f"{node.module}.{a.name}" for a in node.names]
+            else:
+                names = [a.name for a in node.names] if isinstance(node, ast.Import) else []
             bad += [f"{module}: {n}" for n in names if n in kernels]
     assert bad == []
 
@@ -218,3 +220,32 @@ def test_the_guard_catches_a_kernel_reached_around_the_loader() -> None:
     from pointnav_core.vector import _scan_kernel
 
     assert not isinstance(_scan_kernel.cast_worlds, type(check_id))  # the kernel is back
+
+
+def test_inside_numpy_paths_the_default_methods_reach_no_kernel() -> None:
+    """The public functions with compiled paths, called as users call them (``method="auto"``,
+    engines built and stepped), run no kernel inside ``numpy_paths()``."""
+    pytest.importorskip("numba", reason="the compiled paths are the `fast` extra")
+    import numpy as np
+
+    from pointnav_core.scenes import Scene
+    from pointnav_core.sensors import ScanGeometry, cast_rays
+    from pointnav_core.sensors.noise import episode_key, scan_noise
+    from pointnav_core.sensors.raycast import cast_pose_compiled
+    from pointnav_core.vector import VectorPointNavEnv
+
+    grid = np.zeros((24, 24), np.uint8)
+    grid[[0, -1], :] = grid[:, [0, -1]] = 1
+    grid[8:16, 12] = 1
+    scene = Scene.from_array(grid, 0.1)
+    geo = ScanGeometry(scene.floors[0])
+    with guarded_plain_paths():
+        assert cast_rays(geo, [[0.55, 0.55]], [0.0], [0.0, 1.0], 2.0).shape == (1, 2)
+        trig = (np.ones(1), np.zeros(1))
+        assert cast_pose_compiled(geo, np.array([[0.55, 0.55]]), np.array([1.0, 0.0]), trig, 2.0) is None
+        assert scan_noise(episode_key(1, 0), 0, 0, 4, 0.1, 0.1)[0].shape == (4,)
+        env = VectorPointNavEnv(2, n_robots=2, scene=scene, sensors={"scan": {"n_rays": 8, "noise_std": 0.1}})
+        env.reset(seed=0)
+        for _ in range(10):
+            env.step(np.tile([1.0, 0.3], (2, 2, 1)))
+        env.close()
