@@ -15,8 +15,8 @@ arithmetic one ray at a time in a numba kernel, stopping where the ray stops:
 
 Every quantity is the same expression as in the numpy path, evaluated in the same order on
 the same cosines and sines (computed by numpy in :func:`~pointnav_core.sensors.raycast.cast_rays`,
-and turned into ray directions by the same products), so both paths give the same ranges; ``property_tests/test_compiled_paths.py`` checks that
-they are equal (``tests/pairs_scan.py``).
+and turned into ray directions by the same products), so both paths give the same ranges;
+``property_tests/test_compiled_paths.py`` checks that they are equal (``tests/pairs_scan.py``).
 
 numba is optional (the ``fast`` extra). The kernel
 (:mod:`~pointnav_core.sensors._raycast_kernel`) is loaded by
