@@ -10,9 +10,9 @@ over several rounds (the best round of each kept, since the machines are shared)
 - ``cast_rays``: the ray casting alone, one robot per call;
 - ``cast_rays x8``: eight robots in one call, each seeing the others' discs, per robot.
 
-each with ``method="numba"`` (the ``fast`` extra) and ``method="numpy"``; the last column
+each with ``method="numba"`` (the ``fast`` extra) and ``method="array"``; the last column
 is the numpy time over the compiled one. The two paths give equal ranges
-(``property_tests/test_scan_fast_props.py``).
+(``property_tests/test_compiled_paths.py``, checks in ``tests/pairs_scan.py``).
 
 Run: ``python benchmarks/bench_scan.py [--poses 500] [--rounds 5]``
 """
@@ -31,6 +31,7 @@ import pointnav_core  # noqa: F401  (registers pointnav_core/PointNav-v0)
 from pointnav_core import scenes
 from pointnav_core.sensors import RangeScan, ScanGeometry, cast_rays, raycast_jit
 from pointnav_core.task.observations import Frame
+from pointnav_core.utils.compiled import numpy_paths
 
 
 def record_poses(scene: Any, n: int, seed: int) -> list[tuple[float, float, float]]:
@@ -92,18 +93,14 @@ def main() -> None:
         return (time.perf_counter() - start) / (8 * len(groups))
 
     def scan_term_numpy() -> float:
-        # The same term on the numpy path: cast_rays' default, pinned for this run.
-        saved = raycast_jit._KERNEL
-        raycast_jit._KERNEL = None
-        try:
+        # The same term on the array path: every compiled path off for this run.
+        with numpy_paths():
             return scan_term()
-        finally:
-            raycast_jit._KERNEL = saved
 
     rows = {
         "scan term": (scan_term, scan_term_numpy),
-        "cast_rays, 1 robot": (lambda: one("numba"), lambda: one("numpy")),
-        "cast_rays x8, per robot": (lambda: eight("numba"), lambda: eight("numpy")),
+        "cast_rays, 1 robot": (lambda: one("numba"), lambda: one("array")),
+        "cast_rays x8, per robot": (lambda: eight("numba"), lambda: eight("array")),
     }
     for fast, general in rows.values():  # compile / warm up
         fast()

@@ -58,7 +58,7 @@ def test_hand_made_room_by_hand_and_cell_by_cell() -> None:
     by_hand = 2 * math.hypot(1.75 - 1.2, 1.2 - 1.05) + 0.3
     assert field.distance(x, y) == pytest.approx(by_hand, abs=1e-5)
     # The same decisions, one cell at a time (on numpy arrays both: numba's scalar math may
-    # break the symmetric tie the other way, property_tests/test_field_roots_props.py).
+    # break the symmetric tie the other way, check_settle in tests/pairs_geodesic.py).
     with _compiled.numpy_paths():
         fresh = _room().planner(0, 0.0).goal_field(goal)
         kind, label = fresh.settle(cells)

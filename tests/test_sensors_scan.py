@@ -144,17 +144,19 @@ def test_scan_geometry_and_sensors_pickle():
 
 def test_method_names_the_choices():
     geo = ScanGeometry(TraversableMap(np.zeros((2, 2), np.uint8), 1.0))
-    with pytest.raises(ValueError, match=r"method must be one of 'auto', 'numpy', 'numba', got 'fast'"):
+    with pytest.raises(ValueError, match=r"method must be one of 'auto', 'array', 'numba', got 'fast'"):
         cast_rays(geo, [[0.5, 0.5]], [0.0], [0.0], 1.0, method="fast")
+    # The old name of the plain path is refused, and the message says the new one.
+    with pytest.raises(ValueError, match=r"got 'numpy' \(the plain path is 'array'\)"):
+        cast_rays(geo, [[0.5, 0.5]], [0.0], [0.0], 1.0, method="numpy")
 
 
-def test_without_numba_auto_takes_numpy_and_numba_is_refused(monkeypatch):
-    from pointnav_core.sensors import raycast_jit
+def test_without_numba_auto_takes_numpy_and_numba_is_refused():
+    from pointnav_core.utils.compiled import numpy_paths
 
-    monkeypatch.setattr(raycast_jit, "_TRIED", True)
-    monkeypatch.setattr(raycast_jit, "_KERNEL", None)
     geo = ScanGeometry(TraversableMap(np.zeros((1, 4), np.uint8), 1.0))
-    # The map's edge at x = 4 and x = 0, by hand.
-    assert cast_rays(geo, [[0.5, 0.5]], [0.0], [0.0, math.pi], 10.0).tolist() == [[3.5, 0.5]]
-    with pytest.raises(ValueError, match=r"method=\"numba\" needs numba"):
-        cast_rays(geo, [[0.5, 0.5]], [0.0], [0.0], 10.0, method="numba")
+    with numpy_paths():  # the loader finds no kernel, as without numba
+        # The map's edge at x = 4 and x = 0, by hand.
+        assert cast_rays(geo, [[0.5, 0.5]], [0.0], [0.0, math.pi], 10.0).tolist() == [[3.5, 0.5]]
+        with pytest.raises(ValueError, match=r"method=\"numba\" needs numba"):
+            cast_rays(geo, [[0.5, 0.5]], [0.0], [0.0], 10.0, method="numba")

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import importlib.util
 import math
+from collections.abc import Iterator
 
 import numpy as np
 import pytest
@@ -13,6 +14,7 @@ from fleet_reference import compare_fleet, fleet_episodes
 from pointnav_core.floor.maps import OBSTACLE
 from pointnav_core.scenes import Scene
 from pointnav_core.task import PointNavigationTask
+from pointnav_core.utils.compiled import numpy_paths
 from pointnav_core.vector import VectorPointNavEnv
 
 DEVICES = ["numpy"] + (["cpu"] if importlib.util.find_spec("torch") else [])
@@ -145,19 +147,18 @@ RADII_ROBOTS = [{"radius": 0.1, "max_linear_velocity": 0.5}, {"radius": 0.3, "ma
 ONE_RAY = {"scan": {"n_rays": 1, "max_range": 2.0}}
 
 
-def _array_paths(monkeypatch: pytest.MonkeyPatch) -> None:
+@pytest.fixture
+def array_paths() -> Iterator[None]:
     """Make the engine take its array paths (contacts and scan) instead of the compiled ones."""
-    from pointnav_core.vector import contacts_jit, scan
-
-    monkeypatch.setattr(contacts_jit, "available", lambda floors: False)
-    monkeypatch.setattr(scan, "compiled_available", lambda: False)
+    with numpy_paths():
+        yield
 
 
 @pytest.mark.parametrize("path", ["compiled", "array"])
 @pytest.mark.parametrize("device", DEVICES)
-def test_robots_of_radii_01_and_03_touch_at_04_m(device: str, path: str, monkeypatch: pytest.MonkeyPatch) -> None:
+def test_robots_of_radii_01_and_03_touch_at_04_m(device: str, path: str, request: pytest.FixtureRequest) -> None:
     if path == "array":
-        _array_paths(monkeypatch)
+        request.getfixturevalue("array_paths")
     elif importlib.util.find_spec("numba") is None:
         pytest.skip("the compiled path needs numba")
     env = VectorPointNavEnv(1, n_robots=2, scene=room(), robot=RADII_ROBOTS, task={"goal_tolerance": 0.1},

@@ -111,6 +111,9 @@ def test_bad_method_raises() -> None:
     scan, pose = _scan()
     with pytest.raises(ValueError, match="method must be one of"):
         cast_batch(scan.tables, *pose, scan.angles, 1.0, method="gpu")
+    # The single scan's old name of the plain path is refused here too, naming the new one.
+    with pytest.raises(ValueError, match=r"got 'numpy' \(the plain path is 'array'\)"):
+        VectorScan(scan.term, scan.tables, method="numpy")
 
 
 def test_a_sensor_the_batched_engines_do_not_cast_is_refused_by_name(monkeypatch) -> None:

@@ -107,7 +107,7 @@ def test_cast_batch_equals_the_single_scan_on_polygon_floors(method: str, device
         discs = np.column_stack([xy[i, seen], np.full(len(seen), 0.18)])
         own = np.full(r, -1)
         own[seen] = np.arange(len(seen))
-        ref = cast_rays(geo, xy[i], yaw[i], angles, max_range, discs=discs, own_disc=own, method="numpy")
+        ref = cast_rays(geo, xy[i], yaw[i], angles, max_range, discs=discs, own_disc=own, method="array")
         ref[~present[i]] = max_range
         assert np.array_equal(got[i], ref), (i, np.abs(got[i] - ref).max())
     assert (got[0, 0] == 0.0).all() and (got[1, 0] == 0.0).all()  # origins inside a polygon

@@ -1,9 +1,9 @@
 """The compiled path of :meth:`pointnav_core.floor.collision.FloorCollision.segments_clear`'s cell test (imports numba).
 
-Imported only by ``collision`` when numba is installed (the ``fast`` extra), so the package
-imports without it. One segment at a time, band row by band row, with the numpy path's
-expressions in the same order (``_cells_hit`` and ``_stadium_row``), stopping at the
-first blocked row, so both paths give the same answers.
+Imported only through :func:`pointnav_core.utils.compiled.kernel` when numba is installed
+(the ``fast`` extra), so the package imports without it. One segment at a time, band row by
+band row, with the numpy path's expressions in the same order (``_cells_hit`` and
+``_stadium_row``), stopping at the first blocked row, so both paths give the same answers.
 """
 
 from __future__ import annotations

@@ -1,6 +1,6 @@
 """The numba kernel behind :mod:`pointnav_core.sensors.raycast_jit` (imports numba).
 
-Imported only by :func:`pointnav_core.sensors.raycast_jit.kernel`, so that the package
+Imported only by :func:`pointnav_core.utils.compiled.kernel`, so that the package
 imports without numba. Module-level functions, so that ``cache=True`` stores the compiled
 code on disk and later processes load it instead of compiling again. See
 :mod:`~pointnav_core.sensors.raycast_jit` for what the kernel does and why it is exact.

@@ -37,7 +37,7 @@ import numpy as np
 from numpy.typing import NDArray
 from scipy.special import ndtri
 
-from pointnav_core.errors import ArgumentError
+from pointnav_core.utils.compiled import check_method, choose
 
 __all__ = ["DROPOUT", "NOISE", "episode_key", "mix", "normals", "scan_noise", "seed_entropy", "uniforms"]
 
@@ -162,7 +162,7 @@ def scan_noise(
         Standard deviation (m); 0 gives None.
     dropout : float
         Probability of a lost reading; 0 gives None.
-    method : {"auto", "numpy", "numba"}
+    method : {"auto", "array", "numba"}
         The hashing of the rays' words: numpy's whole-array passes, or one compiled loop
         (the ``fast`` extra; ``"auto"`` takes it when numba is installed). The same bits.
 
@@ -172,8 +172,7 @@ def scan_noise(
         ``noise_std * ndtri(u)`` on channel :data:`NOISE`, and ``u < dropout`` on
         channel :data:`DROPOUT`, each of the keys' shape with ``n_rays`` last.
     """
-    if method not in ("auto", "numpy", "numba"):
-        raise ArgumentError(f"method must be 'auto', 'numpy' or 'numba', got {method!r}")
+    check_method(method)
     channels = [c for c, on in ((NOISE, noise_std > 0.0), (DROPOUT, dropout > 0.0)) if on]
     if not channels:
         return None, None
@@ -188,9 +187,7 @@ def scan_noise(
 def _ray_uniforms(h: NDArray[np.uint64], n_rays: int, channels: list[int], method: str) -> NDArray[np.float64]:
     """:func:`uniforms` of keys ``mix(h, ray)`` for every ray and channel: shape
     ``(len(channels),) + h.shape[:-1] + (n_rays,)`` (``h`` has a trailing axis of 1)."""
-    kernel = _kernel() if method != "numpy" else None
-    if method == "numba" and kernel is None:
-        raise ArgumentError('method="numba" needs numba: pip install "pointnav-core[fast]"')
+    kernel = choose(method, "pointnav_core.sensors._noise_kernel", "ray_uniforms")
     if kernel is not None:
         flat = np.ascontiguousarray(h, dtype=np.uint64).reshape(-1)
         out = np.empty((len(channels), flat.shape[0], n_rays))
@@ -203,15 +200,3 @@ def _ray_uniforms(h: NDArray[np.uint64], n_rays: int, channels: list[int], metho
         words = [_finalise(inner ^ np.uint64(c)) >> _S11 for c in channels]
     return (np.stack(words).astype(np.float64) + 0.5) * (1.0 / 9007199254740992.0)
 
-
-_KERNEL: list[Any] = []  # the compiled loop, or None without numba, once looked up
-
-
-def _kernel() -> Any:
-    """The compiled loop of :func:`_ray_uniforms`, or None without numba (looked up once)."""
-    if not _KERNEL:
-        from pointnav_core.utils.compiled import kernel_module
-
-        module = kernel_module("pointnav_core.sensors._noise_kernel")
-        _KERNEL.append(None if module is None else module.ray_uniforms)
-    return _KERNEL[0]

@@ -43,10 +43,11 @@ import shapely
 import shapely.geometry
 from numpy.typing import ArrayLike, NDArray
 
-from pointnav_core.errors import ArgumentError, ArgumentTypeError
+from pointnav_core.errors import ArgumentTypeError
 from pointnav_core.floor.maps import OBSTACLE, TraversableMap
 from pointnav_core.sensors import raycast_jit
 from pointnav_core.sensors.clearance import quadrant_clearance
+from pointnav_core.utils.compiled import check_method, choose
 
 __all__ = ["TOUCH_EPS", "ScanGeometry", "cast_pose_compiled", "cast_rays", "inside_polygon", "polygon_hits"]
 
@@ -56,7 +57,6 @@ TOUCH_EPS = 1e-9
 # Stand-in for a zero direction component (its crossings are then far beyond any range).
 _TINY = 1e-300
 
-_METHODS = ("auto", "numpy", "numba")
 _NO_DISCS = np.zeros((0, 3))
 
 
@@ -218,8 +218,8 @@ def cast_rays(
         Other robots as discs ``(x, y, radius)`` in metres, seen by every ray.
     own_disc : array_like of int, shape (N,), optional
         Index into ``discs`` of each origin's own disc, which it does not see (-1: none).
-    method : {"auto", "numpy", "numba"}
-        ``"numpy"``: the array path of this module; ``"numba"``: the compiled kernel of
+    method : {"auto", "array", "numba"}
+        ``"array"``: the array path of this module (numpy); ``"numba"``: the compiled kernel of
         :mod:`~pointnav_core.sensors.raycast_jit` (the ``fast`` extra), the same ranges at a
         fraction of the cost; ``"auto"`` (default): numba when installed, else numpy.
 
@@ -238,8 +238,7 @@ def cast_rays(
     >>> cast_rays(geo, [[0.5, 0.5]], [0.0], [0.0], 1.0).tolist()  # capped
     [[1.0]]
     """
-    if method not in _METHODS:
-        raise ArgumentError(f"method must be one of {', '.join(map(repr, _METHODS))}, got {method!r}")
+    check_method(method)
     p = np.asarray(origins, dtype=np.float64).reshape(-1, 2)
     yaw = np.asarray(yaws, dtype=np.float64).reshape(-1)
     ang = np.asarray(angles, dtype=np.float64).reshape(-1)
@@ -247,10 +246,8 @@ def cast_rays(
     # evaluates the same products, so both give the same bits).
     cy, sy = np.cos(yaw), np.sin(yaw)
     ca, sa = np.cos(ang), np.sin(ang)
-    if method != "numpy" and raycast_jit.available():
+    if choose(method, *raycast_jit.KERNEL) is not None:
         return _cast_compiled(geometry, p, (cy, sy, ca, sa), float(max_range), discs, own_disc)
-    if method == "numba":
-        raise ArgumentError('method="numba" needs numba: pip install "pointnav-core[fast]"')
     c = cy[:, None] * ca[None, :] - sy[:, None] * sa[None, :]
     s = sy[:, None] * ca[None, :] + cy[:, None] * sa[None, :]
     best = np.minimum(

@@ -15,12 +15,14 @@ arithmetic one ray at a time in a numba kernel, stopping where the ray stops:
 
 Every quantity is the same expression as in the numpy path, evaluated in the same order on
 the same cosines and sines (computed by numpy in :func:`~pointnav_core.sensors.raycast.cast_rays`,
-and turned into ray directions by the same products), so both paths give the same ranges; ``property_tests/test_scan_props.py`` checks that they are equal.
+and turned into ray directions by the same products), so both paths give the same ranges;
+``property_tests/test_compiled_paths.py`` checks that they are equal (``tests/pairs_scan.py``).
 
-numba is optional (the ``fast`` extra). :func:`kernel` imports it lazily, on the first
-scan (the kernel itself is :mod:`~pointnav_core.sensors._raycast_kernel`), and returns None
-when it is missing; ``cast_rays`` then takes the numpy path. The kernel is compiled once and
-cached on disk (``cache=True``), so later processes load it.
+numba is optional (the ``fast`` extra). The kernel
+(:mod:`~pointnav_core.sensors._raycast_kernel`) is loaded by
+:func:`pointnav_core.utils.compiled.kernel` on the first scan; without numba (or inside
+``numpy_paths()``) :func:`available` is false and ``cast_rays`` takes the array path. The
+kernel is compiled once and cached on disk (``cache=True``), so later processes load it.
 """
 
 from __future__ import annotations
@@ -30,27 +32,17 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-__all__ = ["available", "cast_rays_compiled", "kernel"]
+from pointnav_core.utils.compiled import kernel
 
-_KERNEL: Any = None
-_TRIED = False
+__all__ = ["KERNEL", "available", "cast_rays_compiled"]
 
-
-def kernel() -> Any:
-    """The compiled ray-casting kernel, or None when numba is not installed."""
-    global _KERNEL, _TRIED
-    if not _TRIED:
-        _TRIED = True
-        from pointnav_core.utils.compiled import kernel_module
-
-        module = kernel_module("pointnav_core.sensors._raycast_kernel")
-        _KERNEL = None if module is None else module.cast
-    return _KERNEL
+#: The kernel module and function, as :func:`pointnav_core.utils.compiled.kernel` takes them.
+KERNEL = ("pointnav_core.sensors._raycast_kernel", "cast")
 
 
 def available() -> bool:
-    """Whether the compiled path can run (numba importable)."""
-    return kernel() is not None
+    """Whether the compiled path can run (numba importable, outside ``numpy_paths()``)."""
+    return kernel(*KERNEL) is not None
 
 
 def cast_rays_compiled(
@@ -73,7 +65,7 @@ def cast_rays_compiled(
     a cell a polygon touches, and the caller asks shapely about those.
     """
     out = np.empty((len(cy), len(ca)), dtype=np.float64)
-    near = kernel()(
+    near = kernel(*KERNEL)(
         p, cy, sy, ca, sa, geometry.jit_params(max_range), geometry.lookup, geometry.clearance,
         geometry.near_polygon, geometry.edge_table, discs, own, out,
     )

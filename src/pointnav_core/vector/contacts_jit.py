@@ -7,10 +7,11 @@ for every robot of the batch as whole arrays: about a hundred array calls a step
 resolve nothing. On the CPU this module does the same arithmetic one world, robot and wall
 at a time in a numba kernel (:mod:`~pointnav_core.vector._contact_kernel`), stopping where
 each world stops, with the same expressions in the same order, so both paths give the same
-positions and contact flags; ``property_tests/test_vector_contacts_props.py`` checks that
-they are equal.
+positions and contact flags; ``property_tests/test_compiled_paths.py`` checks that they
+are equal (``tests/pairs_vector.py``).
 
-numba is optional (the ``fast`` extra): without it, or for arrays on a GPU, the engines
+numba is optional (the ``fast`` extra): without it (or inside
+:func:`~pointnav_core.utils.compiled.numpy_paths`), or for arrays on a GPU, the engines
 take the array path. torch tensors on the CPU are read and written through numpy views of
 their memory.
 """
@@ -21,10 +22,13 @@ from typing import Any
 
 import numpy as np
 
-from pointnav_core.utils import compiled as _compiled
+from pointnav_core.utils.compiled import kernel
 from pointnav_core.vector.floors import FloorTables
 
-__all__ = ["advance_compiled", "advance_one", "available", "prepare"]
+__all__ = ["KERNEL", "advance_compiled", "advance_one", "available", "prepare"]
+
+#: The kernel module and function, as :func:`pointnav_core.utils.compiled.kernel` takes them.
+KERNEL = ("pointnav_core.vector._contact_kernel", "advance_worlds")
 
 # The walls a robot may meet are within this (m) of its chord, beyond its radius
 # (4 x the backend's _ACTIVE, as vector.contacts.window is called).
@@ -34,7 +38,7 @@ _WALL_MARGIN = 4.0 * 2.0e-9
 def available(floors: FloorTables) -> bool:
     """Whether the compiled path can run for these floors' arrays (CPU, numba importable)."""
     a = floors.arrays
-    return (not a.is_torch or a.device == "cpu") and _kernel() is not None
+    return (not a.is_torch or a.device == "cpu") and kernel(*KERNEL) is not None
 
 
 def prepare(floors: FloorTables) -> None:
@@ -45,10 +49,6 @@ def prepare(floors: FloorTables) -> None:
         a = floors.arrays
         empty = a.zeros((0, 1))
         advance_compiled(floors, a.zeros((0, 1), a.i64), empty, empty, empty, empty, a.zeros((0, 1), a.boolean), 0.0, 0.0)
-
-
-def _kernel() -> Any:
-    return _compiled.kernel("pointnav_core.vector._contact_kernel", "advance_worlds")
 
 
 def advance_compiled(
@@ -79,7 +79,7 @@ def advance_compiled(
     contact : bool numpy array (W, R)
         Whether each slow robot was blocked by a wall or another robot, or blocked one.
     """
-    advance_worlds = _kernel()
+    advance_worlds = kernel(*KERNEL)
     a = floors.arrays
     view = (lambda v: v.numpy()) if a.is_torch else (lambda v: v)
     x, y = np.ascontiguousarray(view(x), np.float64), np.ascontiguousarray(view(y), np.float64)

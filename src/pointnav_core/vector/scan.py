@@ -13,7 +13,7 @@ VOID is not seen; touching counts (within :data:`~pointnav_core.sensors.TOUCH_EP
 origin touching a blocked cell reads 0. Absent robots neither see nor are seen; their rows
 read ``max_range``.
 
-Two paths give the same ranges (``property_tests/test_vector_scan_props.py``):
+Two paths give the same ranges (``property_tests/test_compiled_paths.py``, ``tests/pairs_vector.py``):
 
 - the array path (numpy, or torch on any device, through
   :class:`~pointnav_core.vector.xp.Arrays`): the single env's crossing formulas
@@ -46,14 +46,18 @@ from pointnav_core.sensors.raycast import (
     polygon_hits,
 )
 from pointnav_core.sensors.scan import RangeScan
+from pointnav_core.utils.compiled import check_method, choose, kernel
 from pointnav_core.vector.xp import Arrays
 
-__all__ = ["BLOCK", "ScanTables", "VectorScan", "cast_batch", "compiled_available", "directions", "requested_scan"]
+__all__ = [
+    "BLOCK", "KERNEL", "ScanTables", "VectorScan", "cast_batch", "compiled_available", "directions", "requested_scan",
+]
 
 #: Crossings per family taken together by one iteration of the array path.
 BLOCK = 8
 _TINY = 1e-300  # raycast._TINY: a zero direction component puts its lines at "infinity"
-_METHODS = ("auto", "array", "numba")
+#: The compiled path's kernel module and function (:func:`pointnav_core.utils.compiled.kernel`).
+KERNEL = ("pointnav_core.vector._scan_kernel", "cast_worlds")
 
 
 class ScanTables:
@@ -122,10 +126,8 @@ def requested_scan(sensors: Any) -> RangeScan | None:
 
 
 def compiled_available() -> bool:
-    """Whether the compiled path can run (numba importable)."""
-    from pointnav_core.sensors import raycast_jit
-
-    return raycast_jit.available()
+    """Whether the compiled path can run (numba importable, outside ``numpy_paths()``)."""
+    return kernel(*KERNEL) is not None
 
 
 def directions(arrays: Arrays, yaw: Any, angles: Any) -> tuple[Any, Any]:
@@ -168,6 +170,7 @@ def cast_batch(
     max_range : float
         Longest reading (m).
     method : {"auto", "array", "numba"}
+        ``"array"``: the array path (numpy or torch); ``"numba"``: the compiled path;
         ``"auto"``: numba for arrays on the CPU (numpy, or torch ``"cpu"``) when installed,
         else the array path.
 
@@ -192,16 +195,14 @@ def cast_batch(
     >>> d.round(9).tolist()  # the wall and the other robot; the other robot and the map's edge
     [[[0.25, 0.08], [0.08, 0.15]]]
     """
-    if method not in _METHODS:
-        raise ArgumentError(f"method must be one of {', '.join(map(repr, _METHODS))}, got {method!r}")
+    check_method(method)
     a = tables.arrays
     on_cpu = not a.is_torch or a.device == "cpu"
-    if method == "numba" and not (on_cpu and compiled_available()):
-        raise ArgumentError('method="numba" needs arrays on the CPU and numba: pip install "pointnav-core[fast]"')
+    cast_worlds = choose(method, *KERNEL, usable=on_cpu, needs="arrays on the CPU and numba")
     angles = a.asarray(angles)
     radius = a.xp.zeros_like(x) + radius  # (W, R)
-    if method != "array" and on_cpu and compiled_available():
-        return _cast_compiled(tables, scene, x, y, yaw, angles, present, radius, float(max_range))
+    if cast_worlds is not None:
+        return _cast_compiled(cast_worlds, tables, scene, x, y, yaw, angles, present, radius, float(max_range))
     c, s = directions(a, yaw, angles)
     best = _grid_ranges(tables, scene, x, y, c, s, float(max_range))
     best = a.xp.minimum(best, _disc_ranges(a, x, y, c, s, present, radius))
@@ -210,12 +211,11 @@ def cast_batch(
 
 
 def _cast_compiled(
-    tables: ScanTables, scene: Any, x: Any, y: Any, yaw: Any, angles: Any, present: Any, radius: Any,
-    max_range: float,
+    cast_worlds: Any, tables: ScanTables, scene: Any, x: Any, y: Any, yaw: Any, angles: Any, present: Any,
+    radius: Any, max_range: float,
 ) -> Any:
-    """:func:`cast_batch`'s compiled path, on numpy arrays or torch CPU tensors."""
-    from pointnav_core.vector._scan_kernel import cast_worlds
-
+    """:func:`cast_batch`'s compiled path (the kernel ``cast_worlds``), on numpy arrays or
+    torch CPU tensors."""
     a = tables.arrays
     # torch CPU tensors are read through numpy views of their memory (no copies).
     view = (lambda v: v.numpy()) if a.is_torch else (lambda v: v)
@@ -394,6 +394,7 @@ class VectorScan:
     def __init__(self, term: RangeScan, tables: ScanTables, method: str = "auto") -> None:
         if not isinstance(term, RangeScan):
             raise ArgumentError(f"term must be a RangeScan, got {term!r}")
+        check_method(method)  # refused now, not at the first reading
         self.term = term
         self.tables = tables
         self.method = method

@@ -1,31 +1,165 @@
-"""The batched contacts' compiled path equals their array path.
+"""Plain and compiled paths of the batched engine: the checks of
+``property_tests/test_compiled_paths.py`` for ``vector._scan_kernel`` and
+``vector._contact_kernel``.
 
-For random grid scenes (clutter, walls), robots crowded around a point and random chords
-up to half a cell long (the longest the batched engines make: ``TRAVEL_CELLS``), the robots
-within reach of each other always resolved together (as the engines' slow robots), driven
-for several rounds from where the last round left them (so that they rest against walls
-and each other), :func:`~pointnav_core.vector.contacts_jit.advance_compiled` gives the same end
-positions (bit for bit on numpy, within 1e-12 m on torch) and contact flags as the array
-path, with one radius for all robots or each robot its own: with several robots per world
+Each check takes ``plain_paths``, the context its plain side runs in (``numpy_paths()``); the
+contact checks also take ``device`` (numpy, and torch on the CPU).
+
+The batched range scan: for random grid scenes (obstacle cells, VOID, the map's edge) and
+random poses of up to four robots per world, some absent, at robot radius / cell size ratios
+from 0.3 to 5 (one radius for all robots, or each robot its own), the compiled path (numba)
+and the array path (numpy, and torch on the CPU) give the same ranges, and every range lies
+within 1e-4 m of an independent reference (``scan_reference``: shapely rays against the
+blocked squares, a frame round the map and the other robots' discs), so no ray passes a
+blocked cell; one case is a 2000 x 2000 floor.
+
+The batched contacts: for random grid scenes (clutter, walls), robots crowded around a point
+and random chords up to half a cell long (the longest the batched engines make:
+``TRAVEL_CELLS``), the robots within reach of each other always resolved together (as the
+engines' slow robots), driven for several rounds from where the last round left them (so that
+they rest against walls and each other),
+:func:`~pointnav_core.vector.contacts_jit.advance_compiled` gives the same end positions (bit
+for bit on numpy, within 1e-12 m on torch) and contact flags as the array path, with one
+radius for all robots or each robot its own: with several robots per world
 :func:`~pointnav_core.vector.robots.advance_robots` (which the kinematic backend's resolver
-checks in ``tests/test_vector_robots.py``), with one :func:`~pointnav_core.vector.contacts.advance`.
+checks in ``tests/test_vector_robots.py``), with one :func:`~pointnav_core.vector.contacts.advance`;
+and whole engines step alike on both paths.
 """
 
 from __future__ import annotations
 
+import contextlib
 import importlib.util
+from collections.abc import Callable
+from contextlib import AbstractContextManager
 
 import numpy as np
-import pytest
-from hypothesis import given, settings
+from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
+from scan_reference import assert_within, blocked_shapes, reference_ranges
 
-from pointnav_core.floor.maps import OBSTACLE
+from pointnav_core.floor.maps import OBSTACLE, VOID
 from pointnav_core.scenes import Scene
+from pointnav_core.sensors import scan_angles
+from pointnav_core.vector.scan import ScanTables, cast_batch, compiled_available
+from pointnav_core.vector.xp import make_arrays
 
-pytest.importorskip("numba")
+HAS_TORCH = importlib.util.find_spec("torch") is not None
+DEVICES = ["numpy"] + (["cpu"] if HAS_TORCH else [])
+ATOL = 1e-4
 
-DEVICES = ["numpy"] + (["cpu"] if importlib.util.find_spec("torch") else [])
+Plain = Callable[[], AbstractContextManager[None]]
+
+
+def random_grid(rng: np.random.Generator, rows: int, cols: int, density: float) -> np.ndarray:
+    """A grid of OBSTACLE cells of ``density`` and 5 % VOID cells."""
+    grid = np.zeros((rows, cols), np.uint8)
+    grid[rng.random((rows, cols)) < density] = OBSTACLE
+    grid[rng.random((rows, cols)) < 0.05] = VOID
+    return grid
+
+
+def _paths(plain_paths, scenes, tables_np, scene, x, y, yaw, present, radius, angles, max_range):
+    """Ranges by every available path: array (numpy), numba, torch array, torch numba."""
+    with plain_paths():
+        out = {"array": cast_batch(tables_np, scene, x, y, yaw, present, radius, angles, max_range, "array")}
+    if compiled_available():
+        out["numba"] = cast_batch(tables_np, scene, x, y, yaw, present, radius, angles, max_range, "numba")
+    if HAS_TORCH:
+        import torch
+
+        tables_t = ScanTables(scenes, 0, make_arrays("cpu"))
+        rad = radius if isinstance(radius, float) else torch.as_tensor(radius)
+        args = (torch.as_tensor(scene), *(torch.as_tensor(v) for v in (x, y, yaw, present)), rad, angles, max_range)
+        with plain_paths():
+            out["torch"] = cast_batch(tables_t, *args, "array").numpy()
+        if compiled_available():  # torch on the CPU goes through the kernel, on views
+            out["torch numba"] = cast_batch(tables_t, *args, "numba").numpy()
+    return out
+
+
+def _check_scenes(plain_paths, scenes, x, y, yaw, present, scene, radius, angles, max_range):
+    tables = ScanTables(scenes, 0, make_arrays("numpy"))
+    results = _paths(plain_paths, scenes, tables, scene, x, y, yaw, present, radius, angles, max_range)
+    ref = results["array"]
+    for name, got in results.items():
+        assert got.shape == x.shape + (len(angles),)
+        # The compiled path decides every crossing on the same numbers: equal to the ulp.
+        np.testing.assert_allclose(got, ref, rtol=0, atol=1e-9, err_msg=f"{name} vs array")
+    shapes = {}
+    w_n, r_n = x.shape
+    for w in range(w_n):
+        k = int(scene[w])
+        if k not in shapes:
+            tmap = scenes[k].floors[0]
+            shapes[k] = blocked_shapes(np.asarray(tmap.codes), float(tmap.resolution), tuple(tmap.origin))
+        for i in range(r_n):
+            if not present[w, i]:
+                assert (ref[w, i] == max_range).all()
+                continue
+            rad = np.broadcast_to(radius, x.shape)  # one radius, or each robot's own
+            discs = [(x[w, m], y[w, m], rad[w, m]) for m in range(r_n) if m != i and present[w, m]]
+            loose, strict = reference_ranges(shapes[k], (x[w, i], y[w, i]), yaw[w, i] + angles, max_range, discs)
+            for got in results.values():
+                assert_within(got[w, i], loose, strict, ATOL)
+
+
+@settings(max_examples=25, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(
+    seed=st.integers(0, 2**31 - 1),
+    n_worlds=st.integers(1, 3),
+    n_robots=st.integers(1, 4),
+    ratio=st.floats(0.3, 5.0),
+    res=st.sampled_from([0.05, 0.1, 0.25]),
+    n_rays=st.integers(1, 24),
+    max_range=st.floats(0.3, 4.0),
+    own_radii=st.booleans(),
+)
+def check_batched_scan(seed, n_worlds, n_robots, ratio, res, n_rays, max_range, own_radii, plain_paths: Plain) -> None:
+    """Random scenes of floors of different cell sizes: every path equal, and against shapely."""
+    rng = np.random.default_rng(seed)
+    scenes = []
+    for cell in (res, float(rng.choice([0.05, 0.1, 0.25]))):  # worlds on floors of different cell sizes
+        rows, cols = rng.integers(4, 30, 2)
+        scenes.append(Scene.from_array(random_grid(rng, rows, cols, rng.uniform(0.0, 0.3)), cell, origin=tuple(rng.uniform(-2, 2, 2))))
+    scene = rng.integers(0, 2, n_worlds)
+    x = np.empty((n_worlds, n_robots))
+    y = np.empty((n_worlds, n_robots))
+    for w in range(n_worlds):
+        tmap = scenes[scene[w]].floors[0]
+        h, wd = np.asarray(tmap.codes).shape
+        res = float(tmap.resolution)
+        # Anywhere on the map, obstacles and VOID included; some on grid lines.
+        x[w] = tmap.origin[0] + rng.uniform(0, wd, n_robots) * res
+        y[w] = tmap.origin[1] + rng.uniform(0, h, n_robots) * res
+        snap = rng.random(n_robots) < 0.2
+        x[w, snap] = tmap.origin[0] + np.round(rng.uniform(0, wd, snap.sum())) * res
+    yaw = rng.uniform(-2 * np.pi, 2 * np.pi, (n_worlds, n_robots))
+    present = rng.random((n_worlds, n_robots)) < 0.8
+    angles = scan_angles(n_rays, rng.uniform(0.5, 2 * np.pi))
+    radius = ratio * float(scenes[0].floors[0].resolution)
+    if own_radii:  # each robot its own radius, down to a fifth of the drawn one
+        radius = radius * rng.uniform(0.2, 1.0, (n_worlds, n_robots))
+    _check_scenes(plain_paths, scenes, x, y, yaw, present, scene, radius, angles, max_range)
+
+
+@settings(max_examples=3, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(seed=st.integers(0, 2**31 - 1), ratio=st.floats(0.3, 5.0))
+def check_batched_scan_large_floor(seed, ratio, plain_paths: Plain) -> None:
+    """A 2000 x 2000 floor of 0.05 m cells, sparse clutter, rays up to 5.6 m."""
+    rng = np.random.default_rng(seed)
+    grid = random_grid(rng, 2000, 2000, 0.002)
+    res = 0.05
+    scene = Scene.from_array(grid, res)
+    n = 3
+    x = rng.uniform(0, 2000 * res, (1, n))
+    y = rng.uniform(0, 2000 * res, (1, n))
+    x[0, 1], y[0, 1] = x[0, 0] + 0.8, y[0, 0] - 0.3  # a neighbour in sight
+    x[0, 2], y[0, 2] = rng.uniform(0, 0.5), rng.uniform(0, 0.5)  # near the map's corner
+    yaw = rng.uniform(-np.pi, np.pi, (1, n))
+    present = np.ones((1, n), bool)
+    _check_scenes(plain_paths, [scene], x, y, yaw, present, np.zeros(1, np.int64), ratio * res, scan_angles(32, 2 * np.pi), 5.6)
+
 
 # The chords the batched engines hand their contacts: their control-rate check lets a robot
 # drive at most half a cell in one step (top speed * dt <= 0.5 * resolution), and a faster
@@ -130,14 +264,14 @@ def _resolved(
     return ((rng.random(x.shape) < 0.85) | near.any(-1)) & on_map
 
 
-@pytest.mark.parametrize("device", DEVICES)
 @settings(max_examples=25, deadline=None)
 @given(scene=cluttered_scenes(), seed=st.integers(0, 2**31 - 1), n_robots=st.integers(2, 5),
        radius=st.sampled_from([0.0, 0.05, 0.12, 0.18]), cells=st.sampled_from(TRAVEL_CELLS),
        own_radii=st.booleans())
-def test_compiled_contacts_equal_the_multi_robot_array_path(
-    device: str, scene: Scene, seed: int, n_robots: int, radius: float, cells: float, own_radii: bool
+def check_contacts_multi_robot(
+    device: str, scene: Scene, seed: int, n_robots: int, radius: float, cells: float, own_radii: bool, plain_paths: Plain
 ) -> None:
+    """Several robots a world: ``advance_compiled`` against ``advance_robots``."""
     from pointnav_core.vector.contacts_jit import advance_compiled
     from pointnav_core.vector.floors import FloorTables
     from pointnav_core.vector.robots import advance_robots, robot_walls
@@ -157,7 +291,8 @@ def test_compiled_contacts_equal_the_multi_robot_array_path(
         slow = _resolved(rng, x, y, mx, my, radii, on_map)
         args = [a.asarray(v) for v in (x, y, mx, my)]
         walls = robot_walls(floors, scene_ids, *args, rad, travel)
-        want = [a.numpy(v) for v in advance_robots(a, *args, rad, present=a.asarray(slow, a.boolean), walls=walls)]
+        with plain_paths():
+            want = [a.numpy(v) for v in advance_robots(a, *args, rad, present=a.asarray(slow, a.boolean), walls=walls)]
         got = advance_compiled(floors, scene_ids, *args, a.asarray(slow, a.boolean), rad, travel)
         _assert_same(device, got[0][slow], want[0][slow])
         _assert_same(device, got[1][slow], want[1][slow])
@@ -168,14 +303,14 @@ def test_compiled_contacts_equal_the_multi_robot_array_path(
         x, y = want[0], want[1]
 
 
-@pytest.mark.parametrize("device", DEVICES)
 @settings(max_examples=25, deadline=None)
 @given(scene=cluttered_scenes(), seed=st.integers(0, 2**31 - 1),
        radius=st.sampled_from([0.0, 0.05, 0.12, 0.18]), cells=st.sampled_from(TRAVEL_CELLS),
        own_radii=st.booleans())
-def test_compiled_contacts_equal_the_one_robot_array_path(
-    device: str, scene: Scene, seed: int, radius: float, cells: float, own_radii: bool
+def check_contacts_one_robot(
+    device: str, scene: Scene, seed: int, radius: float, cells: float, own_radii: bool, plain_paths: Plain
 ) -> None:
+    """One robot a world: ``advance_compiled`` against ``vector.contacts.advance``."""
     from pointnav_core.vector.contacts import advance
     from pointnav_core.vector.contacts_jit import advance_compiled
     from pointnav_core.vector.floors import FloorTables
@@ -193,7 +328,8 @@ def test_compiled_contacts_equal_the_one_robot_array_path(
     for _ in range(6):
         mx, my = _chords(rng, (worlds,), travel)
         args = [a.asarray(v) for v in (x, y, mx, my)]
-        want = [a.numpy(v) for v in advance(floors, scene_ids, *args, rad, limit)]
+        with plain_paths():
+            want = [a.numpy(v) for v in advance(floors, scene_ids, *args, rad, limit)]
         got = advance_compiled(floors, scene_ids[:, None], *(v[:, None] for v in args),
                                a.asarray(np.ones((worlds, 1), bool), a.boolean),
                                rad[:, None] if own_radii else rad, limit)
@@ -203,22 +339,18 @@ def test_compiled_contacts_equal_the_one_robot_array_path(
         x, y = want[0], want[1]
 
 
-@pytest.mark.parametrize("device", DEVICES)
 @settings(max_examples=10, deadline=None)
 @given(scene=cluttered_scenes(patch=12), seed=st.integers(0, 2**31 - 1), n_robots=st.integers(1, 3),
        drive=st.sampled_from(["holonomic", "differential"]))
-def test_engines_step_alike_on_the_compiled_and_array_contact_paths(
-    device: str, scene: Scene, seed: int, n_robots: int, drive: str
-) -> None:
+def check_engines_step_alike(device: str, scene: Scene, seed: int, n_robots: int, drive: str, plain_paths: Plain) -> None:
     """Whole engines, sub-steps included (a holonomic robot's diagonal step takes two), give
     the same poses, contacts and rewards with the compiled contacts as with the array path
-    (the path a GPU takes; on torch it runs on the CPU here)."""
-    from unittest import mock
-
+    (the path a GPU takes; on torch it runs on the CPU here). The array run takes every
+    plain path (``plain_paths``), the scan's too, which gives the compiled scan's ranges."""
     from fleet_reference import fleet_episodes
     from vector_reference import random_actions, random_episodes
 
-    from pointnav_core.vector import VectorPointNavEnv, contacts_jit
+    from pointnav_core.vector import VectorPointNavEnv
 
     rng = np.random.default_rng(seed)
     worlds, steps = 6, 40
@@ -232,7 +364,7 @@ def test_engines_step_alike_on_the_compiled_and_array_contact_paths(
               "task": {"goal_tolerance": 0.1, "termination_config": {"max_steps": 25, "max_collisions": 30}}}
     runs = []
     for compiled in (True, False):
-        with mock.patch.object(contacts_jit, "available", lambda floors, on=compiled: on):
+        with contextlib.nullcontext() if compiled else plain_paths():
             env = VectorPointNavEnv(worlds, **kwargs)
             to_np = env.arrays.numpy
             out = [[to_np(env.reset(options={"episodes": episodes})[0])]]

@@ -1,0 +1,202 @@
+"""Plain and compiled paths of the floor's collision tests and the tangent graph's sight
+bounds: the checks of ``property_tests/test_compiled_paths.py`` for
+``floor._collision_kernel`` and ``geodesic._sight_kernel``.
+
+Each check takes ``plain_paths``, the context its plain side runs in (``numpy_paths()``).
+
+- :meth:`FloorCollision.segments_clear` (and the one-segment ``segment_clear``) answers the
+  same with its numba kernels as with its numpy arrays, for random grids (random blocked
+  cells, outside blocked or not), radii (0 included) and segments of every kind (points,
+  axis-aligned, on grid lines, crossing the map's edge, far off it). The numpy path itself is
+  checked against shapely in ``property_tests/test_geometry_agreement.py`` and
+  ``tests/test_collision.py``.
+- On obstacle polygons (boxes, rotated thin walls, triangles, polygons with holes,
+  multipolygons) the compiled polygon test equals shapely's ``dwithin`` (the path without
+  numba), except where shapely's own distance lies within 1e-9 m of the reach, where the two
+  are equally right.
+- :func:`pointnav_core.geodesic.sight.node_sights` gives the same bounds, bit for bit, with
+  numba and as plain Python, and ``edges._misses_full`` (the cheap rejection of candidate
+  tangent segments) the same answers with its kernel and with its numpy samples.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from contextlib import AbstractContextManager
+
+import numpy as np
+import shapely
+from hypothesis import given, settings
+from hypothesis import strategies as st
+from shapely.affinity import rotate
+from shapely.geometry import MultiPolygon, Polygon, box
+
+from pointnav_core.floor.collision import TOUCH_TOL, FloorCollision
+from pointnav_core.geodesic import edges, sight
+from pointnav_core.geodesic.planner import Planner
+from pointnav_core.utils.compiled import kernel
+
+Plain = Callable[[], AbstractContextManager[None]]
+
+
+@settings(max_examples=80, deadline=None)
+@given(
+    seed=st.integers(0, 2**31 - 1),
+    rows=st.integers(1, 40),
+    cols=st.integers(1, 40),
+    density=st.floats(0.0, 0.5),
+    radius=st.one_of(st.just(0.0), st.floats(0.0, 0.6)),
+    resolution=st.sampled_from([0.05, 0.1, 0.5]),
+    outside_blocked=st.booleans(),
+    n=st.integers(1, 60),
+)
+def check_cell_test(
+    seed: int, rows: int, cols: int, density: float, radius: float, resolution: float, outside_blocked: bool, n: int,
+    plain_paths: Plain,
+) -> None:
+    """:meth:`FloorCollision.segments_clear` and ``segment_clear`` (the cell kernels)."""
+    rng = np.random.default_rng(seed)
+    origin = (float(rng.uniform(-2, 2)), float(rng.uniform(-2, 2)))
+    geo = FloorCollision(rng.random((rows, cols)) < density, resolution, origin, outside_blocked=outside_blocked)
+    size = np.array([cols, rows]) * resolution
+    a = origin + rng.uniform(-0.3, 1.3, (n, 2)) * size
+    b = a + rng.normal(0.0, 0.3, (n, 2)) * size
+    kind = rng.integers(0, 5, n)
+    b[kind == 0] = a[kind == 0]  # points
+    b[kind == 1, 1] = a[kind == 1, 1]  # horizontal
+    b[kind == 2, 0] = a[kind == 2, 0]  # vertical
+    on_lines = kind == 3  # ends on grid lines and vertices
+    a[on_lines] = origin + np.round((a[on_lines] - origin) / resolution) * resolution
+    b[on_lines] = origin + np.round((b[on_lines] - origin) / resolution) * resolution
+    a[kind == 4] += 50.0 * size  # far off the map
+    got = geo.segments_clear(a, b, radius)
+    with plain_paths():
+        assert kernel("pointnav_core.floor._collision_kernel", "cells_hit") is None
+        want = geo.segments_clear(a, b, radius)
+    np.testing.assert_array_equal(got, want)
+    assert kernel("pointnav_core.floor._collision_kernel", "cells_hit") is not None
+    # The one-segment call (planners' and worlds' point tests), compiled and not.
+    pairs = list(zip(a.tolist(), b.tolist()))
+    one = np.array([geo.segment_clear(*p, *q, radius) for p, q in pairs])
+    with plain_paths():
+        plain = np.array([geo.segment_clear(*p, *q, radius) for p, q in pairs])
+    np.testing.assert_array_equal(one, want)
+    np.testing.assert_array_equal(plain, want)
+
+
+@st.composite
+def polygons(draw: st.DrawFn):
+    kind = draw(st.sampled_from(["box", "wall", "triangle", "holed", "multi"]))
+    x, y = draw(st.floats(0.5, 4.5)), draw(st.floats(0.5, 4.5))
+    if kind == "box":
+        return box(x, y, x + draw(st.floats(0.05, 1.5)), y + draw(st.floats(0.05, 1.5)))
+    if kind == "wall":
+        return rotate(box(x, y, x + draw(st.floats(0.5, 3.0)), y + draw(st.floats(0.005, 0.08))), draw(st.floats(0, 180)))
+    if kind == "triangle":
+        pts = [(x, y)] + [(x + draw(st.floats(-1, 1)), y + draw(st.floats(-1, 1))) for _ in range(2)]
+        poly = Polygon(pts)
+        return poly if poly.is_valid and poly.area > 1e-4 else box(x, y, x + 0.3, y + 0.3)
+    if kind == "holed":
+        outer = box(x, y, x + 1.5, y + 1.5)
+        return outer.difference(box(x + 0.4, y + 0.4, x + 1.1, y + 1.1))
+    return MultiPolygon([box(x, y, x + 0.3, y + 0.3), box(x + 0.6, y, x + 0.9, y + 0.5)])
+
+
+@settings(max_examples=80, deadline=None)
+@given(polys=st.lists(polygons(), min_size=1, max_size=6), seed=st.integers(0, 2**31 - 1), radius=st.floats(0.0, 0.6))
+def check_polygon_test(polys, seed, radius, plain_paths: Plain) -> None:
+    """:meth:`FloorCollision.segments_clear` on obstacle polygons (the polygon kernel)."""
+    rng = np.random.default_rng(seed)
+    geo = FloorCollision(np.zeros((60, 60), bool), 0.1, (0.0, 0.0), polygons=polys)
+    a = rng.uniform(0.0, 6.0, (200, 2))
+    b = a + rng.normal(0.0, 1.0, (200, 2)) * rng.choice([0.0, 0.1, 1.0, 3.0], (200, 1))
+    assert kernel("pointnav_core.floor._collision_kernel", "polygons_hit") is not None
+    got = geo.segments_clear(a, b, radius)
+    with plain_paths():
+        want = geo.segments_clear(a, b, radius)
+    reach = max(radius - 2 * TOUCH_TOL, TOUCH_TOL / 2)
+    lines = np.array([shapely.LineString([p, q]) if (p != q).any() else shapely.Point(p) for p, q in zip(a, b)])
+    dist = shapely.distance(shapely.union_all(polys), lines)
+    sure = np.abs(dist - reach) > 1e-9
+    np.testing.assert_array_equal(got[sure], want[sure])
+    # The one-segment call (planners' and worlds' point tests) answers as the array call.
+    one = np.array([geo.segment_clear(*p, *q, radius) for p, q in zip(a.tolist(), b.tolist())])
+    np.testing.assert_array_equal(one, got)
+
+
+def floor_collision(seed: int, rows: int, cols: int, density: float, resolution: float, outside: bool) -> FloorCollision:
+    """A random floor: blocked cells of ``density``, a random origin, open outside or not."""
+    rng = np.random.default_rng(seed)
+    blocked = rng.random((rows, cols)) < density
+    origin = (float(rng.uniform(-3, 3)), float(rng.uniform(-3, 3)))
+    return FloorCollision(blocked, resolution, origin, outside_blocked=outside)
+
+
+@settings(max_examples=20, deadline=None)  # the plain path is Python: small floors
+@given(
+    seed=st.integers(0, 2**31 - 1),
+    rows=st.integers(2, 14),
+    cols=st.integers(2, 14),
+    density=st.floats(0.0, 0.4),
+    radius=st.floats(1e-6, 0.5),
+    resolution=st.sampled_from([0.05, 0.1, 0.25, 0.5]),
+    outside=st.booleans(),
+)
+def check_sights(seed, rows, cols, density, radius, resolution, outside, plain_paths: Plain) -> None:
+    """:func:`~pointnav_core.geodesic.sight.node_sights` (the sight-ray kernel), bit for bit."""
+    geo = floor_collision(seed, rows, cols, density, resolution, outside)
+    planner = Planner(geo, radius)
+    assert kernel("pointnav_core.geodesic._sight_kernel", "sight_rays") is not None
+    got, got_profile = sight.node_sights(geo, planner.radius, planner.cx, planner.cy, planner.phi0, planner.span)
+    with plain_paths():
+        assert kernel("pointnav_core.geodesic._sight_kernel", "sight_rays") is None
+        want, want_profile = sight.node_sights(geo, planner.radius, planner.cx, planner.cy, planner.phi0, planner.span)
+    np.testing.assert_array_equal(got, want)
+    np.testing.assert_array_equal(got_profile, want_profile)
+    assert (got > 0).all() and (got_profile.max(axis=1) >= got * (1 - 1e-6)).all()
+
+
+@settings(max_examples=60, deadline=None)
+@given(
+    seed=st.integers(0, 2**31 - 1),
+    rows=st.integers(2, 40),
+    cols=st.integers(2, 40),
+    density=st.floats(0.0, 0.5),
+    radius=st.floats(0.0, 0.3),
+    resolution=st.sampled_from([0.05, 0.1, 0.25]),
+    outside=st.booleans(),
+    n_segments=st.integers(0, 60),
+    step=st.sampled_from([2.0, 0.5, 0.3, 1.0]),
+)
+def check_fully_blocked_samples(
+    seed: int, rows: int, cols: int, density: float, radius: float, resolution: float, outside: bool,
+    n_segments: int, step: float, plain_paths: Plain,
+) -> None:
+    """``_misses_full`` (the cheap rejection of candidate tangent segments) gives the same
+    answer, segment by segment, with its numba kernel and with its numpy samples, for
+    segments on and off the map, of zero length, along cell edges and across the map."""
+    rng = np.random.default_rng(seed)
+    geo = floor_collision(seed, rows, cols, density, resolution, outside)
+    origin = geo.origin
+    planner = Planner(geo, radius)
+    lo = np.array(origin) - 0.2 * np.array([cols, rows]) * resolution
+    hi = np.array(origin) + 1.2 * np.array([cols, rows]) * resolution
+    a = rng.uniform(lo, hi, (n_segments, 2))
+    b = rng.uniform(lo, hi, (n_segments, 2))
+    b[: n_segments // 5] = a[: n_segments // 5]  # zero length
+    # Along a row of cell edges.
+    k = slice(n_segments // 5, 2 * n_segments // 5)
+    a[k, 1] = b[k, 1] = origin[1] + resolution * rng.integers(0, rows + 1, len(a[k]))
+    assert kernel("pointnav_core.geodesic._sight_kernel", "misses_full") is not None
+    got = edges._misses_full(planner, a, b, step)
+    with plain_paths():
+        want = edges._misses_full(planner, a, b, step)
+    np.testing.assert_array_equal(got, want)
+    assert got.dtype == np.bool_ and got.shape == (n_segments,)
+    # A segment with an end in a fully blocked cell (or off a closed map) is rejected.
+    full = planner.fully_blocked_mask()
+    col = np.floor((a[:, 0] - origin[0]) / resolution).astype(np.int64) + 1
+    row = np.floor((a[:, 1] - origin[1]) / resolution).astype(np.int64) + 1
+    on = (col >= 0) & (col < full.shape[1]) & (row >= 0) & (row < full.shape[0])
+    end_bad = np.where(on, full[np.clip(row, 0, full.shape[0] - 1), np.clip(col, 0, full.shape[1] - 1)], outside)
+    assert not (got & end_bad).any()
