@@ -9,9 +9,7 @@ cells, then a random offset inside the cell where the disc still fits).
 - ``d(s, g) <= d(s, a) + d(a, b) + d(b, g)`` (1e-6 m), every leg exact;
 - the lookup of ``p`` is within ``|p - c| + d(p, c)`` of the exact distance, ``c`` the
   centre of the cell the lookup reads (``geodesic.LOOKUP_BOUND``'s statement in general
-  form); at a usable cell's centre the two are equal;
-- the landmark bounds hold the exact geodesic, and the sampler that uses them draws the
-  same episodes as without them.
+  form); at a usable cell's centre the two are equal.
 """
 
 from __future__ import annotations
@@ -22,8 +20,6 @@ import numpy as np
 from hypothesis import HealthCheck, assume, given, settings
 from hypothesis import strategies as st
 from pairs_geodesic import slit_floors, usable_points
-
-from pointnav_core.scenes import Scene
 
 
 @settings(max_examples=30, deadline=None, suppress_health_check=[HealthCheck.too_slow, HealthCheck.filter_too_much])
@@ -68,54 +64,3 @@ def test_the_lookup_is_within_its_bound_of_the_exact_query(floor, seed) -> None:
             assert math.isinf(lookup)
             continue
         assert abs(lookup - exact) <= math.dist(p, c) + to_c + 1e-9
-
-
-@settings(max_examples=30, deadline=None, suppress_health_check=[HealthCheck.too_slow, HealthCheck.filter_too_much])
-@given(floor=slit_floors(), seed=st.integers(0, 2**31 - 1))
-def test_the_landmark_bounds_hold_the_exact_geodesic(floor, seed) -> None:
-    """``Scene.geodesic_bounds`` (ALT landmarks): ``lower <= d(a, b) <= upper`` for the exact
-    A* geodesic, at cell centres and off them, reachable or not."""
-    scene, radius = floor
-    pts = usable_points(scene, radius, np.random.default_rng(seed), 10)
-    assume(len(pts) > 1)
-    planner = scene.planner(0, radius)
-    for a, b in zip(pts[:-1], pts[1:]):
-        lower, upper = scene.geodesic_bounds(0, a, b, robot=radius)
-        _, exact = planner.shortest_path(a, b)  # one A* search, no goal field and no landmark
-        exact = math.inf if exact is None else exact
-        assert lower <= exact <= upper or (math.isinf(exact) and math.isinf(upper))
-
-
-@settings(max_examples=15, deadline=None, suppress_health_check=[HealthCheck.too_slow, HealthCheck.filter_too_much])
-@given(
-    floor=slit_floors(),
-    seed=st.integers(0, 2**31 - 1),
-    low=st.floats(0.0, 3.0),
-    span=st.floats(0.5, 6.0),
-)
-def test_sampling_draws_the_same_episodes_with_and_without_landmark_bounds(floor, seed, low, span) -> None:
-    """The sampler's landmark rejection is a fast path: with the bounds answering ``(0, inf)``
-    (no rejection before the exact geodesic) the same seed draws the same episodes, or
-    fails with the same error."""
-    import gymnasium as gym
-
-    from pointnav_core.errors import SamplingError
-
-    scene, radius = floor
-    plain = Scene(scene.floors)
-    plain.geodesic_bounds = lambda *args, **kwargs: (0.0, math.inf)  # type: ignore[method-assign]
-    task = {"path_range": (low, low + span)}
-    runs = []
-    for sc in (scene, plain):
-        env = gym.make("pointnav_core/PointNav-v0", scene=sc, task=task, robot={"radius": radius})
-        out = []
-        try:
-            env.reset(seed=seed)
-            for _ in range(5):
-                t = env.unwrapped.task
-                out.append((tuple(t.get_start_pos()[:2].tolist()), tuple(t.goal_xy), t.geodesic_dist))
-                env.reset()
-        except SamplingError as err:
-            out.append(str(err))
-        runs.append(out)
-    assert runs[0] == runs[1]

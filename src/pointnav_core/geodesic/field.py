@@ -128,32 +128,20 @@ class GoalField(ThawOnUnpickle):
     def point_distance(self, xy: ArrayLike) -> float:
         """Exact geodesic distance (m) from world point ``xy`` to the goal (inf if none).
 
-        With numba the query runs compiled (:meth:`point_distances`): the same value as
-        :meth:`_best`'s within rounding (a property test)."""
+        With numba the one-point query runs compiled (``geodesic.roots.compiled_roots``):
+        the same value as :meth:`_best`'s within rounding (a property test)."""
         x, y = (float(v) for v in np.asarray(xy, dtype=np.float64).reshape(-1)[:2])
-        return float(self.point_distances(np.array([x]), np.array([y]))[0])
-
-    @staticmethod
-    def queries_compiled(planner: Planner) -> bool:
-        """Whether exact point queries on ``planner``'s floor run compiled (numba)."""
-        return compiled(planner, "best_links") is not None
-
-    def point_distances(self, x: NDArray[np.float64], y: NDArray[np.float64]) -> NDArray[np.float64]:
-        """Exact geodesic distances (m) from world points ``(x[i], y[i])`` to the goal (inf
-        where none), compiled where numba is installed (:func:`compiled_distances`)."""
         p = self.planner
-        out = np.full(len(x), math.inf)
-        if not self.goal_usable:
-            return out
-        clear = np.array([p.is_clear(a, b) for a, b in zip(x.tolist(), y.tolist())], dtype=bool)
-        if not clear.any():
-            return out
-        x, y = x[clear], y[clear]
-        if not self.queries_compiled(p):
-            out[clear] = [self._best(a, b)[0] for a, b in zip(x.tolist(), y.tolist())]
-        else:
-            out[clear] = compiled_distances([self], x, y)[0]
-        return out
+        if compiled(p, "best_links") is not None:
+            if not self.goal_usable or not p.is_clear(x, y):
+                return math.inf
+            links = p.cell_links(build=False)
+            cell = -1 if links is None else centre_cell(p, x, y)
+            if cell >= 0:  # a cell centre (a sampled start): its links are known
+                one = np.array([cell])
+                return float(table_roots(self, self.arc_tables(), links, one, np.array([x]), np.array([y]))[2][0])
+            return float(compiled_roots(self, self.arc_tables(), np.array([x]), np.array([y]))[2][0])
+        return self._best(x, y)[0]
 
     def path(
         self, xy: ArrayLike, exact: bool = True, max_length: float = math.inf
@@ -325,35 +313,11 @@ _EMPTY_KINDS: weakref.WeakKeyDictionary[Planner, NDArray[np.int8]] = weakref.Wea
 
 def _unsettled(planner: Planner) -> NDArray[np.int8]:
     """A fresh copy of ``planner``'s empty root table kinds: UNSETTLED on usable cells, 0
-    elsewhere (made once per planner: a ``where`` over the grid cost a tenth of a reset)."""
+    elsewhere (made once per planner: a ``where`` over the grid was 6 % of a reset)."""
     empty = _EMPTY_KINDS.get(planner)
     if empty is None:
         empty = _EMPTY_KINDS[planner] = np.where(planner.usable.ravel(), UNSETTLED, 0).astype(np.int8)
     return empty.copy()
-
-
-def compiled_distances(
-    fields: list[GoalField], x: NDArray[np.float64], y: NDArray[np.float64]
-) -> NDArray[np.float64]:
-    """Exact geodesic distances (m), ``(len(fields), len(x))``, from the clear world points
-    ``(x[i], y[i])`` to each field's goal; the fields share one planner, whose queries run
-    compiled (:meth:`GoalField.queries_compiled`). Cell centres (sampled points) read their
-    links from the floor's cell links where those are built; other points find theirs."""
-    out = np.empty((len(fields), len(x)))
-    if not fields:
-        return out
-    p = fields[0].planner
-    links = p.cell_links(build=False)
-    cells = np.array([-1 if links is None else centre_cell(p, a, b) for a, b in zip(x.tolist(), y.tolist())], dtype=np.int64)
-    centred = links is not None and bool((cells >= 0).all())
-    for k, field in enumerate(fields):
-        if not field.goal_usable:
-            out[k] = math.inf
-        elif centred:
-            out[k] = table_roots(field, field.arc_tables(), links, cells, x, y)[2]
-        else:
-            out[k] = compiled_roots(field, field.arc_tables(), x, y)[2]
-    return out
 
 
 def around_disc(x: float, y: float, cx: float, cy: float, r: float, qx: float, qy: float) -> float:

@@ -53,7 +53,6 @@ from pointnav_core.geodesic.cache import edge_arrays, edges_from_arrays
 from pointnav_core.geodesic.cell_links import CellLinks
 from pointnav_core.geodesic.edges import build_edges
 from pointnav_core.geodesic.field import GoalField
-from pointnav_core.geodesic.landmarks import Landmarks
 from pointnav_core.geodesic.links import point_links
 from pointnav_core.geodesic.nodes import corner_arcs
 from pointnav_core.geodesic.point_search import PointSearch
@@ -153,7 +152,6 @@ class Planner(ThawOnUnpickle):
         self._usable: NDArray[np.bool_] | None = None
         self._near: NDArray[np.int32] | None = None
         self._fields: dict[tuple[float, float], GoalField] = {}
-        self._landmarks: Landmarks | None = None
         # The cached fields' bytes, kept as they enter, grow and leave (a sum over the
         # cache on every insert cost a tenth of a reset).
         self._field_bytes = 0
@@ -419,13 +417,6 @@ class Planner(ThawOnUnpickle):
         self._fields[key] = field  # most recently used last
         self._trim_fields()
         return field
-
-    def landmarks(self) -> Landmarks:
-        """The floor's :class:`~pointnav_core.geodesic.landmarks.Landmarks`: cheap exact bounds
-        on a geodesic, for samplers that reject goals out of range (built once)."""
-        if self._landmarks is None:
-            self._landmarks = Landmarks(self)
-        return self._landmarks
 
     def field_resized(self, field: GoalField, before: int) -> None:
         """Count a cached ``field`` whose size changed from ``before`` bytes (its root table

@@ -318,36 +318,19 @@ def table_roots(
     """:func:`compiled_roots`' decision for the clear centres ``(x, y)`` of ``cells``, read
     from the floor's :class:`~pointnav_core.geodesic.cell_links.CellLinks`: kinds, labels and
     exact distances (m). Needs numba."""
-    return TableRoots(field, tables, links)(cells, x, y)
-
-
-class TableRoots:
-    """:func:`table_roots` for one field, its arguments gathered once: a caller that asks
-    for a few cells at a time (``geodesic.landmarks``) pays only the compiled call."""
-
-    def __init__(self, field: GoalField, tables: ArcTables, links: CellLinks) -> None:
-        p = field.planner
-        search = field.labels
-        blocked, has_blocked = p.blocked_arcs()
-        self.kernel = compiled(p, "table_roots")
-        self.links = links
-        self.goal = (float(field.goal[0]), float(field.goal[1]))
-        self.fixed = (
-            links.node, links.side, links.pos, links.length, p.n_nodes, p.span, p.radius, ANG_TOL, TOUCH_TOL,
-            tables.start, tables.graph_end, tables.labels, search.pos, search.cost, blocked, has_blocked,
-            *p.geo.kernel_geometry(),
-        )
-
-    def __call__(
-        self, cells: NDArray[np.int64], x: NDArray[np.float64], y: NDArray[np.float64]
-    ) -> tuple[NDArray[np.int8], NDArray[np.int32], NDArray[np.float64]]:
-        kind = np.zeros(len(x), dtype=np.int8)
-        label = np.full(len(x), -1, dtype=np.int64)
-        value = np.empty(len(x))
-        self.kernel(
-            x, y, *self.goal, self.links.first[cells], self.links.count[cells], *self.fixed, kind, label, value,
-        )
-        return kind, label.astype(np.int32), value
+    p = field.planner
+    search = field.labels
+    blocked, has_blocked = p.blocked_arcs()
+    kind = np.zeros(len(x), dtype=np.int8)
+    label = np.full(len(x), -1, dtype=np.int64)
+    value = np.empty(len(x))
+    compiled(p, "table_roots")(
+        x, y, float(field.goal[0]), float(field.goal[1]), links.first[cells], links.count[cells], links.node,
+        links.side, links.pos, links.length, p.n_nodes, p.span, p.radius, ANG_TOL, TOUCH_TOL,
+        tables.start, tables.graph_end, tables.labels, search.pos, search.cost, blocked, has_blocked,
+        *p.geo.kernel_geometry(), kind, label, value,
+    )
+    return kind, label.astype(np.int32), value
 
 
 def _candidates(

@@ -376,19 +376,6 @@ class Scene:
         planner = planner_for(self._floor(floor), robot_radius(robot))
         return FloorGoalField(self._floor(floor), planner.goal_field(as_xy(goal_xy, "goal_xy")))
 
-    def geodesic_bounds(
-        self, floor: int, source_xy: ArrayLike, target_xy: ArrayLike, robot: Any = None
-    ) -> tuple[float, float]:
-        """Lower and upper bounds (m) on :meth:`geodesic_distance`, at a fraction of its cost.
-
-        From a few landmarks' exact distances (``geodesic.landmarks``): a sampler rejects a
-        goal out of its range without building the goal's field. ``(0, inf)`` where nothing
-        is known cheaply (numba is not installed).
-        """
-        src, tgt = as_xy(source_xy, "source_xy"), as_xy(target_xy, "target_xy")
-        landmarks = planner_for(self._floor(floor), robot_radius(robot)).landmarks()
-        return landmarks.bounds((float(src[0]), float(src[1])), (float(tgt[0]), float(tgt[1])))
-
     def geodesic_distance(
         self, floor: int, source_xy: ArrayLike, target_xy: ArrayLike, robot: Any = None
     ) -> float:

@@ -96,8 +96,6 @@ def sample_episode(
     # keep their distribution, and a short range no longer fails by rejection).
     reach = None if path_range is None or not math.isfinite(path_range[1]) else path_range[1]
 
-    out_of_range = f"the geodesic must lie in path_range {path_range} m"
-
     def fail(constraint: str) -> None:
         failures[constraint] = failures.get(constraint, 0) + 1
 
@@ -147,19 +145,12 @@ def sample_episode(
             if broken is not None:
                 fail(broken)
                 continue
-        if path_range is not None and fixed_field is None:
-            # Bounds from a few landmarks reject most goals out of range before their
-            # field is built (the same goals the exact geodesic rejects, at a tenth of it).
-            lower, upper = scene.geodesic_bounds(floor, (sx, sy), (gx, gy), robot=spec)
-            if lower >= path_range[1] or upper <= path_range[0]:
-                fail(out_of_range)
-                continue
         # A new goal costs only its graph solve here; the per-cell table is built on the
         # episode's first lookup, for the goal kept.
         field = fixed_field if fixed_field is not None else scene.goal_field(floor, (gx, gy), robot=spec)
         geodesic = field.exact_distance((sx, sy))
         if path_range is not None and not path_range[0] < geodesic < path_range[1]:
-            fail(out_of_range)
+            fail(f"the geodesic must lie in path_range {path_range} m")
             continue
         return Episode((sx, sy), tuple(quat), (gx, gy), field, geodesic)  # type: ignore[arg-type]
     worst = max(failures, key=failures.__getitem__)
