@@ -45,6 +45,7 @@ PAIRS: dict[Entry, tuple[Callable[..., None], ...]] = {
     ("pointnav_core.floor._collision_kernel", "segments_clear"): (pairs_floor.check_cell_test,),
     ("pointnav_core.floor._collision_kernel", "segment_hits"): (pairs_floor.check_cell_test,),
     ("pointnav_core.floor._collision_kernel", "polygons_hit"): (pairs_floor.check_polygon_test,),
+    ("pointnav_core.floor._draw_kernel", "row_spans"): (pairs_floor.check_draw,),
     ("pointnav_core.geodesic._sight_kernel", "sight_rays"): (pairs_floor.check_sights,),
     ("pointnav_core.geodesic._sight_kernel", "misses_full"): (pairs_floor.check_fully_blocked_samples,),
     ("pointnav_core.geodesic._search_kernel", "seeded_dijkstra"): (pairs_geodesic.check_goal_search,),

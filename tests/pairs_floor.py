@@ -1,6 +1,6 @@
-"""Plain and compiled paths of the floor's collision tests and the tangent graph's sight
-bounds: the checks of ``property_tests/test_compiled_paths.py`` for
-``floor._collision_kernel`` and ``geodesic._sight_kernel``.
+"""Plain and compiled paths of the floor's collision tests, its cell draws and the tangent
+graph's sight bounds: the checks of ``property_tests/test_compiled_paths.py`` for
+``floor._collision_kernel``, ``floor._draw_kernel`` and ``geodesic._sight_kernel``.
 
 Each check takes ``plain_paths``, the context its plain side runs in (``numpy_paths()``).
 
@@ -14,6 +14,8 @@ Each check takes ``plain_paths``, the context its plain side runs in (``numpy_pa
   multipolygons) the compiled polygon test equals shapely's ``dwithin`` (the path without
   numba), except where shapely's own distance lies within 1e-9 m of the reach, where the two
   are equally right.
+- :func:`pointnav_core.floor.draw.draw_cell` draws the same cells with its row spans kernel
+  as with its arrays (which ``tests/test_sampling.py`` checks against ``math.hypot``).
 - :func:`pointnav_core.geodesic.sight.node_sights` gives the same bounds, bit for bit, with
   numba and as plain Python, and ``edges._misses_full`` (the cheap rejection of candidate
   tangent segments) the same answers with its kernel and with its numpy samples.
@@ -200,3 +202,40 @@ def check_fully_blocked_samples(
     on = (col >= 0) & (col < full.shape[1]) & (row >= 0) & (row < full.shape[0])
     end_bad = np.where(on, full[np.clip(row, 0, full.shape[0] - 1), np.clip(col, 0, full.shape[1] - 1)], outside)
     assert not (got & end_bad).any()
+
+
+@settings(max_examples=60, deadline=None)
+@given(
+    seed=st.integers(0, 2**31 - 1),
+    rows=st.integers(1, 50),
+    cols=st.integers(1, 50),
+    density=st.floats(0.0, 0.4),
+    resolution=st.sampled_from([0.05, 0.1, 0.3, 0.5]),
+    cells=st.one_of(st.sampled_from([0.0, 0.5, 5.0, 10.0, 12.5, 15.0]), st.floats(0.0, 80.0)),
+    centred=st.booleans(),
+)
+def check_draw(
+    seed: int, rows: int, cols: int, density: float, resolution: float, cells: float, centred: bool,
+    plain_paths: Plain,
+) -> None:
+    """:func:`pointnav_core.floor.draw.draw_cell` (the row spans kernel) draws the same cell for
+    the same random numbers, on grids with walls splitting rows, reaches on 3-4-5 bounds or
+    any, from a cell centre or off it."""
+    from pointnav_core.floor.draw import draw_cell
+    from pointnav_core.floor.maps import TraversableMap
+
+    rng = np.random.default_rng(seed)
+    origin = (float(rng.uniform(-3, 3)), float(rng.uniform(-3, 3)))
+    tmap = TraversableMap(rng.random((rows, cols)) >= density, resolution=resolution, origin=origin)
+    usable = np.argwhere(tmap.usable(0.0))
+    if not len(usable):
+        return
+    cell = usable[rng.integers(len(usable))]
+    ref = tmap.cell_to_world(cell) + (0.0 if centred else rng.uniform(-0.49, 0.49, 2) * resolution)
+    label = int(tmap.components(0.0)[cell[0], cell[1]])
+    reach = cells * resolution
+    got = [draw_cell(tmap, 0.0, label, ref, reach, np.random.default_rng(s)) for s in range(8)]
+    with plain_paths():
+        assert kernel("pointnav_core.floor._draw_kernel", "row_spans") is None
+        want = [draw_cell(tmap, 0.0, label, ref, reach, np.random.default_rng(s)) for s in range(8)]
+    assert got == want

@@ -8,6 +8,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from pointnav_core.floor.maps import TraversableMap
+from pointnav_core.utils import compiled as _compiled
 
 __all__ = ["draw_cell"]
 
@@ -20,7 +21,8 @@ def draw_cell(
 
     The cells within reach are counted row by row, each row an interval of columns settled
     by the exact test at its two ends, then found by bisection in the component's sorted
-    cells: a draw costs O(rows), not a distance per cell. The one random number drawn, and so
+    cells: a draw costs O(rows), not a distance per cell (compiled with numba:
+    ``floor._draw_kernel``, the same spans). The one random number drawn, and so
     the cell, is the one that picks from the list of every cell within reach in row-major
     order.
 
@@ -53,14 +55,36 @@ def draw_cell(
     rx, ry = float(ref[0]), float(ref[1])
     # Rows whose centres may be within reach (one row of slack each way).
     first = max(0, math.floor((ry - max_distance - oy) / res - 0.5) - 1)
-    rows = np.arange(first, max(first, min(h, math.ceil((ry + max_distance - oy) / res - 0.5) + 2)))
+    rows = np.arange(first, max(first, min(h, math.ceil((ry + max_distance - oy) / res - 0.5) + 2)), dtype=np.int64)
+    kernel = _compiled.kernel("pointnav_core.floor._draw_kernel", "row_spans")
+    if kernel is not None:
+        start, counts = np.empty(len(rows), np.int64), np.empty(len(rows), np.int64)
+        kernel(flat, w, oy, ox, res, rx, ry, float(max_distance), rows, start, counts)
+    else:
+        start, counts = _row_spans(flat, w, oy, ox, res, rx, ry, float(max_distance), rows)
+    total = int(counts.sum())
+    if total == 0:
+        return None
+    k = int(rng.integers(total))
+    ends = np.cumsum(counts)
+    row = int(np.searchsorted(ends, k, side="right"))
+    return int(flat[start[row] + k - (ends[row] - counts[row])])
+
+
+def _row_spans(
+    flat: NDArray[np.intp], w: int, oy: float, ox: float, res: float, rx: float, ry: float, reach: float,
+    rows: NDArray[np.int64],
+) -> tuple[NDArray[np.int64], NDArray[np.int64]]:
+    """For each of ``rows``: where its cells within ``reach`` (m) of ``(rx, ry)`` start in the
+    sorted flat indices ``flat``, and how many there are (the compiled path is
+    ``floor._draw_kernel.row_spans``, with these expressions)."""
     dy = (oy + (rows + 0.5) * res) - ry
 
     def reaches(col: NDArray[np.float64]) -> NDArray[np.bool_]:
         # The same centre and test as listing every cell: cell_to_world, then hypot.
-        return np.hypot((ox + (col + 0.5) * res) - rx, dy) <= max_distance
+        return np.hypot((ox + (col + 0.5) * res) - rx, dy) <= reach
 
-    half = np.sqrt(np.maximum(max_distance * max_distance - dy * dy, 0.0))
+    half = np.sqrt(np.maximum(reach * reach - dy * dy, 0.0))
     # Each row's interval of columns from the square root; rounding moves an end by at most
     # one column, which the exact test then settles.
     lo = np.ceil((rx - half - ox) / res - 0.5)
@@ -71,10 +95,4 @@ def draw_cell(
     lo, hi = np.maximum(lo, 0).astype(np.int64), np.minimum(hi, w - 1).astype(np.int64)
     start = np.searchsorted(flat, rows * w + lo)
     counts = np.where(lo <= hi, np.searchsorted(flat, rows * w + hi, side="right") - start, 0)
-    total = int(counts.sum())
-    if total == 0:
-        return None
-    k = int(rng.integers(total))
-    ends = np.cumsum(counts)
-    row = int(np.searchsorted(ends, k, side="right"))
-    return int(flat[start[row] + k - (ends[row] - counts[row])])
+    return start, counts
