@@ -18,6 +18,10 @@ from pointnav_core.sensors.raycast import TOUCH_EPS
 __all__ = ["cast", "polygon_range"]
 
 _jit = numba.njit(cache=True, nogil=True, error_model="numpy")
+# A helper called edge by edge allocates nothing: it runs without numba's reference
+# counting of the arrays it is handed (_nrt=False; numba refuses to compile one that would
+# need it), which would otherwise cost atomic operations on every call.
+_edge_jit = numba.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
 _EPS = TOUCH_EPS
 _TINY = 1e-300  # raycast._TINY
 _INF = math.inf
@@ -221,7 +225,7 @@ def edge_span(fx, fy, ex, ey, num0, ee):  # pragma: no cover
     return True, 0.0, 0.0
 
 
-@_jit
+@_edge_jit
 def edge_hits(fx, fy, ex, ey, half, c, s, order, k0, k1, out):  # pragma: no cover
     # The rays order[k0:k1] (directions c, s) against one edge (fx, fy, ex, ey as in
     # edge_span; half its |u - 1/2| slack, edge_table's last column): out[r], the ray's
