@@ -1,4 +1,4 @@
-"""The agents of :class:`~pointnav_core.envs.multi_pointnav.MultiPointNavEnv`: names, spaces, and their tasks' resets and steps.
+"""The agents of :class:`~pointnav_core.envs.multi_pointnav.MultiPointNavEnv`: their spaces, resets and steps.
 
 Agent ``robot_<i>`` drives robot ``i``. :class:`AgentTable` holds each agent's action and
 observation spaces (the same objects on every call) and the values the step loop reads

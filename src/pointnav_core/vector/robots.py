@@ -32,6 +32,11 @@ _ACTIVE = 2.0e-9
 _EVENTS_PER_ROBOT = 8
 _CONTACTS = 6  # nearest walls that may be contacts while sliding, as in vector.contacts
 
+#: The geometry of a step, ``(W, ...)`` arrays: the walls ``x0, y0, x1, y1`` (m) and
+#: validity (W, R, K); the pair list (W, R, R); radii (m, (W, R)); contact distances
+#: ``r_i + r_j`` (m, (W, R, R)); hit radii against walls (W, R) and robots (W, R, R) (m).
+Geometry = tuple[Any, Any, Any, Any, Any, Any, Any, Any, Any, Any]
+
 
 def _hit_radius(radius: Any) -> Any:
     # A point robot is a disc of _HIT (the backend's _hit_radius), elementwise.
@@ -98,12 +103,6 @@ def advance_robots(
     mx, my = mx + 0.0, my + 0.0
     _events(a, x, y, mx, my, left, contact, ~active, _EVENTS_PER_ROBOT * moving.sum(-1), geo, upper)
     return _safety_net(xp, x, y, start_x, start_y, geo, contact)
-
-
-#: The geometry of a step, ``(W, ...)`` arrays: the walls ``x0, y0, x1, y1`` (m) and
-#: validity (W, R, K); the pair list (W, R, R); radii (m, (W, R)); contact distances
-#: ``r_i + r_j`` (m, (W, R, R)); hit radii against walls (W, R) and robots (W, R, R) (m).
-Geometry = tuple[Any, Any, Any, Any, Any, Any, Any, Any, Any, Any]
 
 
 def _take(xp: Any, v: Any, idx: Any) -> Any:
