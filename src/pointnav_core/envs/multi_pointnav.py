@@ -186,8 +186,8 @@ from pettingzoo.utils.conversions import parallel_to_aec, parallel_to_aec_wrappe
 from pointnav_core import scenes
 from pointnav_core.backends.protocol import Backend, make_backend
 from pointnav_core.backends.robot_spec import RobotSpec
+from pointnav_core.envs import _multi_actions, _multi_agents
 from pointnav_core.envs import common as _envcommon
-from pointnav_core.envs._multi_actions import check_actions, named_action_error, no_agents_error, step_discrete
 from pointnav_core.envs._multi_state import STATE_FIELDS, global_state, state_space
 from pointnav_core.envs.config import EnvConfig, multi_robot_arguments, takes_config
 from pointnav_core.envs.fleet import (
@@ -196,7 +196,6 @@ from pointnav_core.envs.fleet import (
     check_fixed_positions,
     derived_path_ranges,
     goal_separation,
-    goals_apart,
     make_robots,
     make_tasks,
     prefixed,
@@ -207,14 +206,7 @@ from pointnav_core.task import TaskStateError
 from pointnav_core.task.actions import make_discrete_actions
 from pointnav_core.utils import validation
 
-__all__ = [
-    "FINISHED_MODES",
-    "STATE_FIELDS",
-    "MultiPointNavEnv",
-    "env",
-    "parallel_env",
-    "raw_env",
-]
+__all__ = ["FINISHED_MODES", "STATE_FIELDS", "MultiPointNavEnv", "env", "parallel_env", "raw_env"]
 
 
 class MultiPointNavEnv(ParallelEnv[str, Any, np.ndarray]):
@@ -235,8 +227,7 @@ class MultiPointNavEnv(ParallelEnv[str, Any, np.ndarray]):
         ``PointNavigationTask`` arguments for every robot, or one entry per robot; the env
         sets each task's ``robot_idn``.
     backend : str or type or Backend
-        A registered backend name (``pointnav_core.backends.protocol.available_backends()``), a
-        backend class, or an instance.
+        A registered backend name (``backends.protocol.available_backends()``), a class, or an instance.
     backend_kwargs : dict, optional
         Arguments of the backend's constructor (name or class only).
     max_cycles : int
@@ -287,16 +278,12 @@ class MultiPointNavEnv(ParallelEnv[str, Any, np.ndarray]):
         #: The :class:`~pointnav_core.envs.config.EnvConfig` this env was built from, or None.
         self.config = config
         if render_mode is not None and render_mode not in (*self.metadata["render_modes"], "human"):
-            raise ArgumentError(
-                f"render_mode must be None or one of {self.metadata['render_modes']}, "
-                f"got {render_mode!r}"
-            )
+            modes = self.metadata["render_modes"]
+            raise ArgumentError(f"render_mode must be None or one of {modes}, got {render_mode!r}")
         n = validation.integer("n_robots", n_robots, minimum=1)
         self.max_cycles = validation.integer("max_cycles", max_cycles, minimum=1)
         check_finished(finished)
-        scene, frequency = _envcommon.check_world_args(
-            scene, flatten_obs, action_frequency, backend_kwargs
-        )
+        scene, frequency = _envcommon.check_world_args(scene, flatten_obs, action_frequency, backend_kwargs)
         self.robots = make_robots(robot, n)
         derive = derived_path_ranges(task, n)
         self.discrete_actions = make_discrete_actions(action_space, discrete_actions)
@@ -340,54 +327,27 @@ class MultiPointNavEnv(ParallelEnv[str, Any, np.ndarray]):
         self._started = False  # whether reset() was ever called
 
     def _set_agents(self, tasks: list[Any], frequency: float) -> None:
-        """Name the agents, build their spaces and the state space, and cache the per-agent
-        values the step loop reads (``frequency`` in Hz)."""
-        self.possible_agents = [f"robot_{i}" for i in range(len(tasks))]
+        """Build the agents, their spaces, the state space and the step loop's values (``frequency``, Hz)."""
+        table = _multi_agents.AgentTable(self.robots, tasks, self.discrete_actions, self.flatten_obs, frequency)
+        #: The agents' spaces and per-step values (:class:`~pointnav_core.envs._multi_agents.AgentTable`).
+        self.agent_table = table
+        self.possible_agents = table.names
         self.agents: list[str] = []
-        self._index = {agent: i for i, agent in enumerate(self.possible_agents)}
-        self.action_spaces = {
-            agent: _envcommon.action_space(rb, self.discrete_actions)
-            for agent, rb in zip(self.possible_agents, self.robots)
-        }
-        # Per robot, each discrete action's command and control steps (None: continuous).
-        self._plans = (
-            None if self.discrete_actions is None
-            else [self.discrete_actions.commands(rb, frequency) for rb in self.robots]
-        )
-        self.observation_spaces = {
-            agent: _envcommon.observation_space(t, self.flatten_obs)
-            for agent, t in zip(self.possible_agents, tasks)
-        }
+        self.action_spaces, self.observation_spaces = table.action_spaces, table.observation_spaces
         self.state_space = state_space(self.scene, len(tasks))
         self._state_low = self.state_space.low.astype(np.float64)
         self._state_high = self.state_space.high.astype(np.float64)
-
-        # Per-agent hot-path values, one lookup per agent and step: robot index, action
-        # shape, drive, the task's step and its observation function.
-        self._observe = [t.get_low_dim_obs if self.flatten_obs else t.get_obs for t in tasks]
-        self._slots = {
-            agent: (i, (rb.action_dim,), rb.drive, t.step, self._observe[i])
-            for i, (agent, rb, t) in enumerate(zip(self.possible_agents, self.robots, tasks))
-        }
+        # Read on every step and reset: plain attributes.
+        self._index, self._plans, self._observe, self._slots = table.index, table.plans, table.observe, table.slots
 
     # ------------------------------------------------------------------ PettingZoo API
     def observation_space(self, agent: str) -> spaces.Space[Any]:
         """The observation space of ``agent`` (the same object on every call)."""
-        try:
-            return self.observation_spaces[agent]
-        except KeyError:
-            raise KeyError(
-                f"unknown agent {agent!r}; possible agents are {self.possible_agents}"
-            ) from None
+        return self.agent_table.observation_space(agent)
 
     def action_space(self, agent: str) -> spaces.Box:
         """The action space of ``agent`` (the same object on every call)."""
-        try:
-            return self.action_spaces[agent]  # type: ignore[return-value]
-        except KeyError:
-            raise KeyError(
-                f"unknown agent {agent!r}; possible agents are {self.possible_agents}"
-            ) from None
+        return self.agent_table.action_space(agent)  # type: ignore[return-value]
 
     @property
     def np_random(self) -> np.random.Generator:
@@ -408,18 +368,14 @@ class MultiPointNavEnv(ParallelEnv[str, Any, np.ndarray]):
         """
         if options is not None and not isinstance(options, Mapping):
             raise ArgumentError(f"options must be None or a dict, got {options!r}")
-        given = self._given_episodes((options or {}).get("episodes"))
+        given = self.agent_table.episodes((options or {}).get("episodes"))
         if seed is not None or self._np_random is None:
             self._np_random, self._np_random_seed = seeding.np_random(seed)
         self.agents = []
         self._void = True
         self._started = True
         self.backend.reset()
-        infos: list[dict[str, Any]] = [{}] * len(self.tasks)
-        placed: list[int] = []
-        for i in self.reset_order:
-            infos[i] = self._reset_robot(i, placed, given[i])
-            placed.append(i)
+        infos = _multi_agents.reset_tasks(self, self.tasks, self.reset_order, self.separation, given)
         self._active = [True] * len(self.tasks)
         self._cycles = 0
         self.agents = self.possible_agents[:]
@@ -428,35 +384,7 @@ class MultiPointNavEnv(ParallelEnv[str, Any, np.ndarray]):
         observations = {agent: observe[i](self) for i, agent in enumerate(self.agents)}
         return observations, {agent: infos[i] for i, agent in enumerate(self.agents)}
 
-    def _given_episodes(self, episodes: Any) -> list[Any]:
-        """One dataset episode (or None) per robot, from ``options["episodes"]``."""
-        n = len(self.tasks)
-        if episodes is None:
-            return [None] * n
-        if isinstance(episodes, Mapping):
-            unknown = [a for a in episodes if a not in self.possible_agents]
-            if unknown:
-                raise ArgumentError(f"options['episodes'] has unknown agent {unknown[0]!r}; agents are {self.possible_agents}")
-            return [episodes.get(agent) for agent in self.possible_agents]
-        episodes = list(episodes)
-        if len(episodes) != n:
-            raise ArgumentError(f"options['episodes'] must hold one episode per robot ({n}), got {len(episodes)}")
-        return episodes
-
-    def _reset_robot(self, i: int, placed: list[int], episode: Any = None) -> dict[str, Any]:
-        """Reset task ``i`` with its goal kept apart from the goals decided so far."""
-        constraint = goals_apart(self.tasks, i, placed, self.separation)
-        return self.tasks[i].reset(self, goal_constraint=constraint, episode=episode)
-
-    def step(
-        self, actions: Mapping[str, Any]
-    ) -> tuple[
-        dict[str, Any],
-        dict[str, float],
-        dict[str, bool],
-        dict[str, bool],
-        dict[str, dict[str, Any]],
-    ]:
+    def step(self, actions: Mapping[str, Any]) -> _multi_agents.StepReturns:
         """Apply one action per alive agent for one control step.
 
         Returns observations, rewards, terminations, truncations and infos, each keyed by
@@ -465,22 +393,16 @@ class MultiPointNavEnv(ParallelEnv[str, Any, np.ndarray]):
         """
         agents = self.agents
         if not agents:
-            raise no_agents_error(self._started, self._void)
+            raise _multi_actions.no_agents_error(self._started, self._void)
         # Check every action before anything moves (finiteness: the backend, which moves
         # nothing when it refuses a step): a rejected step changes nothing.
         plans = self._plans
-        commands, todo = check_actions(agents, actions, self._slots, plans, self._index)
-
-        observations: dict[str, Any] = {}
-        rewards: dict[str, float] = {}
-        terminations: dict[str, bool] = {}
-        truncations: dict[str, bool] = {}
-        infos: dict[str, dict[str, Any]] = {}
+        commands, todo = _multi_actions.check_actions(agents, actions, self._slots, plans, self._index)
         if plans is None:
             try:
                 self.backend.step(commands)
             except ValueError as err:  # a rejected step moved nothing: name the agent
-                raise named_action_error(err, todo) from None
+                raise _multi_actions.named_action_error(err, todo) from None
             except BaseException:
                 self.agents = []
                 self._void = True
@@ -488,27 +410,9 @@ class MultiPointNavEnv(ParallelEnv[str, Any, np.ndarray]):
             contacts = None
         try:
             if plans is not None:
-                contacts = step_discrete(self.backend, plans, commands)
+                contacts = _multi_actions.step_discrete(self.backend, plans, commands)
             self._cycles += 1
-            cut = self._cycles >= self.max_cycles
-            alive = []
-            ended = []
-            for agent, i, action, task_step, observe in todo:
-                if contacts is None:
-                    reward, terminated, truncated, info = task_step(self, action)
-                else:
-                    reward, terminated, truncated, info = task_step(self, action, contact=contacts[i])
-                if cut:
-                    truncated = True
-                observations[agent] = observe(self)
-                rewards[agent] = reward
-                terminations[agent] = terminated
-                truncations[agent] = truncated
-                infos[agent] = info
-                if terminated or truncated:
-                    ended.append(i)
-                else:
-                    alive.append(agent)
+            returns, alive, ended = _multi_agents.step_tasks(self, todo, contacts, self._cycles >= self.max_cycles)
             for i in ended:
                 self._finish(i)
             self.agents = alive
@@ -516,7 +420,7 @@ class MultiPointNavEnv(ParallelEnv[str, Any, np.ndarray]):
             self.agents = []
             self._void = True
             raise
-        return observations, rewards, terminations, truncations, infos
+        return returns
 
     def _finish(self, i: int) -> None:
         self._active[i] = False

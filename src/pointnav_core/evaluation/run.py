@@ -30,7 +30,19 @@ loaded only with ``trust_policy_file=True`` (``--trust-policy-file``).
 
 A run survives its faults (:func:`evaluate`): each result is handed to ``on_result`` as
 its episode ends, an episode whose policy raises is named and stopped on or skipped
-(``on_error``), and worker processes end with the run, whatever ends it.
+(``on_error``), and worker processes end with the run, whatever ends it. Every argument,
+and every episode's scene id, is checked before any episode is played; an error names the
+episode and the field.
+
+With an ``env_config`` (:mod:`pointnav_core.envs.config`), every episode's env is built from
+it (sensors, actions, robot, backend, task settings, ``max_steps``) with the episode's scene,
+floor, start, goal and goal radius; ``backend``, ``max_steps`` and ``drive`` must then keep
+their defaults, and every episode's robot radius must be the config's. Without one, a policy
+factory with an ``env_config`` attribute (a checkpoint's) plays in envs built from that.
+
+``isolate=True`` plays in worker processes even with one worker, so that a signal handler
+that raises in this process never lands inside the policy's or the compiler's code
+(``pointnav eval`` does: see :mod:`pointnav_core.cli.datasets`).
 
 This module drives the envs, so it is not part of the core; the CLI uses it.
 """
@@ -53,9 +65,7 @@ from pointnav_core.evaluation.config import (
     check_robot_radius,
     episode_config,
 )
-from pointnav_core.evaluation.report import (
-    EpisodeResult,
-)
+from pointnav_core.evaluation.report import EpisodeResult
 from pointnav_core.policies.spaces import check_spaces
 from pointnav_core.task import metrics
 from pointnav_core.utils.validation import integer
@@ -129,7 +139,6 @@ class _SB3Policy:
     def __call__(self, env: Any) -> Policy:
         model = self.model
         return lambda obs: model.predict(obs, deterministic=True)[0]
-
 
 
 def make_policy(spec: str, sb3_algo: str = "PPO", trust_policy_file: bool = False) -> PolicyFactory:
@@ -292,7 +301,6 @@ class _Runner:
         )
 
 
-
 def _play(runner: _Runner, ep: PointNavEpisode) -> tuple[str, Any]:
     """A worker's task (module level, so that ``spawn`` can find it)."""
     return runner.outcome(ep)
@@ -350,28 +358,23 @@ def evaluate(
     env_config: EnvConfig | None = None,
     isolate: bool = False,
 ) -> list[EpisodeResult]:
-    """Play every episode once (or the subset ``limit`` and ``stride`` select); the
-    results in the episodes' order.
+    """Play every episode once (or the subset ``limit`` and ``stride`` select): see the module notes.
 
     Parameters
     ----------
     episodes : EpisodeDataset or sequence of PointNavEpisode
     policy : str or callable
-        ``"oracle"``, ``"MODULE:CALLABLE"``, a path to a checkpoint ``.pt`` or to an SB3
-        ``.zip``, or a factory ``env -> (observation -> action)`` (with ``workers > 1`` it
-        must be picklable); a factory with an ``env_config`` attribute (a checkpoint's)
-        plays in envs built from it when ``env_config`` is None.
+        A :func:`make_policy` spec, or a factory ``env -> (observation -> action)`` (picklable with ``workers > 1``).
     backend : str
         Registered backend name.
     workers : int
         Worker processes (1: play here); at most one per episode and per usable core.
     max_steps : int
         Step limit per episode.
-    drive : str
-        ``"differential"`` or ``"holonomic"``.
+    drive : {"differential", "holonomic"}
+        The robot's drive.
     scenes_root : str, optional
-        Folder relative scene paths in ``scene_id`` are read from; a scene path must then
-        stay under it (:func:`~pointnav_core.datasets.scene_sets.locate_scene`).
+        Folder relative scene paths in ``scene_id`` are read from (and must stay under).
     sb3_algo : str
         Stable-Baselines3 algorithm class of a ``.zip`` policy.
     progress : bool
@@ -382,36 +385,48 @@ def evaluate(
         When the policy raises in an episode: raise :class:`~pointnav_core.errors.EpisodeError`
         at once, or leave the episode out and go on.
     on_result : callable, optional
-        Called with each result as its episode ends (in the order they end), so that a
-        caller can keep it whatever happens to the run later.
+        Called with each result as its episode ends (in the order they end).
     on_failure : callable, optional
-        With ``on_error="skip"``: called with each failed episode and the message naming
-        it (by default a ``RuntimeWarning``).
+        With ``on_error="skip"``: called with each failed episode and its message (default: a ``RuntimeWarning``).
     limit, stride : int, optional
-        Play only :func:`select_episodes` ``(episodes, limit, stride)``: every
-        ``stride``-th episode, then the first ``limit`` of those.
+        Play only :func:`select_episodes` ``(episodes, limit, stride)``.
     env_config : EnvConfig, optional
-        Build every episode's env from this config (sensors, actions, robot, backend, task
-        settings, ``max_steps``; :mod:`pointnav_core.envs.config`), with the episode's scene,
-        floor, start, goal and goal radius; ``backend``, ``max_steps`` and ``drive`` must
-        then keep their defaults, and every episode's robot radius must be the config's.
+        Build every episode's env from this config (see the module notes).
     isolate : bool
-        Play in worker processes even with one worker, so that a signal handler that
-        raises in this process never lands inside the policy's or the compiler's code
-        (``pointnav eval`` does: see :mod:`pointnav_core.cli.datasets`).
+        Play in worker processes even with one worker (see the module notes).
+
+    Returns
+    -------
+    list of EpisodeResult
+        The results in the episodes' order, without the skipped episodes.
 
     Raises
     ------
     ValueError
-        For a bad argument, or an episode that does not suit its scene or robot (naming the
-        episode and the field); scene ids are checked before any episode is played.
+        For a bad argument, or an episode that does not suit its scene or robot.
     EpisodeError
-        With ``on_error="stop"``, for the first episode whose policy raised, or a worker
-        process that died; its message names the episode.
+        With ``on_error="stop"``: the first episode whose policy raised, or a dead worker.
     KeyboardInterrupt
         Passed on, after every worker process has ended.
     """
     episodes = select_episodes(episodes, limit, stride)
+    args = _runner_args(episodes, policy, workers, on_error, backend, max_steps, drive, scenes_root, sb3_algo,
+                        trust_policy_file, env_config)
+    recorder = _Recorder(episodes, on_error, on_result, on_failure, progress)
+    try:
+        _play_all(episodes, args, recorder, min(workers, len(episodes), usable_cores()), isolate)
+    finally:
+        recorder.bar.close()
+    return [r for r in recorder.results if r is not None]
+
+
+def _runner_args(
+    episodes: list[PointNavEpisode], policy: str | PolicyFactory, workers: int, on_error: str, backend: str,
+    max_steps: int, drive: str, scenes_root: str | None, sb3_algo: str, trust_policy_file: bool,
+    env_config: EnvConfig | None,
+) -> tuple[Any, ...]:
+    """Check :func:`evaluate`'s arguments and scene ids before anything is played; the
+    arguments of a :class:`_Runner` (with the policy's own env config when none is given)."""
     for name, value in (("workers", workers), ("max_steps", max_steps)):
         if isinstance(value, bool) or not isinstance(value, int) or value < 1:
             raise ArgumentError(f"{name} must be an integer >= 1, got {value!r}")
@@ -424,43 +439,59 @@ def evaluate(
         check_beside_config(env_config, backend=backend, max_steps=max_steps, drive=drive)
         check_robot_radius(env_config, episodes)
     check_scene_ids(episodes, scenes_root)
-    args = (policy, backend, max_steps, drive, scenes_root, sb3_algo, trust_policy_file, env_config)
-    results: list[EpisodeResult | None] = [None] * len(episodes)
-    from tqdm import tqdm
+    return (policy, backend, max_steps, drive, scenes_root, sb3_algo, trust_policy_file, env_config)
 
-    bar = tqdm(total=len(episodes), disable=not progress, desc="episodes", unit="ep")
 
-    def record(i: int, kind: str, payload: Any) -> None:
+class _Recorder:
+    """Takes each episode's outcome as it arrives (:meth:`_Runner.outcome`): keeps results in
+    the episodes' order, and stops on or skips failures as ``on_error`` says."""
+
+    def __init__(
+        self, episodes: list[PointNavEpisode], on_error: str, on_result: Callable[[EpisodeResult], None] | None,
+        on_failure: Callable[[PointNavEpisode, str], None] | None, progress: bool,
+    ) -> None:
+        from tqdm import tqdm
+
+        self.episodes, self.on_error, self.on_result, self.on_failure = episodes, on_error, on_result, on_failure
+        self.results: list[EpisodeResult | None] = [None] * len(episodes)
+        self.bar = tqdm(total=len(episodes), disable=not progress, desc="episodes", unit="ep")
+
+    def __call__(self, i: int, kind: str, payload: Any) -> None:
         if kind == "input":
             raise ArgumentError(payload)
         if kind == "error":
-            if on_error == "stop":
+            if self.on_error == "stop":
                 raise EpisodeError(payload)
-            (on_failure or (lambda _ep, msg: warnings.warn(msg, RuntimeWarning, stacklevel=4)))(episodes[i], payload)
+            (self.on_failure or self.warn)(self.episodes[i], payload)
         else:
-            results[i] = payload
-            if on_result is not None:
-                on_result(payload)
-        bar.update(1)
+            self.results[i] = payload
+            if self.on_result is not None:
+                self.on_result(payload)
+        self.bar.update(1)
 
-    try:
-        n_workers = min(workers, len(episodes), usable_cores())
-        if n_workers <= 1 and not isolate:
-            runner = _Runner(*args)
-            for i, ep in enumerate(episodes):
-                record(i, *runner.outcome(ep))
-        elif episodes:
-            with WorkerPool(n_workers, _Runner, args, _play) as pool:
-                try:
-                    for i, (kind, payload) in pool.imap_unordered(enumerate(episodes)):
-                        record(i, kind, payload)  # type: ignore[arg-type]
-                except WorkerError as err:
-                    if err.key is None:
-                        raise EpisodeError(str(err)) from None
-                    ep = episodes[err.key]  # type: ignore[index]
-                    raise EpisodeError(
-                        f"episode {ep.episode_id!r} (scene {ep.scene_id!r}): {err.cause}"
-                    ) from None
-    finally:
-        bar.close()
-    return [r for r in results if r is not None]
+    @staticmethod
+    def warn(_ep: PointNavEpisode, message: str) -> None:
+        """The default ``on_failure``: a ``RuntimeWarning`` pointing at evaluate's caller."""
+        warnings.warn(message, RuntimeWarning, stacklevel=5)  # here, __call__, _play_all, evaluate
+
+
+def _play_all(
+    episodes: list[PointNavEpisode], args: tuple[Any, ...], record: _Recorder, n_workers: int, isolate: bool
+) -> None:
+    """Play every episode, here or in ``n_workers`` processes, handing each outcome to ``record``."""
+    if n_workers <= 1 and not isolate:
+        runner = _Runner(*args)
+        for i, ep in enumerate(episodes):
+            record(i, *runner.outcome(ep))
+    elif episodes:
+        with WorkerPool(n_workers, _Runner, args, _play) as pool:
+            try:
+                for i, (kind, payload) in pool.imap_unordered(enumerate(episodes)):
+                    record(i, kind, payload)  # type: ignore[arg-type]
+            except WorkerError as err:
+                if err.key is None:
+                    raise EpisodeError(str(err)) from None
+                ep = episodes[err.key]  # type: ignore[index]
+                raise EpisodeError(
+                    f"episode {ep.episode_id!r} (scene {ep.scene_id!r}): {err.cause}"
+                ) from None

@@ -2,7 +2,9 @@
 
 Imported only through :func:`pointnav_core.utils.compiled.kernel` when numba is installed (the
 ``fast`` extra), so the package imports without it. :func:`sight_rays` is
-:func:`pointnav_core.geodesic.sight.sight_rays` itself, compiled. :func:`misses_full` is
+:func:`pointnav_core.geodesic.sight.sight_rays` itself, compiled; the plain helpers it calls
+are registered with numba (``register_jitable``), so that its calls to them compile to
+theirs. :func:`misses_full` is
 ``edges._misses_full``'s: each segment's samples, at the numpy path's positions, stop at the
 first that lies in a fully blocked cell.
 """
@@ -12,11 +14,14 @@ from __future__ import annotations
 import math
 
 import numba
+from numba.extending import register_jitable
 
 from pointnav_core.geodesic import sight
 
 __all__ = ["misses_full", "sight_rays"]
 
+for _helper in (sight.march_ray, sight.mark_profile, sight.no_bound):
+    register_jitable(cache=True, nogil=True, error_model="numpy")(_helper)
 sight_rays = numba.njit(cache=True, nogil=True, error_model="numpy")(sight.sight_rays)
 
 

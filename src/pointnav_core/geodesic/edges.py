@@ -28,6 +28,11 @@ __all__ = ["build_edges"]
 _SEG_CHUNK = 200_000
 
 
+#: Per winding pair: sources, source side, destinations, destination side, departure and
+#: arrival positions on the arcs (rad) and segment lengths (m).
+Found = tuple[NDArray[np.int64], int, NDArray[np.int64], int, NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]
+
+
 def build_edges(p: Planner, nodes: NDArray[np.int64]) -> None:
     """Find the tangent edges leaving ``nodes`` on both winding sides and store them in ``p``.
 
@@ -39,21 +44,59 @@ def build_edges(p: Planner, nodes: NDArray[np.int64]) -> None:
     nodes = np.asarray(nodes, dtype=np.int64)
     if not len(nodes):
         return
+    src, dst = _candidates(p, nodes)
+    found, seg_a, seg_b = _tangents(p, src, dst)
+    if found:
+        clear = _clear(p, np.concatenate(seg_a), np.concatenate(seg_b), found)
+        e_src = np.concatenate([f[0] for f in found])[clear]
+        e_s = np.concatenate([np.full(len(f[0]), f[1], np.int8) for f in found])[clear]
+        e_dst = np.concatenate([f[2] for f in found])[clear]
+        e_sb = np.concatenate([np.full(len(f[0]), f[3], np.int8) for f in found])[clear]
+        e_dep = np.concatenate([f[4] for f in found])[clear]
+        e_arr = np.concatenate([f[5] for f in found])[clear]
+        e_len = np.concatenate([f[6] for f in found])[clear]
+    else:
+        e_src = e_dst = np.zeros(0, np.int64)
+        e_s = e_sb = np.zeros(0, np.int8)
+        e_dep = e_arr = e_len = np.zeros(0)
+    _store(p, nodes, e_src, e_s, e_dst, e_sb, e_dep, e_arr, e_len)
+
+
+def _candidates(p: Planner, nodes: NDArray[np.int64]) -> tuple[NDArray[np.int64], NDArray[np.int64]]:
+    """The ``(source, destination)`` node pairs close enough for an edge, sources in ``nodes`` order.
+
+    An edge is a clear segment leaving both nodes' arcs, so the centres are at most either
+    node's sight plus two radii (m) apart (geodesic.sight).
+    """
     r = p.radius
-    # An edge is a clear segment leaving both nodes' arcs, so the centres are at most either
-    # node's sight plus two radii apart (geodesic.sight).
     pts = np.stack([p.cx[nodes], p.cy[nodes]], axis=1)
     lists = p.tree.query_ball_point(pts, p.sights[nodes] + 2 * r)
     counts = np.fromiter((len(v) for v in lists), dtype=np.int64, count=len(lists))
     src = np.repeat(nodes, counts)
     dst = np.fromiter((j for v in lists for j in v), dtype=np.int64, count=int(counts.sum()))
     keep = (src != dst) & (np.hypot(p.cx[src] - p.cx[dst], p.cy[src] - p.cy[dst]) <= p.sights[dst] + 2 * r)
-    src, dst = src[keep], dst[keep]
+    return src[keep], dst[keep]
+
+
+def _tangents(
+    p: Planner, src: NDArray[np.int64], dst: NDArray[np.int64]
+) -> tuple[list[Found], list[NDArray[np.float64]], list[NDArray[np.float64]]]:
+    """The common tangents of every pair that leave and arrive on the two nodes' arcs.
+
+    Returns
+    -------
+    found : list of Found
+        One entry per winding pair ``(s, sb)`` with any tangent, in the order
+        ``(1, 1), (1, -1), (-1, -1), (-1, 1)``.
+    seg_a, seg_b : list of ndarray, shape (n, 2)
+        The tangents' end points (m) on the source and destination arcs, per entry.
+    """
+    r = p.radius
     ax, ay, bx, by = p.cx[src], p.cy[src], p.cx[dst], p.cy[dst]
     dx, dy = bx - ax, by - ay
     L = np.hypot(dx, dy)
     base = np.arctan2(dy, dx)
-    found: list[tuple[NDArray[np.int64], int, NDArray[np.int64], int, NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]] = []
+    found: list[Found] = []
     seg_a: list[NDArray[np.float64]] = []
     seg_b: list[NDArray[np.float64]] = []
     for s in (1, -1):
@@ -79,42 +122,45 @@ def build_edges(p: Planner, nodes: NDArray[np.int64]) -> None:
             dep = dep_ccw[idx] if s > 0 else p.span[src[idx]] - dep_ccw[idx]
             arr = arr_ccw[idx] if sb > 0 else p.span[dst[idx]] - arr_ccw[idx]
             found.append((src[idx], s, dst[idx], sb, dep, arr, seg[idx]))
-    if found:
-        pa = np.concatenate(seg_a)
-        pb = np.concatenate(seg_b)
-        # Cheap rejections first. A clear edge is no longer than either node's sight in its
-        # direction (geodesic.sight), and never enters a cell no disc point can use: coarse
-        # samples reject most candidates at a fraction of the fine pass's cost.
-        e_a = np.concatenate([f[0] for f in found])
-        e_b = np.concatenate([f[2] for f in found])
-        d = pb - pa
-        sub = np.flatnonzero(~blocked_by_profile(p.sight_profile, e_a, d[:, 0], d[:, 1])
-                             & ~blocked_by_profile(p.sight_profile, e_b, -d[:, 0], -d[:, 1]))
-        for step in (2.0, 0.5):
-            ok = np.concatenate(
-                [_misses_full(p, pa[sub[i : i + _SEG_CHUNK]], pb[sub[i : i + _SEG_CHUNK]], step) for i in range(0, len(sub), _SEG_CHUNK)]
-                + [np.zeros(0, dtype=bool)]
-            )
-            sub = sub[ok]
-        n_cand = len(pa)
-        pa, pb = pa[sub], pb[sub]
-        clear = np.zeros(n_cand, dtype=bool)
-        clear[sub] = np.concatenate(
-            [p.geo.segments_clear(pa[i : i + _SEG_CHUNK], pb[i : i + _SEG_CHUNK], r) for i in range(0, len(pa), _SEG_CHUNK)]
+    return found, seg_a, seg_b
+
+
+def _clear(p: Planner, pa: NDArray[np.float64], pb: NDArray[np.float64], found: list[Found]) -> NDArray[np.bool_]:
+    """Which candidate segments ``pa -> pb`` (m; ``found``'s, end to end) are clear for the robot's disc.
+
+    Cheap rejections first. A clear edge is no longer than either node's sight in its
+    direction (geodesic.sight), and never enters a cell no disc point can use: coarse
+    samples reject most candidates at a fraction of the fine pass's cost. The survivors
+    get the exact test.
+    """
+    e_a = np.concatenate([f[0] for f in found])
+    e_b = np.concatenate([f[2] for f in found])
+    d = pb - pa
+    sub = np.flatnonzero(~blocked_by_profile(p.sight_profile, e_a, d[:, 0], d[:, 1])
+                         & ~blocked_by_profile(p.sight_profile, e_b, -d[:, 0], -d[:, 1]))
+    for step in (2.0, 0.5):
+        ok = np.concatenate(
+            [_misses_full(p, pa[sub[i : i + _SEG_CHUNK]], pb[sub[i : i + _SEG_CHUNK]], step) for i in range(0, len(sub), _SEG_CHUNK)]
             + [np.zeros(0, dtype=bool)]
         )
-        e_src = np.concatenate([f[0] for f in found])[clear]
-        e_s = np.concatenate([np.full(len(f[0]), f[1], np.int8) for f in found])[clear]
-        e_dst = np.concatenate([f[2] for f in found])[clear]
-        e_sb = np.concatenate([np.full(len(f[0]), f[3], np.int8) for f in found])[clear]
-        e_dep = np.concatenate([f[4] for f in found])[clear]
-        e_arr = np.concatenate([f[5] for f in found])[clear]
-        e_len = np.concatenate([f[6] for f in found])[clear]
-    else:
-        e_src = e_dst = np.zeros(0, np.int64)
-        e_s = e_sb = np.zeros(0, np.int8)
-        e_dep = e_arr = e_len = np.zeros(0)
-    # Group by (node, side), each group sorted by departure position (stable, as before).
+        sub = sub[ok]
+    n_cand = len(pa)
+    pa, pb = pa[sub], pb[sub]
+    clear = np.zeros(n_cand, dtype=bool)
+    clear[sub] = np.concatenate(
+        [p.geo.segments_clear(pa[i : i + _SEG_CHUNK], pb[i : i + _SEG_CHUNK], p.radius) for i in range(0, len(pa), _SEG_CHUNK)]
+        + [np.zeros(0, dtype=bool)]
+    )
+    return clear
+
+
+def _store(
+    p: Planner, nodes: NDArray[np.int64], e_src: NDArray[np.int64], e_s: NDArray[np.int8], e_dst: NDArray[np.int64],
+    e_sb: NDArray[np.int8], e_dep: NDArray[np.float64], e_arr: NDArray[np.float64], e_len: NDArray[np.float64],
+) -> None:
+    """Store the edges in ``p.edge_store``: per ``(node, side)``, lists of departure
+    position (rad), destination, its side, arrival position (rad) and length (m), sorted
+    by departure (stable); an empty entry for every node in ``nodes`` without edges."""
     key = e_src * 2 + (e_s < 0)
     order = np.lexsort((e_dep, key))
     key = key[order]

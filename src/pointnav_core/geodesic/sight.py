@@ -42,7 +42,7 @@ from pointnav_core.utils import compiled as _compiled
 if TYPE_CHECKING:
     from pointnav_core.floor.collision import FloorCollision
 
-__all__ = ["PROFILE_BINS", "NodeBalls", "blocked_by_profile", "node_sights", "sight_rays"]
+__all__ = ["PROFILE_BINS", "NodeBalls", "blocked_by_profile", "mark_profile", "march_ray", "no_bound", "node_sights", "sight_rays"]
 
 #: Half-width (rad) of the sectors rays start with: 64 rays over a grid corner's quarter arc.
 FIRST_HALF_WIDTH = math.pi / 256
@@ -75,19 +75,15 @@ def sight_rays(cx, cy, phi0, span, r, margin, edt, near_r, near_c, outside, h0, 
     whether everything off the grid is blocked (``outside``). ``profile[n, b]`` (zeros on
     entry) gets the longest ray of every sector that overlaps direction bin ``b`` (bins of
     ``2 pi / B`` from angle 0): no clear segment leaving the arc in a direction of bin ``b``
-    is longer. Plain Python on scalars, so that numba compiles the very same function.
+    is longer. Plain Python on scalars, so that numba compiles the very same function (and
+    the helpers it calls, :func:`march_ray`, :func:`mark_profile` and :func:`no_bound`).
     """
-    n_rows, n_cols = edt.shape
-    n_bins = profile.shape[1]
-    bin_width = 2.0 * math.pi / n_bins
     stack_t = np.empty(_STACK)
     stack_h = np.empty(_STACK)
     if r * (1.0 / min_h - 1.0) < 1.0:
         # Even the narrowest sector proves nothing a cell away (a point robot): no bound.
         for n in range(cx.shape[0]):
-            out[n] = limit
-            for k in range(n_bins):
-                profile[n, k] = limit
+            no_bound(out, profile, n, limit)
         return
     for n in range(cx.shape[0]):
         best = 0.0
@@ -106,44 +102,11 @@ def sight_rays(cx, cy, phi0, span, r, margin, edt, near_r, near_c, outside, h0, 
                 theta = stack_t[top]
                 hw = stack_h[top]
                 cast += 1
-                phi = theta - side * (math.pi / 2)
-                tx = cx[n] + r * math.cos(phi)
-                ty = cy[n] + r * math.sin(phi)
-                ux = math.cos(theta)
-                uy = math.sin(theta)
                 reach = (hw + ANG_TOL)
-                t = 0.0
-                length = -1.0
-                while True:
-                    e = (r + t) * reach
-                    if e >= r - margin:
-                        break  # past this the ray proves nothing: split its sector
-                    x = tx + t * ux
-                    y = ty + t * uy
-                    col = math.floor(x)
-                    row = math.floor(y)
-                    if col < 0 or col >= n_cols or row < 0 or row >= n_rows:
-                        length = t if outside else limit
-                        break
-                    nr = near_r[row, col]
-                    nc = near_c[row, col]
-                    dx = max(nc - x, 0.0, x - (nc + 1))
-                    dy = max(nr - y, 0.0, y - (nr + 1))
-                    if math.sqrt(dx * dx + dy * dy) + e < r - margin:
-                        length = t
-                        break
-                    if t > limit:
-                        length = limit
-                        break
-                    t += max(edt[row, col] - math.sqrt(2.0) - r, 0.25)
+                length = march_ray(cx[n], cy[n], theta, side, reach, r, margin, edt, near_r, near_c, outside, limit)
                 if length >= 0.0:
                     best = max(best, length)
-                    # Every direction bin the sector overlaps (its edges widened by the tolerance).
-                    b0 = math.floor((theta - reach) / bin_width)
-                    b1 = math.floor((theta + reach) / bin_width)
-                    for b in range(b0, b1 + 1):
-                        k = b % n_bins
-                        profile[n, k] = max(profile[n, k], length)
+                    mark_profile(profile, n, theta, reach, length)
                 elif hw <= min_h or top + 2 > _STACK or cast >= _RAY_BUDGET:
                     gave_up = True  # a robot this thin in so open a space: no useful bound
                     break
@@ -155,10 +118,64 @@ def sight_rays(cx, cy, phi0, span, r, margin, edt, near_r, near_c, outside, h0, 
                     top += 2
             if gave_up:
                 break
-        out[n] = limit if gave_up else best
         if gave_up:
-            for k in range(n_bins):
-                profile[n, k] = limit
+            no_bound(out, profile, n, limit)
+        else:
+            out[n] = best
+
+
+def march_ray(cx, cy, theta, side, reach, r, margin, edt, near_r, near_c, outside, limit):  # pragma: no cover
+    """The length (cells) of the ray of direction ``theta`` (rad) from the arc point of node
+    centre ``(cx, cy)`` on winding ``side`` (+1.0 or -1.0), for a sector of half-width
+    ``reach`` (rad, tolerance included); -1.0 where it proves nothing (its sector must split).
+
+    Grid units and arguments as in :func:`sight_rays`.
+    """
+    n_rows, n_cols = edt.shape
+    phi = theta - side * (math.pi / 2)
+    tx = cx + r * math.cos(phi)
+    ty = cy + r * math.sin(phi)
+    ux = math.cos(theta)
+    uy = math.sin(theta)
+    t = 0.0
+    while True:
+        e = (r + t) * reach
+        if e >= r - margin:
+            return -1.0  # past this the ray proves nothing: split its sector
+        x = tx + t * ux
+        y = ty + t * uy
+        col = math.floor(x)
+        row = math.floor(y)
+        if col < 0 or col >= n_cols or row < 0 or row >= n_rows:
+            return t if outside else limit
+        nr = near_r[row, col]
+        nc = near_c[row, col]
+        dx = max(nc - x, 0.0, x - (nc + 1))
+        dy = max(nr - y, 0.0, y - (nr + 1))
+        if math.sqrt(dx * dx + dy * dy) + e < r - margin:
+            return t
+        if t > limit:
+            return limit
+        t += max(edt[row, col] - math.sqrt(2.0) - r, 0.25)
+
+
+def mark_profile(profile, n, theta, reach, length):  # pragma: no cover
+    """Raise node ``n``'s ``profile`` to ``length`` (cells) in every direction bin that the
+    sector of direction ``theta`` and half-width ``reach`` (rad) overlaps."""
+    n_bins = profile.shape[1]
+    bin_width = 2.0 * math.pi / n_bins
+    b0 = math.floor((theta - reach) / bin_width)
+    b1 = math.floor((theta + reach) / bin_width)
+    for b in range(b0, b1 + 1):
+        k = b % n_bins
+        profile[n, k] = max(profile[n, k], length)
+
+
+def no_bound(out, profile, n, limit):  # pragma: no cover
+    """Node ``n`` gets no useful bound: ``limit`` (cells) overall and in every direction bin."""
+    out[n] = limit
+    for k in range(profile.shape[1]):
+        profile[n, k] = limit
 
 
 def node_sights(

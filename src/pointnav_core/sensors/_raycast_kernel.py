@@ -18,6 +18,10 @@ from pointnav_core.sensors.raycast import TOUCH_EPS
 __all__ = ["cast", "polygon_range"]
 
 _jit = numba.njit(cache=True, nogil=True, error_model="numpy")
+# A helper called edge by edge allocates nothing: it runs without numba's reference
+# counting of the arrays it is handed (_nrt=False; numba refuses to compile one that would
+# need it), which would otherwise cost atomic operations on every call.
+_edge_jit = numba.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
 _EPS = TOUCH_EPS
 _TINY = 1e-300  # raycast._TINY
 _INF = math.inf
@@ -180,26 +184,7 @@ def polygon_range(px, py, c, s, phi, edges, max_range, out):  # pragma: no cover
         ny = fy + tt * ey
         if nx * nx + ny * ny > far * far:
             continue
-        full = True
-        lo = hi = 0.0
-        gx2 = fx + ex
-        gy2 = fy + ey
-        # (Squared distances: no square roots.)
-        if (num0 * num0 >= _SPAN_MIN_DIST2 * ee and fx * fx + fy * fy >= _SPAN_MIN_END2
-                and gx2 * gx2 + gy2 * gy2 >= _SPAN_MIN_END2):
-            # Far enough from the edge's line and ends: a ray more than _SPAN_MARGIN
-            # outside the directions of its ends misses it by far more than
-            # rounding and TOUCH_EPS, so only the rays between them are tested.
-            pa = pseudo_angle(fy, fx)
-            pb = pseudo_angle(gy2, gx2)
-            width = pb - pa
-            if width > 2.0:
-                width -= 4.0
-            elif width < -2.0:
-                width += 4.0
-            lo = min(pa, pa + width) - _SPAN_MARGIN
-            hi = max(pa, pa + width) + _SPAN_MARGIN
-            full = False
+        full, lo, hi = edge_span(fx, fy, ex, ey, num0, ee)
         for wrap in range(3):  # the span, and its parts shifted by a full turn
             if full:
                 if wrap != 1:
@@ -213,25 +198,57 @@ def polygon_range(px, py, c, s, phi, edges, max_range, out):  # pragma: no cover
                     continue
                 k0 = np.searchsorted(sphi, a)
                 k1 = np.searchsorted(sphi, b, side="right")
-            for k in range(k0, k1):
-                r = order[k]
-                best = out[r]
-                dx = c[r]
-                dy = s[r]
-                cross = dx * ey - dy * ex
-                num = fx * ey - fy * ex
-                # Without dividing: t = num / cross surely negative (opposite signs,
-                # num far from underflow) or surely beyond best changes nothing.
-                if abs(num) > 1e-250 and (num < 0.0) != (cross < 0.0) and cross != 0.0:
-                    continue
-                if abs(num) > best * abs(cross) * (1.0 + 1e-12):
-                    continue
-                den = 1.0 / cross
-                t = num * den
-                if t >= 0.0 and t < best:
-                    u = (fx * dy - fy * dx) * den
-                    if abs(u - 0.5) <= edges[j, 8]:
-                        out[r] = t
+            edge_hits(fx, fy, ex, ey, edges[j, 8], c, s, order, k0, k1, out)
+
+
+@_jit
+def edge_span(fx, fy, ex, ey, num0, ee):  # pragma: no cover
+    # The pseudo-angles (lo, hi) of the rays an edge can meet, from an origin at -(fx, fy)
+    # from its first end (m), the edge (ex, ey) (m), num0 its cross product with (fx, fy)
+    # and ee its squared length: (full, lo, hi), full when every ray must be tested.
+    gx2 = fx + ex
+    gy2 = fy + ey
+    # (Squared distances: no square roots.)
+    if (num0 * num0 >= _SPAN_MIN_DIST2 * ee and fx * fx + fy * fy >= _SPAN_MIN_END2
+            and gx2 * gx2 + gy2 * gy2 >= _SPAN_MIN_END2):
+        # Far enough from the edge's line and ends: a ray more than _SPAN_MARGIN
+        # outside the directions of its ends misses it by far more than
+        # rounding and TOUCH_EPS, so only the rays between them are tested.
+        pa = pseudo_angle(fy, fx)
+        pb = pseudo_angle(gy2, gx2)
+        width = pb - pa
+        if width > 2.0:
+            width -= 4.0
+        elif width < -2.0:
+            width += 4.0
+        return False, min(pa, pa + width) - _SPAN_MARGIN, max(pa, pa + width) + _SPAN_MARGIN
+    return True, 0.0, 0.0
+
+
+@_edge_jit
+def edge_hits(fx, fy, ex, ey, half, c, s, order, k0, k1, out):  # pragma: no cover
+    # The rays order[k0:k1] (directions c, s) against one edge (fx, fy, ex, ey as in
+    # edge_span; half its |u - 1/2| slack, edge_table's last column): out[r], the ray's
+    # range so far (m), becomes the hit's range where it is nearer.
+    for k in range(k0, k1):
+        r = order[k]
+        best = out[r]
+        dx = c[r]
+        dy = s[r]
+        cross = dx * ey - dy * ex
+        num = fx * ey - fy * ex
+        # Without dividing: t = num / cross surely negative (opposite signs,
+        # num far from underflow) or surely beyond best changes nothing.
+        if abs(num) > 1e-250 and (num < 0.0) != (cross < 0.0) and cross != 0.0:
+            continue
+        if abs(num) > best * abs(cross) * (1.0 + 1e-12):
+            continue
+        den = 1.0 / cross
+        t = num * den
+        if t >= 0.0 and t < best:
+            u = (fx * dy - fy * dx) * den
+            if abs(u - 0.5) <= half:
+                out[r] = t
 
 
 @_jit

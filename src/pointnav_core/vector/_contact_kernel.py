@@ -17,6 +17,10 @@ import numpy as np
 __all__ = ["advance_worlds"]
 
 _jit = numba.njit(cache=True, nogil=True, error_model="numpy")
+# advance_worlds' steps. They allocate nothing, so they run without numba's reference
+# counting (_nrt=False; numba refuses to compile one that would need it): counting the
+# arrays they are handed, call by call, made the kernel twice as slow.
+_step = numba.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
 _INF = math.inf
 # The backend's tolerances (m), as in vector.contacts and vector.robots.
 _HIT = 0.5e-9
@@ -250,6 +254,8 @@ def advance_worlds(x, y, mx, my, slow, scene, radius, meta, edge, dr, dc, ok, se
     """
     n_worlds, n_robots = x.shape
     n_table = dr.shape[1]
+    # One world's slow robots, k = 0 .. n - 1: robot index, radius (m), position (m), start
+    # (m), chord (m), its length (m), contact flag.
     ids = np.empty(n_robots, np.int64)
     rad = np.empty(n_robots)
     px = np.empty(n_robots)
@@ -294,130 +300,168 @@ def advance_worlds(x, y, mx, my, slow, scene, radius, meta, edge, dr, dc, ok, se
             nwall[k] = 0
             if span[k] > 0.0:
                 n_moving += 1
-            # Its edge squares within reach of the whole chord, in row-major order.
-            s = scene[w, i]
-            off = int(meta[s, 0])
-            rows = int(meta[s, 1])
-            width = int(meta[s, 2])
-            ox = meta[s, 3]
-            oy = meta[s, 4]
-            res = meta[s, 5]
-            inv = meta[s, 6]
-            col = math.floor((px[k] - ox) * inv)
-            row = math.floor((py[k] - oy) * inv)
+            # Its walls within reach of the whole chord: edge squares, then polygon edges.
             reach = rad[k] + span[k] + 4.0 * _ACTIVE
-            # Off the map: no squares (its edge polygons, if any, still count).
-            for j in range(n_table if 0 <= col < width and 0 <= row < rows else 0):
-                if not ok[s, j]:
-                    break
-                wr = int(row) + dr[s, j]
-                wc = int(col) + dc[s, j]
-                if not (0 <= wr < rows and 0 <= wc < width) or not edge[off + wr * width + wc]:
-                    continue
-                wx0 = ox + wc * res
-                wy0 = oy + wr * res
-                if square_distance(px[k], py[k], wx0, wy0, wx0 + res, wy0 + res)[0] <= reach:
-                    m = nwall[k]
-                    wall[k, m, 0] = wx0
-                    wall[k, m, 1] = wy0
-                    wall[k, m, 2] = wx0 + res
-                    wall[k, m, 3] = wy0 + res
-                    wall[k, m, 7] = 0.0
-                    nwall[k] = m + 1
-            # Then the polygon edges within reach, in their order (the backend's walls()).
-            for q in range(seg_off[s], seg_off[s + 1]):
-                if segment_distance(px[k], py[k], seg[q, 0], seg[q, 1], seg[q, 4], seg[q, 5], seg[q, 6])[0] <= reach:
-                    m = nwall[k]
-                    for c in range(7):
-                        wall[k, m, c] = seg[q, c]
-                    wall[k, m, 7] = 1.0
-                    nwall[k] = m + 1
+            _square_walls(k, px[k], py[k], reach, scene[w, i], meta, edge, dr, dc, ok, wall, nwall)
+            _segment_walls(k, px[k], py[k], reach, scene[w, i], seg, seg_off, wall, nwall)
         if n_moving == 0:
             for k in range(n):
                 x_out[w, ids[k]] = px[k]
                 y_out[w, ids[k]] = py[k]
                 contact[w, ids[k]] = False
             continue
-        # The backend's pair list: not both still, within reach of each other.
-        for k in range(n):
-            pair[k, k] = False
-            for m in range(k + 1, n):
-                near = False
-                if span[k] > 0.0 or span[m] > 0.0:
-                    reach = rad[k] + rad[m] + span[k] + span[m] + 4.0 * _ACTIVE
-                    near = (px[k] - px[m]) ** 2 + (py[k] - py[m]) ** 2 < reach * reach
-                pair[k, m] = near
-                pair[m, k] = near
-        left = 1.0
-        _resolve(n, px, py, vx, vy, left, nwall, wall, pair, -1, -1, -1, rad, flag, cnx, cny, ckind, cforced)
-        for _ in range(_EVENTS_PER_ROBOT * n_moving):
-            # The first hit: walls robot by robot, then pairs; the first wins a tie.
-            t_first = left
-            ev_k = -1
-            ev_j = -1
-            ev_m = -1
-            for k in range(n):
-                if vx[k] == 0.0 and vy[k] == 0.0:
+        _pair_list(n, px, py, rad, span, pair)
+        _events(n, n_moving, px, py, vx, vy, rad, nwall, wall, pair, flag, cnx, cny, ckind, cforced)
+        _finish(w, n, ids, px, py, sx, sy, rad, flag, nwall, wall, x_out, y_out, contact)
+
+
+@_step
+def _square_walls(k, px, py, reach, s, meta, edge, dr, dc, ok, wall, nwall):  # pragma: no cover
+    # Robot k's edge squares of scene s within reach (m) of (px, py) (m), in row-major
+    # order, appended to its walls (wall[k], nwall[k]); meta, edge, dr, dc, ok as in
+    # advance_worlds. Off the map: none (its polygon edges, if any, still count).
+    off = int(meta[s, 0])
+    rows = int(meta[s, 1])
+    width = int(meta[s, 2])
+    ox = meta[s, 3]
+    oy = meta[s, 4]
+    res = meta[s, 5]
+    inv = meta[s, 6]
+    col = math.floor((px - ox) * inv)
+    row = math.floor((py - oy) * inv)
+    for j in range(dr.shape[1] if 0 <= col < width and 0 <= row < rows else 0):
+        if not ok[s, j]:
+            break
+        wr = int(row) + dr[s, j]
+        wc = int(col) + dc[s, j]
+        if not (0 <= wr < rows and 0 <= wc < width) or not edge[off + wr * width + wc]:
+            continue
+        wx0 = ox + wc * res
+        wy0 = oy + wr * res
+        if square_distance(px, py, wx0, wy0, wx0 + res, wy0 + res)[0] <= reach:
+            m = nwall[k]
+            wall[k, m, 0] = wx0
+            wall[k, m, 1] = wy0
+            wall[k, m, 2] = wx0 + res
+            wall[k, m, 3] = wy0 + res
+            wall[k, m, 7] = 0.0
+            nwall[k] = m + 1
+
+
+@_step
+def _segment_walls(k, px, py, reach, s, seg, seg_off, wall, nwall):  # pragma: no cover
+    # Robot k's polygon edges of scene s within reach (m) of (px, py) (m), in their order
+    # (the backend's walls()), appended to its walls.
+    for q in range(seg_off[s], seg_off[s + 1]):
+        if segment_distance(px, py, seg[q, 0], seg[q, 1], seg[q, 4], seg[q, 5], seg[q, 6])[0] <= reach:
+            m = nwall[k]
+            for c in range(7):
+                wall[k, m, c] = seg[q, c]
+            wall[k, m, 7] = 1.0
+            nwall[k] = m + 1
+
+
+@_step
+def _pair_list(n, px, py, rad, span, pair):  # pragma: no cover
+    # The backend's pair list into pair (n, n): two robots, not both still, within reach
+    # (m) of each other over the whole chord (span, m).
+    for k in range(n):
+        pair[k, k] = False
+        for m in range(k + 1, n):
+            near = False
+            if span[k] > 0.0 or span[m] > 0.0:
+                reach = rad[k] + rad[m] + span[k] + span[m] + 4.0 * _ACTIVE
+                near = (px[k] - px[m]) ** 2 + (py[k] - py[m]) ** 2 < reach * reach
+            pair[k, m] = near
+            pair[m, k] = near
+
+
+@_step
+def _first_event(n, px, py, vx, vy, rad, nwall, wall, pair, left):  # pragma: no cover
+    # The first hit within ``left`` of the step: walls robot by robot, then pairs; the
+    # first wins a tie. (t, k, j, m): robot k against its wall j (m = -1) or robot m
+    # (j = -1); k = -1 and t = left when none.
+    t_first = left
+    ev_k = -1
+    ev_j = -1
+    ev_m = -1
+    for k in range(n):
+        if vx[k] == 0.0 and vy[k] == 0.0:
+            continue
+        speed = math.sqrt(vx[k] * vx[k] + vy[k] * vy[k])
+        hit_w = _hit(rad[k])
+        for j in range(nwall[k]):
+            d, nx, ny = _wall_distance(wall, k, j, px[k], py[k])
+            if vx[k] * nx + vy[k] * ny >= 0.0 or d - hit_w > speed * left:
+                continue
+            t = _enter_wall(wall, k, j, px[k], py[k], vx[k], vy[k], hit_w)
+            if t < t_first:
+                t_first = t
+                ev_k = k
+                ev_j = j
+                ev_m = -1
+    for k in range(n):
+        for m in range(k + 1, n):
+            if not pair[k, m]:
+                continue
+            rvx = vx[k] - vx[m]
+            rvy = vy[k] - vy[m]
+            if rvx == 0.0 and rvy == 0.0:
+                continue
+            t = enter_disc(px[k], py[k], rvx, rvy, px[m], py[m], _hit(rad[k] + rad[m]))
+            if t < t_first:
+                if t == 0.0 and (px[k] - px[m]) * rvx + (py[k] - py[m]) * rvy >= 0.0:
                     continue
-                speed = math.sqrt(vx[k] * vx[k] + vy[k] * vy[k])
-                hit_w = _hit(rad[k])
-                for j in range(nwall[k]):
-                    d, nx, ny = _wall_distance(wall, k, j, px[k], py[k])
-                    if vx[k] * nx + vy[k] * ny >= 0.0 or d - hit_w > speed * left:
-                        continue
-                    t = _enter_wall(wall, k, j, px[k], py[k], vx[k], vy[k], hit_w)
-                    if t < t_first:
-                        t_first = t
-                        ev_k = k
-                        ev_j = j
-                        ev_m = -1
+                t_first = t
+                ev_k = k
+                ev_j = -1
+                ev_m = m
+    return t_first, ev_k, ev_j, ev_m
+
+
+@_step
+def _events(n, n_moving, px, py, vx, vy, rad, nwall, wall, pair, flag, cnx, cny, ckind, cforced):  # pragma: no cover
+    # One world's step: every robot follows its chord (vx, vy, m) at once; at each event
+    # the world moves to _PLACE short of touching and resolves its contacts (_resolve),
+    # for at most _EVENTS_PER_ROBOT events per moving robot. Moves px, py (m) in place.
+    left = 1.0
+    _resolve(n, px, py, vx, vy, left, nwall, wall, pair, -1, -1, -1, rad, flag, cnx, cny, ckind, cforced)
+    for _ in range(_EVENTS_PER_ROBOT * n_moving):
+        t_first, ev_k, ev_j, ev_m = _first_event(n, px, py, vx, vy, rad, nwall, wall, pair, left)
+        if ev_k < 0:
             for k in range(n):
-                for m in range(k + 1, n):
-                    if not pair[k, m]:
-                        continue
-                    rvx = vx[k] - vx[m]
-                    rvy = vy[k] - vy[m]
-                    if rvx == 0.0 and rvy == 0.0:
-                        continue
-                    t = enter_disc(px[k], py[k], rvx, rvy, px[m], py[m], _hit(rad[k] + rad[m]))
-                    if t < t_first:
-                        if t == 0.0 and (px[k] - px[m]) * rvx + (py[k] - py[m]) * rvy >= 0.0:
-                            continue
-                        t_first = t
-                        ev_k = k
-                        ev_j = -1
-                        ev_m = m
-            if ev_k < 0:
-                for k in range(n):
-                    px[k] = px[k] + vx[k] * left
-                    py[k] = py[k] + vy[k] * left
-                left = 0.0
-                break
-            k = ev_k
-            if ev_m < 0:
-                j = ev_j
-                place = _enter_wall(wall, k, j, px[k], py[k], vx[k], vy[k], rad[k] + _PLACE)
-            else:
-                m = ev_m
-                place = enter_disc(px[k], py[k], vx[k] - vx[m], vy[k] - vy[m], px[m], py[m], rad[k] + rad[m] + _PLACE)
-            step = min(max(place, 0.0), t_first)
-            for q in range(n):
-                px[q] = px[q] + vx[q] * step
-                py[q] = py[q] + vy[q] * step
-            left = left - step
-            _resolve(n, px, py, vx, vy, left, nwall, wall, pair, ev_k, ev_j, ev_m, rad, flag, cnx, cny, ckind, cforced)
-        # Safety net against rounding: never end deeper in a wall than at the start.
-        for k in range(n):
-            i = ids[k]
-            if flag[k] and (px[k] != sx[k] or py[k] != sy[k]):
-                depth_end = -_INF
-                depth_start = -_INF
-                for j in range(nwall[k]):
-                    depth_end = max(depth_end, rad[k] - _wall_distance(wall, k, j, px[k], py[k])[0])
-                    depth_start = max(depth_start, rad[k] - _wall_distance(wall, k, j, sx[k], sy[k])[0])
-                if depth_end > _HIT and depth_end > depth_start:
-                    px[k] = sx[k]
-                    py[k] = sy[k]
-            x_out[w, i] = px[k]
-            y_out[w, i] = py[k]
-            contact[w, i] = flag[k]
+                px[k] = px[k] + vx[k] * left
+                py[k] = py[k] + vy[k] * left
+            break
+        k = ev_k
+        if ev_m < 0:
+            place = _enter_wall(wall, k, ev_j, px[k], py[k], vx[k], vy[k], rad[k] + _PLACE)
+        else:
+            m = ev_m
+            place = enter_disc(px[k], py[k], vx[k] - vx[m], vy[k] - vy[m], px[m], py[m], rad[k] + rad[m] + _PLACE)
+        step = min(max(place, 0.0), t_first)
+        for q in range(n):
+            px[q] = px[q] + vx[q] * step
+            py[q] = py[q] + vy[q] * step
+        left = left - step
+        _resolve(n, px, py, vx, vy, left, nwall, wall, pair, ev_k, ev_j, ev_m, rad, flag, cnx, cny, ckind, cforced)
+
+
+@_step
+def _finish(w, n, ids, px, py, sx, sy, rad, flag, nwall, wall, x_out, y_out, contact):  # pragma: no cover
+    # Write world w's end positions (m) and contact flags, with the safety net against
+    # rounding: a robot never ends deeper in a wall than at its start (sx, sy).
+    for k in range(n):
+        i = ids[k]
+        if flag[k] and (px[k] != sx[k] or py[k] != sy[k]):
+            depth_end = -_INF
+            depth_start = -_INF
+            for j in range(nwall[k]):
+                depth_end = max(depth_end, rad[k] - _wall_distance(wall, k, j, px[k], py[k])[0])
+                depth_start = max(depth_start, rad[k] - _wall_distance(wall, k, j, sx[k], sy[k])[0])
+            if depth_end > _HIT and depth_end > depth_start:
+                px[k] = sx[k]
+                py[k] = sy[k]
+        x_out[w, i] = px[k]
+        y_out[w, i] = py[k]
+        contact[w, i] = flag[k]

@@ -32,6 +32,11 @@ _ACTIVE = 2.0e-9
 _EVENTS_PER_ROBOT = 8
 _CONTACTS = 6  # nearest walls that may be contacts while sliding, as in vector.contacts
 
+#: The geometry of a step, ``(W, ...)`` arrays: the walls ``x0, y0, x1, y1`` (m) and
+#: validity (W, R, K); the pair list (W, R, R); radii (m, (W, R)); contact distances
+#: ``r_i + r_j`` (m, (W, R, R)); hit radii against walls (W, R) and robots (W, R, R) (m).
+Geometry = tuple[Any, Any, Any, Any, Any, Any, Any, Any, Any, Any]
+
 
 def _hit_radius(radius: Any) -> Any:
     # A point robot is a disc of _HIT (the backend's _hit_radius), elementwise.
@@ -67,7 +72,6 @@ def advance_robots(
     """
     a = arrays
     xp = a.xp
-    inf = math.inf
     n_robots = x.shape[1]
     rad = xp.zeros_like(x) + radius  # (W, R)
     # The distance at which robots i and j touch: r_i + r_j, (W, R, R).
@@ -79,8 +83,6 @@ def advance_robots(
         walls = (far, far, far + 1.0, far + 1.0, far < 0.0)
     wx0, wy0, wx1, wy1, wvalid = walls
     wvalid = wvalid & present[..., None]
-    n_walls = wx0.shape[-1]
-    n_near = min(_CONTACTS, n_walls)
     start_x, start_y = x, y
     mx = xp.where(present, mx, 0.0 * mx)
     my = xp.where(present, my, 0.0 * my)
@@ -88,112 +90,119 @@ def advance_robots(
     moving = span > 0.0
     eye = a.arange(n_robots)
     upper = eye.reshape(1, -1, 1) < eye.reshape(1, 1, -1)
-    # The backend's pair list: robots on the floor, not both still, within reach of each other.
+    pair = _pair_list(xp, x, y, rsum, span, moving, present, upper)
+    geo = (wx0, wy0, wx1, wy1, wvalid, pair, rad, rsum, _hit_radius(rad), _hit_radius(rsum))
+    left = xp.ones_like(x[:, 0])
+    contact = xp.zeros_like(x) > 1.0
+    no_pair = xp.zeros_like(rsum) > 1.0
+    no_wall = xp.zeros_like(wx0) > 1.0
+    active = moving.any(-1)
+    x, y = x + 0.0, y + 0.0
+    mx, my, hit = _resolve(a, x, y, mx, my, no_pair, no_wall, left, active, geo)
+    contact = contact | hit
+    mx, my = mx + 0.0, my + 0.0
+    _events(a, x, y, mx, my, left, contact, ~active, _EVENTS_PER_ROBOT * moving.sum(-1), geo, upper)
+    return _safety_net(xp, x, y, start_x, start_y, geo, contact)
+
+
+def _take(xp: Any, v: Any, idx: Any) -> Any:
+    return take_along(xp, v, idx)[..., 0]
+
+
+def _pair_list(xp: Any, x: Any, y: Any, rsum: Any, span: Any, moving: Any, present: Any, upper: Any) -> Any:
+    """The backend's pair list (W, R, R), both ways: robots on the floor, not both still,
+    within reach (m) of each other over their chords (``span``, m)."""
     reach = rsum + span[:, :, None] + span[:, None, :] + 4.0 * _ACTIVE
     gap2 = (x[:, :, None] - x[:, None, :]) ** 2 + (y[:, :, None] - y[:, None, :]) ** 2
     pair = (
         upper & present[:, :, None] & present[:, None, :]
         & (moving[:, :, None] | moving[:, None, :]) & (gap2 < reach * reach)
     )
-    pair = pair | swap_last_two(xp, pair)
-    hit_w = _hit_radius(rad)
-    hit_r = _hit_radius(rsum)
-    left = xp.ones_like(x[:, 0])
-    contact = xp.zeros_like(x) > 1.0
-    no_pair = xp.zeros_like(gap2) > 1.0
-    no_wall = xp.zeros_like(wx0) > 1.0
-    wk = a.arange(n_walls)
+    return pair | swap_last_two(xp, pair)
 
-    def take(v: Any, idx: Any) -> Any:
-        return take_along(xp, v, idx)[..., 0]
 
-    def resolve(
-        x: Any, y: Any, mx: Any, my: Any, forced_p: Any, forced_w: Any, left: Any, active: Any, geo: tuple[Any, ...]
-    ) -> tuple[Any, Any, Any]:
-        # Every moving robot of an active world: slide along (or stop at) what it touches
-        # if its motion goes into it; contacts are its walls, then the other robots.
-        # The walls within _ACTIVE of touching are among the nearest few (a disc touches at
-        # most four squares): only those take part, in their original order.
-        wx0, wy0, wx1, wy1, wvalid, pair, rad, rsum, hit_w, hit_r = geo
-        wd = square_distance(xp, x[..., None], y[..., None], wx0, wy0, wx1, wy1)[0]
-        near = nearest(xp, xp.where(wvalid, wd, inf), n_near)
-        cx0, cy0, cx1, cy1, cvalid, forced_w = (take_along(xp, v, near) for v in (wx0, wy0, wx1, wy1, wvalid, forced_w))
-        wd, wnx, wny = square_distance(xp, x[..., None], y[..., None], cx0, cy0, cx1, cy1)
-        wtouch = cvalid & (wd <= rad[..., None] + _ACTIVE)
-        ex, ey = x[:, :, None] - x[:, None, :], y[:, :, None] - y[:, None, :]
-        dist = xp.sqrt(ex * ex + ey * ey)
-        ptouch = pair & (dist <= rsum + _ACTIVE)
-        safe = xp.where(dist > 0.0, dist, 1.0)
-        nx = cat(xp, [wnx, xp.where(dist > 0.0, ex / safe, 1.0)], -1)
-        ny = cat(xp, [wny, xp.where(dist > 0.0, ey / safe, 0.0)], -1)
-        touching = cat(xp, [wtouch, ptouch], -1)
-        forced = cat(xp, [forced_w, forced_p], -1)
-        px, py = x[:, :, None, None], y[:, :, None, None]
+def _resolve(
+    a: Arrays, x: Any, y: Any, mx: Any, my: Any, forced_p: Any, forced_w: Any, left: Any, active: Any, geo: Geometry
+) -> tuple[Any, Any, Any]:
+    """Every moving robot of an ``active`` world at ``(x, y)`` (m): slide along (or stop at)
+    what it touches if its chord ``(mx, my)`` (m) goes into it, for ``left`` of the step.
 
-        def blocks(tx: Any, ty: Any) -> Any:
-            # (W, R, T) motions of robot i against its contacts: (W, R, T, K + R).
-            into = tx[..., None] * nx[:, :, None, :] + ty[..., None] * ny[:, :, None, :] < 0.0
-            tw = enter_rounded_square(
-                xp, px, py, tx[..., None], ty[..., None], cx0[:, :, None, :], cy0[:, :, None, :],
-                cx1[:, :, None, :], cy1[:, :, None, :], hit_w[:, :, None, None],
-            )
-            tr = enter_disc(xp, px, py, tx[..., None], ty[..., None], x[:, None, None, :], y[:, None, None, :],
-                            hit_r[:, :, None, :])
-            t = cat(xp, [tw, tr], -1)
-            return touching[:, :, None, :] & into & (forced[:, :, None, :] | (t <= left[:, None, None, None]))
+    Contacts are its walls, then the other robots; a ``forced`` one (the event just
+    reached) blocks however shallow. The walls within ``_ACTIVE`` of touching are among the
+    nearest few (a disc touches at most four squares): only those take part, in their
+    original order. Returns the new chords (m) and whether each robot was blocked or blocked
+    one.
+    """
+    xp = a.xp
+    inf = math.inf
+    wx0, wy0, wx1, wy1, wvalid, pair, rad, rsum, hit_w, hit_r = geo
+    n_robots = x.shape[1]
+    n_near = min(_CONTACTS, wx0.shape[-1])
+    wd = square_distance(xp, x[..., None], y[..., None], wx0, wy0, wx1, wy1)[0]
+    near = nearest(xp, xp.where(wvalid, wd, inf), n_near)
+    cx0, cy0, cx1, cy1, cvalid, forced_w = (take_along(xp, v, near) for v in (wx0, wy0, wx1, wy1, wvalid, forced_w))
+    wd, wnx, wny = square_distance(xp, x[..., None], y[..., None], cx0, cy0, cx1, cy1)
+    wtouch = cvalid & (wd <= rad[..., None] + _ACTIVE)
+    ex, ey = x[:, :, None] - x[:, None, :], y[:, :, None] - y[:, None, :]
+    dist = xp.sqrt(ex * ex + ey * ey)
+    ptouch = pair & (dist <= rsum + _ACTIVE)
+    safe = xp.where(dist > 0.0, dist, 1.0)
+    nx = cat(xp, [wnx, xp.where(dist > 0.0, ex / safe, 1.0)], -1)
+    ny = cat(xp, [wny, xp.where(dist > 0.0, ey / safe, 0.0)], -1)
+    touching = cat(xp, [wtouch, ptouch], -1)
+    forced = cat(xp, [forced_w, forced_p], -1)
+    px, py = x[:, :, None, None], y[:, :, None, None]
 
-        go = ((mx != 0.0) | (my != 0.0)) & active[:, None]
-        blocked = blocks(mx[..., None], my[..., None])[:, :, 0, :] & go[..., None]
-        any_blocked = blocked.any(-1)
-        hit = any_blocked | blocked[..., n_near:].any(1)  # the robot it ran into too
-        dot = mx[..., None] * nx + my[..., None] * ny
-        tx, ty = mx[..., None] - dot * nx, my[..., None] - dot * ny
-        length = tx * tx + ty * ty
-        bad = blocks(tx, ty)
-        ck = a.arange(n_near + n_robots)
-        bad = bad & (ck.reshape(1, 1, -1, 1) != ck.reshape(1, 1, 1, -1))  # along its own contact
-        ok = touching & ~bad.any(-1) & (length > 0.0)
-        score = xp.where(ok, length, -1.0)
-        best = xp.argmax(score, -1)[..., None]
-        has = take(score, best) > 0.0
-        sx, sy = xp.where(has, take(tx, best), 0.0), xp.where(has, take(ty, best), 0.0)
-        return xp.where(any_blocked, sx, mx), xp.where(any_blocked, sy, my), hit
+    def blocks(tx: Any, ty: Any) -> Any:
+        # (W, R, T) motions of robot i against its contacts: (W, R, T, K + R).
+        into = tx[..., None] * nx[:, :, None, :] + ty[..., None] * ny[:, :, None, :] < 0.0
+        tw = enter_rounded_square(
+            xp, px, py, tx[..., None], ty[..., None], cx0[:, :, None, :], cy0[:, :, None, :],
+            cx1[:, :, None, :], cy1[:, :, None, :], hit_w[:, :, None, None],
+        )
+        tr = enter_disc(xp, px, py, tx[..., None], ty[..., None], x[:, None, None, :], y[:, None, None, :],
+                        hit_r[:, :, None, :])
+        t = cat(xp, [tw, tr], -1)
+        return touching[:, :, None, :] & into & (forced[:, :, None, :] | (t <= left[:, None, None, None]))
 
-    active = moving.any(-1)
-    x, y = x + 0.0, y + 0.0
-    mx, my, hit = resolve(x, y, mx, my, no_pair, no_wall, left, active,
-                          (wx0, wy0, wx1, wy1, wvalid, pair, rad, rsum, hit_w, hit_r))
-    contact = contact | hit
-    done = ~active
-    mx, my = mx + 0.0, my + 0.0
-    budget = _EVENTS_PER_ROBOT * moving.sum(-1)
-    for k in range(_EVENTS_PER_ROBOT * n_robots):
+    go = ((mx != 0.0) | (my != 0.0)) & active[:, None]
+    blocked = blocks(mx[..., None], my[..., None])[:, :, 0, :] & go[..., None]
+    any_blocked = blocked.any(-1)
+    hit = any_blocked | blocked[..., n_near:].any(1)  # the robot it ran into too
+    dot = mx[..., None] * nx + my[..., None] * ny
+    tx, ty = mx[..., None] - dot * nx, my[..., None] - dot * ny
+    length = tx * tx + ty * ty
+    bad = blocks(tx, ty)
+    ck = a.arange(n_near + n_robots)
+    bad = bad & (ck.reshape(1, 1, -1, 1) != ck.reshape(1, 1, 1, -1))  # along its own contact
+    ok = touching & ~bad.any(-1) & (length > 0.0)
+    score = xp.where(ok, length, -1.0)
+    best = xp.argmax(score, -1)[..., None]
+    has = _take(xp, score, best) > 0.0
+    sx, sy = xp.where(has, _take(xp, tx, best), 0.0), xp.where(has, _take(xp, ty, best), 0.0)
+    return xp.where(any_blocked, sx, mx), xp.where(any_blocked, sy, my), hit
+
+
+def _events(
+    a: Arrays, x: Any, y: Any, mx: Any, my: Any, left: Any, contact: Any, done: Any, budget: Any, geo: Geometry,
+    upper: Any,
+) -> None:
+    """Every world's events, round by round, each world on its own clock: in place, the
+    positions ``x, y`` (m), chords ``mx, my`` (m), time ``left``, ``contact`` flags and
+    ``done``, for at most ``budget`` (W,) events per world.
+
+    Only the worlds still under way take part in a round: the Python loop is over rounds,
+    never over worlds or robots.
+    """
+    xp = a.xp
+    for k in range(_EVENTS_PER_ROBOT * x.shape[1]):
         live = ~done & (budget > k)
         if not a.any(live):
             break
-        # Only the worlds still under way take part in the round.
         sel = a.nonzero(live)
-        n = sel.shape[0]
-        rows = a.arange(n)
-        geo = tuple(v[sel] for v in (wx0, wy0, wx1, wy1, wvalid, pair, rad, rsum, hit_w, hit_r))
-        gx0, gy0, gx1, gy1, gvalid, gpair, grad, grsum, ghit_w, ghit_r = geo
+        sub = tuple(v[sel] for v in geo)
         sx, sy, smx, smy, sleft = x[sel], y[sel], mx[sel], my[sel], left[sel]
-        # Wall events, robot by robot and wall by wall, then pair events: the first wins a tie.
-        wd, wnx, wny = square_distance(xp, sx[..., None], sy[..., None], gx0, gy0, gx1, gy1)
-        speed = xp.sqrt(smx * smx + smy * smy)
-        towards = gvalid & (smx[..., None] * wnx + smy[..., None] * wny < 0.0)
-        towards = towards & ~(wd - ghit_w[..., None] > (speed * sleft[:, None])[..., None])
-        tw = enter_rounded_square(xp, sx[..., None], sy[..., None], smx[..., None], smy[..., None], gx0, gy0, gx1, gy1,
-                                  ghit_w[..., None])
-        tw = xp.where(towards, tw, inf)
-        vx = smx[:, :, None] - smx[:, None, :]
-        vy = smy[:, :, None] - smy[:, None, :]
-        tp = enter_disc(xp, sx[:, :, None], sy[:, :, None], vx, vy, sx[:, None, :], sy[:, None, :], ghit_r)
-        apart = (sx[:, :, None] - sx[:, None, :]) * vx + (sy[:, :, None] - sy[:, None, :]) * vy >= 0.0
-        tp = xp.where(gpair & upper & ((vx != 0.0) | (vy != 0.0)) & ~((tp == 0.0) & apart), tp, inf)
-        flat = cat(xp, [tw.reshape(n, -1), tp.reshape(n, -1)], -1)
-        first = xp.argmin(flat, -1)
-        t_first = take(flat, first[:, None])
+        first, t_first = _first_event(xp, sx, sy, smx, smy, sleft, sub, upper)
         event = t_first < sleft
         free = ~event
         sx = xp.where(free[:, None], sx + smx * sleft[:, None], sx)
@@ -201,39 +210,86 @@ def advance_robots(
         sleft = xp.where(free, xp.zeros_like(sleft), sleft)
         done[sel] = free
         if a.any(event):
-            is_wall = first < n_robots * n_walls
-            fw = xp.where(is_wall, first, 0)
-            wi, wkk = fw // max(n_walls, 1), fw % max(n_walls, 1)
-            fp = xp.where(is_wall, 0, first - n_robots * n_walls)
-            i, j = xp.where(is_wall, wi, fp // n_robots), fp % n_robots
-            ex0, ey0, ex1, ey1 = (v[rows, wi, wkk] for v in (gx0, gy0, gx1, gy1))
-            place_w = enter_rounded_square(
-                xp, sx[rows, wi], sy[rows, wi], smx[rows, wi], smy[rows, wi], ex0, ey0, ex1, ey1, grad[rows, wi] + _PLACE
-            )
-            place_p = enter_disc(
-                xp, sx[rows, i], sy[rows, i], smx[rows, i] - smx[rows, j], smy[rows, i] - smy[rows, j],
-                sx[rows, j], sy[rows, j], grsum[rows, i, j] + _PLACE,
-            )
-            place = xp.where(is_wall, place_w, place_p)
-            step = xp.minimum(xp.maximum(place, xp.zeros_like(place)), t_first)
-            step = xp.where(event, step, xp.zeros_like(step))
-            sx, sy = sx + smx * step[:, None], sy + smy * step[:, None]
-            sleft = sleft - step
-            ii, jj = eye.reshape(1, -1, 1), eye.reshape(1, 1, -1)
-            pe = (event & ~is_wall)[:, None, None]
-            forced_p = pe & (
-                ((ii == i[:, None, None]) & (jj == j[:, None, None]))
-                | ((ii == j[:, None, None]) & (jj == i[:, None, None]))
-            )
-            we = (event & is_wall)[:, None, None]
-            forced_w = we & (ii == wi[:, None, None]) & (wk.reshape(1, 1, -1) == wkk[:, None, None])
-            nmx, nmy, hit = resolve(sx, sy, smx, smy, forced_p, forced_w, sleft, event, geo)
+            sx, sy, sleft, nmx, nmy, hit = _meet(a, sx, sy, smx, smy, sleft, first, t_first, event, sub)
             mx[sel], my[sel] = xp.where(event[:, None], nmx, smx), xp.where(event[:, None], nmy, smy)
             contact[sel] = contact[sel] | (hit & event[:, None])
         x[sel], y[sel], left[sel] = sx, sy, sleft
         if not a.any(event):
             break
-    # Safety net against rounding: never end deeper in a wall than at the start.
+
+
+def _first_event(xp: Any, x: Any, y: Any, mx: Any, my: Any, left: Any, geo: Geometry, upper: Any) -> tuple[Any, Any]:
+    """Each world's first event within ``left`` of the step: its flat index (walls robot by
+    robot and wall by wall, then pairs; the first wins a tie) and its time (inf if none)."""
+    inf = math.inf
+    wx0, wy0, wx1, wy1, wvalid, pair, _, _, hit_w, hit_r = geo
+    n = x.shape[0]
+    wd, wnx, wny = square_distance(xp, x[..., None], y[..., None], wx0, wy0, wx1, wy1)
+    speed = xp.sqrt(mx * mx + my * my)
+    towards = wvalid & (mx[..., None] * wnx + my[..., None] * wny < 0.0)
+    towards = towards & ~(wd - hit_w[..., None] > (speed * left[:, None])[..., None])
+    tw = enter_rounded_square(xp, x[..., None], y[..., None], mx[..., None], my[..., None], wx0, wy0, wx1, wy1,
+                              hit_w[..., None])
+    tw = xp.where(towards, tw, inf)
+    vx = mx[:, :, None] - mx[:, None, :]
+    vy = my[:, :, None] - my[:, None, :]
+    tp = enter_disc(xp, x[:, :, None], y[:, :, None], vx, vy, x[:, None, :], y[:, None, :], hit_r)
+    apart = (x[:, :, None] - x[:, None, :]) * vx + (y[:, :, None] - y[:, None, :]) * vy >= 0.0
+    tp = xp.where(pair & upper & ((vx != 0.0) | (vy != 0.0)) & ~((tp == 0.0) & apart), tp, inf)
+    flat = cat(xp, [tw.reshape(n, -1), tp.reshape(n, -1)], -1)
+    first = xp.argmin(flat, -1)
+    return first, _take(xp, flat, first[:, None])
+
+
+def _meet(
+    a: Arrays, x: Any, y: Any, mx: Any, my: Any, left: Any, first: Any, t_first: Any, event: Any, geo: Geometry
+) -> tuple[Any, Any, Any, Any, Any, Any]:
+    """Move every world with an ``event`` to ``_PLACE`` (m) short of its first contact
+    (``first``, at ``t_first``) and resolve its robots' contacts there, that one forced.
+
+    Returns the positions (m), the time left, the new chords (m) and the robots blocked.
+    """
+    xp = a.xp
+    wx0, wy0, wx1, wy1, _, _, rad, rsum, _, _ = geo
+    n, n_robots, n_walls = wx0.shape
+    rows = a.arange(n)
+    is_wall = first < n_robots * n_walls
+    fw = xp.where(is_wall, first, 0)
+    wi, wkk = fw // max(n_walls, 1), fw % max(n_walls, 1)
+    fp = xp.where(is_wall, 0, first - n_robots * n_walls)
+    i, j = xp.where(is_wall, wi, fp // n_robots), fp % n_robots
+    ex0, ey0, ex1, ey1 = (v[rows, wi, wkk] for v in (wx0, wy0, wx1, wy1))
+    place_w = enter_rounded_square(
+        xp, x[rows, wi], y[rows, wi], mx[rows, wi], my[rows, wi], ex0, ey0, ex1, ey1, rad[rows, wi] + _PLACE
+    )
+    place_p = enter_disc(
+        xp, x[rows, i], y[rows, i], mx[rows, i] - mx[rows, j], my[rows, i] - my[rows, j],
+        x[rows, j], y[rows, j], rsum[rows, i, j] + _PLACE,
+    )
+    place = xp.where(is_wall, place_w, place_p)
+    step = xp.minimum(xp.maximum(place, xp.zeros_like(place)), t_first)
+    step = xp.where(event, step, xp.zeros_like(step))
+    x, y = x + mx * step[:, None], y + my * step[:, None]
+    left = left - step
+    eye = a.arange(n_robots)
+    ii, jj = eye.reshape(1, -1, 1), eye.reshape(1, 1, -1)
+    pe = (event & ~is_wall)[:, None, None]
+    forced_p = pe & (
+        ((ii == i[:, None, None]) & (jj == j[:, None, None]))
+        | ((ii == j[:, None, None]) & (jj == i[:, None, None]))
+    )
+    we = (event & is_wall)[:, None, None]
+    forced_w = we & (ii == wi[:, None, None]) & (a.arange(n_walls).reshape(1, 1, -1) == wkk[:, None, None])
+    mx, my, hit = _resolve(a, x, y, mx, my, forced_p, forced_w, left, event, geo)
+    return x, y, left, mx, my, hit
+
+
+def _safety_net(xp: Any, x: Any, y: Any, start_x: Any, start_y: Any, geo: Geometry, contact: Any) -> tuple[Any, Any, Any]:
+    """Against rounding: a robot in contact never ends deeper in a wall than at its start
+    ``(start_x, start_y)`` (m); such a robot stays there. Returns the end positions (m) and
+    ``contact``."""
+    inf = math.inf
+    wx0, wy0, wx1, wy1, wvalid, _, rad, _, _, _ = geo
     d_end = square_distance(xp, x[..., None], y[..., None], wx0, wy0, wx1, wy1)[0]
     d_start = square_distance(xp, start_x[..., None], start_y[..., None], wx0, wy0, wx1, wy1)[0]
     depth_end = xp.amax(xp.where(wvalid, rad[..., None] - d_end, -inf), -1)
