@@ -10,11 +10,6 @@ from pathlib import Path
 SRC = Path(__file__).resolve().parents[1] / "src"
 MAX_MODULE_LINES = 500
 MAX_FUNCTION_LINES = 80
-# Functions still over the limit while they are being split, as "path/to/module.py:name";
-# this list only ever shrinks.
-ALLOWED_LONG_FUNCTIONS = {
-    "pointnav_core/task/sampling.py:sample_episode",
-}
 
 
 def _modules() -> list[Path]:
@@ -49,18 +44,8 @@ def test_no_function_is_over_80_lines():
     long = {}
     for path in _modules():
         for name, n in _long_functions(path):
-            key = f"{path.relative_to(SRC).as_posix()}:{name}"
-            if key not in ALLOWED_LONG_FUNCTIONS:
-                long[key] = n
+            long[f"{path.relative_to(SRC).as_posix()}:{name}"] = n
     assert not long, long
-
-
-def test_the_allow_list_names_only_long_functions():
-    # An entry whose function got short (or went) must leave the list.
-    long = {
-        f"{path.relative_to(SRC).as_posix()}:{name}" for path in _modules() for name, _ in _long_functions(path)
-    }
-    assert ALLOWED_LONG_FUNCTIONS <= long, ALLOWED_LONG_FUNCTIONS - long
 
 
 def test_the_check_catches_a_long_function(tmp_path):

@@ -100,22 +100,7 @@ def sample_episode(
         failures[constraint] = failures.get(constraint, 0) + 1
 
     for _ in range(1 if both_fixed else max_trials):
-        if initial_pos is not None:
-            sx, sy = initial_pos
-        else:
-            _, point = scene.get_random_point(
-                floor=floor,
-                reference_point=goal_pos,
-                robot=spec,
-                rng=rng,
-                max_distance=None if goal_pos is None else reach,
-            )
-            sx, sy = float(point[0]), float(point[1])
-        if initial_quat is not None:
-            quat = initial_quat
-        else:
-            half = 0.5 * float(rng.uniform(0.0, _TWO_PI))
-            quat = (0.0, 0.0, math.sin(half), math.cos(half))
+        sx, sy, quat = _start_pose(scene, rng, floor, spec, initial_pos, initial_quat, goal_pos, reach)
         # Land first: validity is checked on the robot's floor, and other robots that are
         # already placed (multi-robot resets place robots one by one) count.
         backend.land(robot_idn, floor, (sx, sy, floor_height), quat)
@@ -140,11 +125,9 @@ def sample_episode(
         if not both_fixed and math.hypot(gx - sx, gy - sy) < goal_tolerance:
             fail(f"the goal must be at least goal_tolerance ({goal_tolerance} m) from the start")
             continue
-        if goal_constraint is not None and goal_pos is None:
-            broken = goal_constraint(gx, gy)
-            if broken is not None:
-                fail(broken)
-                continue
+        if goal_constraint is not None and goal_pos is None and (broken := goal_constraint(gx, gy)) is not None:
+            fail(broken)
+            continue
         # A new goal costs only its graph solve here; the per-cell table is built on the
         # episode's first lookup, for the goal kept.
         field = fixed_field if fixed_field is not None else scene.goal_field(floor, (gx, gy), robot=spec)
@@ -153,12 +136,43 @@ def sample_episode(
             fail(f"the geodesic must lie in path_range {path_range} m")
             continue
         return Episode((sx, sy), tuple(quat), (gx, gy), field, geodesic)  # type: ignore[arg-type]
+    raise _exhausted(failures, robot_idn, floor, max_trials)
+
+
+def _exhausted(failures: dict[str, int], robot_idn: int, floor: int, max_trials: int) -> SamplingError:
+    """The error after ``max_trials`` rejections: the constraint that failed most, and every count."""
     worst = max(failures, key=failures.__getitem__)
     detail = "; ".join(f"{c}: failed {n} time(s)" for c, n in failures.items())
-    raise SamplingError(
+    return SamplingError(
         f"could not sample an episode for robot {robot_idn} on floor {floor} in {max_trials} "
         f"trials: {worst} ({detail})"
     )
+
+
+def _start_pose(
+    scene: Any,
+    rng: Any,
+    floor: int,
+    spec: Any,
+    initial_pos: tuple[float, float] | None,
+    initial_quat: tuple[float, float, float, float] | None,
+    goal_pos: tuple[float, float] | None,
+    reach: float | None,
+) -> tuple[float, float, tuple[float, float, float, float]]:
+    """One trial's start ``(x, y)`` (m) and orientation ``(x, y, z, w)``: the fixed ones, or
+    drawn (a start within ``reach`` m of a fixed goal, a uniform heading)."""
+    if initial_pos is not None:
+        sx, sy = initial_pos
+    else:
+        _, point = scene.get_random_point(
+            floor=floor, reference_point=goal_pos, robot=spec, rng=rng,
+            max_distance=None if goal_pos is None else reach,
+        )
+        sx, sy = float(point[0]), float(point[1])
+    if initial_quat is not None:
+        return sx, sy, initial_quat
+    half = 0.5 * float(rng.uniform(0.0, _TWO_PI))
+    return sx, sy, (0.0, 0.0, math.sin(half), math.cos(half))
 
 
 def sample_task_episode(
