@@ -148,7 +148,8 @@ def cell_roots(field: GoalField, cells: NDArray[np.int64]) -> tuple[NDArray[np.i
     rows, cols = np.divmod(cells, geo.shape[1])
     xs = geo.origin[0] + (cols + 0.5) * geo.resolution
     ys = geo.origin[1] + (rows + 0.5) * geo.resolution
-    clear = np.flatnonzero(geo.points_clear(np.stack([xs, ys], axis=1), p.radius))
+    # The planner's usable mask is this same exact test at these same centres, made once.
+    clear = np.flatnonzero(p.usable.ravel()[cells])
     tables = field.arc_tables() if p.n_nodes else None
     if tables is not None and compiled(p, "best_links") is not None:
         links = p.cell_links(build=False)
