@@ -20,11 +20,9 @@ from hypothesis import strategies as st
 from hypothesis.stateful import RuleBasedStateMachine, initialize, invariant, rule
 
 from pointnav_core.backends.protocol import available_backends
-from pointnav_core.envs.multi_pointnav import (
-    FINISHED_MODES,
-    STATE_FIELDS,
-    MultiPointNavEnv,
-)
+from pointnav_core.envs._multi_state import STATE_FIELDS
+from pointnav_core.envs.fleet import FINISHED_MODES
+from pointnav_core.envs.multi_pointnav import MultiPointNavEnv
 from pointnav_core.task import TaskStateError
 from pointnav_core.testing.strategies import (
     nav_robot_specs,

@@ -17,6 +17,7 @@ from pointnav_core import scenes
 from pointnav_core.backends.protocol import available_backends
 from pointnav_core.backends.robot_spec import RobotSpec
 from pointnav_core.envs import multi_pointnav as parallel
+from pointnav_core.envs._multi_state import STATE_FIELDS
 from pointnav_core.envs.multi_pointnav import MultiPointNavEnv
 from pointnav_core.envs.registration import AEC_ENV_IDS, PARALLEL_ENV_IDS, register_envs
 from pointnav_core.errors import SamplingError
@@ -294,7 +295,7 @@ def test_state_holds_every_robots_pose_goal_and_activity():
     state = env.state()
     assert state.shape == env.state_space.shape == (8 * 3,) and state.dtype == np.float32
     assert env.state_space.contains(state)
-    rows = state.reshape(3, len(parallel.STATE_FIELDS))
+    rows = state.reshape(3, len(STATE_FIELDS))
     for i, row in enumerate(rows):
         x, y = xy(env, i)
         np.testing.assert_allclose(row[:2], (x, y), atol=1e-5)

@@ -7,11 +7,7 @@ Registered as ``"pymunk"`` in the entry-point group ``pointnav_core.backends``:
 True
 """
 
-from pointnav_pymunk.backend import (
-    CONTACT_SLOP,
-    OVERLAP_TOLERANCE,
-    TOUCH_TOLERANCE,
-    PymunkBackend,
-)
+from pointnav_pymunk.backend import OVERLAP_TOLERANCE, PymunkBackend
+from pointnav_pymunk.floor import CONTACT_SLOP, TOUCH_TOLERANCE
 
 __all__ = ["CONTACT_SLOP", "OVERLAP_TOLERANCE", "TOUCH_TOLERANCE", "PymunkBackend"]

@@ -23,13 +23,12 @@ from pointnav_core.floor.maps import VOID
 from pointnav_pymunk.floor import (
     _ROBOT,
     _WALL_SKIN,
-    CONTACT_SLOP,
     TOUCH_TOLERANCE,
     _Floor,
 )
 from pointnav_pymunk.velocity import closest_feasible
 
-__all__ = ["CONTACT_SLOP", "OVERLAP_TOLERANCE", "TOUCH_TOLERANCE", "PymunkBackend"]
+__all__ = ["OVERLAP_TOLERANCE", "PymunkBackend"]
 
 #: Largest overlap (m) with an obstacle or another robot that a robot may have at the end
 #: of a control step (the conformance kit's bound). In practice a robot ends clear of the

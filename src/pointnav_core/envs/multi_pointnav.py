@@ -188,10 +188,9 @@ from pointnav_core.backends.protocol import Backend, make_backend
 from pointnav_core.backends.robot_spec import RobotSpec
 from pointnav_core.envs import _multi_actions, _multi_agents
 from pointnav_core.envs import common as _envcommon
-from pointnav_core.envs._multi_state import STATE_FIELDS, global_state, state_space
+from pointnav_core.envs._multi_state import global_state, state_space
 from pointnav_core.envs.config import EnvConfig, multi_robot_arguments, takes_config
 from pointnav_core.envs.fleet import (
-    FINISHED_MODES,
     check_finished,
     check_fixed_positions,
     derived_path_ranges,
@@ -206,7 +205,7 @@ from pointnav_core.task import TaskStateError
 from pointnav_core.task.actions import make_discrete_actions
 from pointnav_core.utils import validation
 
-__all__ = ["FINISHED_MODES", "STATE_FIELDS", "MultiPointNavEnv", "env", "parallel_env", "raw_env"]
+__all__ = ["MultiPointNavEnv", "env", "parallel_env", "raw_env"]
 
 
 class MultiPointNavEnv(ParallelEnv[str, Any, np.ndarray]):

@@ -45,7 +45,7 @@ from pointnav_core.geodesic.paths import resample_path
 from pointnav_core.scenes.goal_field import FloorGoalField, as_xy
 from pointnav_core.utils import validation
 
-__all__ = ["Scene", "robot_radius", "rooms", "maze", "clutter"]
+__all__ = ["Scene", "robot_radius"]
 
 
 def robot_radius(robot: Any) -> float:
@@ -441,8 +441,3 @@ class Scene:
 
     def __repr__(self) -> str:
         return f"Scene(n_floors={self.n_floors}, floors={self.floors!r})"
-
-
-# The generators name their scenes as datasets do (a module of their own, imported last:
-# they build Scenes).
-from pointnav_core.scenes.generated import clutter, maze, rooms

@@ -45,15 +45,14 @@ from typing import Any, ClassVar
 from numpy.typing import ArrayLike
 
 from pointnav_core.backends.protocol import float_twin
-from pointnav_core.errors import ArgumentError, TaskStateError
+from pointnav_core.errors import ArgumentError
 from pointnav_core.task.config import (
-    REWARD_TYPES,
     TaskConfig,
     compose_terms,
     merge_config,
 )
 from pointnav_core.task.episode_state import EpisodeState
-from pointnav_core.task.lifecycle import IDLE, TaskState, allows, move
+from pointnav_core.task.lifecycle import IDLE, allows, move
 from pointnav_core.task.lifecycle import Event as _Event
 from pointnav_core.task.markers import TaskMarkers
 from pointnav_core.task.observations import (
@@ -80,14 +79,7 @@ from pointnav_core.task.terminations import (
 )
 from pointnav_core.utils.frozen import FrozenMapping
 
-__all__ = [
-    "REWARD_TYPES",
-    "PointNavigationTask",
-    "TaskConfig",
-    "TaskEnv",
-    "TaskState",
-    "TaskStateError",
-]
+__all__ = ["PointNavigationTask"]
 
 
 class PointNavigationTask(OmniGibsonTaskAPI):

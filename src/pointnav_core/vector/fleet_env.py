@@ -27,7 +27,7 @@ import numpy as np
 
 from pointnav_core import scenes
 from pointnav_core.envs.config import EnvConfig, takes_config, vector_fleet_arguments
-from pointnav_core.envs.fleet import FINISHED_MODES, check_finished
+from pointnav_core.envs.fleet import check_finished
 from pointnav_core.errors import ArgumentError, TaskStateError
 from pointnav_core.utils import validation
 from pointnav_core.vector import contacts_jit
@@ -59,7 +59,7 @@ from pointnav_core.vector.scan import requested_scan
 from pointnav_core.vector.state import Motion
 from pointnav_core.vector.xp import amax, as_dtype, copy, make_arrays
 
-__all__ = ["FINISHED_MODES", "VectorFleetEnv"]
+__all__ = ["VectorFleetEnv"]
 
 
 class VectorFleetEnv(VectorPointNavEnv):
