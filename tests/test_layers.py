@@ -1,4 +1,5 @@
-"""The packages import one way: the layer picture in docs/architecture.md against the code.
+"""The packages import one way: the layer picture in docs/architecture.md against the code;
+and each name has one home (a module's ``__all__`` lists only what it defines).
 
 Every import in ``src/pointnav_core`` (module-level, function-level and ``TYPE_CHECKING``
 ones alike) is read with ``ast`` and mapped to its package; an import may go to its own
@@ -103,3 +104,35 @@ def test_a_wrong_picture_is_caught(picture, expect):
     text = f"<!-- layers: read by tests/test_layers.py -->\n```text\n{picture}\n```\n"
     found = violations(picture_layers(text))
     assert any(expect in v for v in found), found
+
+
+def _re_exports(path: Path) -> list[str]:
+    """Names a module's ``__all__`` lists that the module does not define itself."""
+    tree = ast.parse(path.read_text(encoding="utf-8"))
+    defined = set()
+    for node in tree.body:
+        if isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef, ast.ClassDef)):
+            defined.add(node.name)
+        elif isinstance(node, (ast.Assign, ast.AnnAssign)):
+            targets = node.targets if isinstance(node, ast.Assign) else [node.target]
+            defined.update(n.id for t in targets for n in ast.walk(t) if isinstance(n, ast.Name))
+    listed = [
+        ast.literal_eval(node.value)
+        for node in tree.body
+        if isinstance(node, ast.Assign) and any(getattr(t, "id", "") == "__all__" for t in node.targets)
+    ]
+    return sorted(set(listed[0]) - defined) if listed else []
+
+
+def test_no_module_re_exports_another_modules_names():
+    # A package's __init__ is its API and gathers names; any other module lists only what
+    # it defines, so that each name has one home (no compatibility re-exports).
+    src = ROOT / "src"
+    found = {str(p.relative_to(src)): names for p in src.rglob("*.py") if p.name != "__init__.py" and (names := _re_exports(p))}
+    assert found == {}
+
+
+def test_a_re_export_is_caught(tmp_path):
+    module = tmp_path / "m.py"
+    module.write_text("from os import sep\nX = 1\n\ndef f():\n    pass\n\n__all__ = ['X', 'f', 'sep']\n")
+    assert _re_exports(module) == ["sep"]
