@@ -13,6 +13,7 @@ Each check takes ``plain_paths``, the context its plain side runs in (``numpy_pa
 - Larger floors (20-60 cells a side, random boxes and long walls with slits, radius/cell from
   0.3 to 5, 0.05-0.5 m per cell): the compiled goal search equals scipy's, the compiled point
   links the numpy ones, and the compiled exact query the one-point search.
+- ``ArcTables`` (the labels grouped by arc) equal, array for array, compiled and not.
 """
 
 from __future__ import annotations
@@ -208,6 +209,26 @@ def check_goal_search(floor, seed, plain_paths: Plain) -> None:
     assert np.array_equal(np.isfinite(fast.cost), np.isfinite(plain.cost))
     ok = np.isfinite(fast.cost)
     np.testing.assert_allclose(fast.cost[ok], plain.cost[ok], rtol=1e-12, atol=1e-12)
+
+
+@settings(max_examples=30, deadline=None, suppress_health_check=[HealthCheck.too_slow, HealthCheck.filter_too_much])
+@given(floor=slit_floors(), seed=st.integers(0, 2**31 - 1))
+def check_arc_tables(floor, seed, plain_paths: Plain) -> None:
+    """``ArcTables``: the compiled counting sort gives the numpy path's arrays, dtype and all,
+    for goal fields that reach all, some or none of the floor."""
+    from pointnav_core.geodesic.roots import ArcTables
+
+    scene, radius = floor
+    planner = scene.planner(0, radius)
+    for p in usable_points(scene, radius, np.random.default_rng(seed), 3):
+        search = planner.goal_field(p).labels
+        fast = ArcTables(planner, search)
+        with plain_paths():
+            plain = ArcTables(planner, search)
+        for name in ("labels", "start", "graph_end", "cheapest", "by_cheap"):
+            got, want = getattr(fast, name), getattr(plain, name)
+            assert got.dtype == want.dtype, name
+            np.testing.assert_array_equal(got, want, err_msg=name)
 
 
 @settings(max_examples=30, deadline=None, suppress_health_check=[HealthCheck.too_slow, HealthCheck.filter_too_much])

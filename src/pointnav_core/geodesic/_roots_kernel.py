@@ -10,7 +10,8 @@ squares, then polygon edges), after the node's sight profile has ruled out the l
 surely are hidden (:func:`pointnav_core.geodesic.sight.blocked_by_profile`). The scalar
 math may round differently from numpy's array loops in the last bit, so the two paths agree
 in value (a property test holds them equal within 1e-9 m), and in the root wherever two
-roots do not tie.
+roots do not tie. :func:`arc_tables` builds a field's
+:class:`~pointnav_core.geodesic.roots.ArcTables` in one pass, the same arrays as numpy's.
 """
 
 from __future__ import annotations
@@ -18,10 +19,11 @@ from __future__ import annotations
 import math
 
 import numba
+import numpy as np
 
 from pointnav_core.floor._collision_kernel import segment_hits as _hits
 
-__all__ = ["best_links", "cell_links", "point_links", "table_roots"]
+__all__ = ["arc_tables", "best_links", "cell_links", "point_links", "table_roots"]
 
 _jit = numba.njit(cache=True, nogil=True, error_model="numpy")
 
@@ -304,3 +306,35 @@ def table_roots(  # pragma: no cover
                 best_lab[i] = lab
                 kind[i] = 2
         best_value[i] = best
+
+
+@_jit
+def arc_tables(cost, group, n_vertices, n_groups):  # pragma: no cover
+    """:class:`~pointnav_core.geodesic.roots.ArcTables`' arrays in one pass: the reached
+    labels grouped by arc (a stable counting sort, so each group keeps label order, graph
+    vertices first), each group's start and graph end, each group's cheapest cost, and the
+    nodes with a reached arc by their cheapest label (a stable sort)."""
+    start = np.zeros(n_groups + 1, dtype=np.int64)
+    for lab in range(cost.shape[0]):
+        if math.isfinite(cost[lab]):
+            start[group[lab] + 1] += 1
+    for g in range(n_groups):
+        start[g + 1] += start[g]
+    labels = np.empty(start[n_groups], dtype=np.int64)
+    fill = start[:n_groups].copy()
+    graph_end = start[:n_groups].copy()
+    cheapest = np.full(n_groups, math.inf)
+    for lab in range(cost.shape[0]):
+        c = cost[lab]
+        if math.isfinite(c):
+            g = group[lab]
+            labels[fill[g]] = lab
+            fill[g] += 1
+            if lab < n_vertices:
+                graph_end[g] += 1
+            if c < cheapest[g]:
+                cheapest[g] = c
+    node_cheap = np.minimum(cheapest[0::2], cheapest[1::2])
+    reached = np.flatnonzero(np.isfinite(node_cheap))
+    by_cheap = reached[np.argsort(node_cheap[reached], kind="mergesort")].astype(np.int64)
+    return labels, start, graph_end, cheapest, by_cheap

@@ -84,6 +84,12 @@ class ArcTables:
     """
 
     def __init__(self, planner: Planner, search: FieldLabels) -> None:
+        kernel = compiled(planner, "arc_tables")
+        if kernel is not None:  # one pass in compiled code, the same arrays (a property test)
+            self.labels, self.start, self.graph_end, self.cheapest, self.by_cheap = kernel(
+                search.cost, search.group, search.graph.n_vertices, 2 * planner.n_nodes
+            )
+            return
         labs = np.flatnonzero(np.isfinite(search.cost))
         group = search.group[labs]
         order = np.argsort(group, kind="stable")
