@@ -4,6 +4,8 @@ import math
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 from shapely.geometry import box
 
 from pointnav_core.floor.maps import FREE, OBSTACLE, VOID, BoundedCache, TraversableMap
@@ -147,3 +149,28 @@ def test_a_usable_cell_centre_belongs_to_its_own_cells_component_and_a_nudged_po
     assert np.array_equal(tmap.component_at(nudged[fits], 0.05), got[fits])
     # Blocked and off-map points are in no component.
     assert tmap.component_at(np.array([[1.05, 0.55], [-1.0, -1.0]]), 0.05).tolist() == [0, 0]
+
+
+@settings(max_examples=200, deadline=None)
+@given(
+    seed=st.integers(0, 2**31 - 1),
+    resolution=st.sampled_from([0.05, 0.1, 0.3, 0.5, 1.0]),
+    radius=st.floats(0.0, 0.4),
+    kind=st.sampled_from(["centre", "inside", "edge", "off"]),
+)
+def test_one_point_component_at_is_the_general_paths(seed, resolution, radius, kind):
+    # One point takes a float fast path (a usable cell's exact centre); two points take the
+    # array path: the same label for the same point.
+    rng = np.random.default_rng(seed)
+    tmap = TraversableMap(rng.random((12, 15)) < 0.8, resolution=resolution, origin=tuple(rng.uniform(-3, 3, 2)))
+    cell = np.array([rng.integers(12), rng.integers(15)])
+    point = tmap.cell_to_world(cell)
+    if kind == "inside":
+        point = point + rng.uniform(-0.49, 0.49, 2) * resolution
+    elif kind == "edge":
+        point = point + 0.5 * resolution
+    elif kind == "off":
+        point = point + 20 * resolution
+    one = int(tmap.component_at(point, radius))
+    assert one == int(tmap.component_at(np.stack([point, point]), radius)[0])
+    assert tmap.component_at(point, radius).shape == ()

@@ -304,6 +304,18 @@ class TraversableMap:
         key = round(radius, 12)
         return self._labels.get_or_create(key, lambda: self._label(radius))
 
+    def usable_indices(self, radius: float) -> NDArray[np.intp]:
+        """Flat (row-major) indices of the :meth:`usable` cells (cached, read-only), so that
+        draws over the whole floor do not scan the grid each time."""
+        radius = _check_radius(radius)
+
+        def build() -> NDArray[np.intp]:
+            flat = np.flatnonzero(self.usable(radius))
+            flat.flags.writeable = False
+            return flat
+
+        return self._component_cells.get_or_create((round(radius, 12), None), build)
+
     def component_cells(self, radius: float, label: int) -> tuple[NDArray[np.intp], NDArray[np.float64]]:
         """The cells of component ``label`` of :meth:`components` (row-major flat indices) and
         their centres (world metres, ``(N, 2)``); cached, so that sampling many points in one
@@ -375,6 +387,8 @@ class TraversableMap:
         pts = _as_points(xy, "xy")
         flat = pts.reshape(-1, 2)
         labels = self.components(radius)
+        if len(flat) == 1 and (own := self._centre_label(float(flat[0, 0]), float(flat[0, 1]), labels)) > 0:
+            return np.full(pts.shape[:-1], own, dtype=np.int32)  # one sampled point, in floats
         out = np.zeros(len(flat), dtype=np.int32)
         # A point on a labelled cell's centre (every sampled point) is that cell's: the
         # nearest candidate, at distance 0, which the loop below would find first. The
@@ -404,6 +418,17 @@ class TraversableMap:
             if len(hit):
                 out[i] = labels[cand[hit[0], 0], cand[hit[0], 1]]
         return out.reshape(pts.shape[:-1])
+
+    def _centre_label(self, x: float, y: float, labels: NDArray[np.int32]) -> int:
+        """The label of the cell whose centre is exactly ``(x, y)`` (m), else 0: the general
+        path's centred test (``world_to_cell``, ``cell_to_world``) for one point in floats, the
+        same expressions (a property test holds them equal)."""
+        (ox, oy), res = self.origin, self.resolution
+        col, row = math.floor((x - ox) / res), math.floor((y - oy) / res)
+        h, w = self.shape
+        if 0 <= row < h and 0 <= col < w and ox + (col + 0.5) * res == x and oy + (row + 0.5) * res == y:
+            return int(labels[row, col])
+        return 0
 
     def __repr__(self) -> str:
         h, w = self.shape

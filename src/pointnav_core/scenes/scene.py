@@ -342,7 +342,7 @@ class Scene:
             if not (validation.is_real(max_distance) and max_distance >= 0):
                 raise ArgumentError(f"max_distance must be None or a number >= 0 (m), got {max_distance!r}")
         if floor is None:
-            candidates = [i for i, f in enumerate(self.floors) if f.usable(radius).any()]
+            candidates = [i for i, f in enumerate(self.floors) if len(f.usable_indices(radius))]
             if not candidates:
                 raise SamplingError(f"no floor has a usable cell for a robot of radius {radius} m")
             floor = candidates[int(rng.integers(len(candidates)))]
@@ -350,7 +350,7 @@ class Scene:
         # Usable cell centres: the disc misses the floor's one blocked set, which every
         # backend collides with, so every backend accepts the point.
         if reference_point is None:
-            cells = np.flatnonzero(tmap.usable(radius))
+            cells = tmap.usable_indices(radius)
             index = int(cells[int(rng.integers(len(cells)))]) if len(cells) else None
         else:
             ref = as_xy(reference_point, "reference_point")
