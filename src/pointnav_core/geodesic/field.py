@@ -35,7 +35,7 @@ from pointnav_core.utils.frozen import ThawOnUnpickle
 if TYPE_CHECKING:
     from pointnav_core.geodesic.planner import Planner
 
-__all__ = ["BLOCK", "GoalField", "LOOKUP_BOUND"]
+__all__ = ["BLOCK", "GoalField", "LOOKUP_BOUND", "UNSETTLED", "block_cells"]
 
 #: Side (cells) of the square blocks of the root table, each settled on its first lookup
 #: (4: a reset's first lookup settles 16 cells; a path of L cells settles about 4 L, against 8 L at 8).
@@ -248,20 +248,14 @@ class GoalField(ThawOnUnpickle):
             idx = idx.astype(np.int64)
             if idx.size and (idx.min() < 0 or idx.max() >= h * w):
                 raise ArgumentError(f"cells must lie in [0, {h * w}), got {idx.min()} to {idx.max()}")
-        b = BLOCK
-        blocks = np.unique((idx // w) // b * t["blocks_w"] + (idx % w) // b)
+        blocks = np.unique((idx // w) // BLOCK * t["blocks_w"] + (idx % w) // BLOCK)
         todo = blocks[~t["done"][blocks]]
-        if len(todo) > 16:
-            # Many blocks (a pool's window): their cells by one mask over the grid, not a
-            # list per block (the order does not change any root).
-            wanted = np.zeros(len(t["done"]), dtype=bool)
-            wanted[todo] = True
-            rows, cols = np.divmod(np.arange(h * w), w)
+        if len(todo):
             t["done"][todo] = True
-            self._settle_cells(np.flatnonzero(wanted[rows // b * t["blocks_w"] + cols // b]))
-        elif len(todo):
-            t["done"][todo] = True
-            self._settle_cells(np.concatenate([_block_cells(int(k), t["blocks_w"], h, w) for k in todo.tolist()]))
+            cells = block_cells(todo, h, w)
+            # Many blocks (a pool's window) in row-major order, as a mask over the grid gave
+            # them (the order changes no root: a property test; kept to keep tables byte-equal).
+            self._settle_cells(np.sort(cells) if len(todo) > 16 else cells)
         kind, label = t["kind"].view(), t["label"].view()
         kind.flags.writeable = label.flags.writeable = False
         return kind, label
@@ -273,7 +267,7 @@ class GoalField(ThawOnUnpickle):
         w = self.planner.geo.shape[1]
         k = (i // w) // BLOCK * t["blocks_w"] + (i % w) // BLOCK
         t["done"][k] = True
-        self._settle_cells(_block_cells(k, t["blocks_w"], *self.planner.geo.shape))
+        self._settle_cells(block_cells(np.array([k]), *self.planner.geo.shape))
 
     def _settle_cells(self, cells: NDArray[np.int64]) -> None:
         """Give the usable ``cells`` their centres' exact roots (the others have kind 0)."""
@@ -336,9 +330,13 @@ def around_disc(x: float, y: float, cx: float, cy: float, r: float, qx: float, q
     return math.sqrt(L * L - r * r) + r * (turn - seen)
 
 
-def _block_cells(k: int, blocks_w: int, h: int, w: int) -> NDArray[np.int64]:
-    """Flat indices of the cells of block ``k`` (row-major blocks, BLOCK cells square)."""
-    r0, c0 = (k // blocks_w) * BLOCK, (k % blocks_w) * BLOCK
-    rows = np.arange(r0, min(r0 + BLOCK, h))
-    cols = np.arange(c0, min(c0 + BLOCK, w))
-    return (rows[:, None] * w + cols[None, :]).ravel().astype(np.int64)
+def block_cells(blocks: NDArray[np.int64], h: int, w: int) -> NDArray[np.int64]:
+    """Flat indices (``row * w + col``) of the cells of ``blocks`` (row-major blocks of
+    ``BLOCK`` cells square over an ``h`` x ``w`` grid), block by block."""
+    blocks_w = -(-w // BLOCK)
+    step = np.arange(BLOCK)
+    rows = (blocks // blocks_w * BLOCK)[:, None, None] + step[:, None]
+    cols = (blocks % blocks_w * BLOCK)[:, None, None] + step[None, :]
+    rows, cols = np.broadcast_arrays(rows, cols)
+    inside = (rows < h) & (cols < w)
+    return (rows[inside] * w + cols[inside]).astype(np.int64)

@@ -103,9 +103,10 @@ class ScenePart:
 
 
 def settle_part(table: np.ndarray, field_of: np.ndarray, fields: Sequence[Any], reach: float,
-                cells_before: int = 0, goals_before: int = 0) -> ScenePart:
+                cells_before: int = 0, goals_before: int = 0, lazy: bool = False) -> ScenePart:
     """Settle ``fields`` (GoalFields) over the cells within ``reach`` (m) of their episodes'
-    starts (the first two columns of ``table``'s rows).
+    starts (the first two columns of ``table``'s rows); with ``lazy``, keep the fields to
+    settle their cells on the first lookups instead (in the stepping process only).
 
     Raises
     ------
@@ -116,7 +117,7 @@ def settle_part(table: np.ndarray, field_of: np.ndarray, fields: Sequence[Any], 
     """
     windows = [reach_window(f, table[field_of == i][:, :2], reach) for i, f in enumerate(fields)]
     check_budget(windows, cells_before, goals_before)
-    parts = [field_part(f, w) for f, w in zip(fields, windows)]
+    parts = [field_part(f, w, lazy) for f, w in zip(fields, windows)]
     return ScenePart(table, field_of, parts, sum((r1 - r0) * (c1 - c0) for r0, r1, c0, c1 in windows))
 
 
@@ -182,9 +183,10 @@ class EpisodePool:
 
     @staticmethod
     def scene_part(env: Any, s: int, pool_size: int, seeds: Sequence[int], starts: int = 1, reach: float = math.inf,
-                   cells_before: int = 0, goals_before: int = 0) -> ScenePart:
+                   cells_before: int = 0, goals_before: int = 0, lazy: bool = False) -> ScenePart:
         """Scene ``s``'s part: ``pool_size`` episodes drawn by its sampler ``env`` from
-        ``seeds`` (one per goal), each goal with ``starts`` starts, its fields settled."""
+        ``seeds`` (one per goal), each goal with ``starts`` starts, its fields settled (or
+        left to settle lazily, :func:`settle_part`)."""
         from pointnav_core.task.sampling import sample_episode
 
         rows, fields, field_of = [], [], []
@@ -208,21 +210,22 @@ class EpisodePool:
                 field_of.append(len(fields))
             fields.append(task.goal_field.field)
         table = np.array(rows, dtype=np.float64).reshape(-1, 7)
-        return settle_part(table, np.asarray(field_of, dtype=np.int64), fields, reach, cells_before, goals_before)
+        return settle_part(table, np.asarray(field_of, dtype=np.int64), fields, reach, cells_before, goals_before, lazy)
 
     def __len__(self) -> int:
         return int(self.sx.shape[0])
 
 
 def build_in_process(kind: Any, samplers: Sequence[Any], pool_size: int, seeds: Sequence[int], starts: int,
-                     reach: float, done: Callable[[int], Any] | None = None) -> list[ScenePart]:
+                     reach: float, done: Callable[[int], Any] | None = None, lazy: bool = False) -> list[ScenePart]:
     """Every scene's part of a pool of ``kind`` (a class with ``scene_part``), here, in
     order; the byte budget is checked before each scene's fields are settled. ``done(1)``
-    is called after each scene (a progress bar's ``update``)."""
+    is called after each scene (a progress bar's ``update``); ``lazy``: see :func:`settle_part`."""
     parts: list[ScenePart] = []
     cells = goals = 0
     for s, env in enumerate(samplers):
-        part = kind.scene_part(env, s, pool_size, seeds[s * pool_size:(s + 1) * pool_size], starts, reach, cells, goals)
+        part = kind.scene_part(env, s, pool_size, seeds[s * pool_size:(s + 1) * pool_size], starts, reach, cells, goals,
+                               lazy)
         cells, goals = cells + part.cells, goals + len(part.fields)
         parts.append(part)
         if done is not None:
@@ -254,4 +257,4 @@ def _fixed_part(samplers: Sequence[Any], fixed: Sequence[tuple[Any, float, Any, 
         fields.append(ffield.field)
     table = np.array(rows, dtype=np.float64).reshape(-1, 7)
     cells, goals = sum(p.cells for p in before), sum(len(p.fields) for p in before)
-    return settle_part(table, np.arange(len(rows), dtype=np.int64), fields, reach, cells, goals)
+    return settle_part(table, np.arange(len(rows), dtype=np.int64), fields, reach, cells, goals, lazy=True)

@@ -15,6 +15,13 @@ longest chord per step), so with the episodes' ``starts`` and that ``reach`` a f
 only its window of cells (:func:`reach_window`), and only the blocks those cells look up
 are checked: on a large map the settling and the memory scale with the episodes' reach,
 not with the map.
+
+Tables built in the stepping process are settled lazily, as the single env's field is: a
+cell starts unsettled (kind 4) and its block is settled (``GoalField.settle``, the same
+roots) the first time a robot's lookup lands in it, so that a pool's build costs its goals'
+searches and not every cell of every window. Tables built in a worker process (a pool's
+scenes, a refresh) are settled there, whole, since the worker has the time and the parent
+would have to build the floor's geometry again.
 """
 
 from __future__ import annotations
@@ -22,6 +29,7 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass
+from dataclasses import field as member
 from typing import Any
 
 import numpy as np
@@ -29,6 +37,7 @@ from numpy.typing import ArrayLike
 
 from pointnav_core.errors import ArgumentError
 from pointnav_core.geodesic import GoalField
+from pointnav_core.geodesic.field import BLOCK, UNSETTLED, block_cells
 from pointnav_core.geodesic.tangents import ANG_TOL, TWO_PI
 from pointnav_core.vector.xp import Arrays
 
@@ -81,6 +90,11 @@ class FieldPart:
         The goal (m).
     grid : (ox, oy, res, radius)
         The grid's origin and cell size and the robot radius (m).
+    used : ndarray of int64
+        Per row of :attr:`labels`, its label in the field's own search (``GoalField.labels``).
+    source : GoalField or None
+        The field itself, where cells are left unsettled (kind 4) to settle on their first
+        lookup; None where every cell of the window is settled.
     """
 
     window: tuple[int, int, int, int]
@@ -89,10 +103,14 @@ class FieldPart:
     labels: np.ndarray
     goal: tuple[float, float]
     grid: tuple[float, float, float, float]
+    used: np.ndarray
+    source: GoalField | None = member(default=None, compare=False, repr=False)
 
 
-def field_part(field: GoalField, window: tuple[int, int, int, int]) -> FieldPart:
-    """Settle ``field`` over ``window`` (:func:`reach_window`) and take its share of the tables.
+def field_part(field: GoalField, window: tuple[int, int, int, int], lazy: bool = False) -> FieldPart:
+    """``field``'s share of the tables over ``window`` (:func:`reach_window`): settled there,
+    or with ``lazy`` only as far as the field is settled already (the rest kind 4, settled
+    by :meth:`FieldTables.distance` as lookups land).
 
     Only the cells the window's cells look up are settled (every one for the whole grid),
     and only the labels the window's cells name are kept: a search labels every arc node of
@@ -103,11 +121,20 @@ def field_part(field: GoalField, window: tuple[int, int, int, int]) -> FieldPart
     r0, r1, c0, c1 = window
     near = np.asarray(p.near_usable, dtype=np.int64).reshape(h, w)[r0:r1, c0:c1].ravel()
     whole = (r0, r1, c0, c1) == (0, h, 0, w)
-    kind_of, label_of = field.settle(None if whole else near[near >= 0])
+    kind_of, label_of = field.settle(np.empty(0, np.int64) if lazy else None if whole else near[near >= 0])
     kind = np.where(near >= 0, kind_of[np.maximum(near, 0)], 0).astype(np.int64)
     label = np.where(kind == 2, label_of[np.maximum(near, 0)], 0).astype(np.int64)
     used = np.unique(label[kind == 2])
     label = np.where(kind == 2, np.searchsorted(used, label), 0).astype(np.int64)
+    goal = (float(field.goal[0]), float(field.goal[1]))
+    grid = (float(p.geo.origin[0]), float(p.geo.origin[1]), float(p.geo.resolution), float(p.radius))
+    return FieldPart(window, kind, label, label_rows(field, used), goal, grid, used, field if lazy else None)
+
+
+def label_rows(field: GoalField, used: np.ndarray) -> np.ndarray:
+    """The rows ``(n, 9)`` of the label table (the columns of ``_PER_LABEL``) for the labels
+    ``used`` of ``field``'s search: cost and node in m, angles in rad."""
+    p = field.planner
     s = field.labels
     node = np.asarray(s.node, dtype=np.int64)[used]
     side = np.asarray(s.side, dtype=np.float64)[used]
@@ -115,13 +142,10 @@ def field_part(field: GoalField, window: tuple[int, int, int, int]) -> FieldPart
     n_lab = len(node)
     ccw = np.where(side > 0, pos, p.span[node] - pos) if n_lab else pos
     ang = p.phi0[node] + ccw if n_lab else pos
-    labels = np.stack([
+    return np.stack([
         np.asarray(s.cost, dtype=np.float64)[used], p.cx[node], p.cy[node], side, p.phi0[node],
         p.span[node], pos, p.cx[node] + p.radius * np.cos(ang), p.cy[node] + p.radius * np.sin(ang),
     ], 1).reshape(n_lab, 9)
-    goal = (float(field.goal[0]), float(field.goal[1]))
-    grid = (float(p.geo.origin[0]), float(p.geo.origin[1]), float(p.geo.resolution), float(p.radius))
-    return FieldPart(window, kind, label, labels, goal, grid)
 
 
 class FieldTables:
@@ -155,12 +179,12 @@ class FieldTables:
 
     def __init__(
         self, fields: Sequence[GoalField], arrays: Arrays, starts: Sequence[ArrayLike] | None = None,
-        reach: float = math.inf,
+        reach: float = math.inf, lazy: bool = False,
     ) -> None:
         windows = [(0, f.planner.geo.shape[0], 0, f.planner.geo.shape[1]) if starts is None
                    else reach_window(f, starts[i], reach) for i, f in enumerate(fields)]
         check_budget(windows)
-        self._assemble([field_part(f, w) for f, w in zip(fields, windows)], arrays)
+        self._assemble([field_part(f, w, lazy) for f, w in zip(fields, windows)], arrays)
 
     @classmethod
     def from_parts(cls, parts: Sequence[FieldPart], arrays: Arrays) -> FieldTables:
@@ -173,6 +197,10 @@ class FieldTables:
     def _assemble(self, parts: Sequence[FieldPart], arrays: Arrays) -> None:
         kinds, labels, lab_arrays, goal, geo = [], [], [], [], []
         cell_off = lab_off = 0
+        # Lazy settling's state, on the host: per field its GoalField (or None), and its
+        # search's labels already in the table (rows lab_off on, or a map once settling adds more).
+        self._sources = [part.source for part in parts]
+        self._known: list[Any] = []
         for part in parts:
             r0, r1, c0, c1 = part.window
             kinds.append(part.kind)
@@ -180,6 +208,7 @@ class FieldTables:
             lab_arrays.append(part.labels)
             goal.append(part.goal)
             geo.append((cell_off, r1 - r0, c1 - c0, *part.grid, r0, c0))
+            self._known.append((part.used, lab_off))
             cell_off += (r1 - r0) * (c1 - c0)
             lab_off += len(part.labels)
         a = arrays
@@ -190,6 +219,7 @@ class FieldTables:
         lab = np.concatenate([*lab_arrays, np.zeros((1, 9))])
         for i, name in enumerate(_PER_LABEL):
             setattr(self, name, a.asarray(lab[:, i]))
+        self._n_labels = lab_off
         gxy = np.array(goal, dtype=np.float64).reshape(-1, 2)
         self.gx, self.gy = a.asarray(gxy[:, 0]), a.asarray(gxy[:, 1])
         self.offset = a.asarray(g[:, 0], a.i64)
@@ -197,19 +227,27 @@ class FieldTables:
         self.rows, self.width = a.asarray(g[:, 1], a.i64), a.asarray(g[:, 2], a.i64)
         self.row0, self.col0 = a.asarray(g[:, 7], a.i64), a.asarray(g[:, 8], a.i64)
         self.ox, self.oy, self.res, self.radius = (a.asarray(g[:, i]) for i in (3, 4, 5, 6))
+        self._windows = g[:, (0, 1, 2, 7, 8)].astype(np.int64)
         self.arrays = a
 
     def __len__(self) -> int:
         return int(self.gx.shape[0])
 
+    @property
+    def lazy(self) -> bool:
+        """Whether some cells may still be unsettled (kind 4), to settle on their first lookup."""
+        return any(source is not None for source in self._sources)
+
     def to(self, arrays: Arrays) -> FieldTables:
         """These tables on ``arrays``' device (numpy tables from a worker process, say)."""
-        moved = FieldTables.__new__(FieldTables)
+        moved: FieldTables = FieldTables.__new__(FieldTables)
         moved.arrays = arrays
         for name in _PER_LABEL + _PER_FIELD_FLOAT:
             setattr(moved, name, arrays.asarray(self.arrays.numpy(getattr(self, name))))
         for name in _INDICES:
             setattr(moved, name, arrays.asarray(self.arrays.numpy(getattr(self, name)), arrays.i64))
+        moved._lazy_state(self._sources, [k.copy() if isinstance(k, np.ndarray) else k for k in self._known],
+                          self._n_labels, self._windows)
         return moved
 
     @classmethod
@@ -218,14 +256,94 @@ class FieldTables:
         ``len(first) + f``), on ``first``'s device."""
         a = first.arrays
         cat = a.xp.concatenate
-        joined = cls.__new__(cls)
+        joined: FieldTables = cls.__new__(cls)
         joined.arrays = a
+        n1, n2 = first._n_labels, second._n_labels
         joined.kind = cat([first.kind, second.kind])
-        joined.label = cat([first.label, second.label + first.cost.shape[0]])
-        for name in _PER_LABEL + _PER_FIELD_FLOAT + ("rows", "width", "row0", "col0"):
+        joined.label = cat([first.label, second.label + n1])
+        for name in _PER_LABEL:  # the labels in use, then one spare row
+            setattr(joined, name, cat([getattr(first, name)[:n1], getattr(second, name)[:n2 + 1]]))
+        for name in _PER_FIELD_FLOAT + ("rows", "width", "row0", "col0"):
             setattr(joined, name, cat([getattr(first, name), getattr(second, name)]))
         joined.offset = cat([first.offset, second.offset + first.kind.shape[0]])
+        shifted = [np.where(k >= 0, k + n1, -1) if isinstance(k, np.ndarray) else (k[0], k[1] + n1) for k in second._known]
+        windows = second._windows + np.array([first.kind.shape[0], 0, 0, 0, 0])
+        joined._lazy_state(first._sources + second._sources, [*first._known, *shifted], n1 + n2,
+                           np.concatenate([first._windows, windows]))
         return joined
+
+    def _lazy_state(self, sources: list[Any], known: list[Any], n_labels: int, windows: np.ndarray) -> None:
+        self._sources, self._known, self._n_labels, self._windows = list(sources), known, n_labels, windows
+
+    # ------------------------------------------------------------- lazy settling
+    def _settle_cells(self, cells: np.ndarray) -> None:
+        """Settle the blocks of the table cells ``cells`` (global indices, unsettled) in their
+        fields, as ``GoalField.distance`` settles a lookup's block, and write them here."""
+        a = self.arrays
+        owner = np.searchsorted(self._windows[:, 0], cells, side="right") - 1
+        where, kinds, labels = [], [], []
+        for f in np.unique(owner).tolist():
+            idx, kind, label = self._settle_blocks(f, cells[owner == f])
+            where.append(idx)
+            kinds.append(kind)
+            labels.append(label)
+        idx = a.asarray(np.concatenate(where), a.i64)
+        self.label[idx] = a.asarray(np.concatenate(labels), a.i64)
+        self.kind[idx] = a.asarray(np.concatenate(kinds), a.i64)
+
+    def _settle_blocks(self, f: int, cells: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Field ``f``'s grid blocks (``BLOCK`` cells square) that hold its table cells
+        ``cells``: their window cells' global indices, kinds and global labels."""
+        field = self._sources[f]
+        if field is None:  # settled in a worker: no cell of it is pending
+            raise AssertionError(f"goal field {f} has unsettled cells but no field to settle them")
+        off, rows, width, r0, c0 = (int(v) for v in self._windows[f])
+        p = field.planner
+        w = p.geo.shape[1]
+        local = cells - off
+        row, col = local // width + r0, local % width + c0
+        blocks_w = -(-w // BLOCK)
+        rr, cc = np.divmod(block_cells(np.unique(row // BLOCK * blocks_w + col // BLOCK), *p.geo.shape), w)
+        keep = (rr >= r0) & (rr < r0 + rows) & (cc >= c0) & (cc < c0 + width)
+        rr, cc = rr[keep], cc[keep]
+        near = np.asarray(p.near_usable, dtype=np.int64)[rr * w + cc]
+        kind_of, label_of = field.settle(near[near >= 0])
+        at = np.maximum(near, 0)
+        kind = np.where(near >= 0, kind_of[at], 0).astype(np.int64)
+        label = np.zeros(len(kind), dtype=np.int64)
+        two = kind == 2
+        label[two] = self._table_labels(f, field, label_of[at[two]].astype(np.int64))
+        return off + (rr - r0) * width + (cc - c0), kind, label
+
+    def _table_labels(self, f: int, field: GoalField, ids: np.ndarray) -> np.ndarray:
+        """The table rows of field ``f``'s search labels ``ids``, appending those not in the table."""
+        known = self._known[f]
+        if not isinstance(known, np.ndarray):  # first growth: the part's labels as a map
+            used, base = known
+            known = np.full(len(field.labels.cost), -1, dtype=np.int64)
+            known[used] = base + np.arange(len(used))
+            self._known[f] = known
+        new = np.unique(ids[known[ids] < 0])
+        if len(new):
+            known[new] = self._append_labels(label_rows(field, new))
+        return known[ids]
+
+    def _append_labels(self, rows: np.ndarray) -> np.ndarray:
+        """Add ``rows`` (the columns of ``_PER_LABEL``) after the labels in use, growing the
+        arrays by doubling (one spare row stays at the end); their indices."""
+        a = self.arrays
+        n, k = self._n_labels, len(rows)
+        size = int(self.cost.shape[0])
+        if n + k + 1 > size:
+            grown = max(2 * size, n + k + 1)
+            for name in _PER_LABEL:
+                column = a.zeros(grown)
+                column[:n] = getattr(self, name)[:n]
+                setattr(self, name, column)
+        for i, name in enumerate(_PER_LABEL):
+            getattr(self, name)[n:n + k] = a.asarray(rows[:, i])
+        self._n_labels = n + k
+        return np.arange(n, n + k)
 
     def distance(self, field: Any, x: Any, y: Any) -> Any:
         """Geodesic distance (m) from each ``(x, y)`` to the goal of its ``field`` (index array); inf if none.
@@ -242,6 +360,9 @@ class FieldTables:
         inside = (row >= 0) & (row < self.rows[field]) & (col >= 0) & (col < self.width[field])
         cell = xp.where(inside, self.offset[field] + row * self.width[field] + col, 0)
         kind = xp.where(inside, self.kind[cell], 0)
+        if self.lazy and a.any(kind == UNSETTLED):
+            self._settle_cells(np.unique(a.numpy(cell[kind == UNSETTLED])))
+            kind = xp.where(inside, self.kind[cell], 0)
         lab = self.label[cell]
         direct = xp.sqrt((x - self.gx[field]) ** 2 + (y - self.gy[field]) ** 2)
         r = self.radius[field]

@@ -118,7 +118,7 @@ class FleetPool:
 
     @staticmethod
     def scene_part(env: Any, s: int, pool_size: int, seeds: Sequence[int], starts: int = 1, reach: float = math.inf,
-                   cells_before: int = 0, goals_before: int = 0) -> ScenePart:
+                   cells_before: int = 0, goals_before: int = 0, lazy: bool = False) -> ScenePart:
         """Scene ``s``'s part: ``pool_size`` episodes drawn by its multi-robot env ``env``
         from ``seeds``, each with ``starts`` sets of starts, every robot's field settled."""
         rows: list[list[tuple[float, ...]]] = []
@@ -139,7 +139,7 @@ class FleetPool:
         n_robots = len(env.tasks)
         table = np.array(rows, dtype=np.float64).reshape(-1, n_robots, 6)
         index = np.array(field_of, dtype=np.int64).reshape(-1, n_robots)
-        return settle_part(table, index, fields, reach, cells_before, goals_before)
+        return settle_part(table, index, fields, reach, cells_before, goals_before, lazy)
 
     def __len__(self) -> int:
         return int(self.sx.shape[0])
@@ -182,4 +182,4 @@ def _fixed_part(samplers: Sequence[Any], fixed: Sequence[tuple[Sequence[tuple[An
     table = np.array(rows, dtype=np.float64).reshape(-1, n_robots, 6)
     index = np.arange(len(fields), dtype=np.int64).reshape(-1, n_robots)
     cells, goals = sum(p.cells for p in before), sum(len(p.fields) for p in before)
-    return settle_part(table, index, fields, reach, cells, goals)
+    return settle_part(table, index, fields, reach, cells, goals, lazy=True)

@@ -111,7 +111,8 @@ def build_parts(kind: Any, samplers: Sequence[Any], pool_size: int, seeds: Seque
                     "them must guard its entry point with `if __name__ == '__main__':`; building the pool "
                     "in this process (workers=1 does so without trying)", RuntimeWarning, stacklevel=4,
                 )
-        return build_in_process(kind, samplers, pool_size, seeds, starts, reach, bar.update)
+        # Here, in the stepping process: the fields settle lazily, as robots arrive.
+        return build_in_process(kind, samplers, pool_size, seeds, starts, reach, bar.update, lazy=True)
 
 
 def _in_workers(kind: Any, samplers: Sequence[Any], pool_size: int, seeds: Sequence[int], starts: int, reach: float,
