@@ -137,3 +137,18 @@ def test_array_math_gives_the_same_bits_for_any_length(fn) -> None:
     one = np.array([fn(*(a[i : i + 1] for a in args))[0] for i in range(len(whole))])
     strided = fn(*(np.repeat(a, 2)[::2] for a in args))
     assert np.array_equal(whole, one) and np.array_equal(whole, strided)
+
+
+@pytest.mark.parametrize("shape", [(10, 7), (4, 4), (9, 13), (1, 5)])
+def test_block_cells_are_the_cells_of_their_blocks_by_brute_force(shape: tuple[int, int]) -> None:
+    # Every cell's block by hand (4 cells square, row-major over the blocks), block by block.
+    from pointnav_core.geodesic.field import block_cells
+
+    h, w = shape
+    blocks_w = -(-w // 4)
+    of = {(r, c): r // 4 * blocks_w + c // 4 for r in range(h) for c in range(w)}
+    n_blocks = -(-h // 4) * blocks_w
+    rng = np.random.default_rng(h * 100 + w)
+    for chosen in [[k] for k in range(n_blocks)] + [sorted(rng.choice(n_blocks, min(3, n_blocks), replace=False))]:
+        want = [r * w + c for k in chosen for (r, c) in sorted(of) if of[r, c] == k]
+        assert block_cells(np.array(chosen, dtype=np.int64), h, w).tolist() == want

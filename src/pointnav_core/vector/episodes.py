@@ -18,6 +18,7 @@ assembled here into the same arrays as a build in this process.
 
 from __future__ import annotations
 
+import functools
 import math
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
@@ -36,7 +37,7 @@ from pointnav_core.vector.fields import (
 )
 from pointnav_core.vector.xp import Arrays
 
-__all__ = ["EpisodePool", "ScenePart", "assemble_parts", "fixed_pose", "settle_part"]
+__all__ = ["EpisodePool", "ScenePart", "assemble_parts", "fixed_pose", "sampler_field", "settle_part"]
 
 
 def fixed_pose(where: str, episode: Any, scene: Any, floor: int, robot: Any) -> tuple[Any, float, Any]:
@@ -103,10 +104,12 @@ class ScenePart:
 
 
 def settle_part(table: np.ndarray, field_of: np.ndarray, fields: Sequence[Any], reach: float,
-                cells_before: int = 0, goals_before: int = 0, lazy: bool = False) -> ScenePart:
+                cells_before: int = 0, goals_before: int = 0, lazy: bool = False,
+                origins: Sequence[tuple[int, int]] | None = None) -> ScenePart:
     """Settle ``fields`` (GoalFields) over the cells within ``reach`` (m) of their episodes'
     starts (the first two columns of ``table``'s rows); with ``lazy``, keep the fields to
-    settle their cells on the first lookups instead (in the stepping process only).
+    settle their cells on the first lookups instead, or with ``origins`` (per field its
+    scene and robot, in a worker) what makes each field again in the stepping process.
 
     Raises
     ------
@@ -117,17 +120,32 @@ def settle_part(table: np.ndarray, field_of: np.ndarray, fields: Sequence[Any], 
     """
     windows = [reach_window(f, table[field_of == i][:, :2], reach) for i, f in enumerate(fields)]
     check_budget(windows, cells_before, goals_before)
-    parts = [field_part(f, w, lazy) for f, w in zip(fields, windows)]
+    parts = [field_part(f, w, lazy, None if origins is None else origins[i]) for i, (f, w) in enumerate(zip(fields, windows))]
     return ScenePart(table, field_of, parts, sum((r1 - r0) * (c1 - c0) for r0, r1, c0, c1 in windows))
 
 
-def assemble_parts(parts: Sequence[ScenePart], arrays: Arrays) -> tuple[np.ndarray, np.ndarray, FieldTables]:
-    """The parts end to end: their rows, each row's field (a global index) and the tables."""
+def assemble_parts(parts: Sequence[ScenePart], arrays: Arrays,
+                   resolve: Callable[..., Any] | None = None) -> tuple[np.ndarray, np.ndarray, FieldTables]:
+    """The parts end to end: their rows, each row's field (a global index) and the tables
+    (with ``resolve``, :attr:`FieldTables.resolve`, for parts built in workers)."""
     offsets = np.cumsum([0, *(len(p.fields) for p in parts)])
     table = np.concatenate([p.table for p in parts])
     field_of = np.concatenate([p.field_of + off for p, off in zip(parts, offsets)]).astype(np.int64)
     check_budget([], sum(p.cells for p in parts), int(offsets[-1]))
-    return table, field_of, FieldTables.from_parts([f for p in parts for f in p.fields], arrays)
+    tables = FieldTables.from_parts([f for p in parts for f in p.fields], arrays)
+    tables.resolve = resolve
+    return table, field_of, tables
+
+
+def sampler_field(samplers: Sequence[Any], origin: tuple[int, int], goal: tuple[float, float]) -> Any:
+    """The goal field of ``goal`` (m) for robot ``origin[1]`` of scene ``origin[0]``'s
+    sampler (a single or a multi-robot env), as its task builds it: the field a worker
+    built, made again here (the floor's geometry reloads from the disk cache)."""
+    env = samplers[origin[0]]
+    tasks = getattr(env, "tasks", None)
+    if tasks is None:
+        return env.scene.goal_field(env.task.floor, goal, robot=env.robot).field
+    return env.scene.goal_field(tasks[origin[1]].floor, goal, robot=env.robots[origin[1]]).field
 
 
 class EpisodePool:
@@ -173,7 +191,7 @@ class EpisodePool:
         parts: Sequence[ScenePart] | None = None,
     ) -> None:
         parts = pool_parts(type(self), samplers, pool_size, seeds, starts, reach, fixed, parts)
-        table, field_of, self.fields = assemble_parts(parts, arrays)
+        table, field_of, self.fields = assemble_parts(parts, arrays, functools.partial(sampler_field, list(samplers)))
         a = arrays
         self.sx, self.sy, self.syaw, self.gx, self.gy, self.d0 = (a.asarray(table[:, i]) for i in range(6))
         self.scene = a.asarray(table[:, 6], a.i64)
@@ -183,10 +201,12 @@ class EpisodePool:
 
     @staticmethod
     def scene_part(env: Any, s: int, pool_size: int, seeds: Sequence[int], starts: int = 1, reach: float = math.inf,
-                   cells_before: int = 0, goals_before: int = 0, lazy: bool = False) -> ScenePart:
+                   cells_before: int = 0, goals_before: int = 0, lazy: bool = False,
+                   portable: bool = False) -> ScenePart:
         """Scene ``s``'s part: ``pool_size`` episodes drawn by its sampler ``env`` from
         ``seeds`` (one per goal), each goal with ``starts`` starts, its fields settled (or
-        left to settle lazily, :func:`settle_part`)."""
+        left to settle lazily, in this process or, ``portable``, in the one it is sent to:
+        :func:`settle_part`)."""
         from pointnav_core.task.sampling import sample_episode
 
         rows, fields, field_of = [], [], []
@@ -210,7 +230,9 @@ class EpisodePool:
                 field_of.append(len(fields))
             fields.append(task.goal_field.field)
         table = np.array(rows, dtype=np.float64).reshape(-1, 7)
-        return settle_part(table, np.asarray(field_of, dtype=np.int64), fields, reach, cells_before, goals_before, lazy)
+        origins = [(s, 0)] * len(fields) if portable else None
+        return settle_part(table, np.asarray(field_of, dtype=np.int64), fields, reach, cells_before, goals_before, lazy,
+                           origins)
 
     def __len__(self) -> int:
         return int(self.sx.shape[0])

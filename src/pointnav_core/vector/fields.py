@@ -27,7 +27,7 @@ would have to build the floor's geometry again.
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from dataclasses import field as member
 from typing import Any
@@ -92,9 +92,11 @@ class FieldPart:
         The grid's origin and cell size and the robot radius (m).
     used : ndarray of int64
         Per row of :attr:`labels`, its label in the field's own search (``GoalField.labels``).
-    source : GoalField or None
-        The field itself, where cells are left unsettled (kind 4) to settle on their first
-        lookup; None where every cell of the window is settled.
+    source : GoalField, (scene, robot) or None
+        Where cells are left unsettled (kind 4) to settle on their first lookup: the field
+        itself, or, for a part built in a worker, the scene and robot whose sampler makes
+        the same field again in the stepping process (:attr:`FieldTables.resolve`); None
+        where every cell of the window is settled.
     """
 
     window: tuple[int, int, int, int]
@@ -104,13 +106,15 @@ class FieldPart:
     goal: tuple[float, float]
     grid: tuple[float, float, float, float]
     used: np.ndarray
-    source: GoalField | None = member(default=None, compare=False, repr=False)
+    source: GoalField | tuple[int, int] | None = member(default=None, compare=False, repr=False)
 
 
-def field_part(field: GoalField, window: tuple[int, int, int, int], lazy: bool = False) -> FieldPart:
+def field_part(field: GoalField, window: tuple[int, int, int, int], lazy: bool = False,
+               origin: tuple[int, int] | None = None) -> FieldPart:
     """``field``'s share of the tables over ``window`` (:func:`reach_window`): settled there,
     or with ``lazy`` only as far as the field is settled already (the rest kind 4, settled
-    by :meth:`FieldTables.distance` as lookups land).
+    by :meth:`FieldTables.distance` as lookups land). With an ``origin`` (scene, robot) the
+    part keeps that instead of the field, to pickle from a worker.
 
     Only the cells the window's cells look up are settled (every one for the whole grid),
     and only the labels the window's cells name are kept: a search labels every arc node of
@@ -121,14 +125,20 @@ def field_part(field: GoalField, window: tuple[int, int, int, int], lazy: bool =
     r0, r1, c0, c1 = window
     near = np.asarray(p.near_usable, dtype=np.int64).reshape(h, w)[r0:r1, c0:c1].ravel()
     whole = (r0, r1, c0, c1) == (0, h, 0, w)
-    kind_of, label_of = field.settle(np.empty(0, np.int64) if lazy else None if whole else near[near >= 0])
+    if lazy and origin is not None:
+        # For the stepping process, which makes the field again: every cell unsettled, no
+        # labels (its search numbers its labels itself).
+        kind_of, label_of = np.full(h * w, UNSETTLED, np.int8), np.zeros(h * w, np.int32)
+    else:
+        kind_of, label_of = field.settle(np.empty(0, np.int64) if lazy else None if whole else near[near >= 0])
     kind = np.where(near >= 0, kind_of[np.maximum(near, 0)], 0).astype(np.int64)
     label = np.where(kind == 2, label_of[np.maximum(near, 0)], 0).astype(np.int64)
     used = np.unique(label[kind == 2])
     label = np.where(kind == 2, np.searchsorted(used, label), 0).astype(np.int64)
     goal = (float(field.goal[0]), float(field.goal[1]))
     grid = (float(p.geo.origin[0]), float(p.geo.origin[1]), float(p.geo.resolution), float(p.radius))
-    return FieldPart(window, kind, label, label_rows(field, used), goal, grid, used, field if lazy else None)
+    source = (field if origin is None else origin) if lazy else None
+    return FieldPart(window, kind, label, label_rows(field, used), goal, grid, used, source)
 
 
 def label_rows(field: GoalField, used: np.ndarray) -> np.ndarray:
@@ -166,6 +176,9 @@ class FieldTables:
         distance, the whole grid).
     """
 
+    #: Makes a worker-built part's field again here, from its ``(scene, robot)`` and goal
+    #: ``(gx, gy)`` (m); set by the pool that holds the tables (its samplers' scenes).
+    resolve: Callable[[tuple[int, int], tuple[float, float]], GoalField] | None = None
     # Per label (one spare row at the end of each field's labels): see _PER_LABEL.
     cost: Any
     cx: Any
@@ -247,7 +260,7 @@ class FieldTables:
         for name in _INDICES:
             setattr(moved, name, arrays.asarray(self.arrays.numpy(getattr(self, name)), arrays.i64))
         moved._lazy_state(self._sources, [k.copy() if isinstance(k, np.ndarray) else k for k in self._known],
-                          self._n_labels, self._windows)
+                          self._n_labels, self._windows, self.resolve)
         return moved
 
     @classmethod
@@ -269,11 +282,13 @@ class FieldTables:
         shifted = [np.where(k >= 0, k + n1, -1) if isinstance(k, np.ndarray) else (k[0], k[1] + n1) for k in second._known]
         windows = second._windows + np.array([first.kind.shape[0], 0, 0, 0, 0])
         joined._lazy_state(first._sources + second._sources, [*first._known, *shifted], n1 + n2,
-                           np.concatenate([first._windows, windows]))
+                           np.concatenate([first._windows, windows]), first.resolve or second.resolve)
         return joined
 
-    def _lazy_state(self, sources: list[Any], known: list[Any], n_labels: int, windows: np.ndarray) -> None:
+    def _lazy_state(self, sources: list[Any], known: list[Any], n_labels: int, windows: np.ndarray,
+                    resolve: Any = None) -> None:
         self._sources, self._known, self._n_labels, self._windows = list(sources), known, n_labels, windows
+        self.resolve = resolve
 
     # ------------------------------------------------------------- lazy settling
     def _settle_cells(self, cells: np.ndarray) -> None:
@@ -295,7 +310,12 @@ class FieldTables:
         """Field ``f``'s grid blocks (``BLOCK`` cells square) that hold its table cells
         ``cells``: their window cells' global indices, kinds and global labels."""
         field = self._sources[f]
-        if field is None:  # settled in a worker: no cell of it is pending
+        if isinstance(field, tuple):  # built in a worker: the same field again, here, once
+            if self.resolve is None:
+                raise AssertionError(f"goal field {f} was built in a worker, and its tables have no resolve")
+            goal = (float(self.arrays.numpy(self.gx[f])), float(self.arrays.numpy(self.gy[f])))
+            field = self._sources[f] = self.resolve(field, goal)
+        if field is None:  # settled whole: no cell of it is pending
             raise AssertionError(f"goal field {f} has unsettled cells but no field to settle them")
         off, rows, width, r0, c0 = (int(v) for v in self._windows[f])
         p = field.planner

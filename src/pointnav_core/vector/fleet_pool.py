@@ -15,6 +15,7 @@ the robots placed before it, a random heading, the geodesic in ``path_range``).
 
 from __future__ import annotations
 
+import functools
 import math
 from collections.abc import Sequence
 from typing import Any
@@ -27,6 +28,7 @@ from pointnav_core.vector.episodes import (
     assemble_parts,
     fixed_pose,
     pool_parts,
+    sampler_field,
     settle_part,
 )
 from pointnav_core.vector.xp import Arrays
@@ -107,7 +109,7 @@ class FleetPool:
     ) -> None:
         n_robots = len(samplers[0].tasks)
         parts = pool_parts(type(self), samplers, pool_size, seeds, starts, reach, fixed, parts, _fixed_part)
-        table, field_index, self.fields = assemble_parts(parts, arrays)
+        table, field_index, self.fields = assemble_parts(parts, arrays, functools.partial(sampler_field, list(samplers)))
         table = table.reshape(-1, n_robots, 6)
         a = arrays
         self.sx, self.sy, self.syaw, self.gx, self.gy, self.d0 = (a.asarray(table[..., i]) for i in range(6))
@@ -118,7 +120,8 @@ class FleetPool:
 
     @staticmethod
     def scene_part(env: Any, s: int, pool_size: int, seeds: Sequence[int], starts: int = 1, reach: float = math.inf,
-                   cells_before: int = 0, goals_before: int = 0, lazy: bool = False) -> ScenePart:
+                   cells_before: int = 0, goals_before: int = 0, lazy: bool = False,
+                   portable: bool = False) -> ScenePart:
         """Scene ``s``'s part: ``pool_size`` episodes drawn by its multi-robot env ``env``
         from ``seeds``, each with ``starts`` sets of starts, every robot's field settled."""
         rows: list[list[tuple[float, ...]]] = []
@@ -139,7 +142,8 @@ class FleetPool:
         n_robots = len(env.tasks)
         table = np.array(rows, dtype=np.float64).reshape(-1, n_robots, 6)
         index = np.array(field_of, dtype=np.int64).reshape(-1, n_robots)
-        return settle_part(table, index, fields, reach, cells_before, goals_before, lazy)
+        origins = [(s, i % n_robots) for i in range(len(fields))] if portable else None
+        return settle_part(table, index, fields, reach, cells_before, goals_before, lazy, origins)
 
     def __len__(self) -> int:
         return int(self.sx.shape[0])

@@ -5,7 +5,12 @@ sampler from its own seeds, and their goal fields settled) depends on nothing el
 the seeds of every scene are drawn up front. So the parts are built by
 :class:`~pointnav_core.utils.workers.WorkerPool` (spawned workers that die with this process,
 ignore Ctrl-C and report the item they held) on every usable core, and assembled here in
-scene order: the same arrays as a build in this process, byte for byte.
+scene order: the same episodes as a build in this process, and the same distance at every
+point. With the geometry disk cache on, a worker only samples its scene's episodes and
+runs their goals' searches: its fields' cells are left to settle in the stepping process as
+robots arrive (``FieldTables``), which makes each field again from its scene's sampler,
+reloading the floor's geometry from the cache (or building it again, where that took under
+``cache.MIN_SECONDS``); with the cache off, a worker settles them.
 
 Each worker reloads a floor's geometry from the disk cache (:mod:`pointnav_core.geodesic.cache`)
 when another process built it before, rather than building it again.
@@ -21,6 +26,7 @@ from typing import Any
 import numpy as np
 
 from pointnav_core.errors import ArgumentError
+from pointnav_core.geodesic.cache import cache_dir
 from pointnav_core.utils import validation
 from pointnav_core.utils.workers import WorkerError, WorkerPool, usable_cores
 from pointnav_core.vector.episodes import ScenePart, build_in_process
@@ -53,16 +59,16 @@ def pool_options(workers: Any, progress: Any, n_scenes: int) -> tuple[int, bool 
     return pool_workers(workers, n_scenes), None if progress is None else bool(progress)
 
 
-def _init(kind: Any, pool_size: int, starts: int, reach: float) -> tuple[Any, int, int, float]:
-    return kind, pool_size, starts, reach
+def _init(kind: Any, pool_size: int, starts: int, reach: float, lazy: bool) -> tuple[Any, int, int, float, bool]:
+    return kind, pool_size, starts, reach, lazy
 
 
-def _scene_task(state: tuple[Any, int, int, float], item: tuple[int, Any, list[int]]) -> tuple[int, str, Any]:
+def _scene_task(state: tuple[Any, int, int, float, bool], item: tuple[int, Any, list[int]]) -> tuple[int, str, Any]:
     """Scene ``s``'s part in a worker; an error comes back as a value, to be raised with its type."""
-    kind, pool_size, starts, reach = state
+    kind, pool_size, starts, reach, lazy = state
     s, env, seeds = item
     try:
-        return s, "done", kind.scene_part(env, s, pool_size, seeds, starts, reach)
+        return s, "done", kind.scene_part(env, s, pool_size, seeds, starts, reach, lazy=lazy, portable=True)
     except Exception as error:  # noqa: BLE001 (raised again in the parent, naming the scene)
         return s, "raised", error
 
@@ -123,7 +129,10 @@ def _in_workers(kind: Any, samplers: Sequence[Any], pool_size: int, seeds: Seque
     cells = goals = 0
     items = ((f"scene {s}", (s, env, [int(v) for v in seeds[s * pool_size:(s + 1) * pool_size]]))
              for s, env in enumerate(samplers))
-    with WorkerPool(min(workers, n), _init, (kind, pool_size, starts, reach), _scene_task) as pool:
+    # With the geometry disk cache on, the parent reloads each floor's geometry cheaply, so
+    # the workers only sample and the fields settle in the parent as robots arrive.
+    lazy = cache_dir() is not None
+    with WorkerPool(min(workers, n), _init, (kind, pool_size, starts, reach, lazy), _scene_task) as pool:
         for _, (s, status, value) in pool.imap_unordered(items):
             if status == "raised":
                 raise _scene_error(s, value)
