@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from dataclasses import field as member
 from typing import Any
 
 import numpy as np
@@ -129,17 +130,22 @@ class _Plan:
     #: ``(start, leg)``: the chord from ``start`` to the end of ``leg`` (less _SHORT) was
     #: found clear for a disc _ON_CHORD wider than ``radius``.
     chord: tuple[NDArray[np.float64], int] | None = None
+    xy: list[list[float]] = member(init=False, repr=False)
+
+    def __post_init__(self) -> None:
+        # The vertices as Python floats, read every step by locate (numpy scalars are slower).
+        self.xy = self.points.tolist()
 
     def locate(self, xy: NDArray[np.float64]) -> tuple[int, float] | None:
         """``(leg, distance)``: the nearest of the next :data:`_WINDOW` legs to ``xy`` and
         its distance (m); None when that is over :data:`_LEAVE` (the robot left the path)."""
         x, y = float(xy[0]), float(xy[1])
-        pts = self.points
+        pts = self.xy
         best, where = math.inf, self.leg
         # A few legs at most: plain floats are several times quicker than numpy here.
         for i in range(self.leg, min(self.leg + _WINDOW, len(pts) - 1)):
-            ax, ay = float(pts[i, 0]), float(pts[i, 1])
-            dx, dy = float(pts[i + 1, 0]) - ax, float(pts[i + 1, 1]) - ay
+            ax, ay = pts[i]
+            dx, dy = pts[i + 1][0] - ax, pts[i + 1][1] - ay
             length2 = dx * dx + dy * dy
             t = min(max(((x - ax) * dx + (y - ay) * dy) / length2, 0.0), 1.0) if length2 > 0.0 else 0.0
             off = math.hypot(ax + t * dx - x, ay + t * dy - y)
