@@ -1,0 +1,189 @@
+"""The compiled candidate search of :mod:`pointnav_core.geodesic.edges` (imports numba).
+
+Imported only through :func:`pointnav_core.utils.compiled.kernel` when numba is installed (the
+``fast`` extra), so the package imports without it. :func:`edge_pairs` finds the node pairs
+that ``edges._candidates`` finds with the KD-tree (the same test, ``dx * dx + dy * dy <= reach
+* reach``, in the same order: sources in the given order, destinations ascending) without a
+Python list per node, and leaves out early the pairs that no common tangent can join: a
+loose form of ``edges._tangents``'s arc tests, with :data:`_SLACK` to spare, so that it never
+leaves out a pair the exact numpy tests keep. Angles are in radians, lengths in metres.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numba
+import numpy as np
+
+from pointnav_core.geodesic.tangents import ANG_TOL, TWO_PI
+
+__all__ = ["edge_pairs"]
+
+#: Extra room (rad, and relative on lengths) of the loose tests: far above the few ulps by
+#: which numba's and numpy's trigonometry may differ, far below anything geometric.
+_SLACK = 1e-6
+
+_jit = numba.njit(cache=True, nogil=True, error_model="numpy")
+
+
+@_jit
+def _buckets(cx, cy, x0, y0, cell, nx, ny):  # pragma: no cover
+    # Nodes by grid bucket of side cell (m) from (x0, y0): members[start[k]:start[k + 1]] are
+    # bucket k's (k = row * nx + col), ascending (a counting sort, stable by node).
+    n = cx.shape[0]
+    key = np.empty(n, np.int64)
+    start = np.zeros(nx * ny + 1, np.int64)
+    for i in range(n):
+        col = min(int((cx[i] - x0) / cell), nx - 1)
+        row = min(int((cy[i] - y0) / cell), ny - 1)
+        key[i] = row * nx + col
+        start[key[i] + 1] += 1
+    for k in range(nx * ny):
+        start[k + 1] += start[k]
+    fill = start[:-1].copy()
+    members = np.empty(n, np.int64)
+    for i in range(n):
+        members[fill[key[i]]] = i
+        fill[key[i]] += 1
+    return start, members
+
+
+@_jit
+def _span(lo, hi, n):  # pragma: no cover
+    # The bucket indices covering grid coordinates [lo, hi], one bucket to spare each side
+    # (a node on a bucket's edge may round into its neighbour), clipped to [0, n - 1].
+    a = max(min(math.floor(lo) - 1.0, n - 1.0), 0.0)
+    b = max(min(math.floor(hi) + 1.0, n - 1.0), 0.0)
+    return int(a), int(b)
+
+
+@_jit
+def _near(i, cx, cy, reach, x0, y0, cell, nx, ny, start, members, buf):  # pragma: no cover
+    # Node i's KD-tree ball: every node j with dx * dx + dy * dy <= reach[i] ** 2 (the very
+    # test and rounding of scipy's query_ball_point), in bucket order in buf[:count] (buf
+    # grown as needed). Returns (count, buf).
+    x, y, rad = cx[i], cy[i], reach[i]
+    c0, c1 = _span((x - rad - x0) / cell, (x + rad - x0) / cell, nx)
+    r0, r1 = _span((y - rad - y0) / cell, (y + rad - y0) / cell, ny)
+    bound = rad * rad
+    count = 0
+    for row in range(r0, r1 + 1):
+        for k in range(start[row * nx + c0], start[row * nx + c1 + 1]):
+            j = members[k]
+            dx = cx[j] - x
+            dy = cy[j] - y
+            if dx * dx + dy * dy <= bound:
+                if count == buf.shape[0]:
+                    buf = np.concatenate((buf, np.empty_like(buf)))
+                buf[count] = j
+                count += 1
+    return count, buf
+
+
+@_jit
+def _on_arc(ang, phi0, span):  # pragma: no cover
+    # Loose ``tangents.ccw_pos`` validity: True wherever the exact one is. Angles here lie
+    # within a few turns of each other: a turn added or taken is cheaper than a modulo.
+    c = ang - phi0
+    if abs(c) > 8.0 * TWO_PI:
+        c %= TWO_PI
+    while c < 0.0:
+        c += TWO_PI
+    while c >= TWO_PI:
+        c -= TWO_PI
+    return c <= span + ANG_TOL + _SLACK or c >= TWO_PI - ANG_TOL - _SLACK
+
+
+@_jit
+def _may_join(ax, ay, bx, by, phi_a, span_a, phi_b, span_b, r):  # pragma: no cover
+    # Whether some common tangent of the circles (radius r) at a and b may leave a's arc and
+    # arrive on b's: ``edges._tangents``'s four winding pairs, each test loosened by _SLACK.
+    dx = bx - ax
+    dy = by - ay
+    length = math.hypot(dx, dy)
+    if length <= 0.0:
+        return False
+    base = math.atan2(dy, dx)
+    # Outer tangents (sb = s) first: they leave and arrive at the same angle, no arcsine.
+    for s in (1.0, -1.0):
+        ang = base - s * (math.pi / 2)
+        if _on_arc(ang, phi_a, span_a) and _on_arc(ang, phi_b, span_b):
+            return True
+    if length <= 2.0 * r * (1.0 - _SLACK):
+        return False  # the circles overlap: no crossing tangent
+    tilt = math.asin(min(2.0 * r / length, 1.0))
+    for s in (1.0, -1.0):
+        # Crossing tangent (sb = -s): it arrives half a turn from where it leaves.
+        ang = base - s * (math.pi / 2) + s * tilt
+        if _on_arc(ang, phi_a, span_a) and _on_arc(ang + s * math.pi, phi_b, span_b):
+            return True
+    return False
+
+
+@_jit
+def _grid(cx, cy):  # pragma: no cover
+    # Bucket side (m) and counts for about 8 nodes a bucket: (x0, y0, cell, nx, ny).
+    x0, y0 = cx.min(), cy.min()
+    extent = max(cx.max() - x0, cy.max() - y0)
+    per_side = max(int(math.sqrt(cx.shape[0] / 8.0)), 1)
+    cell = extent / per_side if extent > 0.0 else 1.0
+    nx = min(int((cx.max() - x0) / cell), per_side - 1) + 1
+    ny = min(int((cy.max() - y0) / cell), per_side - 1) + 1
+    return x0, y0, cell, nx, ny
+
+
+@_jit
+def edge_pairs(nodes, cx, cy, reach, phi0, span, r):  # pragma: no cover
+    """The candidate pairs of ``edges._candidates``, found in one compiled pass.
+
+    Parameters
+    ----------
+    nodes : ndarray of int64, shape (K,)
+        The source nodes.
+    cx, cy, reach : ndarray of float64, shape (N,)
+        Every node's centre (m) and its sight plus two radii (m).
+    phi0, span : ndarray of float64, shape (N,)
+        Every node's free arc (rad).
+    r : float
+        Robot radius (m).
+
+    Returns
+    -------
+    src, dst : ndarray of int64
+        The pairs ``(i, j)`` with ``j != i``, ``j`` in ``i``'s ball (``dx * dx + dy * dy <=
+        reach[i] ** 2``, as the KD-tree tests), ``i`` about within ``reach[j]`` (loosely:
+        ``edges._candidates`` decides exactly) and some common tangent that may leave ``i``'s
+        arc and arrive on ``j``'s (loosely: ``edges._tangents`` decides). Sources in
+        ``nodes`` order, each one's destinations ascending (the KD-tree's order).
+    """
+    x0, y0, cell, nx, ny = _grid(cx, cy)
+    start, members = _buckets(cx, cy, x0, y0, cell, nx, ny)
+    buf = np.empty(1024, np.int64)
+    src = np.empty(4096, np.int64)
+    dst = np.empty(4096, np.int64)
+    n_out = 0
+    for i in nodes:
+        count, buf = _near(i, cx, cy, reach, x0, y0, cell, nx, ny, start, members, buf)
+        kept = 0
+        for k in range(count):
+            j = buf[k]
+            dx = cx[j] - cx[i]
+            dy = cy[j] - cy[i]
+            loose = reach[j] * (1.0 + _SLACK)
+            if j == i or dx * dx + dy * dy > loose * loose:
+                continue
+            if not _may_join(cx[i], cy[i], cx[j], cy[j], phi0[i], span[i], phi0[j], span[j], r):
+                continue
+            buf[kept] = j
+            kept += 1
+        buf[:kept].sort()  # the KD-tree's order, which ties in _store keep
+        if n_out + kept > src.shape[0]:
+            grow = max(src.shape[0], kept)
+            src = np.concatenate((src, np.empty(grow, np.int64)))
+            dst = np.concatenate((dst, np.empty(grow, np.int64)))
+        for k in range(kept):
+            src[n_out] = i
+            dst[n_out] = buf[k]
+            n_out += 1
+    return src[:n_out].copy(), dst[:n_out].copy()
