@@ -96,29 +96,31 @@ def _on_arc(ang, phi0, span):  # pragma: no cover
 
 
 @_jit
-def _may_join(ax, ay, bx, by, phi_a, span_a, phi_b, span_b, r):  # pragma: no cover
-    # Whether some common tangent of the circles (radius r) at a and b may leave a's arc and
-    # arrive on b's: ``edges._tangents``'s four winding pairs, each test loosened by _SLACK.
+def _windings(ax, ay, bx, by, phi_a, span_a, phi_b, span_b, r):  # pragma: no cover
+    # Which common tangents of the circles (radius r) at a and b may leave a's arc and arrive
+    # on b's: bit k for ``edges.WINDINGS[k]``, each of ``edges._tangents``'s tests loosened by
+    # _SLACK (0: none can).
     dx = bx - ax
     dy = by - ay
     length = math.hypot(dx, dy)
     if length <= 0.0:
-        return False
+        return 0
     base = math.atan2(dy, dx)
-    # Outer tangents (sb = s) first: they leave and arrive at the same angle, no arcsine.
-    for s in (1.0, -1.0):
+    # Crossing tangents (sb = -s) only where the circles do not overlap.
+    cross = length > 2.0 * r * (1.0 - _SLACK)
+    tilt = math.asin(min(2.0 * r / length, 1.0)) if cross else 0.0
+    bits = 0
+    for k in range(2):
+        s = 1.0 - 2.0 * k
+        # Outer tangent (sb = s): it leaves and arrives at the same angle.
         ang = base - s * (math.pi / 2)
         if _on_arc(ang, phi_a, span_a) and _on_arc(ang, phi_b, span_b):
-            return True
-    if length <= 2.0 * r * (1.0 - _SLACK):
-        return False  # the circles overlap: no crossing tangent
-    tilt = math.asin(min(2.0 * r / length, 1.0))
-    for s in (1.0, -1.0):
-        # Crossing tangent (sb = -s): it arrives half a turn from where it leaves.
-        ang = base - s * (math.pi / 2) + s * tilt
-        if _on_arc(ang, phi_a, span_a) and _on_arc(ang + s * math.pi, phi_b, span_b):
-            return True
-    return False
+            bits |= 1 << (2 * k)
+        # Crossing tangent: it arrives half a turn from where it leaves.
+        ang += s * tilt
+        if cross and _on_arc(ang, phi_a, span_a) and _on_arc(ang + s * math.pi, phi_b, span_b):
+            bits |= 1 << (2 * k + 1)
+    return bits
 
 
 @_jit
@@ -156,12 +158,16 @@ def edge_pairs(nodes, cx, cy, reach, phi0, span, r):  # pragma: no cover
         ``edges._candidates`` decides exactly) and some common tangent that may leave ``i``'s
         arc and arrive on ``j``'s (loosely: ``edges._tangents`` decides). Sources in
         ``nodes`` order, each one's destinations ascending (the KD-tree's order).
+    windings : ndarray of uint8
+        Per pair, bit ``k`` set where the tangent of winding pair ``edges.WINDINGS[k]`` may
+        leave and arrive on the arcs (loosely again).
     """
     x0, y0, cell, nx, ny = _grid(cx, cy)
     start, members = _buckets(cx, cy, x0, y0, cell, nx, ny)
     buf = np.empty(1024, np.int64)
     src = np.empty(4096, np.int64)
     dst = np.empty(4096, np.int64)
+    wind = np.empty(4096, np.uint8)
     n_out = 0
     for i in nodes:
         count, buf = _near(i, cx, cy, reach, x0, y0, cell, nx, ny, start, members, buf)
@@ -173,17 +179,19 @@ def edge_pairs(nodes, cx, cy, reach, phi0, span, r):  # pragma: no cover
             loose = reach[j] * (1.0 + _SLACK)
             if j == i or dx * dx + dy * dy > loose * loose:
                 continue
-            if not _may_join(cx[i], cy[i], cx[j], cy[j], phi0[i], span[i], phi0[j], span[j], r):
-                continue
-            buf[kept] = j
-            kept += 1
+            bits = _windings(cx[i], cy[i], cx[j], cy[j], phi0[i], span[i], phi0[j], span[j], r)
+            if bits:
+                buf[kept] = j * 16 + bits  # sorts by j: bits < 16
+                kept += 1
         buf[:kept].sort()  # the KD-tree's order, which ties in _store keep
         if n_out + kept > src.shape[0]:
             grow = max(src.shape[0], kept)
             src = np.concatenate((src, np.empty(grow, np.int64)))
             dst = np.concatenate((dst, np.empty(grow, np.int64)))
+            wind = np.concatenate((wind, np.empty(grow, np.uint8)))
         for k in range(kept):
             src[n_out] = i
-            dst[n_out] = buf[k]
+            dst[n_out] = buf[k] >> 4
+            wind[n_out] = buf[k] & 15
             n_out += 1
-    return src[:n_out].copy(), dst[:n_out].copy()
+    return src[:n_out].copy(), dst[:n_out].copy(), wind[:n_out].copy()
