@@ -74,17 +74,18 @@ def _candidates(
     node's sight plus two radii (m) apart (geodesic.sight). Destinations come in ascending
     order per source (the KD-tree's order): the stable sort of :func:`_store` keeps it
     among edges that leave at the same position. With numba the pairs come from
-    :mod:`pointnav_core.geodesic._edges_kernel`, which also leaves out those that no common
-    tangent can join and says which winding pairs may (bit ``k`` for ``WINDINGS[k]``; None
-    without numba: all), both by loose tests that never leave out what :func:`_tangents`
-    keeps, so that its numpy work runs on a sixteenth of the pairs and windings.
+    :mod:`pointnav_core.geodesic._edges_kernel`, which also says which winding pairs may give
+    an edge (bit ``k`` for ``WINDINGS[k]``; None without numba: all) and leaves out the pairs
+    with none, by loose forms of the tests of :func:`_tangents` and of :func:`_clear`'s sight
+    profiles that never leave out a tangent they keep: the numpy work after it runs on a
+    hundredth of the pair windings of a large map.
     """
     r = p.radius
     reach = p.sights + 2 * r
     kernel = _compiled.kernel("pointnav_core.geodesic._edges_kernel", "edge_pairs")
     windings = None
     if kernel is not None:
-        src, dst, windings = kernel(nodes, p.cx, p.cy, reach, p.phi0, p.span, float(r))
+        src, dst, windings = kernel(nodes, p.cx, p.cy, reach, p.phi0, p.span, p.sight_profile, float(r))
     else:
         pts = np.stack([p.cx[nodes], p.cy[nodes]], axis=1)
         lists = p.tree.query_ball_point(pts, reach[nodes])
