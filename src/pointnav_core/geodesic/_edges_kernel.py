@@ -98,57 +98,50 @@ def _on_arc(ang, phi0, span):  # pragma: no cover
 
 
 @_jit
-def _within_sight(profile, n, dx, dy, tol):  # pragma: no cover
-    # Loose ``sight.blocked_by_profile`` (negated): False only where the segment (dx, dy) (m)
-    # leaving node n, known to tol (m), is surely longer than n's profile allows. Its
-    # direction is known to far less than a bin: the bins either side count too.
-    length = math.hypot(dx, dy)
+def _within_sight(profile, n, heading, length, tol):  # pragma: no cover
+    # Loose ``sight.blocked_by_profile`` (negated): False only where a segment of direction
+    # heading (rad) and length (m), both known to tol (m) at its ends, leaving node n, is
+    # surely longer than n's profile allows. Its direction is then known to far less than a
+    # bin: the bins either side count too.
     if length <= tol:
         return True  # too short to know its direction
     bins = profile.shape[1]
-    b = math.floor((math.atan2(dy, dx) % TWO_PI) / (TWO_PI / bins))
+    b = math.floor((heading % TWO_PI) / (TWO_PI / bins))
     most = max(profile[n, (b - 1) % bins], profile[n, b % bins], profile[n, (b + 1) % bins])
     return length <= most * (1.0 + _SLACK) + tol
 
 
 @_jit
-def _may_be_clear(i, j, cx, cy, dep, arr, r, profile):  # pragma: no cover
-    # Whether the tangent from angle dep (rad) on node i's circle to angle arr on node j's
-    # may pass both nodes' sight profiles (``edges._clear``'s first test, loosened).
-    ax, ay, bx, by = cx[i], cy[i], cx[j], cy[j]
-    dx = (bx + r * math.cos(arr)) - (ax + r * math.cos(dep))
-    dy = (by + r * math.sin(arr)) - (ay + r * math.sin(dep))
-    # Far above the rounding of coordinates this large.
-    tol = _SLACK * (abs(ax) + abs(ay) + abs(bx) + abs(by) + r)
-    return _within_sight(profile, i, dx, dy, tol) and _within_sight(profile, j, -dx, -dy, tol)
-
-
-@_jit
 def _windings(i, j, cx, cy, phi0, span, profile, r):  # pragma: no cover
     # Which common tangents of nodes i's and j's circles (radius r) may leave i's arc, arrive
-    # on j's and pass their sight profiles: bit k for ``edges.WINDINGS[k]``, each of
-    # ``edges._tangents``'s and ``_clear``'s tests loosened by _SLACK (0: none can).
+    # on j's and pass both sight profiles: bit k for ``edges.WINDINGS[k]``, each of
+    # ``edges._tangents``'s and ``_clear``'s tests loosened by _SLACK (0: none can). A
+    # tangent runs along its heading for ``seg`` (m): numpy's segment between its computed
+    # ends differs by roundings of the coordinates, far below tol.
     dx = cx[j] - cx[i]
     dy = cy[j] - cy[i]
     length = math.hypot(dx, dy)
     if length <= 0.0:
         return 0
+    tol = _SLACK * (abs(cx[i]) + abs(cy[i]) + abs(cx[j]) + abs(cy[j]) + r)
     base = math.atan2(dy, dx)
     # Crossing tangents (sb = -s) only where the circles do not overlap.
     cross = length > 2.0 * r * (1.0 - _SLACK)
     tilt = math.asin(min(2.0 * r / length, 1.0)) if cross else 0.0
+    seg = math.sqrt(max(length * length - 4.0 * r * r, 0.0))
     bits = 0
     for k in range(2):
         s = 1.0 - 2.0 * k
         # Outer tangent (sb = s): it leaves and arrives at the same angle.
         ang = base - s * (math.pi / 2)
-        on_arcs = _on_arc(ang, phi0[i], span[i]) and _on_arc(ang, phi0[j], span[j])
-        if on_arcs and _may_be_clear(i, j, cx, cy, ang, ang, r, profile):
+        if (_on_arc(ang, phi0[i], span[i]) and _on_arc(ang, phi0[j], span[j])
+                and _within_sight(profile, i, base, length, tol) and _within_sight(profile, j, base + math.pi, length, tol)):
             bits |= 1 << (2 * k)
         # Crossing tangent: it arrives half a turn from where it leaves.
-        ang += s * tilt
-        on_arcs = cross and _on_arc(ang, phi0[i], span[i]) and _on_arc(ang + s * math.pi, phi0[j], span[j])
-        if on_arcs and _may_be_clear(i, j, cx, cy, ang, ang + s * math.pi, r, profile):
+        heading = base + s * tilt
+        ang = heading - s * (math.pi / 2)
+        if (cross and _on_arc(ang, phi0[i], span[i]) and _on_arc(ang + s * math.pi, phi0[j], span[j])
+                and _within_sight(profile, i, heading, seg, tol) and _within_sight(profile, j, heading + math.pi, seg, tol)):
             bits |= 1 << (2 * k + 1)
     return bits
 
