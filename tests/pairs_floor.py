@@ -1,6 +1,7 @@
 """Plain and compiled paths of the floor's collision tests, its cell draws and the tangent
 graph's sight bounds: the checks of ``property_tests/test_compiled_paths.py`` for
-``floor._collision_kernel``, ``floor._draw_kernel`` and ``geodesic._sight_kernel``.
+``floor._collision_kernel``, ``floor._draw_kernel``, ``geodesic._sight_kernel`` and
+``geodesic._edges_kernel``.
 
 Each check takes ``plain_paths``, the context its plain side runs in (``numpy_paths()``).
 
@@ -17,8 +18,10 @@ Each check takes ``plain_paths``, the context its plain side runs in (``numpy_pa
 - :func:`pointnav_core.floor.draw.draw_cell` draws the same cells with its row spans kernel
   as with its arrays (which ``tests/test_sampling.py`` checks against ``math.hypot``).
 - :func:`pointnav_core.geodesic.sight.node_sights` gives the same bounds, bit for bit, with
-  numba and as plain Python, and ``edges._misses_full`` (the cheap rejection of candidate
-  tangent segments) the same answers with its kernel and with its numpy samples.
+  numba and as plain Python, ``edges._misses_full`` (the cheap rejection of candidate
+  tangent segments) the same answers with its kernel and with its numpy samples, and
+  ``edges.build_edges`` the same edges, in the same order, with its candidate pair kernel
+  and with the KD-tree.
 """
 
 from __future__ import annotations
@@ -202,6 +205,36 @@ def check_fully_blocked_samples(
     on = (col >= 0) & (col < full.shape[1]) & (row >= 0) & (row < full.shape[0])
     end_bad = np.where(on, full[np.clip(row, 0, full.shape[0] - 1), np.clip(col, 0, full.shape[1] - 1)], outside)
     assert not (got & end_bad).any()
+
+
+
+@settings(max_examples=40, deadline=None)
+@given(
+    seed=st.integers(0, 2**31 - 1),
+    rows=st.integers(2, 45),
+    cols=st.integers(2, 45),
+    density=st.floats(0.0, 0.4),
+    radius=st.one_of(st.just(0.0), st.floats(0.0, 0.5)),
+    resolution=st.sampled_from([0.05, 0.1, 0.25, 0.5]),
+    outside=st.booleans(),
+)
+def check_edges(
+    seed: int, rows: int, cols: int, density: float, radius: float, resolution: float, outside: bool,
+    plain_paths: Plain,
+) -> None:
+    """``edges.build_edges`` (the candidate pair kernel) stores the same tangent edges as the
+    KD-tree and numpy: the same lists, bit for bit, in the same order where departures tie
+    (grid corners in a row leave at one position)."""
+    geo = floor_collision(seed, rows, cols, density, resolution, outside)
+    # Both with compiled sights (check_sights holds them equal to the plain ones).
+    fast, plain = Planner(geo, radius), Planner(geo, radius)
+    assert kernel("pointnav_core.geodesic._edges_kernel", "edge_pairs") is not None
+    fast.build_all_edges()
+    with plain_paths():
+        assert kernel("pointnav_core.geodesic._edges_kernel", "edge_pairs") is None
+        plain.build_all_edges()
+    assert fast.edge_store == plain.edge_store
+    assert len(fast.edge_store) == 2 * fast.n_nodes
 
 
 @settings(max_examples=60, deadline=None)

@@ -22,10 +22,13 @@ from pointnav_core.utils import compiled as _compiled
 if TYPE_CHECKING:
     from pointnav_core.geodesic.planner import Planner
 
-__all__ = ["build_edges"]
+__all__ = ["WINDINGS", "build_edges"]
 
 #: Segments tested for clearance per call (bounds the temporary arrays).
 _SEG_CHUNK = 200_000
+#: The winding pairs ``(s, sb)`` of a tangent (leaving side, arriving side), in the order
+#: their edges are found (which orders edges that leave at one position).
+WINDINGS = ((1, 1), (1, -1), (-1, -1), (-1, 1))
 
 
 #: Per winding pair: sources, source side, destinations, destination side, departure and
@@ -44,8 +47,8 @@ def build_edges(p: Planner, nodes: NDArray[np.int64]) -> None:
     nodes = np.asarray(nodes, dtype=np.int64)
     if not len(nodes):
         return
-    src, dst = _candidates(p, nodes)
-    found, seg_a, seg_b = _tangents(p, src, dst)
+    src, dst, windings = _candidates(p, nodes)
+    found, seg_a, seg_b = _tangents(p, src, dst, windings)
     if found:
         clear = _clear(p, np.concatenate(seg_a), np.concatenate(seg_b), found)
         e_src = np.concatenate([f[0] for f in found])[clear]
@@ -62,32 +65,51 @@ def build_edges(p: Planner, nodes: NDArray[np.int64]) -> None:
     _store(p, nodes, e_src, e_s, e_dst, e_sb, e_dep, e_arr, e_len)
 
 
-def _candidates(p: Planner, nodes: NDArray[np.int64]) -> tuple[NDArray[np.int64], NDArray[np.int64]]:
+def _candidates(
+    p: Planner, nodes: NDArray[np.int64]
+) -> tuple[NDArray[np.int64], NDArray[np.int64], NDArray[np.uint8] | None]:
     """The ``(source, destination)`` node pairs close enough for an edge, sources in ``nodes`` order.
 
     An edge is a clear segment leaving both nodes' arcs, so the centres are at most either
-    node's sight plus two radii (m) apart (geodesic.sight).
+    node's sight plus two radii (m) apart (geodesic.sight). Destinations come in ascending
+    order per source (the KD-tree's order): the stable sort of :func:`_store` keeps it
+    among edges that leave at the same position. With numba the pairs come from
+    :mod:`pointnav_core.geodesic._edges_kernel`, which also says which winding pairs may give
+    an edge (bit ``k`` for ``WINDINGS[k]``; None without numba: all) and leaves out the pairs
+    with none, by loose forms of the tests of :func:`_tangents` and of :func:`_clear`'s sight
+    profiles that never leave out a tangent they keep: the numpy work after it runs on a
+    hundredth of the pair windings of a large map.
     """
     r = p.radius
-    pts = np.stack([p.cx[nodes], p.cy[nodes]], axis=1)
-    lists = p.tree.query_ball_point(pts, p.sights[nodes] + 2 * r)
-    counts = np.fromiter((len(v) for v in lists), dtype=np.int64, count=len(lists))
-    src = np.repeat(nodes, counts)
-    dst = np.fromiter((j for v in lists for j in v), dtype=np.int64, count=int(counts.sum()))
-    keep = (src != dst) & (np.hypot(p.cx[src] - p.cx[dst], p.cy[src] - p.cy[dst]) <= p.sights[dst] + 2 * r)
-    return src[keep], dst[keep]
+    reach = p.sights + 2 * r
+    kernel = _compiled.kernel("pointnav_core.geodesic._edges_kernel", "edge_pairs")
+    windings = None
+    if kernel is not None:
+        src, dst, windings = kernel(nodes, p.cx, p.cy, reach, p.phi0, p.span, p.sight_profile, float(r))
+    else:
+        pts = np.stack([p.cx[nodes], p.cy[nodes]], axis=1)
+        lists = p.tree.query_ball_point(pts, reach[nodes])
+        counts = np.fromiter((len(v) for v in lists), dtype=np.int64, count=len(lists))
+        src = np.repeat(nodes, counts)
+        dst = np.fromiter((j for v in lists for j in v), dtype=np.int64, count=int(counts.sum()))
+    keep = (src != dst) & (np.hypot(p.cx[src] - p.cx[dst], p.cy[src] - p.cy[dst]) <= reach[dst])
+    return src[keep], dst[keep], None if windings is None else windings[keep]
 
 
 def _tangents(
-    p: Planner, src: NDArray[np.int64], dst: NDArray[np.int64]
+    p: Planner, src: NDArray[np.int64], dst: NDArray[np.int64], windings: NDArray[np.uint8] | None = None
 ) -> tuple[list[Found], list[NDArray[np.float64]], list[NDArray[np.float64]]]:
     """The common tangents of every pair that leave and arrive on the two nodes' arcs.
+
+    ``windings`` (bit ``k`` for ``WINDINGS[k]``) limits each winding pair's tests to the
+    pairs with its bit set (None: every pair); the same numpy expressions on fewer elements
+    give the same numbers.
 
     Returns
     -------
     found : list of Found
-        One entry per winding pair ``(s, sb)`` with any tangent, in the order
-        ``(1, 1), (1, -1), (-1, -1), (-1, 1)``.
+        One entry per winding pair ``(s, sb)`` with any tangent, in the order of
+        :data:`WINDINGS`.
     seg_a, seg_b : list of ndarray, shape (n, 2)
         The tangents' end points (m) on the source and destination arcs, per entry.
     """
@@ -99,29 +121,30 @@ def _tangents(
     found: list[Found] = []
     seg_a: list[NDArray[np.float64]] = []
     seg_b: list[NDArray[np.float64]] = []
-    for s in (1, -1):
-        for sb in (s, -s):
-            if sb == s:
-                ok = L > 0
-                heading = base
-                seg = L
-            else:
-                ok = L > 2 * r * (1 + 1e-12) if r > 0 else L > 0
-                heading = base + s * np.arcsin(np.clip(2 * r / np.where(ok, L, 1.0), -1.0, 1.0))
-                seg = np.sqrt(np.maximum(L * L - 4 * r * r, 0.0))
-            dep_ang = heading - s * (math.pi / 2)
-            arr_ang = heading - sb * (math.pi / 2)
-            dep_ccw, ok_a = ccw_pos(dep_ang, p.phi0[src], p.span[src])
-            arr_ccw, ok_b = ccw_pos(arr_ang, p.phi0[dst], p.span[dst])
-            idx = np.flatnonzero(ok & ok_a & ok_b)
-            if not len(idx):
-                continue
-            da, aa = dep_ang[idx], arr_ang[idx]
-            seg_a.append(np.stack([ax[idx] + r * np.cos(da), ay[idx] + r * np.sin(da)], axis=1))
-            seg_b.append(np.stack([bx[idx] + r * np.cos(aa), by[idx] + r * np.sin(aa)], axis=1))
-            dep = dep_ccw[idx] if s > 0 else p.span[src[idx]] - dep_ccw[idx]
-            arr = arr_ccw[idx] if sb > 0 else p.span[dst[idx]] - arr_ccw[idx]
-            found.append((src[idx], s, dst[idx], sb, dep, arr, seg[idx]))
+    for k, (s, sb) in enumerate(WINDINGS):
+        w = np.arange(len(src)) if windings is None else np.flatnonzero(windings & (1 << k))
+        w_src, w_dst, w_L = src[w], dst[w], L[w]
+        if sb == s:
+            ok = w_L > 0
+            heading = base[w]
+            seg = w_L
+        else:
+            ok = w_L > 2 * r * (1 + 1e-12) if r > 0 else w_L > 0
+            heading = base[w] + s * np.arcsin(np.clip(2 * r / np.where(ok, w_L, 1.0), -1.0, 1.0))
+            seg = np.sqrt(np.maximum(w_L * w_L - 4 * r * r, 0.0))
+        dep_ang = heading - s * (math.pi / 2)
+        arr_ang = heading - sb * (math.pi / 2)
+        dep_ccw, ok_a = ccw_pos(dep_ang, p.phi0[w_src], p.span[w_src])
+        arr_ccw, ok_b = ccw_pos(arr_ang, p.phi0[w_dst], p.span[w_dst])
+        idx = np.flatnonzero(ok & ok_a & ok_b)
+        if not len(idx):
+            continue
+        da, aa, i_src, i_dst = dep_ang[idx], arr_ang[idx], w_src[idx], w_dst[idx]
+        seg_a.append(np.stack([ax[w[idx]] + r * np.cos(da), ay[w[idx]] + r * np.sin(da)], axis=1))
+        seg_b.append(np.stack([bx[w[idx]] + r * np.cos(aa), by[w[idx]] + r * np.sin(aa)], axis=1))
+        dep = dep_ccw[idx] if s > 0 else p.span[i_src] - dep_ccw[idx]
+        arr = arr_ccw[idx] if sb > 0 else p.span[i_dst] - arr_ccw[idx]
+        found.append((i_src, s, i_dst, sb, dep, arr, seg[idx]))
     return found, seg_a, seg_b
 
 
