@@ -30,8 +30,8 @@ geometry. Neighbours are found among all ``n`` agents, O(n²) per step.
 >>> pos, vel = orca_step([[0.0, 0.0], [4.0, 0.0]], np.zeros((2, 2)), [[1.0, 0.0], [-1.0, 0.0]],
 ...                      radius=0.5, max_speed=1.0, dt=0.5, neighbor_dist=10.0, max_neighbors=5,
 ...                      time_horizon=2.0)
->>> bool(vel[0, 0] < 1.0), bool(vel[0, 1] != 0.0)  # slowed down and turned aside
-(True, True)
+>>> vel.tolist(), pos.tolist()  # head-on: each takes half of the slowing down
+([[0.75, 0.0], [-0.75, 0.0]], [[0.375, 0.0], [3.625, 0.0]])
 """
 
 from __future__ import annotations
