@@ -26,6 +26,7 @@ from functools import partial
 from pathlib import Path
 from unittest import mock
 
+import pairs_crowds
 import pairs_floor
 import pairs_geodesic
 import pairs_scan
@@ -41,6 +42,7 @@ Entry = tuple[str, str]  # (kernel module, function)
 
 #: Every entry point's checks (each takes ``plain_paths``, the context of its plain side).
 PAIRS: dict[Entry, tuple[Callable[..., None], ...]] = {
+    ("pointnav_core.crowds._orca_kernel", "orca_worlds"): (pairs_crowds.check_orca,),
     ("pointnav_core.floor._collision_kernel", "cells_hit"): (pairs_floor.check_cell_test,),
     ("pointnav_core.floor._collision_kernel", "segments_clear"): (pairs_floor.check_cell_test,),
     ("pointnav_core.floor._collision_kernel", "segment_hits"): (pairs_floor.check_cell_test,),
