@@ -118,7 +118,7 @@ def _lp1(lines, no, radius, optx, opty, direction_opt, result):  # pragma: no co
         t = num / den
         # std::min(t_right, t) and std::max(t_left, t), which keep the first of equals
         if den >= _ZERO:
-            if t < t_right:
+            if t < t_right:  # noqa: PLR1730 (min() need not keep the first of equal zeros)
                 t_right = t
         elif t_left < t:
             t_left = t
