@@ -181,13 +181,14 @@ def guarded_plain_paths() -> Iterator[None]:
     """``numpy_paths()``, with every kernel module's compiled functions replaced by stubs that
     fail: a plain side that reaches a kernel by any road fails its check."""
     kernels, _ = _sources()
+    # Every kernel module is imported before any is patched: one imported after would bind
+    # another's stub for good (``from ..._collision_kernel import segment_hits as _hits``).
+    modules = {module: importlib.import_module(module) for module in kernels}
     with ExitStack() as stack:
         stack.enter_context(numpy_paths())
         for module, text in kernels.items():
             names = list(jitted(ast.parse(text)))
-            if not names:
-                continue
-            loaded = importlib.import_module(module)
+            loaded = modules[module]
             for name in names:
                 def stub(*args: object, _where: str = f"{module}.{name}") -> None:
                     raise AssertionError(f"{_where} ran inside numpy_paths()")
