@@ -26,6 +26,7 @@ from functools import partial
 from pathlib import Path
 from unittest import mock
 
+import pairs_crowds
 import pairs_floor
 import pairs_geodesic
 import pairs_scan
@@ -41,6 +42,7 @@ Entry = tuple[str, str]  # (kernel module, function)
 
 #: Every entry point's checks (each takes ``plain_paths``, the context of its plain side).
 PAIRS: dict[Entry, tuple[Callable[..., None], ...]] = {
+    ("pointnav_core.crowds._orca_kernel", "orca_worlds"): (pairs_crowds.check_orca,),
     ("pointnav_core.floor._collision_kernel", "cells_hit"): (pairs_floor.check_cell_test,),
     ("pointnav_core.floor._collision_kernel", "segments_clear"): (pairs_floor.check_cell_test,),
     ("pointnav_core.floor._collision_kernel", "segment_hits"): (pairs_floor.check_cell_test,),
@@ -180,13 +182,14 @@ def guarded_plain_paths() -> Iterator[None]:
     """``numpy_paths()``, with every kernel module's compiled functions replaced by stubs that
     fail: a plain side that reaches a kernel by any road fails its check."""
     kernels, _ = _sources()
+    # Every kernel module is imported before any is patched: one imported after would bind
+    # another's stub for good (``from ..._collision_kernel import segment_hits as _hits``).
+    modules = {module: importlib.import_module(module) for module in kernels}
     with ExitStack() as stack:
         stack.enter_context(numpy_paths())
         for module, text in kernels.items():
             names = list(jitted(ast.parse(text)))
-            if not names:
-                continue
-            loaded = importlib.import_module(module)
+            loaded = modules[module]
             for name in names:
                 def stub(*args: object, _where: str = f"{module}.{name}") -> None:
                     raise AssertionError(f"{_where} ran inside numpy_paths()")
