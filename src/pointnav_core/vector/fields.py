@@ -213,6 +213,7 @@ class FieldTables:
         # Lazy settling's state, on the host: per field its GoalField (or None), and its
         # search's labels already in the table (rows lab_off on, or a map once settling adds more).
         self._sources = [part.source for part in parts]
+        self._lazy = any(source is not None for source in self._sources)  # read every step
         self._known: list[Any] = []
         for part in parts:
             r0, r1, c0, c1 = part.window
@@ -249,7 +250,7 @@ class FieldTables:
     @property
     def lazy(self) -> bool:
         """Whether some cells may still be unsettled (kind 4), to settle on their first lookup."""
-        return any(source is not None for source in self._sources)
+        return self._lazy
 
     def to(self, arrays: Arrays) -> FieldTables:
         """These tables on ``arrays``' device (numpy tables from a worker process, say)."""
@@ -259,8 +260,7 @@ class FieldTables:
             setattr(moved, name, arrays.asarray(self.arrays.numpy(getattr(self, name))))
         for name in _INDICES:
             setattr(moved, name, arrays.asarray(self.arrays.numpy(getattr(self, name)), arrays.i64))
-        moved._lazy_state(self._sources, [k.copy() if isinstance(k, np.ndarray) else k for k in self._known],
-                          self._n_labels, self._windows, self.resolve)
+        moved._lazy_state(self._sources, self._known, self._n_labels, self._windows, self.resolve)
         return moved
 
     @classmethod
@@ -287,7 +287,10 @@ class FieldTables:
 
     def _lazy_state(self, sources: list[Any], known: list[Any], n_labels: int, windows: np.ndarray,
                     resolve: Any = None) -> None:
-        self._sources, self._known, self._n_labels, self._windows = list(sources), known, n_labels, windows
+        self._sources, self._n_labels, self._windows = list(sources), n_labels, windows
+        # Each table its own label maps: they name rows of its own label arrays.
+        self._known = [k.copy() if isinstance(k, np.ndarray) else k for k in known]
+        self._lazy = any(source is not None for source in self._sources)
         self.resolve = resolve
 
     # ------------------------------------------------------------- lazy settling
