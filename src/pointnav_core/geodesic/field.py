@@ -40,6 +40,8 @@ __all__ = ["BLOCK", "GoalField", "LOOKUP_BOUND", "UNSETTLED", "block_cells"]
 #: Side (cells) of the square blocks of the root table, each settled on its first lookup
 #: (4: a reset's first lookup settles 16 cells; a path of L cells settles about 4 L, against 8 L at 8).
 BLOCK = 4
+#: A block's row (or column) offsets, for :func:`block_cells`.
+_STEP = np.arange(BLOCK)
 #: Table kind of a cell not settled yet.
 UNSETTLED = 4
 #: The lookup's documented bound: ``|distance(p) - point_distance(p)| <= LOOKUP_BOUND * |p - c|``,
@@ -343,5 +345,3 @@ def block_cells(blocks: NDArray[np.int64], h: int, w: int) -> NDArray[np.int64]:
     inside = (rows < h)[:, :, None] & (cols < w)[:, None, :]
     return (rows[:, :, None] * w + cols[:, None, :])[inside].astype(np.int64)
 
-
-_STEP = np.arange(BLOCK)

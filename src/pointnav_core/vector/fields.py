@@ -123,7 +123,7 @@ def field_part(field: GoalField, window: tuple[int, int, int, int], lazy: bool =
     p = field.planner
     h, w = p.geo.shape
     r0, r1, c0, c1 = window
-    near = np.asarray(p.near_usable, dtype=np.int64).reshape(h, w)[r0:r1, c0:c1].ravel()
+    near = p.near_usable.reshape(h, w)[r0:r1, c0:c1].ravel().astype(np.int64)
     whole = (r0, r1, c0, c1) == (0, h, 0, w)
     if lazy and origin is not None:
         # For the stepping process, which makes the field again: every cell unsettled, no
@@ -329,7 +329,7 @@ class FieldTables:
         rr, cc = np.divmod(block_cells(np.unique(row // BLOCK * blocks_w + col // BLOCK), *p.geo.shape), w)
         keep = (rr >= r0) & (rr < r0 + rows) & (cc >= c0) & (cc < c0 + width)
         rr, cc = rr[keep], cc[keep]
-        near = np.asarray(p.near_usable, dtype=np.int64)[rr * w + cc]
+        near = p.near_usable[rr * w + cc].astype(np.int64)  # the block's cells, not the grid, widened
         kind_of, label_of = field.settle(near[near >= 0])
         at = np.maximum(near, 0)
         kind = np.where(near >= 0, kind_of[at], 0).astype(np.int64)
@@ -383,7 +383,7 @@ class FieldTables:
         inside = (row >= 0) & (row < self.rows[field]) & (col >= 0) & (col < self.width[field])
         cell = xp.where(inside, self.offset[field] + row * self.width[field] + col, 0)
         kind = xp.where(inside, self.kind[cell], 0)
-        if self.lazy and a.any(kind == UNSETTLED):
+        if self._lazy and a.any(kind == UNSETTLED):
             self._settle_cells(np.unique(a.numpy(cell[kind == UNSETTLED])))
             kind = xp.where(inside, self.kind[cell], 0)
         lab = self.label[cell]
