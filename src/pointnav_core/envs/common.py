@@ -20,6 +20,7 @@ from typing import Any
 
 import numpy as np
 from gymnasium import spaces
+from numpy.typing import NDArray
 
 from pointnav_core import scenes
 from pointnav_core.backends.robot_spec import RobotSpec
@@ -370,3 +371,59 @@ def check_action(
             if not -math.inf < value < math.inf:  # also False for NaN
                 raise ArgumentError(f"{name} must be finite, got {action.tolist()}")
     return action
+
+
+# ---------------------------------------------------------------------- pedestrians
+def make_crowd(pedestrians: Any, scene: Any) -> Any:
+    """The env's :class:`~pointnav_core.crowds.Crowd` for ``pedestrians={...}``, or None."""
+    from pointnav_core.crowds import Crowd, make_pedestrians
+
+    config = make_pedestrians(pedestrians)
+    return None if config is None else Crowd(config, scene)
+
+
+def add_pedestrian_termination(task: Any, crowd: Any, name: str = "task") -> Any:
+    """``task`` with :class:`~pointnav_core.task.PedestrianCollision` among its
+    ``termination_conditions`` when the crowd's contacts end episodes."""
+    from pointnav_core.task import PedestrianCollision
+
+    if crowd is None or not crowd.config.end_on_collision:
+        return task
+    if task is None:
+        task = {}
+    if isinstance(task, PointNavigationTask):
+        raise ArgumentError(
+            f"pedestrians['end_on_collision'] cannot change a ready PointNavigationTask ({name}): pass "
+            f"the task as a dict of its arguments, or put PedestrianCollision() in its termination_conditions"
+        )
+    if not isinstance(task, Mapping):
+        return task  # make_task names the problem
+    given = list(task.get("termination_conditions") or ())
+    if any(getattr(term, "name", None) == PedestrianCollision.name for term in given):
+        return task
+    return {**task, "termination_conditions": [*given, PedestrianCollision()]}
+
+
+def robot_discs(env: Any) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """``(M, 3)`` discs ``(x, y, radius)`` and ``(M, 2)`` planar velocities of the env's
+    robots present on its crowd's floor (m, m/s)."""
+    backend, floor = env.backend, env.crowd.floor
+    discs, velocities = [], []
+    for j, spec in enumerate(env.robots):
+        if not backend.is_present(j) or backend.get_robot_floor(j) != floor:
+            continue
+        position, _ = backend.get_pose(j)
+        linear, _ = backend.get_velocity(j)
+        discs.append((position[0], position[1], spec.radius))
+        velocities.append((linear[0], linear[1]))
+    return np.array(discs, dtype=np.float64).reshape(-1, 3), np.array(velocities, dtype=np.float64).reshape(-1, 2)
+
+
+def spawn_crowd(env: Any) -> None:
+    """Place the env's pedestrians for a new episode on its task's floor, clear of its
+    robots, from a generator drawn from ``env.np_random`` (so the reset seed fixes the crowd)."""
+    task = env.task if hasattr(env, "task") else env.tasks[0]
+    env.crowd.floor = task.floor
+    seed = int(env.np_random.integers(2**63))
+    robots, _ = robot_discs(env)
+    env.crowd.spawn(task.floor, np.random.default_rng(seed), robots)

@@ -220,6 +220,7 @@ class PointNavEnv(gym.Env[Any, np.ndarray]):
         sensors: Mapping[str, Any] | None = None,
         action_space: str = "continuous",
         discrete_actions: Mapping[str, Any] | None = None,
+        pedestrians: Mapping[str, Any] | None = None,
         config: EnvConfig | None = None,
     ) -> None:
         #: The :class:`~pointnav_core.envs.config.EnvConfig` this env was built from, or None.
@@ -235,7 +236,11 @@ class PointNavEnv(gym.Env[Any, np.ndarray]):
         self.robot = _envcommon.make_robot(robot)
         self._derive_path_range = _envcommon.derives_path_range(task)
         self.discrete_actions = make_discrete_actions(action_space, discrete_actions)
+        #: The pedestrians (:class:`~pointnav_core.crowds.Crowd`), or None without them.
+        self.crowd = _envcommon.make_crowd(pedestrians, scene)
+        self._touched, self._pedestrian_steps = False, 0
         task = _envcommon.add_stop(_envcommon.add_sensors(task, sensors), self.discrete_actions)
+        task = _envcommon.add_pedestrian_termination(task, self.crowd)
         self.task = _envcommon.make_task(task)
         self.scene = scene
         self.robots = (self.robot,)
@@ -272,6 +277,10 @@ class PointNavEnv(gym.Env[Any, np.ndarray]):
             raise ArgumentError(f"options must be None or a dict, got {options!r}")
         self.backend.reset()
         info = self.task.reset(self, episode=(options or {}).get("episode"))
+        if self.crowd is not None:
+            _envcommon.spawn_crowd(self)
+            self._touched, self._pedestrian_steps = False, 0
+            info["pedestrian_collisions"] = 0
         return self._get_obs(), info
 
     def step(self, action: Any) -> tuple[Any, float, bool, bool, dict[str, Any]]:
@@ -281,8 +290,12 @@ class PointNavEnv(gym.Env[Any, np.ndarray]):
             return self._step_discrete(action)
         action = self._check_action(action)
         self.backend.step({self._idn: action})
+        if self.crowd is None:
+            reward, terminated, truncated, info = self.task.step(self, action)
+            return self._get_obs(), reward, terminated, truncated, info
+        contact = self._step_crowd()
         reward, terminated, truncated, info = self.task.step(self, action)
-        return self._get_obs(), reward, terminated, truncated, info
+        return self._get_obs(), reward, terminated, truncated, self._count_contact(info, contact)
 
     def render(self) -> NDArray[np.uint8] | None:
         """Return a top-down RGB image (H, W, 3) uint8 when ``render_mode="rgb_array"``."""
@@ -330,14 +343,36 @@ class PointNavEnv(gym.Env[Any, np.ndarray]):
         index = check_discrete_action(action, len(self._plan))  # type: ignore[arg-type]
         command, steps = self._plan[index]  # type: ignore[index]
         idn, backend = self._idn, self.backend
-        contact = False
+        contact = touched = False
         for _ in range(steps):
             backend.step({idn: command})
+            if self.crowd is not None:
+                touched = self._step_crowd() or touched
             if backend.in_contact(idn):
                 contact = True
                 break
+        self._touched = touched
         reward, terminated, truncated, info = self.task.step(self, index, contact=contact)
-        return self._get_obs(), reward, terminated, truncated, info
+        if self.crowd is None:
+            return self._get_obs(), reward, terminated, truncated, info
+        return self._get_obs(), reward, terminated, truncated, self._count_contact(info, touched)
+
+    def pedestrian_contact(self, idn: int) -> bool:
+        """Whether robot ``idn`` touched a pedestrian during the last step (for
+        :class:`~pointnav_core.task.terminations.PedestrianCollision`)."""
+        return bool(self._touched) and idn == self._idn
+
+    def _step_crowd(self) -> bool:
+        """Move the pedestrians one control step beside the robot; whether they touch it."""
+        robots, velocities = _envcommon.robot_discs(self)
+        self.crowd.step(1.0 / self.action_frequency, robots, velocities)  # type: ignore[union-attr]
+        self._touched = touched = bool(self.crowd.contacts(robots)[0])  # type: ignore[union-attr]
+        return touched
+
+    def _count_contact(self, info: dict[str, Any], touched: bool) -> dict[str, Any]:
+        self._pedestrian_steps += int(touched)
+        info["pedestrian_collisions"] = self._pedestrian_steps
+        return info
 
     def _check_action(self, action: Any) -> Any:
         # Finiteness is the backend's check: a rejected step moves nothing (conformance).

@@ -44,6 +44,9 @@ WAYPOINT_COLOR: RGB = (30, 170, 60)
 MARKER_COLORS: Mapping[str, RGB] = {"start": START_COLOR, "goal": GOAL_COLOR, "waypoint": WAYPOINT_COLOR}
 """Marker colour by :attr:`~pointnav_core.task.markers.VisualMarker.kind`."""
 
+PEDESTRIAN_COLOR: RGB = (120, 120, 120)
+"""Pedestrians (grey), opaque discs with a heading tick, drawn below the robots."""
+
 SCAN_RAY_COLOR: RGB = (250, 200, 140)
 """Range scan rays (light orange), one-pixel lines from the robot's centre to each reading."""
 SCAN_HIT_COLOR: RGB = (200, 0, 200)

@@ -15,6 +15,7 @@ from pointnav_core.errors import ArgumentError
 from pointnav_core.floor.maps import BoundedCache, TraversableMap
 from pointnav_core.render.glyphs import (
     MARKER_COLORS,
+    PEDESTRIAN_COLOR,
     Marker,
     RobotGlyph,
     ScanGlyph,
@@ -154,6 +155,7 @@ def render_env(
     -------
     ndarray of uint8, shape (H, W, 3)
         A new RGB array. It shows the floor of the first task (floor 0 without tasks);
+        the env's pedestrians on that floor (``env.crowd``) as grey discs with a heading tick;
         every robot that is present and on that floor as a disc of its spec's ``radius``,
         coloured ``ROBOT_PALETTE[idn % 8]``, with a heading tick (robots whose task has not
         had an episode yet are not placed, and not drawn); and over the floor, below the
@@ -187,8 +189,19 @@ def render_env(
     renderer = _renderer_for(env.scene.floors[floor], ppm, renderers)
 
     markers = _marker_glyphs(tasks, floor)
-    robots = _robot_glyphs(env, tasks, floor)
+    robots = _pedestrian_glyphs(env, floor) + _robot_glyphs(env, tasks, floor)
     return renderer.draw(robots, markers, _scan_glyphs(env.backend, tasks, floor))
+
+
+def _pedestrian_glyphs(env: Any, floor: int) -> list[RobotGlyph]:
+    """The env's pedestrians on ``floor`` (its ``crowd``), grey, facing where they walk."""
+    crowd = getattr(env, "crowd", None)
+    if crowd is None or crowd.floor != floor:
+        return []
+    return [
+        RobotGlyph(position_xy=(x, y), yaw=yaw, radius=r, color=PEDESTRIAN_COLOR)
+        for (x, y), yaw, r in zip(crowd.positions.tolist(), crowd.headings.tolist(), crowd.radius.tolist())
+    ]
 
 
 def _marker_glyphs(tasks: list[Any], floor: int) -> list[Marker]:

@@ -20,17 +20,24 @@ from pointnav_core.sensors.local_map import (
     LOCAL_BLOCKED,
     LOCAL_FREE,
     LOCAL_MAP_DTYPES,
+    LOCAL_PEDESTRIAN,
     LOCAL_ROBOT,
     LOCAL_VOID,
     LocalMap,
 )
 from pointnav_core.sensors.raycast import TOUCH_EPS, ScanGeometry, cast_rays
-from pointnav_core.sensors.scan import RangeScan, other_robot_discs, scan_angles
+from pointnav_core.sensors.scan import (
+    RangeScan,
+    other_robot_discs,
+    pedestrian_discs,
+    scan_angles,
+)
 
 __all__ = [
     "LOCAL_BLOCKED",
     "LOCAL_FREE",
     "LOCAL_MAP_DTYPES",
+    "LOCAL_PEDESTRIAN",
     "LOCAL_ROBOT",
     "LOCAL_VOID",
     "SENSORS",
@@ -42,5 +49,6 @@ __all__ = [
     "cast_rays",
     "make_sensors",
     "other_robot_discs",
+    "pedestrian_discs",
     "scan_angles",
 ]

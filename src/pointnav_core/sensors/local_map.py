@@ -12,6 +12,7 @@ value                  code   what is under the cell's centre
 :data:`LOCAL_BLOCKED`  1      an OBSTACLE cell of the floor's grid
 :data:`LOCAL_VOID`     2      VOID (a hole), or off the map
 :data:`LOCAL_ROBOT`    3      another robot present on the floor (its disc covers it)
+:data:`LOCAL_PEDESTRIAN` 4    a pedestrian (:mod:`pointnav_core.crowds`; only in an env with them)
 =====================  =====  =======================================================
 
 The floor is read from its grid of cell codes at the map's resolution (the grid a floor
@@ -21,8 +22,8 @@ is not drawn: it stands at the centre of the grid (between the four middle cells
 ``cells`` is even).
 
 The values are the codes above, as ``uint8`` (the default) or ``float32``
-(``dtype="float32"``), in a ``Box(0, 3, (cells, cells))`` of that dtype in the ``Dict``
-observation, and row by row (row 0 first) in the flat one.
+(``dtype="float32"``), in a ``Box(0, 3, (cells, cells))`` of that dtype (``Box(0, 4, ...)``
+in an env with pedestrians) in the ``Dict`` observation, and row by row (row 0 first) in the flat one.
 
 Examples
 --------
@@ -48,15 +49,18 @@ from numpy.typing import NDArray
 from pointnav_core.errors import ArgumentError
 from pointnav_core.floor.maps import FREE, OBSTACLE, VOID
 from pointnav_core.sensors._checks import check_int, check_number
-from pointnav_core.sensors.scan import other_robot_discs
+from pointnav_core.sensors.scan import other_robot_discs, pedestrian_discs
 from pointnav_core.task.observations import Frame, ObservationTerm
 
-__all__ = ["LOCAL_BLOCKED", "LOCAL_FREE", "LOCAL_MAP_DTYPES", "LOCAL_ROBOT", "LOCAL_VOID", "LocalMap"]
+__all__ = [
+    "LOCAL_BLOCKED", "LOCAL_FREE", "LOCAL_MAP_DTYPES", "LOCAL_PEDESTRIAN", "LOCAL_ROBOT", "LOCAL_VOID", "LocalMap",
+]
 
 LOCAL_FREE = 0
 LOCAL_BLOCKED = 1
 LOCAL_VOID = 2
 LOCAL_ROBOT = 3
+LOCAL_PEDESTRIAN = 4
 #: The dtypes a local map can be declared with.
 LOCAL_MAP_DTYPES = ("uint8", "float32")
 
@@ -119,7 +123,8 @@ class LocalMap(ObservationTerm):
         )
 
     def bounds(self, task: Any, env: Any) -> tuple[Sequence[float], Sequence[float]]:
-        return (0.0,) * self.size, (float(LOCAL_ROBOT),) * self.size
+        top = LOCAL_ROBOT if getattr(env, "crowd", None) is None else LOCAL_PEDESTRIAN
+        return (0.0,) * self.size, (float(top),) * self.size
 
     def cell_centres(self, x: float, y: float, yaw: float) -> NDArray[np.float64]:
         """World ``(x, y)`` of every cell centre, row by row, shape ``(cells * cells, 2)``."""
@@ -143,6 +148,8 @@ class LocalMap(ObservationTerm):
         out = np.where(inside, _LUT[tmap.codes.ravel()[flat]], LOCAL_VOID).astype(np.uint8)
         for ox, oy, r in other_robot_discs(env, task.robot_idn, task.floor).tolist():
             out[(wx - ox) ** 2 + (wy - oy) ** 2 <= r * r] = LOCAL_ROBOT
+        for ox, oy, r in pedestrian_discs(env, task.floor).tolist():
+            out[(wx - ox) ** 2 + (wy - oy) ** 2 <= r * r] = LOCAL_PEDESTRIAN
         return out.reshape(self.shape)
 
     def values(self, frame: Frame) -> NDArray[np.uint8]:

@@ -56,7 +56,7 @@ from pointnav_core.sensors.noise import episode_key, scan_noise, seed_entropy
 from pointnav_core.sensors.raycast import ScanGeometry, cast_pose_compiled, cast_rays
 from pointnav_core.task.observations import Frame, ObservationTerm
 
-__all__ = ["RangeScan", "ScanShare", "other_robot_discs", "scan_angles"]
+__all__ = ["RangeScan", "ScanShare", "other_robot_discs", "pedestrian_discs", "scan_angles"]
 
 _TWO_PI = 2.0 * math.pi
 
@@ -95,6 +95,15 @@ def other_robot_discs(env: Any, idn: int, floor: int) -> NDArray[np.float64]:
             x, y = backend.get_pose(j)[0][:2].tolist()
         out.append((x, y, spec.radius))
     return np.array(out, dtype=np.float64).reshape(-1, 3)
+
+
+def pedestrian_discs(env: Any, floor: int) -> NDArray[np.float64]:
+    """``(P, 3)`` discs ``(x, y, radius)`` of the env's pedestrians on ``floor`` (its
+    ``crowd``, :mod:`pointnav_core.crowds`); empty without them."""
+    crowd = getattr(env, "crowd", None)
+    if crowd is None or crowd.floor != floor:
+        return np.zeros((0, 3))
+    return crowd.discs()
 
 
 class RangeScan(ObservationTerm):
@@ -210,13 +219,17 @@ class RangeScan(ObservationTerm):
     def ranges(self, frame: Frame) -> NDArray[np.float64]:
         """The exact ranges (m) at the frame's pose, before the min-range rule and noise."""
         task, env = frame.task, frame.env
-        if self._share is not None and self._share.geometry.tmap is env.scene.floors[task.floor]:
+        crowd = getattr(env, "crowd", None)
+        if crowd is None and self._share is not None and self._share.geometry.tmap is env.scene.floors[task.floor]:
             shared = self._share.ranges(env, task.robot_idn, task.floor)
             if shared is not None:
                 return shared
         if self._geometry is None or self._geometry.tmap is not env.scene.floors[task.floor]:
             self._geometry = ScanGeometry(env.scene.floors[task.floor])
         discs = other_robot_discs(env, task.robot_idn, task.floor) if len(env.robots) > 1 else None
+        if crowd is not None:
+            walkers = pedestrian_discs(env, task.floor)
+            discs = walkers if discs is None else np.concatenate([discs, walkers])
         origin, yaw, heading = self._pose
         origin[0, 0] = frame.x
         origin[0, 1] = frame.y

@@ -19,6 +19,7 @@ from pointnav_core.task.task_env import TaskEnv
 from pointnav_core.task.terminations import (
     Falling,
     MaxCollision,
+    PedestrianCollision,
     PointGoal,
     TerminationCondition,
     Timeout,
@@ -30,6 +31,7 @@ __all__ = [
     "Falling",
     "MaxCollision",
     "ObservationTerm",
+    "PedestrianCollision",
     "PointGoal",
     "PointGoalReward",
     "PointNavigationTask",

@@ -14,6 +14,10 @@ Falling           ``"falling"``        no       no          z < floor height - `
 PointGoal         ``"pointgoal"``      yes      no          xy distance < ``goal_tolerance``
 ================  ===================  =======  ==========  ==================================
 
+:class:`PedestrianCollision` (``"pedestrian_collision"``, failure: the robot touched a
+pedestrian) is not among the task's defaults; the envs add it for ``pedestrians={...,
+"end_on_collision": True}``.
+
 What a condition may read
 -------------------------
 The task refreshes a per-step snapshot *before* it asks any condition, so that the backend
@@ -50,6 +54,7 @@ __all__ = [
     "Timeout",
     "Falling",
     "PointGoal",
+    "PedestrianCollision",
 ]
 
 
@@ -274,3 +279,19 @@ class PointGoal(TerminationCondition):
 
     def __repr__(self) -> str:
         return f"PointGoal(goal_tolerance={self.goal_tolerance})"
+
+
+class PedestrianCollision(TerminationCondition):
+    """Ends the episode when the robot touches a pedestrian (failure).
+
+    Done on a step in which ``env.pedestrian_contact(task.robot_idn)`` is True: the robot's
+    disc overlapped a pedestrian's after the step (:mod:`pointnav_core.crowds`). An env
+    without pedestrians never ends an episode here. ``pedestrians={"end_on_collision":
+    True}`` adds it to the env's task.
+    """
+
+    name = "pedestrian_collision"
+
+    def terminate(self, task: Any, env: Any, action: Any) -> bool:
+        contact = getattr(env, "pedestrian_contact", None)
+        return bool(contact(task.robot_idn)) if contact is not None else False

@@ -1,0 +1,296 @@
+"""A crowd of pedestrians walking a scene's floor along its geodesic paths.
+
+:class:`Crowd` places pedestrians where they fit (clear of the walls, the robots and each
+other), gives each a goal in its part of the floor and the exact shortest path there
+(:meth:`Scene.get_shortest_path <pointnav_core.scenes.Scene.get_shortest_path>`, for the
+crowd's largest radius), and advances them one control step at a time:
+
+1. each pedestrian's *preferred velocity* points at its next waypoint at its preferred speed
+   (slowing to arrive on the last one); a waypoint nearer than one step is passed when the
+   one after it is in plain sight;
+2. the behaviour turns the preferred velocities into new ones: ORCA (:func:`orca_step`, among
+   the pedestrians and the robots they see, as CrowdNav puts the robot in RVO2's simulator),
+   ``"static"`` (they never move) or the user's callable;
+3. every pedestrian moves by its velocity for the step, unless that would take a disc of the
+   crowd's largest radius into a wall: then it takes its preferred velocity instead, and if
+   that too is blocked it stands still for the step and plans again from where it is (ORCA
+   here has no wall lines; the paths keep that radius plus
+   :data:`~pointnav_core.crowds.config.PATH_MARGIN` from the walls, and a push by a
+   neighbour is undone by the new plan);
+4. a pedestrian within 0.1 m of its goal gets a new goal and path.
+
+Robots are not pushed by pedestrians (there is no physics): a robot's disc that overlaps a
+pedestrian's is a *pedestrian contact*, which the env counts apart from its collisions, as
+iGibson's social navigation task and CrowdNav do.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from pointnav_core.crowds.config import CrowdView, PedestrianConfig
+from pointnav_core.crowds.orca import orca_step
+from pointnav_core.errors import ArgumentError, SamplingError
+
+__all__ = ["Crowd"]
+
+#: Tries to place one pedestrian before the crowd is declared not to fit.
+PLACE_TRIES = 200
+#: How near (m) a pedestrian must come to its goal to draw the next one.
+GOAL_REACHED = 0.1
+#: Goals nearer than this (m) to the pedestrian are drawn again (up to 10 times).
+MIN_GOAL_DISTANCE = 1.0
+
+
+class Crowd:
+    """The pedestrians of one env's scene (see the module notes for how they move).
+
+    Parameters
+    ----------
+    config : PedestrianConfig
+    scene : Scene
+        The scene they walk; pedestrians are on one floor at a time (the robot's).
+
+    Attributes
+    ----------
+    positions, velocities : ndarray, shape (P, 2)
+        Centres (m) and velocities (m/s) after the last step.
+    headings : ndarray, shape (P,)
+        Walking directions (rad, world frame): of the velocity, kept while standing.
+    radius, speed : ndarray, shape (P,)
+        Disc radii (m) and preferred speeds (m/s).
+    goals : ndarray, shape (P, 2)
+        The goal each walks to now (m).
+    floor : int
+        The floor they are on.
+    """
+
+    def __init__(self, config: PedestrianConfig, scene: Any) -> None:
+        self.config = config
+        self.scene = scene
+        self.floor = 0
+        self._rng = np.random.default_rng(0)
+        self._set_count(0)
+
+    def _set_count(self, n: int) -> None:
+        self.positions = np.zeros((n, 2))
+        self.velocities = np.zeros((n, 2))
+        self.headings = np.zeros(n)
+        self.radius = np.zeros(n)
+        self.speed = np.zeros(n)
+        self.goals = np.zeros((n, 2))
+        self._paths = np.zeros((n, 1, 2))  # each path padded with its last point
+        self._last = np.zeros(n, dtype=np.int64)  # index of each path's last point
+        self._next = np.zeros(n, dtype=np.int64)  # index of each one's next waypoint
+
+    @property
+    def n(self) -> int:
+        """Number of pedestrians."""
+        return len(self.radius)
+
+    def discs(self) -> NDArray[np.float64]:
+        """``(P, 3)`` discs ``(x, y, radius)`` of the pedestrians (m)."""
+        return np.column_stack([self.positions, self.radius])
+
+    # ------------------------------------------------------------------ placing
+    def spawn(self, floor: int, rng: np.random.Generator, robots: NDArray[np.float64]) -> None:
+        """Place a new crowd on ``floor``, clear of the ``(M, 3)`` robot discs ``robots``.
+
+        Raises
+        ------
+        SamplingError
+            When the crowd's count does not fit: naming the count and the pedestrian that
+            found no place after :data:`PLACE_TRIES` tries.
+        """
+        cfg, scene = self.config, self.scene
+        self.floor, self._rng = int(floor), rng
+        tmap = scene.floors[self.floor]
+        n = cfg.number(float(tmap.free.sum()) * tmap.resolution**2)
+        self._set_count(n)
+        lo, hi = cfg.radius
+        self.radius[:] = rng.uniform(lo, hi, n) if hi > lo else lo
+        lo, hi = cfg.speed
+        self.speed[:] = rng.uniform(lo, hi, n) if hi > lo else lo
+        robots = np.asarray(robots, dtype=np.float64).reshape(-1, 3)
+        for i in range(n):
+            self.positions[i] = self._place(i, robots)
+        self.headings[:] = rng.uniform(-math.pi, math.pi, n)
+        paths = [self._plan(i, new_goal=True) for i in range(n)]
+        self._set_paths(range(n), paths)
+
+    def _place(self, i: int, robots: NDArray[np.float64]) -> NDArray[np.float64]:
+        """A usable point for pedestrian ``i`` that overlaps no robot and no pedestrian before it."""
+        r = self.radius[i]
+        others = np.concatenate([robots, self.discs()[:i]])
+        for _ in range(PLACE_TRIES):
+            _, point = self.scene.get_random_point(self.floor, robot=self.config.plan_radius, rng=self._rng)
+            gap = np.hypot(others[:, 0] - point[0], others[:, 1] - point[1]) - others[:, 2] - r
+            if not len(gap) or gap.min() >= 0.0:
+                return point[:2]
+        what = f"count={self.n}" if self.config.count is not None else f"{self.n} pedestrians (density={self.config.density})"
+        raise SamplingError(
+            f"pedestrians: {what} do not fit on floor {self.floor}: pedestrian {i} found no place clear of "
+            f"the walls, the robots and the pedestrians before it in {PLACE_TRIES} tries; ask for fewer"
+        )
+
+    # ------------------------------------------------------------------ paths
+    def _plan(self, i: int, new_goal: bool) -> NDArray[np.float64]:
+        """Pedestrian ``i``'s path from where it stands to its goal (a new one if asked, or
+        if the old one cannot be reached); a one-point path when none is reachable."""
+        scene, floor, radius = self.scene, self.floor, self.config.plan_radius
+        here = self.positions[i]
+        start = self._anchor(here)
+        if start is None:
+            return here[None].copy()
+        for attempt in range(10):
+            if new_goal or attempt:
+                goal = start
+                for _ in range(10):
+                    _, goal = scene.get_random_point(floor, reference_point=start, robot=radius, rng=self._rng)
+                    goal = goal[:2]
+                    if math.dist(goal, start) >= MIN_GOAL_DISTANCE:
+                        break
+                self.goals[i] = goal
+            points, _ = scene.get_shortest_path(floor, start, self.goals[i], entire_path=True, robot=radius)
+            if points is not None:
+                points = np.asarray(points, dtype=np.float64)
+                return points if start is here else np.concatenate([here[None], points])
+        return here[None].copy()
+
+    def _anchor(self, here: NDArray[np.float64]) -> NDArray[np.float64] | None:
+        """Where to plan from: ``here`` when the paths' radius fits there, else the nearest
+        cell centre within 3 cells where it does (a neighbour's push can leave a pedestrian
+        a little nearer a wall than its path runs); None if there is none."""
+        tmap, radius = self.scene.floors[self.floor], self.config.plan_radius
+        if tmap.is_usable(here, radius):
+            return here
+        usable = tmap.usable(radius)
+        row, col = (int(v) for v in tmap.world_to_cell(here))
+        rows, cols = np.mgrid[max(row - 3, 0): row + 4, max(col - 3, 0): col + 4]
+        inside = (rows < usable.shape[0]) & (cols < usable.shape[1])
+        rows, cols = rows[inside], cols[inside]
+        ok = usable[rows, cols]
+        if not ok.any():
+            return None
+        centres = tmap.cell_to_world(np.column_stack([rows[ok], cols[ok]]))
+        return centres[int(np.argmin(np.linalg.norm(centres - here, axis=1)))]
+
+    def set_route(self, i: int, points: Any) -> None:
+        """Send pedestrian ``i`` along the polyline ``points`` ``(N, 2)`` (m) to its last
+        point, its new goal (the path is taken as given: it is not checked against the walls)."""
+        pts = np.asarray(points, dtype=np.float64)
+        if pts.ndim != 2 or pts.shape[1] != 2 or not len(pts) or not np.isfinite(pts).all():
+            raise ArgumentError(f"points must be an (N, 2) array of finite numbers (m), N >= 1, got {points!r}")
+        self.goals[i] = pts[-1]
+        self._set_paths([i], [pts])
+
+    def _set_paths(self, rows: Any, paths: list[NDArray[np.float64]]) -> None:
+        """Store ``paths`` for the pedestrians ``rows``, widening the padded table if needed."""
+        rows = list(rows)
+        longest = max([len(p) for p in paths], default=1)
+        if longest > self._paths.shape[1]:
+            pad = np.repeat(self._paths[:, -1:], longest - self._paths.shape[1], axis=1)
+            self._paths = np.concatenate([self._paths, pad], axis=1)
+        for i, path in zip(rows, paths):
+            self._paths[i, : len(path)] = path
+            self._paths[i, len(path):] = path[-1]
+            self._last[i] = len(path) - 1
+            self._next[i] = min(1, len(path) - 1)
+
+    # ------------------------------------------------------------------ stepping
+    def preferred(self, dt: float) -> NDArray[np.float64]:
+        """``(P, 2)`` velocities toward each next waypoint at the preferred speeds (m/s),
+        passing waypoints nearer than one step and slowing to stop on the last one."""
+        rows = np.arange(self.n)
+        reach = np.maximum(self.speed * dt, 0.05)
+        collision, radius = self.scene.floors[self.floor].collision, self.config.radius[1]
+        for _ in range(4):  # arcs are drawn as short pieces: pass a few per step
+            gap = np.linalg.norm(self._paths[rows, self._next] - self.positions, axis=1)
+            near = np.flatnonzero((gap < reach) & (self._next < self._last))
+            if not len(near):
+                break
+            # Passed only where the one after is in plain sight: a pedestrian pushed off its
+            # path must not cut a corner into a wall.
+            ahead = self._paths[near, self._next[near] + 1]
+            self._next[near] += collision.segments_clear(self.positions[near], ahead, radius)
+        delta = self._paths[rows, self._next] - self.positions
+        dist = np.linalg.norm(delta, axis=1)
+        speed = np.where(self._next == self._last, np.minimum(self.speed, dist / dt), self.speed)
+        with np.errstate(invalid="ignore", divide="ignore"):
+            return np.where(dist[:, None] > 0, delta * (speed / dist)[:, None], 0.0)
+
+    def step(self, dt: float, robots: NDArray[np.float64], robot_velocities: NDArray[np.float64]) -> None:
+        """Advance the crowd by ``dt`` s beside the ``(M, 3)`` robot discs ``robots`` moving
+        at ``(M, 2)`` ``robot_velocities`` (see the module notes)."""
+        if not self.n:
+            return
+        cfg = self.config
+        pref = self.preferred(dt)
+        if cfg.behaviour == "static":
+            return
+        if not cfg.sees_robots:
+            robots, robot_velocities = np.zeros((0, 3)), np.zeros((0, 2))
+        if cfg.behaviour == "orca":
+            vel = self._orca(pref, dt, robots, robot_velocities)
+        else:
+            vel = self._called(pref, dt, robots, robot_velocities)
+        tmap = self.scene.floors[self.floor]
+        blocked = ~np.asarray(tmap.is_usable(self.positions + vel * dt, cfg.radius[1]))
+        if blocked.any():  # ORCA knows no walls: its way there is the path's way
+            vel[blocked] = pref[blocked]
+            blocked &= ~np.asarray(tmap.is_usable(self.positions + vel * dt, cfg.radius[1]))
+            vel[blocked] = 0.0
+        new = self.positions + vel * dt
+        self.positions = np.where(blocked[:, None], self.positions, new)
+        self.velocities = vel
+        moving = np.hypot(vel[:, 0], vel[:, 1]) > 1e-9
+        self.headings = np.where(moving, np.arctan2(vel[:, 1], vel[:, 0]), self.headings)
+        arrived = np.linalg.norm(self.goals - self.positions, axis=1) < GOAL_REACHED
+        replan = np.flatnonzero(blocked | arrived)
+        if len(replan):
+            paths = [self._plan(int(i), new_goal=bool(arrived[i])) for i in replan]
+            self._set_paths(replan, paths)
+
+    def _orca(self, pref: NDArray[np.float64], dt: float, robots: NDArray[np.float64],
+              robot_velocities: NDArray[np.float64]) -> NDArray[np.float64]:
+        """ORCA among the pedestrians and the robots they see; the robots keep their own
+        velocities (they are agents that do not react), and only the pedestrians' are kept."""
+        cfg, n = self.config, self.n
+        pos = np.concatenate([self.positions, robots[:, :2]])
+        vel = np.concatenate([self.velocities, robot_velocities])
+        pref = np.concatenate([pref, robot_velocities])
+        radius = np.concatenate([self.radius, robots[:, 2]])
+        top = np.concatenate([self.speed, np.hypot(robot_velocities[:, 0], robot_velocities[:, 1])])
+        _, new = orca_step(pos, vel, pref, radius, top, dt, cfg.neighbor_dist, cfg.max_neighbors, cfg.time_horizon)
+        return new[:n]
+
+    def _called(self, pref: NDArray[np.float64], dt: float, robots: NDArray[np.float64],
+                robot_velocities: NDArray[np.float64]) -> NDArray[np.float64]:
+        """The user's behaviour's velocities, checked and clipped to each preferred speed."""
+        view = CrowdView(self.positions.copy(), self.velocities.copy(), pref.copy(), self.radius.copy(),
+                         self.speed.copy(), robots.copy(), robot_velocities.copy(), float(dt))
+        got = self.config.behaviour(view)  # type: ignore[operator]
+        try:
+            vel = np.array(got, dtype=np.float64)
+        except (TypeError, ValueError):
+            vel = None
+        if vel is None or vel.shape != (self.n, 2) or not np.isfinite(vel).all():
+            raise ArgumentError(
+                f"pedestrians['behaviour'] must return an array of shape ({self.n}, 2) of finite velocities (m/s), got {got!r}"
+            )
+        norm = np.hypot(vel[:, 0], vel[:, 1])
+        scale = np.where(norm > self.speed, self.speed / np.maximum(norm, 1e-300), 1.0)
+        return vel * scale[:, None]
+
+    # ------------------------------------------------------------------ the robots' side
+    def contacts(self, robots: NDArray[np.float64]) -> NDArray[np.bool_]:
+        """Whether each of the ``(M, 3)`` robot discs ``robots`` overlaps a pedestrian."""
+        robots = np.asarray(robots, dtype=np.float64).reshape(-1, 3)
+        if not self.n or not len(robots):
+            return np.zeros(len(robots), dtype=bool)
+        d = np.hypot(robots[:, None, 0] - self.positions[None, :, 0], robots[:, None, 1] - self.positions[None, :, 1])
+        return (d < robots[:, None, 2] + self.radius[None, :]).any(axis=1)
