@@ -1,6 +1,7 @@
 """The point-goal navigation task: OmniGibson's ``PointNavigationTask`` as a state machine,
 with its lifecycle, configuration, terms (rewards, terminations, observations), metrics,
-episode sampling, markers and discrete actions.
+episode sampling, markers and discrete actions; the social-navigation metrics of a
+recorded episode (``social_metrics``).
 """
 
 from pointnav_core.errors import TaskStateError
@@ -8,6 +9,7 @@ from pointnav_core.task.config import REWARD_TYPES, TaskConfig
 from pointnav_core.task.lifecycle import TaskState
 from pointnav_core.task.metrics import soft_spl, spl
 from pointnav_core.task.observations import ObservationTerm
+from pointnav_core.task.social import SOCIAL_METRIC_KEYS, social_metrics
 from pointnav_core.task.rewards import (
     CollisionReward,
     PointGoalReward,
@@ -26,6 +28,7 @@ from pointnav_core.task.terminations import (
 
 __all__ = [
     "REWARD_TYPES",
+    "SOCIAL_METRIC_KEYS",
     "CollisionReward",
     "Falling",
     "MaxCollision",
@@ -41,6 +44,7 @@ __all__ = [
     "TaskStateError",
     "TerminationCondition",
     "Timeout",
+    "social_metrics",
     "soft_spl",
     "spl",
 ]
