@@ -26,14 +26,14 @@ __version__ = "0.1.0"
 
 __all__ = [
     "FREE",
-    "MultiPointNavEnv",
-    "SOCIAL_METRIC_KEYS",
     "OBSTACLE",
+    "SOCIAL_METRIC_KEYS",
     "VOID",
     "ArgumentError",
     "ArgumentTypeError",
     "BackendError",
     "EnvConfig",
+    "MultiPointNavEnv",
     "PointNavEnv",
     "PointNavError",
     "PointNavigationTask",

@@ -9,13 +9,13 @@ from pointnav_core.task.config import REWARD_TYPES, TaskConfig
 from pointnav_core.task.lifecycle import TaskState
 from pointnav_core.task.metrics import soft_spl, spl
 from pointnav_core.task.observations import ObservationTerm
-from pointnav_core.task.social import SOCIAL_METRIC_KEYS, social_metrics
 from pointnav_core.task.rewards import (
     CollisionReward,
     PointGoalReward,
     PotentialReward,
     RewardFunction,
 )
+from pointnav_core.task.social import SOCIAL_METRIC_KEYS, social_metrics
 from pointnav_core.task.task import PointNavigationTask
 from pointnav_core.task.task_env import TaskEnv
 from pointnav_core.task.terminations import (

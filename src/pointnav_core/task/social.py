@@ -35,7 +35,13 @@ from numpy.typing import NDArray
 
 from pointnav_core.errors import ArgumentError
 from pointnav_core.task.metrics import spl_values
-from pointnav_core.utils.validation import boolean, integer, is_real, is_real_array, real
+from pointnav_core.utils.validation import (
+    boolean,
+    integer,
+    is_real,
+    is_real_array,
+    real,
+)
 
 __all__ = [
     "DEFAULT_PERSONAL_SPACE",
