@@ -264,17 +264,22 @@ def time_to_collision(relative_positions: Any, relative_velocities: Any, radius:
 
 
 def _ttc(dp: NDArray[np.float64], dv: NDArray[np.float64], r: Any) -> NDArray[np.float64]:
-    # |dp + dv tau|^2 = r^2:  a tau^2 + b tau + c = 0 with a = dv.dv, b = 2 dp.dv,
-    # c = dp.dp - r^2. The earlier root is 2c / (-b + sqrt(b^2 - 4ac)), a form without
-    # cancellation when b < 0 (closing); b >= 0 (not closing, or a = 0) never touches.
-    a = np.einsum("...i,...i->...", dv, dv)
-    b = 2.0 * np.einsum("...i,...i->...", dp, dv)
-    c = np.einsum("...i,...i->...", dp, dp) - np.square(r)
-    disc = b * b - 4.0 * a * c
-    closing = (b < 0.0) & (disc >= 0.0)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        tau = np.where(closing, 2.0 * c / (np.sqrt(np.where(closing, disc, 0.0)) - b), np.inf)
-    return np.where(c <= 0.0, 0.0, tau)
+    # Along the unit direction u of dv: the gap closes while dp.u < 0, and the path passes
+    # the other centre at the miss distance |dp x u|; it touches iff that is <= r, first at
+    # tau = (-dp.u - s) / |dv| with s = sqrt(r^2 - (dp x u)^2), written as
+    # (|dp|^2 - r^2) / ((s - dp.u) |dv|) to avoid cancellation near contact. Working with
+    # u rather than the quadratic's dv.dv keeps a tiny |dv| from underflowing to a false
+    # contact.
+    speed = np.hypot(dv[..., 0], dv[..., 1])
+    u = dv / np.where(speed > 0.0, speed, 1.0)[..., None]
+    along = dp[..., 0] * u[..., 0] + dp[..., 1] * u[..., 1]
+    cross = dp[..., 0] * u[..., 1] - dp[..., 1] * u[..., 0]
+    gap2 = dp[..., 0] * dp[..., 0] + dp[..., 1] * dp[..., 1] - np.square(r)
+    room = np.square(r) - cross * cross
+    closing = (speed > 0.0) & (along < 0.0) & (room >= 0.0)
+    with np.errstate(divide="ignore", over="ignore", invalid="ignore"):
+        tau = np.where(closing, gap2 / ((np.sqrt(np.where(closing, room, 0.0)) - along) * speed), np.inf)
+    return np.where(gap2 <= 0.0, 0.0, tau)
 
 
 def min_time_to_collision(
