@@ -4,6 +4,9 @@ their refusals. Each scene's numbers are derived in the comments."""
 from __future__ import annotations
 
 import math
+import re
+import runpy
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -286,3 +289,13 @@ def test_bad_max_steps_and_pairs() -> None:
         time_to_collision([[1.0, 0.0]], [[1.0, 0.0], [0.0, 0.0]], 0.5)
     with pytest.raises(ValueError, match="^duration "):
         stl(True, 1.0, -1.0, 1.0)
+
+
+def test_the_docs_example_runs(tmp_path, capsys) -> None:
+    # docs/social_metrics.md's example runs as written (its assert checks two values).
+    doc = (Path(__file__).resolve().parents[1] / "docs" / "social_metrics.md").read_text(encoding="utf-8")
+    (block,) = re.findall(r"^```python\n(.*?)^```", doc, flags=re.DOTALL | re.MULTILINE)
+    script = tmp_path / "social_metrics_example.py"
+    script.write_text(block, encoding="utf-8")
+    runpy.run_path(str(script))
+    assert "'psc': 0.875" in capsys.readouterr().out
