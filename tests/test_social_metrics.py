@@ -251,11 +251,15 @@ GOOD = {
         ("robot_positions", np.full((9, 2), np.nan)),
         ("robot_positions", np.zeros((9, 2), bool)),
         ("robot_positions", [["0", "1"]] * 9),
+        ("robot_positions", [[0.0, 1.0], [2.0]] + [[0.0, 0.0]] * 7),  # ragged
         ("headings", np.zeros(8)),
         ("headings", [math.inf] * 9),
         ("pedestrian_positions", np.zeros((8, 1, 2))),  # one sample short
         ("pedestrian_positions", np.zeros((9, 2))),
         ("dt", 0.0),
+        ("dt", 1e-7),  # under a microsecond: jerk's dt**3 would overflow
+        ("robot_positions", np.full((9, 2), 2e9)),  # beyond 1e9 m
+        ("robot_radius", 1e10),
         ("dt", -0.1),
         ("dt", True),
         ("dt", "0.5"),
@@ -265,6 +269,7 @@ GOOD = {
         ("pedestrian_radii", [0.2, 0.2]),  # one pedestrian
         ("pedestrian_radii", -0.2),
         ("pedestrian_radii", [True]),
+        ("pedestrian_radii", [[0.2], [0.2, 0.1]]),  # ragged
         ("success", 1),
         ("success", "yes"),
         ("geodesic_dist", -1.0),
@@ -299,3 +304,15 @@ def test_the_docs_example_runs(tmp_path, capsys) -> None:
     script.write_text(block, encoding="utf-8")
     runpy.run_path(str(script))
     assert "'psc': 0.875" in capsys.readouterr().out
+
+
+def test_extreme_accepted_input_stays_finite() -> None:
+    # The bounds (coordinates within 1e9 m, dt >= 1 microsecond) keep every value finite:
+    # a robot jumping across 2e9 m each microsecond, pedestrians at the far corners.
+    robot = np.array([[-1e9, -1e9], [1e9, 1e9], [-1e9, 1e9], [1e9, -1e9]])
+    peds = np.stack([-robot, robot], axis=1)
+    got = social_metrics(
+        robot, [1e9, -1e9, 1e9, -1e9], peds, dt=1e-6, robot_radius=1e9, pedestrian_radii=[1e9, 0.0],
+        success=True, geodesic_dist=1e9, max_speed=1e-9, personal_space=1e9, goal=(1e9, 1e9),
+    )
+    assert all(v is None or math.isfinite(v) for v in got.values()), got

@@ -63,6 +63,12 @@ __all__ = [
 #: Personal-space radius (m) between centres: iGibson's ``orca_radius`` default.
 DEFAULT_PERSONAL_SPACE = 0.5
 
+# Bounds that keep every difference, square and division by dt**3 finite, so that no
+# accepted input yields NaN or inf: coordinates, radii and headings within 1e9 (m, rad),
+# steps of at least a microsecond.
+_MAX_MAGNITUDE = 1e9
+_MIN_DT = 1e-6
+
 #: The keys of :func:`social_metrics`, in order, with their units.
 SOCIAL_METRIC_KEYS = (
     "psc",  # 1, in [0, 1]
@@ -86,14 +92,20 @@ SOCIAL_METRIC_KEYS = (
 def _array(name: str, value: Any, shape: tuple[int | None, ...], what: str) -> NDArray[np.float64]:
     """``value`` as a float64 array of finite numbers whose shape matches ``shape`` (None:
     any size), or an ArgumentError naming ``name``."""
-    arr = np.asarray(value) if is_real_array(value) else None
+    try:
+        arr = np.asarray(value) if is_real_array(value) else None
+    except ValueError:  # ragged nested lists
+        arr = None
     ok = arr is not None and arr.ndim == len(shape) and all(w is None or w == s for w, s in zip(shape, arr.shape))
     if ok:
         arr = arr.astype(np.float64)
-        ok = bool(np.isfinite(arr).all())
+        ok = bool((np.abs(arr) <= _MAX_MAGNITUDE).all())  # also refuses NaN and inf
     if not ok:
         want = "(" + ", ".join("n" if w is None else str(w) for w in shape) + ")"
-        raise ArgumentError(f"{name} must be an array of shape {want} of finite numbers ({what}), got {value!r}")
+        raise ArgumentError(
+            f"{name} must be an array of shape {want} of finite numbers within +-{_MAX_MAGNITUDE:g} "
+            f"({what}), got {value!r}"
+        )
     return arr  # type: ignore[return-value]
 
 
@@ -113,15 +125,28 @@ def _pedestrians(pedestrian_positions: Any, samples: int) -> NDArray[np.float64]
 def _radii(name: str, value: Any, count: int) -> NDArray[np.float64]:
     """A radius (m) >= 0, or one per pedestrian, as a ``(count,)`` array."""
     if is_real(value):
-        return np.full(count, real(name, value, minimum=0.0))
-    arr = np.asarray(value) if is_real_array(value) else None
-    if arr is None or arr.shape != (count,) or not (np.isfinite(arr.astype(np.float64)).all() and (arr >= 0).all()):
-        raise ArgumentError(f"{name} must be a finite number >= 0 (m) or {count} of them, got {value!r}")
+        return np.full(count, real(name, value, minimum=0.0, maximum=_MAX_MAGNITUDE))
+    try:
+        arr = np.asarray(value) if is_real_array(value) else None
+    except ValueError:  # ragged nested lists
+        arr = None
+    if arr is None or arr.shape != (count,) or not ((arr >= 0).all() and (arr <= _MAX_MAGNITUDE).all()):
+        raise ArgumentError(
+            f"{name} must be a number >= 0 and <= {_MAX_MAGNITUDE:g} (m), or {count} of them, got {value!r}"
+        )
     return arr.astype(np.float64)
 
 
+def _radius(robot_radius: Any) -> float:
+    return real("robot_radius", robot_radius, minimum=0.0, maximum=_MAX_MAGNITUDE)
+
+
+def _personal_space(personal_space: Any) -> float:
+    return real("personal_space", personal_space, minimum=0.0, maximum=_MAX_MAGNITUDE)
+
+
 def _dt(dt: Any) -> float:
-    return real("dt", dt, minimum=0.0, strict=True, unit="s")
+    return real("dt", dt, minimum=_MIN_DT, unit="s")
 
 
 # --- distances and personal space ------------------------------------------------------
@@ -148,7 +173,7 @@ def min_pedestrian_distance(
     """
     robot = _robot(robot_positions)
     peds = _pedestrians(pedestrian_positions, robot.shape[0])
-    r_robot = real("robot_radius", robot_radius, minimum=0.0)
+    r_robot = _radius(robot_radius)
     r_peds = _radii("pedestrian_radii", pedestrian_radii, peds.shape[1])
     if peds.shape[1] == 0:
         return None
@@ -170,7 +195,7 @@ def personal_space_steps(
     than ``personal_space`` (m): iGibson's ``personal_space_violation_steps``."""
     robot = _robot(robot_positions)
     peds = _pedestrians(pedestrian_positions, robot.shape[0])
-    return _violations(robot, peds, real("personal_space", personal_space, minimum=0.0))
+    return _violations(robot, peds, _personal_space(personal_space))
 
 
 def personal_space_time(
@@ -205,7 +230,7 @@ def psc(
     peds = _pedestrians(pedestrian_positions, robot.shape[0])
     steps = robot.shape[0] - 1
     n = steps if max_steps is None else integer("max_steps", max_steps, minimum=steps)
-    return 1.0 - _violations(robot, peds, real("personal_space", personal_space, minimum=0.0)) / n
+    return 1.0 - _violations(robot, peds, _personal_space(personal_space)) / n
 
 
 # --- time and efficiency ---------------------------------------------------------------
@@ -297,7 +322,7 @@ def min_time_to_collision(
     robot = _robot(robot_positions)
     peds = _pedestrians(pedestrian_positions, robot.shape[0])
     step = _dt(dt)
-    r = real("robot_radius", robot_radius, minimum=0.0) + _radii("pedestrian_radii", pedestrian_radii, peds.shape[1])
+    r = _radius(robot_radius) + _radii("pedestrian_radii", pedestrian_radii, peds.shape[1])
     if peds.shape[1] == 0:
         return None
     v_robot = np.diff(robot, axis=0) / step  # (T, 2)
@@ -315,7 +340,7 @@ def pedestrian_collisions(
     before (a contact held over several steps counts once; one at the start counts)."""
     robot = _robot(robot_positions)
     peds = _pedestrians(pedestrian_positions, robot.shape[0])
-    r = real("robot_radius", robot_radius, minimum=0.0) + _radii("pedestrian_radii", pedestrian_radii, peds.shape[1])
+    r = _radius(robot_radius) + _radii("pedestrian_radii", pedestrian_radii, peds.shape[1])
     touch = _center_distances(robot, peds) <= r  # (T + 1, P)
     onsets = touch[1:] & ~touch[:-1]
     return int(np.count_nonzero(onsets) + np.count_nonzero(touch[0]))
