@@ -19,19 +19,21 @@ from pointnav_core.floor.maps import FREE, OBSTACLE, VOID, TraversableMap
 from pointnav_core.scenes import Scene
 from pointnav_core.task import PointNavigationTask, TaskState, TaskStateError
 from pointnav_core.task.metrics import soft_spl, spl
+from pointnav_core.task.social import SOCIAL_METRIC_KEYS, social_metrics
 from pointnav_core.utils.lazy import lazy_exports
 
 __version__ = "0.1.0"
 
 __all__ = [
     "FREE",
-    "MultiPointNavEnv",
     "OBSTACLE",
+    "SOCIAL_METRIC_KEYS",
     "VOID",
     "ArgumentError",
     "ArgumentTypeError",
     "BackendError",
     "EnvConfig",
+    "MultiPointNavEnv",
     "PointNavEnv",
     "PointNavError",
     "PointNavigationTask",
@@ -42,6 +44,7 @@ __all__ = [
     "TraversableMap",
     "__version__",
     "register_envs",
+    "social_metrics",
     "soft_spl",
     "spl",
 ]

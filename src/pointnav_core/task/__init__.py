@@ -1,6 +1,7 @@
 """The point-goal navigation task: OmniGibson's ``PointNavigationTask`` as a state machine,
 with its lifecycle, configuration, terms (rewards, terminations, observations), metrics,
-episode sampling, markers and discrete actions.
+episode sampling, markers and discrete actions; the social-navigation metrics of a
+recorded episode (``social_metrics``).
 """
 
 from pointnav_core.errors import TaskStateError
@@ -14,6 +15,7 @@ from pointnav_core.task.rewards import (
     PotentialReward,
     RewardFunction,
 )
+from pointnav_core.task.social import SOCIAL_METRIC_KEYS, social_metrics
 from pointnav_core.task.task import PointNavigationTask
 from pointnav_core.task.task_env import TaskEnv
 from pointnav_core.task.terminations import (
@@ -27,6 +29,7 @@ from pointnav_core.task.terminations import (
 
 __all__ = [
     "REWARD_TYPES",
+    "SOCIAL_METRIC_KEYS",
     "CollisionReward",
     "Falling",
     "MaxCollision",
@@ -43,6 +46,7 @@ __all__ = [
     "TaskStateError",
     "TerminationCondition",
     "Timeout",
+    "social_metrics",
     "soft_spl",
     "spl",
 ]
