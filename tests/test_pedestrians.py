@@ -218,3 +218,25 @@ def test_orca_pedestrians_keep_apart_from_a_robot_they_see() -> None:
             env.step(np.zeros(2))
             closest = min(closest, math.dist(env.crowd.positions[0], (1.0, 2.0)))
         assert (closest < 0.25 + env.robot.radius) is touches, (sees, closest)
+
+
+def test_the_episode_end_carries_its_social_metrics_measured_on_its_own_positions() -> None:
+    """The minimum centre distance and the personal-space time, recomputed here from the
+    positions the test reads after every step, equal the env's ``info["social"]``."""
+    env = PointNavEnv(pedestrians={"count": 8}, task={"termination_config": {"max_steps": 120}})
+    env.reset(seed=4)
+    robot, walkers = [env.backend.get_pose(0)[0][:2]], [env.crowd.positions.copy()]
+    while True:
+        _, _, terminated, truncated, info = env.step(np.array([0.8, 0.3]))
+        robot.append(env.backend.get_pose(0)[0][:2])
+        walkers.append(env.crowd.positions.copy())
+        if terminated or truncated:
+            break
+        assert "social" not in info
+    robot_xy, peds = np.array(robot), np.array(walkers)
+    gaps = [math.dist(r, p) for r, step in zip(robot_xy, peds) for p in step]
+    social = info["social"]
+    assert social["min_ped_distance"] == pytest.approx(min(gaps), abs=1e-12)
+    inside = sum(any(math.dist(r, p) < 0.5 for p in step) for r, step in zip(robot_xy[1:], peds[1:]))
+    assert social["personal_space_time"] == pytest.approx(inside * 0.1)
+    assert social["psc"] == pytest.approx(1 - inside / (len(robot_xy) - 1))

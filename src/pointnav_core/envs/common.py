@@ -427,3 +427,37 @@ def spawn_crowd(env: Any) -> None:
     seed = int(env.np_random.integers(2**63))
     robots, _ = robot_discs(env)
     env.crowd.spawn(task.floor, np.random.default_rng(seed), robots)
+
+
+class CrowdTrack:
+    """The robot's and the pedestrians' positions at every control step of an episode, for
+    its social metrics (:func:`pointnav_core.task.social_metrics`) at the end."""
+
+    def __init__(self, env: Any) -> None:
+        self.robot: list[tuple[float, float]] = []
+        self.heading: list[float] = []
+        self.pedestrians: list[NDArray[np.float64]] = []
+        self.record(env)
+
+    def record(self, env: Any) -> None:
+        """Add the env's positions now (after a control step, or at the reset)."""
+        from pointnav_core.transforms import quat2yaw
+
+        position, quat = env.backend.get_pose(env.task.robot_idn)
+        self.robot.append((float(position[0]), float(position[1])))
+        self.heading.append(float(quat2yaw(quat)))
+        self.pedestrians.append(env.crowd.positions.copy())
+
+    def metrics(self, env: Any, info: Mapping[str, Any]) -> dict[str, float | None]:
+        """The episode's social metrics, from what was recorded and the task's ``info``."""
+        from pointnav_core.task import social_metrics
+
+        robot = np.array(self.robot)
+        if len(robot) < 2:  # an episode that ended before any control step ran
+            robot, self.heading, self.pedestrians = np.repeat(robot, 2, axis=0), self.heading * 2, self.pedestrians * 2
+        return social_metrics(
+            robot, np.array(self.heading), np.array(self.pedestrians).reshape(len(robot), env.crowd.n, 2),
+            dt=1.0 / env.action_frequency, robot_radius=env.robot.radius, pedestrian_radii=env.crowd.radius,
+            success=bool(info["success"]), geodesic_dist=float(info["geodesic_dist"]),
+            max_speed=env.robot.max_linear_velocity, goal=env.task.get_goal_pos()[:2],
+        )

@@ -178,6 +178,7 @@ class PointNavEnv(gym.Env[Any, np.ndarray]):
     | `sensors`          | **dict** or `None`           | `None`            | `scan`, `local_map`  |
     | `action_space`     | **str**                      | `"continuous"`    | or `"discrete"`      |
     | `discrete_actions` | **dict** or `None`           | `None`            | step, angle, STOP    |
+    | `pedestrians`      | **dict** or `None`           | `None`            | a crowd (see below)  |
     | `config`           | **EnvConfig** or `None`      | `None`            | all of the above but |
     |                    |                              |                   | scene, render_mode   |
 
@@ -195,6 +196,33 @@ class PointNavEnv(gym.Env[Any, np.ndarray]):
     >>> obs, reward, terminated, truncated, info = env.step(0)  # MOVE_FORWARD
     >>> round(info["path_length"], 6)
     0.25
+
+    ```
+
+    ## Pedestrians
+
+    `pedestrians={"count": 10}` (or `{"density": 1 / 8}`, pedestrians per m² of free floor,
+    iGibson's social navigation density) puts a crowd on the robot's floor at every reset
+    (`pointnav_core.crowds`): discs of `radius` m (default a range, `(0.2, 0.3)`, drawn per
+    pedestrian) that walk at `speed` m/s (`(0.5, 1.0)`) along the scene's exact shortest
+    paths between goals drawn on their part of the floor, with `behaviour` `"orca"`
+    (the default: RVO2's ORCA among the pedestrians and, with `sees_robots=True`, the
+    robot), `"static"` or a callable. They start clear of the walls, the robot and each
+    other, never enter a wall, and are drawn from the reset's seed. The scan and the local
+    map (code 4) see them and `render()` draws them, grey with a heading tick. The robot is
+    not pushed by them: a step on which its disc overlaps a pedestrian's adds one to
+    `info["pedestrian_collisions"]` (not to `collisions`), and with
+    `end_on_collision=True` ends the episode as a failure (`"pedestrian_collision"` in
+    `termination_conditions`). At the episode's end `info["social"]` holds its social
+    metrics (`pointnav_core.task.social_metrics`, defined in `docs/social_metrics.md`): PSC,
+    STL, the minimum distance, time in personal space, minimum time-to-collision, path
+    irregularity, and speed, acceleration and jerk, over every control step.
+
+    ```python
+    >>> env = PointNavEnv(pedestrians={"count": 5, "end_on_collision": True})
+    >>> obs, info = env.reset(seed=0)
+    >>> env.crowd.positions.shape, info["pedestrian_collisions"]
+    ((5, 2), 0)
 
     ```
 
@@ -239,6 +267,7 @@ class PointNavEnv(gym.Env[Any, np.ndarray]):
         #: The pedestrians (:class:`~pointnav_core.crowds.Crowd`), or None without them.
         self.crowd = _envcommon.make_crowd(pedestrians, scene)
         self._touched, self._pedestrian_steps = False, 0
+        self._track: _envcommon.CrowdTrack | None = None
         task = _envcommon.add_stop(_envcommon.add_sensors(task, sensors), self.discrete_actions)
         task = _envcommon.add_pedestrian_termination(task, self.crowd)
         self.task = _envcommon.make_task(task)
@@ -280,6 +309,7 @@ class PointNavEnv(gym.Env[Any, np.ndarray]):
         if self.crowd is not None:
             _envcommon.spawn_crowd(self)
             self._touched, self._pedestrian_steps = False, 0
+            self._track = _envcommon.CrowdTrack(self)
             info["pedestrian_collisions"] = 0
         return self._get_obs(), info
 
@@ -367,11 +397,14 @@ class PointNavEnv(gym.Env[Any, np.ndarray]):
         robots, velocities = _envcommon.robot_discs(self)
         self.crowd.step(1.0 / self.action_frequency, robots, velocities)  # type: ignore[union-attr]
         self._touched = touched = bool(self.crowd.contacts(robots)[0])  # type: ignore[union-attr]
+        self._track.record(self)
         return touched
 
     def _count_contact(self, info: dict[str, Any], touched: bool) -> dict[str, Any]:
         self._pedestrian_steps += int(touched)
         info["pedestrian_collisions"] = self._pedestrian_steps
+        if info["done"]:
+            info["social"] = self._track.metrics(self, info)
         return info
 
     def _check_action(self, action: Any) -> Any:
