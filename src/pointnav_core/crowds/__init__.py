@@ -2,8 +2,12 @@
 
 - :func:`~pointnav_core.crowds.orca.orca_step`: one step of ORCA (van den Berg et al. 2011)
   as the RVO2 Library computes it, in its float32, for one crowd or a batch of worlds.
+- :func:`~pointnav_core.crowds.social_force.social_force_step`: one step of the social force
+  model (Helbing and Molnár 1995; Moussaïd et al. 2009's repulsion by default) as
+  pysocialforce computes it, with its parameters (:class:`SocialForceParams`), walls optional.
 """
 
 from pointnav_core.crowds.orca import orca_step
+from pointnav_core.crowds.social_force import SocialForceParams, social_force_step
 
-__all__ = ["orca_step"]
+__all__ = ["SocialForceParams", "orca_step", "social_force_step"]
