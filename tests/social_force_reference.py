@@ -73,7 +73,12 @@ def simulator(crowd: Crowd, model: str = "moussaid") -> Any:
     social force, obstacles, and group forces that are zero without groups), or with
     ``PedRepulsiveForce`` (Helbing and Molnár) for the social force; ``step_width`` = dt."""
     psf = pysocialforce()
-    walls = None if crowd.walls is None else [(a[0], b[0], a[1], b[1]) for a, b in crowd.walls]
+    walls = None if crowd.walls is None else [
+        # pysocialforce's EnvState samples a segment shorter than 0.1 m to an empty (0,) array,
+        # which ObstacleForce then cannot stack: such a segment has no point on both sides.
+        (a[0], b[0], a[1], b[1])
+        for a, b in crowd.walls if int(np.linalg.norm(a - b) * 10.0) > 0
+    ]
     state = np.concatenate([crowd.positions, crowd.velocities, crowd.goals], axis=-1)
     sim = psf.Simulator(state.copy(), obstacles=walls)
     sim.peds.step_width = crowd.dt
@@ -121,7 +126,8 @@ def worst_gap(
     states = {method: (crowd.positions, crowd.velocities) for method in methods}
     worst = 0.0
     for _ in range(steps):
-        sim.step()
+        with np.errstate(divide="ignore", invalid="ignore"):  # pysocialforce divides by zero speeds
+            sim.step()
         for method, (pos, vel) in states.items():
             pos, vel = states[method] = social_force_step(pos, vel, crowd.goals, method=method, **args)
             worst = max(worst, float(np.abs(pos - sim.peds.pos()).max()), float(np.abs(vel - sim.peds.vel()).max()))
