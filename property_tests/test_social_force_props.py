@@ -9,12 +9,11 @@ steps cannot be followed by any other code), and sometimes a pedestrian starting
 from __future__ import annotations
 
 import numpy as np
-import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
-from social_force_reference import random_crowd, worst_gap
+from social_force_reference import random_crowd, skip_without_reference, worst_gap
 
-pytest.importorskip("pysocialforce", reason="the reference is in the dev extra")
+skip_without_reference()
 
 
 @settings(max_examples=30, deadline=None)

@@ -26,6 +26,17 @@ import numpy as np
 from numpy.typing import NDArray
 
 
+def skip_without_reference() -> None:
+    """Skip the calling test (or module) without pysocialforce, without importing it
+    (``pytest.importorskip`` would, from the working folder)."""
+    import importlib.util
+
+    import pytest
+
+    if importlib.util.find_spec("pysocialforce") is None:
+        pytest.skip("the reference is in the dev extra", allow_module_level=True)
+
+
 def pysocialforce() -> ModuleType:
     """pysocialforce, imported without touching the logging or the working folder."""
     root = logging.getLogger()

@@ -15,7 +15,7 @@ import math
 
 import numpy as np
 import pytest
-from social_force_reference import Crowd, random_crowd, simulator, worst_gap
+from social_force_reference import Crowd, random_crowd, simulator, skip_without_reference, worst_gap
 
 from pointnav_core.crowds import SocialForceParams, social_force_step
 from pointnav_core.errors import ArgumentError
@@ -29,7 +29,7 @@ needs_reference = pytest.mark.usefixtures("reference")
 
 @pytest.fixture
 def reference():
-    pytest.importorskip("pysocialforce", reason="the reference is in the dev extra")
+    skip_without_reference()
 
 
 @pytest.mark.parametrize("method", METHODS)
@@ -55,7 +55,7 @@ def test_two_pedestrians_helbing_molnar_by_hand(method):
     # |r| = sqrt(4 + 1e-6). -f points along +x, 90° from the desired direction (0, 1),
     # within the 100° field of view: weight 1, then factor 1.5. For pedestrian 1, r = (2, 0)
     # and the x difference moves to |r| = 2 + 1e-3: a forward difference is not symmetric.
-    v = lambda d: 2.1 * math.exp(-d / 0.3)  # noqa: E731
+    v = lambda d: 2.1 * math.exp(-d / 0.3)
     fy = -(v(math.sqrt(4.0 + 1e-6)) - v(2.0)) / 1e-3
     want = [0.1 * np.array([1.5 * -(v(2.0 - sign * 1e-3) - v(2.0)) / 1e-3, 2.6 + 1.5 * fy]) for sign in (1, -1)]
     pos, vel = social_force_step([[0.0, 0.0], [2.0, 0.0]], np.zeros((2, 2)), [[0.0, 10.0], [2.0, 10.0]],

@@ -15,8 +15,25 @@ import numba
 import numpy as np
 
 from pointnav_core.crowds._social_force_array import (
-    COS_PHI, DELTA, DT, FOV_FACTOR, GAMMA, GOAL_THRESHOLD, LAMBDA, N, N_PRIME, RADIUS, REPULSION, SIGMA, SOCIAL,
-    STOP, TAU, V0, WALL, WALL_SIGMA, WALL_THRESHOLD,
+    COS_PHI,
+    DELTA,
+    DT,
+    FOV_FACTOR,
+    GAMMA,
+    GOAL_THRESHOLD,
+    LAMBDA,
+    N_PRIME,
+    RADIUS,
+    REPULSION,
+    SIGMA,
+    SOCIAL,
+    STOP,
+    TAU,
+    V0,
+    WALL,
+    WALL_SIGMA,
+    WALL_THRESHOLD,
+    N,
 )
 
 __all__ = ["social_force_worlds"]
