@@ -96,7 +96,8 @@ class SocialForceParams:
         the finite-difference step of the gradient (m, ``PedPedPotential.grad_r_ab``).
     wall_factor, wall_sigma, wall_threshold, wall_resolution, radius : float
         The wall force (``obstacle_force.*``, ``scene.agent_radius``, ``scene.resolution``):
-        its factor (m/s²), decay length (m), reach beyond the pedestrian's edge (m), wall
+        its factor (m/s²), decay length (m), reach (m: points closer than ``wall_threshold +
+        2 radius`` to the centre push, as pysocialforce adds the radius on both sides), wall
         points per metre (1/m), and the pedestrians' radius (m).
     """
 
@@ -125,7 +126,7 @@ class SocialForceParams:
             real(name, value, minimum=0.0, strict=name in _POSITIVE, unit=_UNITS.get(name, ""))
 
 
-#: Parameters that are divided by (the others may be 0), and the units of the others' messages.
+#: The parameters something is divided by (> 0; the others may be 0), and the units named in the errors.
 _POSITIVE = ("relaxation_time", "gamma", "sigma", "gradient_step", "wall_sigma")
 _UNITS = {
     "relaxation_time": "s", "goal_threshold": "m", "stop_distance": "m", "social_factor": "m/s²", "lambda_importance": "s",
