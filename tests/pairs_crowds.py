@@ -1,5 +1,7 @@
-"""Plain and compiled paths of :func:`pointnav_core.crowds.orca_step`: the check of
-``property_tests/test_compiled_paths.py`` for ``crowds._orca_kernel``.
+"""Plain and compiled paths of :func:`pointnav_core.crowds.orca_step` and
+:func:`pointnav_core.crowds.social_force_step`: the checks of
+``property_tests/test_compiled_paths.py`` for ``crowds._orca_kernel`` and
+``crowds._social_force_kernel``.
 
 Both paths give the same floats, bit for bit, on random crowds in batches of worlds (one
 to 30 agents, more than RVO2's k-d tree leaf of 10), with per-agent radii and speeds, ties of
@@ -16,8 +18,9 @@ import numpy as np
 from hypothesis import given, settings
 from hypothesis import strategies as st
 from orca_reference import preferred, random_crowd
+from social_force_reference import random_crowd as random_pedestrians
 
-from pointnav_core.crowds import orca_step
+from pointnav_core.crowds import orca_step, social_force_step
 from pointnav_core.utils.compiled import kernel
 
 Plain = Callable[[], AbstractContextManager[None]]
@@ -55,3 +58,36 @@ def check_orca(
         np.testing.assert_array_equal(got[0], want[0])
         np.testing.assert_array_equal(got[1], want[1])
     assert kernel("pointnav_core.crowds._orca_kernel", "orca_worlds") is not None
+
+
+@settings(max_examples=30, deadline=None)
+@given(
+    seed=st.integers(0, 2**31 - 1),
+    worlds=st.integers(1, 3),
+    n=st.integers(1, 20),
+    side=st.floats(0.5, 10.0),
+    walls=st.integers(0, 3),
+    model=st.sampled_from(["moussaid", "helbing_molnar"]),
+    steps=st.integers(1, 10),
+)
+def check_social_force(
+    seed: int, worlds: int, n: int, side: float, walls: int, model: str, steps: int, plain_paths: Plain,
+) -> None:
+    """social_force_step with its kernel and inside ``plain_paths()``: within 1e-9 m (and
+    m/s). Not bit for bit: numpy's ``exp`` and ``arctan2`` and the C library's, which the
+    kernel calls, differ in the last bit for some arguments; the sums run in the same order."""
+    rng = np.random.default_rng(seed)
+    crowds = [random_pedestrians(rng, n, side, walls) for _ in range(worlds)]
+    pos, vel, goals = (np.stack([getattr(c, name) for c in crowds]) for name in ("positions", "velocities", "goals"))
+    segments = np.stack([c.walls for c in crowds]) if walls else None
+    speed = rng.uniform(0.5, 1.5, (worlds, n))
+    args = (goals, speed, 1.3 * speed, 0.1)
+    got = want = (pos, vel)
+    for _ in range(steps):
+        got = social_force_step(*got, *args, model=model, walls=segments)
+        with plain_paths():
+            assert kernel("pointnav_core.crowds._social_force_kernel", "social_force_worlds") is None
+            want = social_force_step(*want, *args, model=model, walls=segments)
+        np.testing.assert_allclose(got[0], want[0], rtol=0, atol=1e-9)
+        np.testing.assert_allclose(got[1], want[1], rtol=0, atol=1e-9)
+    assert kernel("pointnav_core.crowds._social_force_kernel", "social_force_worlds") is not None

@@ -6,6 +6,9 @@
   :func:`~pointnav_core.crowds.config.make_pedestrians`: an env's ``pedestrians={...}``.
 - :class:`~pointnav_core.crowds.crowd.Crowd`: the pedestrians of one env, placed, planned
   and stepped.
+- :func:`~pointnav_core.crowds.social_force.social_force_step`: one step of the social force
+  model (Helbing and Molnár 1995; Moussaïd et al. 2009's repulsion by default) as
+  pysocialforce computes it, with its parameters (:class:`SocialForceParams`), walls optional.
 """
 
 from pointnav_core.crowds.config import (
@@ -16,5 +19,9 @@ from pointnav_core.crowds.config import (
 )
 from pointnav_core.crowds.crowd import Crowd
 from pointnav_core.crowds.orca import orca_step
+from pointnav_core.crowds.social_force import SocialForceParams, social_force_step
 
-__all__ = ["BEHAVIOURS", "Crowd", "CrowdView", "PedestrianConfig", "make_pedestrians", "orca_step"]
+__all__ = [
+    "BEHAVIOURS", "Crowd", "CrowdView", "PedestrianConfig", "SocialForceParams", "make_pedestrians", "orca_step",
+    "social_force_step",
+]

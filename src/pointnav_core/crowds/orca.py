@@ -41,42 +41,15 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from pointnav_core.crowds._arguments import agents, per_agent
 from pointnav_core.crowds._orca_array import orca_array
 from pointnav_core.errors import ArgumentError
 from pointnav_core.utils.compiled import check_method, choose
-from pointnav_core.utils.validation import integer, is_real_array, real
+from pointnav_core.utils.validation import integer, real
 
 __all__ = ["orca_step"]
 
 KERNEL = ("pointnav_core.crowds._orca_kernel", "orca_worlds")
-
-
-def _agents(name: str, value: Any, shape: tuple[int, ...] | None) -> NDArray[np.float32]:
-    """``value`` as a float32 array of ``(n, 2)`` or ``(w, n, 2)`` finite numbers (of
-    ``shape`` when given), rounded to float32 as RVO2's ``Vector2`` holds it."""
-    arr = np.asarray(value) if is_real_array(value) else None
-    ok = arr is not None and arr.ndim in (2, 3) and arr.shape[-1] == 2 and (shape is None or arr.shape == shape)
-    if ok:
-        arr = arr.astype(np.float64)
-        ok = bool(np.isfinite(arr).all() and (np.abs(arr) <= np.finfo(np.float32).max).all())
-    if not ok:
-        want = "an (n, 2) or (w, n, 2) array" if shape is None else f"an array of shape {shape}"
-        raise ArgumentError(f"{name} must be {want} of finite numbers (m, m/s), got {value!r}")
-    return arr.astype(np.float32)
-
-
-def _per_agent(name: str, value: Any, shape: tuple[int, int], unit: str) -> NDArray[np.float32]:
-    """``value`` (a number, one per agent ``(n,)`` or per world and agent ``(w, n)``) as a
-    ``(w, n)`` float32 array of finite numbers >= 0."""
-    if not (is_real_array(value) or isinstance(value, (int, float, np.integer, np.floating))) or isinstance(value, bool):
-        raise ArgumentError(f"{name} must be a number >= 0 ({unit}) or one per agent, got {value!r}")
-    arr = np.asarray(value, dtype=np.float64)
-    if arr.ndim > 2 or arr.shape not in ((), shape[1:], shape) or not (np.isfinite(arr).all() and (arr >= 0).all()):
-        raise ArgumentError(
-            f"{name} must be a finite number >= 0 ({unit}), or an array of shape {shape[1:]} or {shape} "
-            f"of them, got {value!r}"
-        )
-    return np.ascontiguousarray(np.broadcast_to(arr.astype(np.float32), shape))
 
 
 def orca_step(
@@ -127,15 +100,15 @@ def orca_step(
         An argument of the wrong shape, not finite, or out of its range.
     """
     check_method(method)
-    pos = _agents("positions", positions, None)
-    vel = _agents("velocities", velocities, pos.shape)
-    pref = _agents("preferred", preferred, pos.shape)
+    pos = agents("positions", positions, None, np.float32)
+    vel = agents("velocities", velocities, pos.shape, np.float32)
+    pref = agents("preferred", preferred, pos.shape, np.float32)
     batched = pos.ndim == 3
     if not batched:
         pos, vel, pref = pos[None], vel[None], pref[None]
     shape = pos.shape[:2]
-    radius_ = _per_agent("radius", radius, shape, "m")
-    speed = _per_agent("max_speed", max_speed, shape, "m/s")
+    radius_ = per_agent("radius", radius, shape, "m", np.float32)
+    speed = per_agent("max_speed", max_speed, shape, "m/s", np.float32)
     step = np.float32(real("dt", dt, minimum=0.0, strict=True, unit="s"))
     dist = np.float32(real("neighbor_dist", neighbor_dist, minimum=0.0))
     k = integer("max_neighbors", max_neighbors, minimum=0)
