@@ -75,9 +75,10 @@ def test_no_pedestrian_starts_overlapping_a_wall_a_robot_or_another(seed: int) -
     spawn_is_clear(grid, env)
 
 
-def test_pedestrians_walk_and_never_enter_a_wall() -> None:
+@pytest.mark.parametrize("behaviour", ["orca", "social_force"])
+def test_pedestrians_walk_and_never_enter_a_wall(behaviour: str) -> None:
     grid = room(seed=1)
-    env = env_in(grid, pedestrians={"count": 8}, task={"termination_config": {"max_steps": 400}})
+    env = env_in(grid, pedestrians={"count": 8, "behaviour": behaviour}, task={"termination_config": {"max_steps": 400}})
     env.reset(seed=1)
     start = env.crowd.positions.copy()
     goals = {tuple(g) for g in env.crowd.goals.tolist()}

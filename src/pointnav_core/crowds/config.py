@@ -10,7 +10,7 @@ key                 default          what
 ``radius``          ``(0.2, 0.3)``   disc radius (m): a number, or a ``(min, max)`` range drawn
                                      uniformly per pedestrian
 ``speed``           ``(0.5, 1.0)``   preferred walking speed (m/s): a number or a range
-``behaviour``       ``"orca"``       ``"orca"``, ``"static"`` or a callable
+``behaviour``       ``"orca"``       ``"orca"``, ``"social_force"``, ``"static"`` or a callable
 ``sees_robots``     ``True``         whether pedestrians avoid the robots
 ``end_on_collision`` ``False``       whether touching a pedestrian ends the robot's episode
 ``orca``            RVO2's/iGibson's ``neighbor_dist`` 5 m, ``max_neighbors`` 10,
@@ -38,7 +38,7 @@ from pointnav_core.utils import validation
 __all__ = ["BEHAVIOURS", "PATH_MARGIN", "CrowdView", "PedestrianConfig", "make_pedestrians"]
 
 #: The built-in behaviours.
-BEHAVIOURS = ("orca", "static")
+BEHAVIOURS = ("orca", "social_force", "static")
 
 #: How much farther from the walls (m) the crowd's paths run than its largest radius needs.
 PATH_MARGIN = 0.05

@@ -10,7 +10,8 @@ crowd's largest radius), and advances them one control step at a time:
    one after it is in plain sight;
 2. the behaviour turns the preferred velocities into new ones: ORCA (:func:`orca_step`, among
    the pedestrians and the robots they see, as CrowdNav puts the robot in RVO2's simulator),
-   ``"static"`` (they never move) or the user's callable;
+   the social force model (:func:`social_force_step`, pysocialforce's, pulled toward the
+   next waypoint), ``"static"`` (they never move) or the user's callable;
 3. every pedestrian moves by its velocity for the step, unless that would take a disc of the
    crowd's largest radius into a wall: then it takes its preferred velocity instead, and if
    that too is blocked it stands still for the step and plans again from where it is (ORCA
@@ -34,6 +35,7 @@ from numpy.typing import NDArray
 
 from pointnav_core.crowds.config import CrowdView, PedestrianConfig
 from pointnav_core.crowds.orca import orca_step
+from pointnav_core.crowds.social_force import SocialForceParams, social_force_step
 from pointnav_core.errors import ArgumentError, SamplingError
 
 __all__ = ["Crowd"]
@@ -44,6 +46,13 @@ PLACE_TRIES = 200
 GOAL_REACHED = 0.1
 #: Goals nearer than this (m) to the pedestrian are drawn again (up to 10 times).
 MIN_GOAL_DISTANCE = 1.0
+#: Social force: the speed limit over the preferred speed (pysocialforce's 1.3).
+MAX_SPEED_FACTOR = 1.3
+#: Social force: a robot's goal is where its velocity takes it in this many seconds.
+ROBOT_LOOKAHEAD = 10.0
+# pysocialforce's parameters without its stops near the goal: a pedestrian's goal in the
+# model is its next waypoint, and the crowd passes waypoints and draws new goals itself.
+_SOCIAL_FORCE = SocialForceParams(goal_threshold=0.0, stop_distance=0.0)
 
 
 class Crowd:
@@ -236,6 +245,8 @@ class Crowd:
             robots, robot_velocities = np.zeros((0, 3)), np.zeros((0, 2))
         if cfg.behaviour == "orca":
             vel = self._orca(pref, dt, robots, robot_velocities)
+        elif cfg.behaviour == "social_force":
+            vel = self._social_force(dt, robots, robot_velocities)
         else:
             vel = self._called(pref, dt, robots, robot_velocities)
         tmap = self.scene.floors[self.floor]
@@ -266,6 +277,21 @@ class Crowd:
         radius = np.concatenate([self.radius, robots[:, 2]])
         top = np.concatenate([self.speed, np.hypot(robot_velocities[:, 0], robot_velocities[:, 1])])
         _, new = orca_step(pos, vel, pref, radius, top, dt, cfg.neighbor_dist, cfg.max_neighbors, cfg.time_horizon)
+        return new[:n]
+
+    def _social_force(self, dt: float, robots: NDArray[np.float64],
+                      robot_velocities: NDArray[np.float64]) -> NDArray[np.float64]:
+        """The social force model among the pedestrians and the robots they see, each
+        pedestrian pulled toward its next waypoint; the robots pull toward where their
+        velocities take them in :data:`ROBOT_LOOKAHEAD` s, and only the pedestrians' results
+        are kept. The crowd decides arrival itself, so the model's stops near a goal are off."""
+        n = self.n
+        rows = np.arange(n)
+        pos = np.concatenate([self.positions, robots[:, :2]])
+        vel = np.concatenate([self.velocities, robot_velocities])
+        goals = np.concatenate([self._paths[rows, self._next], robots[:, :2] + ROBOT_LOOKAHEAD * robot_velocities])
+        speed = np.concatenate([self.speed, np.hypot(robot_velocities[:, 0], robot_velocities[:, 1])])
+        _, new = social_force_step(pos, vel, goals, speed, speed * MAX_SPEED_FACTOR, dt, params=_SOCIAL_FORCE)
         return new[:n]
 
     def _called(self, pref: NDArray[np.float64], dt: float, robots: NDArray[np.float64],
