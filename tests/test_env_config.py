@@ -33,6 +33,7 @@ FULL = {
     "flatten_obs": False,
     "action_frequency": 5.0,
     "backend": "pymunk",
+    "pedestrians": {"count": 6, "radius": [0.2, 0.3], "behaviour": "social_force", "orca": {"time_horizon": 3.0}},
 }
 
 YAML_TEXT = """\
@@ -74,7 +75,7 @@ def test_a_hand_written_yaml_file_gives_the_config_it_says(tmp_path):
         "robot": {"radius": 0.18, "max_linear_velocity": 0.5, "max_angular_velocity": 1.5, "drive": "differential"},
         "sensors": {"scan": {"n_rays": 16}}, "action_space": "discrete", "discrete_actions": {"stop": False},
         "task": {"goal_in_polar": True}, "max_steps": 150, "flatten_obs": True, "action_frequency": 10.0,
-        "backend": "kinematic",
+        "backend": "kinematic", "pedestrians": None,
     }
     assert config.robot == RobotSpec()
     # None and {} both mean a sensor's defaults: one form.
@@ -105,6 +106,8 @@ def test_a_hand_written_yaml_file_gives_the_config_it_says(tmp_path):
         ({"backend": "mujoco"}, r"backend must be one of \["),
         ({"robot": {"radius": -1}}, "radius must be a finite number >= 0"),
         ({"robot": {"size": 1}}, "robot has an unknown key 'size'"),
+        ({"pedestrians": {"count": 3, "behaviour": "flock"}}, r"pedestrians\['behaviour'\] must be one of"),
+        ({"pedestrians": {"density": -1}}, r"pedestrians\['density'\] must be a finite number >= 0"),
     ],
 )
 def test_bad_fields_are_refused_naming_them(fields, match):

@@ -241,3 +241,23 @@ def test_the_episode_end_carries_its_social_metrics_measured_on_its_own_position
     inside = sum(any(math.dist(r, p) < 0.5 for p in step) for r, step in zip(robot_xy[1:], peds[1:]))
     assert social["personal_space_time"] == pytest.approx(inside * 0.1)
     assert social["psc"] == pytest.approx(1 - inside / (len(robot_xy) - 1))
+
+
+def test_an_env_config_carries_the_crowd() -> None:
+    """``EnvConfig(pedestrians=...)`` round-trips, builds the crowd, names a bad key, and the
+    batched engine (no pedestrians yet) refuses it by name."""
+    from pointnav_core.envs.config import EnvConfig
+    from pointnav_core.vector import VectorPointNavEnv
+
+    config = EnvConfig(pedestrians={"count": 4, "radius": [0.2, 0.25], "behaviour": "social_force"})
+    assert EnvConfig.from_dict(config.to_dict()) == config
+    env = PointNavEnv(config=config)
+    env.reset(seed=0)
+    assert env.crowd.n == 4 and env.crowd.config.behaviour == "social_force"
+    assert EnvConfig().to_dict()["pedestrians"] is None
+    with pytest.raises(ValueError, match=re_escape("pedestrians['density']")):
+        EnvConfig(pedestrians={"density": -1.0})
+    with pytest.raises(ValueError, match="pedestrians"):
+        EnvConfig(pedestrians={"count": 2, "behaviour": print})  # a callable cannot be saved
+    with pytest.raises(ValueError, match="config.pedestrians"):
+        VectorPointNavEnv(num_envs=2, config=config)

@@ -140,6 +140,18 @@ def _env_config(args: argparse.Namespace, factory: Any) -> None:
         setattr(args, name, value)
 
 
+#: The social metrics ``pointnav eval`` prints with pedestrians: key, label, unit.
+_SOCIAL_ROWS = (
+    ("psc", "PSC", ""),
+    ("stl", "STL", ""),
+    ("min_ped_distance", "min pedestrian dist.", " m"),
+    ("personal_space_time", "in personal space", " s"),
+    ("min_ttc", "min time-to-collision", " s"),
+    ("path_irregularity", "path irregularity", " rad/m"),
+    ("jerk_mean", "mean jerk", " m/s³"),
+)
+
+
 def _print_summary(args: argparse.Namespace, summary: dict[str, Any], of: int) -> None:
     """The summary as the table ``pointnav eval`` prints, with 95 % intervals."""
     ci = summary["intervals"]
@@ -157,6 +169,11 @@ def _print_summary(args: argparse.Namespace, summary: dict[str, Any], of: int) -
         ("collisions", f"{summary['collisions']:.3f} per episode"),
         ("path length", f"{summary['path_length']:.2f} m (mean)"),
     ]
+    if "pedestrian_collisions" in summary:  # an env config with pedestrians
+        rows.append(("pedestrian contacts", f"{summary['pedestrian_collisions']:.3f} steps per episode"))
+        for key, label, unit in _SOCIAL_ROWS:
+            if f"social_{key}" in summary:
+                rows.append((label, f"{summary[f'social_{key}']:.3f}{unit} (mean where defined)"))
     width = max(len(name) for name, _ in rows)
     subset = (f", --stride {args.stride}" if args.stride > 1 else "") + (
         f", --limit {args.limit}" if args.limit is not None else ""

@@ -141,6 +141,10 @@ class EnvConfig:
         Control rate (Hz), from 0.1 to 10,000 (default 10).
     backend : str
         A registered backend name (default ``"kinematic"``).
+    pedestrians : dict, optional
+        The crowd, as the envs' ``pedestrians`` (:mod:`pointnav_core.crowds.config`; a
+        callable behaviour cannot be saved); None: no pedestrians. The single and the
+        multi-robot envs take it; the batched engine has no pedestrians yet.
 
     Raises
     ------
@@ -157,9 +161,11 @@ class EnvConfig:
     flatten_obs: bool = True
     action_frequency: float = 10.0
     backend: str = "kinematic"
+    pedestrians: Mapping[str, Any] | None = None
 
     def __post_init__(self) -> None:
         from pointnav_core.backends.protocol import available_backends
+        from pointnav_core.crowds import make_pedestrians
         from pointnav_core.envs.common import check_action_frequency, make_robot
         from pointnav_core.sensors import make_sensors
         from pointnav_core.task.actions import make_discrete_actions
@@ -181,6 +187,9 @@ class EnvConfig:
         set_(self, "action_frequency", check_action_frequency(self.action_frequency))
         if not isinstance(self.backend, str) or self.backend not in available_backends():
             raise ArgumentError(f"backend must be one of {available_backends()}, got {self.backend!r}")
+        pedestrians = _plain("pedestrians", self.pedestrians)
+        make_pedestrians(_thaw(pedestrians))  # names a bad key or value
+        set_(self, "pedestrians", pedestrians)
 
     def __hash__(self) -> int:
         return hash(json.dumps(self.to_dict(), sort_keys=True))
@@ -245,7 +254,7 @@ class EnvConfig:
 
     def env_arguments(self) -> dict[str, Any]:
         """The :class:`~pointnav_core.envs.pointnav.PointNavEnv` keyword arguments of this config."""
-        return {
+        out = {
             "robot": self.robot,
             "task": self.task_arguments(),
             "backend": self.backend,
@@ -255,6 +264,9 @@ class EnvConfig:
             "action_space": self.action_space,
             "discrete_actions": _thaw(self.discrete_actions),
         }
+        if self.pedestrians is not None:
+            out["pedestrians"] = _thaw(self.pedestrians)
+        return out
 
 
 def _suffix(path: str, what: str = "env config") -> str:
@@ -350,6 +362,8 @@ def vector_arguments(config: EnvConfig, given: Mapping[str, Any]) -> dict[str, A
         )
     if not out.pop("flatten_obs"):
         raise ArgumentError("config.flatten_obs is False, but the batched engine's observations are flat: set it True")
+    if out.pop("pedestrians", None) is not None:
+        raise ArgumentError("config.pedestrians is set, but the batched engine has no pedestrians yet: use PointNavEnv or parallel_env")
     return out
 
 

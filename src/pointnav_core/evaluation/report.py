@@ -80,6 +80,11 @@ class EpisodeResult:
     steps : int
     ended_by : str
         The termination conditions that ended the episode, joined by ``+``.
+    pedestrian_collisions : int or None
+        Steps in which the robot touched a pedestrian; None in an env without pedestrians.
+    social : dict or None
+        The episode's social metrics (:func:`pointnav_core.task.social_metrics`, the env's
+        ``info["social"]``), values None where undefined; None without pedestrians.
     """
 
     episode_id: str
@@ -94,15 +99,27 @@ class EpisodeResult:
     collisions: int
     steps: int
     ended_by: str
+    pedestrian_collisions: int | None = None
+    social: Mapping[str, float | None] | None = None
 
 
 def summarize(results: Sequence[EpisodeResult]) -> dict[str, float]:
     """Means over episodes: ``success``, ``spl``, ``soft_spl``, ``distance_to_goal`` (m),
-    ``path_length`` (m), ``collisions`` (per episode), ``steps``; and ``episodes``."""
+    ``path_length`` (m), ``collisions`` (per episode), ``steps``; and ``episodes``. With
+    pedestrians also ``pedestrian_collisions`` (per episode) and ``social_<metric>`` for
+    each social metric, the mean over the episodes where it is defined (not None)."""
     if not results:
         raise ArgumentError("no results to summarize")
     keys = ("success", "spl", "soft_spl", "distance_to_goal", "path_length", "collisions", "steps")
     summary = {k: float(np.mean([float(getattr(r, k)) for r in results])) for k in keys}
+    counts = [r.pedestrian_collisions for r in results if r.pedestrian_collisions is not None]
+    if counts:
+        summary["pedestrian_collisions"] = float(np.mean(counts))
+    socials = [r.social for r in results if r.social]
+    for key in dict.fromkeys(k for social in socials for k in social):
+        defined = [float(v) for social in socials if (v := social.get(key)) is not None]
+        if defined:
+            summary[f"social_{key}"] = float(np.mean(defined))
     summary["episodes"] = float(len(results))
     return summary
 
@@ -218,9 +235,7 @@ def write_results(
             writer = csv.DictWriter(fh, fieldnames=names, lineterminator="\n")
             writer.writeheader()
             for r in results:
-                writer.writerow(
-                    {k: repr(v) if isinstance(v, float) else v for k, v in asdict(r).items()}
-                )
+                writer.writerow({k: _csv_cell(v) for k, v in asdict(r).items()})
         else:
             if run is not None:
                 fh.write(run_line(run))
@@ -231,6 +246,16 @@ def write_results(
         records = {"pointnav_eval": dict(run or {}), "summary": dict(summary or {})}
         with atomic_writer(summary_path(path), "w", encoding="utf-8") as fh:
             fh.write(json.dumps(records, indent=1) + "\n")
+
+
+def _csv_cell(value: Any) -> Any:
+    """A CSV cell: floats exactly (``repr``), a dict (the social metrics) as JSON, and
+    None as an empty cell."""
+    if isinstance(value, float):
+        return repr(value)
+    if isinstance(value, Mapping):
+        return json.dumps(dict(value))
+    return "" if value is None else value
 
 
 def _records(path: str | os.PathLike[str]) -> Iterable[dict[str, Any]]:

@@ -298,6 +298,8 @@ class _Runner:
             collisions=int(info["collisions"]),
             steps=int(info["episode_length"]),
             ended_by=ended,
+            pedestrian_collisions=info.get("pedestrian_collisions"),
+            social=info.get("social"),
         )
 
 
