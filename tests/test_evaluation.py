@@ -190,7 +190,7 @@ def test_module_callable_policy(dataset_file):
     "spec, match",
     [
         ("", "policy must be 'oracle'"),
-        ("no_colon", "unknown policy 'no_colon': expected 'oracle', MODULE:CALLABLE"),
+        ("no_colon", "unknown policy 'no_colon': expected 'oracle', 'orca_robot', 'dwa', MODULE:CALLABLE"),
         ("no_such_module_xyz:f", "cannot import module 'no_such_module_xyz'"),
         ("eval_policies:missing", "has no attribute 'missing'"),
         ("missing.zip", "no such SB3 .zip"),
@@ -424,7 +424,7 @@ def test_cli_refuses_bad_subsets_and_unknown_policies(dataset_file, tmp_path, ca
         (["--limit", "-3"], "--limit must be an integer >= 1, got '-3'"),
         (["--limit", "two"], "--limit must be an integer >= 1, got 'two'"),
         (["--stride", "0"], "--stride must be an integer >= 1, got '0'"),
-        (["--policy", "nonsense"], "unknown policy 'nonsense': expected 'oracle', MODULE:CALLABLE"),
+        (["--policy", "nonsense"], "unknown policy 'nonsense': expected 'oracle', 'orca_robot', 'dwa', MODULE:CALLABLE"),
     ):
         assert main([*base, *extra]) == 2
         err = capsys.readouterr().err

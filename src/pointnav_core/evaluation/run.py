@@ -11,7 +11,10 @@ the floor it records, for at most ``max_steps`` steps.
 
 Policies (``policy`` argument, or ``pointnav eval --policy``):
 
-- ``"oracle"``: :class:`~pointnav_core.policies.oracle.ShortestPathFollower`;
+- ``"oracle"``: :class:`~pointnav_core.policies.oracle.ShortestPathFollower` (ignores
+  pedestrians);
+- ``"orca_robot"``, ``"dwa"``: the crowd baselines of :mod:`pointnav_core.policies.crowd`
+  (an ORCA robot, the dynamic window approach), toward the oracle's carrot;
 - ``"MODULE:CALLABLE"``: ``CALLABLE(env)`` is called after each reset and returns a
   function ``observation -> action``;
 - a path to a Stable-Baselines3 ``.zip``: the model (``sb3_algo``, PPO by default) acts
@@ -79,7 +82,7 @@ DEFAULT_MAX_STEPS = 1000
 ON_ERROR = ("stop", "skip")
 #: The accepted forms of a policy spec, for messages.
 POLICY_FORMS = (
-    "'oracle', MODULE:CALLABLE (a function env -> (observation -> action)), the path to "
+    "'oracle', 'orca_robot', 'dwa', MODULE:CALLABLE (a function env -> (observation -> action)), the path to "
     "a checkpoint .pt (pointnav train's) or the path to a Stable-Baselines3 .zip"
 )
 #: The suffix of a checkpoint (pointnav_core.policies.checkpoint.CHECKPOINT_SUFFIX, which
@@ -96,6 +99,24 @@ def _oracle(env: Any) -> Policy:
 
     follower = ShortestPathFollower(env)
     return lambda _obs: follower.act()
+
+
+def _orca_robot(env: Any) -> Policy:
+    from pointnav_core.policies.crowd import OrcaRobot
+
+    robot = OrcaRobot(env)
+    return lambda _obs: robot.act()
+
+
+def _dwa(env: Any) -> Policy:
+    from pointnav_core.policies.crowd import DynamicWindow
+
+    robot = DynamicWindow(env)
+    return lambda _obs: robot.act()
+
+
+#: The built-in policies by name: the oracle (ignores pedestrians) and the crowd baselines.
+BUILT_IN = {"oracle": _oracle, "orca_robot": _orca_robot, "dwa": _dwa}
 
 
 class _SB3Policy:
@@ -157,8 +178,8 @@ def make_policy(spec: str, sb3_algo: str = "PPO", trust_policy_file: bool = Fals
     """
     if not isinstance(spec, str) or not spec:
         raise ArgumentError(f"policy must be {POLICY_FORMS}, got {spec!r}")
-    if spec == "oracle":
-        return _oracle
+    if spec in BUILT_IN:
+        return BUILT_IN[spec]
     if spec.endswith(CHECKPOINT_SUFFIX):
         if not os.path.isfile(spec):
             raise ArgumentError(f"policy {spec!r}: no such checkpoint file")

@@ -233,8 +233,9 @@ class ShortestPathFollower:
         # chord was proven clear that much wider); None: the arc is tested.
         self._room: float | None = None
 
-    def _carrot(self, xy: NDArray[np.float64]) -> NDArray[np.float64] | None:
-        """The point to head for from ``xy`` (see the class notes), or None if there is none."""
+    def carrot(self, xy: NDArray[np.float64]) -> NDArray[np.float64] | None:
+        """The point (m, world frame) to head for from ``xy`` along the geodesic (see the
+        class notes), or None if there is none. The crowd baselines steer toward it too."""
         self._room = None
         goal = np.asarray(self.task.get_goal_pos(), dtype=np.float64)[:2]
         plan = self._plan
@@ -391,7 +392,7 @@ class ShortestPathFollower:
         position, quat = env.backend.get_pose(task.robot_idn)
         xy = position[:2]
         action = np.zeros(spec.action_dim, dtype=np.float32)
-        target = self._carrot(xy)
+        target = self.carrot(xy)
         if target is None:
             return action
         dt = 1.0 / getattr(env, "action_frequency", 10.0)
