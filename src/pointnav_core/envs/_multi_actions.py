@@ -175,16 +175,19 @@ def named_action_error(err: ValueError, todo: Sequence[Todo]) -> ValueError:
 
 
 def step_discrete(
-    backend: Any, plans: Sequence[Any], actions: dict[int, int]
+    backend: Any, plans: Sequence[Any], actions: dict[int, int], after: Callable[[], None] | None = None
 ) -> dict[int, bool]:
     """Run each robot's discrete action for its control steps, all robots together; a
     robot's action ends at its first contact. ``plans[i][a]`` is robot ``i``'s command and
-    control steps for action ``a``. Returns whether each robot touched something
+    control steps for action ``a``; ``after`` is called after every control step (the
+    pedestrians walk). Returns whether each robot touched something
     (:mod:`pointnav_core.task.actions`)."""
     todo = {i: plans[i][a] for i, a in actions.items()}
     contacts = dict.fromkeys(todo, False)
     for k in range(max(steps for _, steps in todo.values())):
         backend.step({i: cmd for i, (cmd, steps) in todo.items() if k < steps and not contacts[i]})
+        if after is not None:
+            after()
         for i in todo:
             if not contacts[i] and backend.in_contact(i):
                 contacts[i] = True

@@ -383,12 +383,15 @@ def make_crowd(pedestrians: Any, scene: Any) -> Any:
 
 
 def add_pedestrian_termination(task: Any, crowd: Any, name: str = "task") -> Any:
-    """``task`` with :class:`~pointnav_core.task.PedestrianCollision` among its
-    ``termination_conditions`` when the crowd's contacts end episodes."""
+    """``task`` (None, a dict, or a list of them) with
+    :class:`~pointnav_core.task.PedestrianCollision` among its ``termination_conditions``
+    when the crowd's contacts end episodes."""
     from pointnav_core.task import PedestrianCollision
 
     if crowd is None or not crowd.config.end_on_collision:
         return task
+    if isinstance(task, (list, tuple)):
+        return [add_pedestrian_termination(entry, crowd, f"{name}[{i}]") for i, entry in enumerate(task)]
     if task is None:
         task = {}
     if isinstance(task, PointNavigationTask):
@@ -404,19 +407,26 @@ def add_pedestrian_termination(task: Any, crowd: Any, name: str = "task") -> Any
     return {**task, "termination_conditions": [*given, PedestrianCollision()]}
 
 
-def robot_discs(env: Any) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-    """``(M, 3)`` discs ``(x, y, radius)`` and ``(M, 2)`` planar velocities of the env's
-    robots present on its crowd's floor (m, m/s)."""
+def crowd_robots(env: Any) -> tuple[list[int], NDArray[np.float64], NDArray[np.float64]]:
+    """The env's robots present on its crowd's floor: their indices, ``(M, 3)`` discs
+    ``(x, y, radius)`` and ``(M, 2)`` planar velocities (m, m/s)."""
     backend, floor = env.backend, env.crowd.floor
-    discs, velocities = [], []
+    ids, discs, velocities = [], [], []
     for j, spec in enumerate(env.robots):
         if not backend.is_present(j) or backend.get_robot_floor(j) != floor:
             continue
         position, _ = backend.get_pose(j)
         linear, _ = backend.get_velocity(j)
+        ids.append(j)
         discs.append((position[0], position[1], spec.radius))
         velocities.append((linear[0], linear[1]))
-    return np.array(discs, dtype=np.float64).reshape(-1, 3), np.array(velocities, dtype=np.float64).reshape(-1, 2)
+    return ids, np.array(discs, dtype=np.float64).reshape(-1, 3), np.array(velocities, dtype=np.float64).reshape(-1, 2)
+
+
+def robot_discs(env: Any) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """:func:`crowd_robots`' discs and velocities."""
+    _, discs, velocities = crowd_robots(env)
+    return discs, velocities
 
 
 def spawn_crowd(env: Any) -> None:
@@ -430,10 +440,13 @@ def spawn_crowd(env: Any) -> None:
 
 
 class CrowdTrack:
-    """The robot's and the pedestrians' positions at every control step of an episode, for
-    its social metrics (:func:`pointnav_core.task.social_metrics`) at the end."""
+    """A robot's and the pedestrians' positions at every control step of its episode, for
+    its social metrics (:func:`pointnav_core.task.social_metrics`) at the end.
 
-    def __init__(self, env: Any) -> None:
+    ``idn`` is the robot's index (default: the single env's robot)."""
+
+    def __init__(self, env: Any, idn: int | None = None) -> None:
+        self.idn = env.task.robot_idn if idn is None else idn
         self.robot: list[tuple[float, float]] = []
         self.heading: list[float] = []
         self.pedestrians: list[NDArray[np.float64]] = []
@@ -443,7 +456,7 @@ class CrowdTrack:
         """Add the env's positions now (after a control step, or at the reset)."""
         from pointnav_core.transforms import quat2yaw
 
-        position, quat = env.backend.get_pose(env.task.robot_idn)
+        position, quat = env.backend.get_pose(self.idn)
         self.robot.append((float(position[0]), float(position[1])))
         self.heading.append(float(quat2yaw(quat)))
         self.pedestrians.append(env.crowd.positions.copy())
@@ -455,9 +468,11 @@ class CrowdTrack:
         robot = np.array(self.robot)
         if len(robot) < 2:  # an episode that ended before any control step ran
             robot, self.heading, self.pedestrians = np.repeat(robot, 2, axis=0), self.heading * 2, self.pedestrians * 2
+        spec = env.robots[self.idn]
+        task = env.tasks[self.idn] if hasattr(env, "tasks") else env.task
         return social_metrics(
             robot, np.array(self.heading), np.array(self.pedestrians).reshape(len(robot), env.crowd.n, 2),
-            dt=1.0 / env.action_frequency, robot_radius=env.robot.radius, pedestrian_radii=env.crowd.radius,
+            dt=1.0 / env.action_frequency, robot_radius=spec.radius, pedestrian_radii=env.crowd.radius,
             success=bool(info["success"]), geodesic_dist=float(info["geodesic_dist"]),
-            max_speed=env.robot.max_linear_velocity, goal=env.task.get_goal_pos()[:2],
+            max_speed=spec.max_linear_velocity, goal=task.get_goal_pos()[:2],
         )

@@ -61,6 +61,13 @@ config=None)``; ``config`` (an :class:`~pointnav_core.envs.config.EnvConfig`) se
 |                    |                             |                   | every robot            |
 | `action_space`     | **str**                     | `"continuous"`    | or `"discrete"`        |
 | `discrete_actions` | **dict** or `None`          | `None`            | step, angle, STOP      |
+| `pedestrians`      | **dict** or `None`          | `None`            | a crowd (`PointNavEnv`)|
+
+``pedestrians`` puts one crowd on the first robot's floor, with the keys and rules of
+:class:`~pointnav_core.envs.pointnav.PointNavEnv`'s: it starts clear of every robot, avoids
+every robot present there (``sees_robots``), and each robot's contacts
+(``info["pedestrian_collisions"]``, ``end_on_collision``) and social metrics
+(``info["social"]`` when its episode ends) are its own.
 
 ``task`` entries are :class:`~pointnav_core.task.PointNavigationTask` keyword arguments
 (a list may also hold ready tasks); the env sets ``robot_idn`` (an entry that gives one must
@@ -172,6 +179,8 @@ Version History
 
 from __future__ import annotations
 
+import functools
+
 from collections.abc import Mapping, Sequence
 from typing import Any
 
@@ -188,6 +197,7 @@ from pointnav_core.backends.protocol import Backend, make_backend
 from pointnav_core.backends.robot_spec import RobotSpec
 from pointnav_core.envs import _multi_actions, _multi_agents
 from pointnav_core.envs import common as _envcommon
+from pointnav_core.envs._multi_crowd import FleetCrowd
 from pointnav_core.envs._multi_state import global_state, state_space
 from pointnav_core.envs.config import EnvConfig, multi_robot_arguments, takes_config
 from pointnav_core.envs.fleet import (
@@ -272,6 +282,7 @@ class MultiPointNavEnv(ParallelEnv[str, Any, np.ndarray]):
         sensors: Mapping[str, Any] | None = None,
         action_space: str = "continuous",
         discrete_actions: Mapping[str, Any] | None = None,
+        pedestrians: Mapping[str, Any] | None = None,
         config: EnvConfig | None = None,
     ) -> None:
         #: The :class:`~pointnav_core.envs.config.EnvConfig` this env was built from, or None.
@@ -286,8 +297,12 @@ class MultiPointNavEnv(ParallelEnv[str, Any, np.ndarray]):
         self.robots = make_robots(robot, n)
         derive = derived_path_ranges(task, n)
         self.discrete_actions = make_discrete_actions(action_space, discrete_actions)
+        crowd = _envcommon.make_crowd(pedestrians, scene)
         task = _envcommon.add_stop(_envcommon.add_sensors(task, sensors), self.discrete_actions)
-        tasks = make_tasks(task, n)
+        tasks = make_tasks(_envcommon.add_pedestrian_termination(task, crowd), n)
+        #: The pedestrians (:class:`~pointnav_core.crowds.Crowd`), or None without them.
+        self.crowd = crowd
+        self._fleet_crowd = None if crowd is None else FleetCrowd(crowd, n)
 
         self.scene = scene
         self.render_mode = render_mode
@@ -375,6 +390,10 @@ class MultiPointNavEnv(ParallelEnv[str, Any, np.ndarray]):
         self._started = True
         self.backend.reset()
         infos = _multi_agents.reset_tasks(self, self.tasks, self.reset_order, self.separation, given)
+        if self._fleet_crowd is not None:
+            self._fleet_crowd.reset(self)
+            for info in infos:
+                info["pedestrian_collisions"] = 0
         self._active = [True] * len(self.tasks)
         self._cycles = 0
         self.agents = self.possible_agents[:]
@@ -397,9 +416,16 @@ class MultiPointNavEnv(ParallelEnv[str, Any, np.ndarray]):
         # nothing when it refuses a step): a rejected step changes nothing.
         plans = self._plans
         commands, todo = _multi_actions.check_actions(agents, actions, self._slots, plans, self._index)
+        fleet = self._fleet_crowd
+        after = None
+        if fleet is not None:
+            fleet.begin()
+            after = functools.partial(fleet.step, self)  # the crowd walks every control step
         if plans is None:
             try:
                 self.backend.step(commands)
+                if after is not None:
+                    after()
             except ValueError as err:  # a rejected step moved nothing: name the agent
                 raise _multi_actions.named_action_error(err, todo) from None
             except BaseException:
@@ -409,9 +435,11 @@ class MultiPointNavEnv(ParallelEnv[str, Any, np.ndarray]):
             contacts = None
         try:
             if plans is not None:
-                contacts = _multi_actions.step_discrete(self.backend, plans, commands)
+                contacts = _multi_actions.step_discrete(self.backend, plans, commands, after)
             self._cycles += 1
             returns, alive, ended = _multi_agents.step_tasks(self, todo, contacts, self._cycles >= self.max_cycles)
+            if fleet is not None:
+                fleet.finish(self, self._index, returns)
             for i in ended:
                 self._finish(i)
             self.agents = alive
@@ -420,6 +448,11 @@ class MultiPointNavEnv(ParallelEnv[str, Any, np.ndarray]):
             self._void = True
             raise
         return returns
+
+    def pedestrian_contact(self, idn: int) -> bool:
+        """Whether robot ``idn`` touched a pedestrian during the last action (for
+        :class:`~pointnav_core.task.terminations.PedestrianCollision`)."""
+        return self._fleet_crowd is not None and self._fleet_crowd.touched[idn]
 
     def _finish(self, i: int) -> None:
         self._active[i] = False

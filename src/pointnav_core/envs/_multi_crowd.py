@@ -1,0 +1,67 @@
+"""The pedestrians of a multi-robot env: one crowd beside every robot.
+
+:class:`FleetCrowd` is what :class:`~pointnav_core.envs.multi_pointnav.MultiPointNavEnv`
+keeps for ``pedestrians={...}``: the crowd walks on the first robot's floor beside every
+robot present there (each seen, with ``sees_robots``), and each robot's contacts, count and
+social metrics are its own, as in the single env (:mod:`pointnav_core.crowds`).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from typing import Any
+
+from pointnav_core.envs import common as _envcommon
+
+__all__ = ["FleetCrowd"]
+
+
+class FleetCrowd:
+    """The crowd of a multi-robot env and each robot's side of it.
+
+    Attributes
+    ----------
+    crowd : Crowd
+    touched : list of bool
+        Whether each robot touched a pedestrian during the current action (its control steps).
+    counts : list of int
+        Each robot's pedestrian contact steps this episode.
+    """
+
+    def __init__(self, crowd: Any, n_robots: int) -> None:
+        self.crowd = crowd
+        self.n = n_robots
+        self.touched = [False] * n_robots
+        self.counts = [0] * n_robots
+        self.tracks: list[_envcommon.CrowdTrack] = []
+
+    def reset(self, env: Any) -> None:
+        """Place the crowd for new episodes (after the robots' resets)."""
+        _envcommon.spawn_crowd(env)
+        self.touched = [False] * self.n
+        self.counts = [0] * self.n
+        self.tracks = [_envcommon.CrowdTrack(env, i) for i in range(self.n)]
+
+    def begin(self) -> None:
+        """Start an action: no robot has touched a pedestrian yet."""
+        self.touched = [False] * self.n
+
+    def step(self, env: Any) -> None:
+        """Move the crowd one control step beside the robots; note who touches a pedestrian."""
+        ids, discs, velocities = _envcommon.crowd_robots(env)
+        self.crowd.step(1.0 / env.action_frequency, discs, velocities)
+        for i, hit in zip(ids, self.crowd.contacts(discs).tolist()):
+            self.touched[i] = self.touched[i] or hit
+        for track in self.tracks:
+            track.record(env)
+
+    def finish(self, env: Any, index: Mapping[str, int], returns: Any) -> None:
+        """Add each acting robot's contact count, and its social metrics where its episode
+        ended, to its info in ``returns`` (``step()``'s five dicts)."""
+        _, _, terminations, truncations, infos = returns
+        for agent, info in infos.items():
+            i = index[agent]
+            self.counts[i] += int(self.touched[i])
+            info["pedestrian_collisions"] = self.counts[i]
+            if terminations[agent] or truncations[agent]:
+                info["social"] = self.tracks[i].metrics(env, info)
