@@ -15,7 +15,14 @@ key                 default          what
 ``end_on_collision`` ``False``       whether touching a pedestrian ends the robot's episode
 ``orca``            RVO2's/iGibson's ``neighbor_dist`` 5 m, ``max_neighbors`` 10,
                                      ``time_horizon`` 2 s (iGibson's social navigation task)
+``starts``          drawn            fixed starts ``[[x, y], ...]`` (m), one per pedestrian
+                                     (then ``count`` may be left out)
+``goals``           drawn            fixed goals per pedestrian ``[[[x, y], ...], ...]`` (m),
+                                     walked in turn, round and round
 ==================  ===============  ===========================================================
+
+Fixed starts and goals make a scenario repeat exactly (:mod:`pointnav_core.crowds.presets`);
+they are plain lists, so an :class:`~pointnav_core.envs.config.EnvConfig` saves them.
 
 A callable behaviour is called once per control step with a :class:`CrowdView` and returns
 the pedestrians' new velocities, shape ``(P, 2)`` (m/s); the crowd clips them to each
@@ -43,7 +50,7 @@ BEHAVIOURS = ("orca", "social_force", "static")
 #: How much farther from the walls (m) the crowd's paths run than its largest radius needs.
 PATH_MARGIN = 0.05
 
-_KEYS = ("count", "density", "radius", "speed", "behaviour", "sees_robots", "end_on_collision", "orca")
+_KEYS = ("count", "density", "radius", "speed", "behaviour", "sees_robots", "end_on_collision", "orca", "starts", "goals")
 _ORCA_DEFAULTS = {"neighbor_dist": 5.0, "max_neighbors": 10, "time_horizon": 2.0}
 
 
@@ -94,6 +101,8 @@ class PedestrianConfig:
     neighbor_dist: float = 5.0
     max_neighbors: int = 10
     time_horizon: float = 2.0
+    starts: tuple[tuple[float, float], ...] | None = None
+    goals: tuple[tuple[tuple[float, float], ...], ...] | None = None
 
     def number(self, free_area: float) -> int:
         """Pedestrians per episode on a floor of ``free_area`` m² (``density`` rounds to
@@ -124,9 +133,22 @@ def make_pedestrians(value: Any, name: str = "pedestrians") -> PedestrianConfig 
     if not isinstance(value, Mapping):
         raise ArgumentError(f"{name} must be None or a dict of {list(_KEYS)}, got {value!r}")
     validation.known_keys(name, value, _KEYS)
+    starts = _points(f"{name}['starts']", value["starts"]) if value.get("starts") is not None else None
+    if starts is not None and "count" not in value and "density" not in value:
+        value = {**value, "count": len(starts)}
     if ("count" in value) == ("density" in value):
         raise ArgumentError(f"{name} needs exactly one of 'count' (pedestrians) and 'density' (pedestrians per m²), got {dict(value)!r}")
     count = density = None
+    if starts is not None and value.get("count") != len(starts):
+        raise ArgumentError(f"{name}['count'] must be the number of starts ({len(starts)}) when 'starts' is given, got {value.get('count')!r}")
+    goals = None
+    if value.get("goals") is not None:
+        raw = value["goals"]
+        if not isinstance(raw, (list, tuple)) or (starts is not None and len(raw) != len(starts)) or (
+            starts is None and "count" in value and len(raw) != value["count"]
+        ):
+            raise ArgumentError(f"{name}['goals'] must be a list of one goal list per pedestrian, got {raw!r}")
+        goals = tuple(_points(f"{name}['goals'][{i}]", g) for i, g in enumerate(raw))
     if "count" in value:
         count = validation.integer(f"{name}['count']", value["count"], minimum=0)
     else:
@@ -150,4 +172,13 @@ def make_pedestrians(value: Any, name: str = "pedestrians") -> PedestrianConfig 
         neighbor_dist=validation.real(f"{name}['orca']['neighbor_dist']", orca["neighbor_dist"], minimum=0.0),
         max_neighbors=validation.integer(f"{name}['orca']['max_neighbors']", orca["max_neighbors"], minimum=0),
         time_horizon=validation.real(f"{name}['orca']['time_horizon']", orca["time_horizon"], minimum=0.0, strict=True, unit="s"),
+        starts=starts,
+        goals=goals,
     )
+
+
+def _points(name: str, value: Any) -> tuple[tuple[float, float], ...]:
+    """A non-empty list of ``[x, y]`` points (m) as a tuple of float pairs."""
+    if not isinstance(value, (list, tuple)) or not value:
+        raise ArgumentError(f"{name} must be a non-empty list of [x, y] points (m), got {value!r}")
+    return tuple(tuple(float(c) for c in validation.vector(f"{name}[{i}]", p, sizes=(2,))) for i, p in enumerate(value))  # type: ignore[misc]

@@ -95,6 +95,7 @@ class Crowd:
         self._paths = np.zeros((n, 1, 2))  # each path padded with its last point
         self._last = np.zeros(n, dtype=np.int64)  # index of each path's last point
         self._next = np.zeros(n, dtype=np.int64)  # index of each one's next waypoint
+        self._goal_index = np.full(n, -1, dtype=np.int64)  # in each one's fixed goal list
 
     @property
     def n(self) -> int:
@@ -126,7 +127,7 @@ class Crowd:
         self.speed[:] = rng.uniform(lo, hi, n) if hi > lo else lo
         robots = np.asarray(robots, dtype=np.float64).reshape(-1, 3)
         for i in range(n):
-            self.positions[i] = self._place(i, robots)
+            self.positions[i] = self._place(i, robots) if cfg.starts is None else self._fixed(i, robots)
         self.headings[:] = rng.uniform(-math.pi, math.pi, n)
         paths = [self._plan(i, new_goal=True) for i in range(n)]
         self._set_paths(range(n), paths)
@@ -146,6 +147,20 @@ class Crowd:
             f"the walls, the robots and the pedestrians before it in {PLACE_TRIES} tries; ask for fewer"
         )
 
+    def _fixed(self, i: int, robots: NDArray[np.float64]) -> NDArray[np.float64]:
+        """Pedestrian ``i``'s fixed start, checked: its disc must fit there and overlap no
+        robot and no pedestrian before it."""
+        point = np.array(self.config.starts[i], dtype=np.float64)  # type: ignore[index]
+        others = np.concatenate([robots, self.discs()[:i]])
+        gap = np.hypot(others[:, 0] - point[0], others[:, 1] - point[1]) - others[:, 2] - self.radius[i]
+        tmap = self.scene.floors[self.floor]
+        if not tmap.is_usable(point, self.config.plan_radius) or (len(gap) and gap.min() < 0.0):
+            raise SamplingError(
+                f"pedestrians['starts'][{i}] {point.tolist()} is not clear on floor {self.floor}: a disc of "
+                f"{self.config.plan_radius} m must fit there, apart from the robots and the pedestrians before it"
+            )
+        return point
+
     # ------------------------------------------------------------------ paths
     def _plan(self, i: int, new_goal: bool) -> NDArray[np.float64]:
         """Pedestrian ``i``'s path from where it stands to its goal (a new one if asked, or
@@ -155,8 +170,15 @@ class Crowd:
         start = self._anchor(here)
         if start is None:
             return here[None].copy()
+        fixed = self.config.goals
         for attempt in range(10):
-            if new_goal or attempt:
+            if fixed is not None:  # the next goal of its list, round and round
+                if new_goal:
+                    self._goal_index[i] += 1
+                walk = fixed[i]
+                self.goals[i] = walk[int(self._goal_index[i]) % len(walk)]
+                new_goal = True  # an unreachable fixed goal: try the next one
+            elif new_goal or attempt:
                 goal = start
                 for _ in range(10):
                     _, goal = scene.get_random_point(floor, reference_point=start, robot=radius, rng=self._rng)
