@@ -132,6 +132,22 @@ def make_task(
     )
 
 
+def edit_task(task: Any, name: str, edit: Any, ready: str) -> Any:
+    """``task`` (None, a dict of task arguments, a task, or a list of them) changed by
+    ``edit(dict, name) -> dict``: each entry of a list (named ``name[i]``), and ``{}`` for
+    None. A ready ``PointNavigationTask`` cannot change: a ValueError saying ``ready`` (with
+    the name). Anything else is returned as it is, for ``make_task`` to name."""
+    if isinstance(task, (list, tuple)):
+        return [edit_task(entry, f"{name}[{i}]", edit, ready) for i, entry in enumerate(task)]
+    if task is None:
+        task = {}
+    if isinstance(task, PointNavigationTask):
+        raise ArgumentError(ready.format(name=name))
+    if not isinstance(task, Mapping):
+        return task
+    return edit(task, name)
+
+
 def add_sensors(task: Any, sensors: Mapping[str, Any] | None, name: str = "task") -> Any:
     """``task`` (None, a dict of task arguments, a task, or a list of them) with the terms
     of ``sensors`` (:func:`pointnav_core.sensors.make_sensors`) added to its
@@ -149,25 +165,21 @@ def add_sensors(task: Any, sensors: Mapping[str, Any] | None, name: str = "task"
     terms = make_sensors(sensors)
     if not terms:
         return task
-    if isinstance(task, (list, tuple)):
-        return [add_sensors(entry, sensors, f"{name}[{i}]") for i, entry in enumerate(task)]
-    if task is None:
-        task = {}
-    if isinstance(task, PointNavigationTask):
-        raise ArgumentError(
-            f"sensors cannot be added to a ready PointNavigationTask ({name}): pass the task "
-            f"as a dict of its arguments, or put the sensor terms in its observation_terms"
-        )
-    if not isinstance(task, Mapping):
-        return task  # make_task names the problem
-    given = list(task.get("observation_terms") or ())
-    names = {getattr(term, "name", None) for term in given}
-    for term in terms:
-        if term.name in names:
-            raise ArgumentError(
-                f"sensors turns on {term.name!r}, which {name}['observation_terms'] already has"
-            )
-    return {**task, "observation_terms": [*terms, *given]}
+
+    def edit(entry: Mapping[str, Any], where: str) -> dict[str, Any]:
+        given = list(entry.get("observation_terms") or ())
+        names = {getattr(term, "name", None) for term in given}
+        for term in terms:
+            if term.name in names:
+                raise ArgumentError(
+                    f"sensors turns on {term.name!r}, which {where}['observation_terms'] already has"
+                )
+        return {**entry, "observation_terms": [*terms, *given]}
+
+    return edit_task(task, name, edit, (
+        "sensors cannot be added to a ready PointNavigationTask ({name}): pass the task "
+        "as a dict of its arguments, or put the sensor terms in its observation_terms"
+    ))
 
 
 def check_world_args(
@@ -390,21 +402,17 @@ def add_pedestrian_termination(task: Any, crowd: Any, name: str = "task") -> Any
 
     if crowd is None or not crowd.config.end_on_collision:
         return task
-    if isinstance(task, (list, tuple)):
-        return [add_pedestrian_termination(entry, crowd, f"{name}[{i}]") for i, entry in enumerate(task)]
-    if task is None:
-        task = {}
-    if isinstance(task, PointNavigationTask):
-        raise ArgumentError(
-            f"pedestrians['end_on_collision'] cannot change a ready PointNavigationTask ({name}): pass "
-            f"the task as a dict of its arguments, or put PedestrianCollision() in its termination_conditions"
-        )
-    if not isinstance(task, Mapping):
-        return task  # make_task names the problem
-    given = list(task.get("termination_conditions") or ())
-    if any(getattr(term, "name", None) == PedestrianCollision.name for term in given):
-        return task
-    return {**task, "termination_conditions": [*given, PedestrianCollision()]}
+
+    def edit(entry: Mapping[str, Any], where: str) -> Mapping[str, Any]:
+        given = list(entry.get("termination_conditions") or ())
+        if any(getattr(term, "name", None) == PedestrianCollision.name for term in given):
+            return entry
+        return {**entry, "termination_conditions": [*given, PedestrianCollision()]}
+
+    return edit_task(task, name, edit, (
+        "pedestrians['end_on_collision'] cannot change a ready PointNavigationTask ({name}): pass "
+        "the task as a dict of its arguments, or put PedestrianCollision() in its termination_conditions"
+    ))
 
 
 def crowd_robots(env: Any) -> tuple[list[int], NDArray[np.float64], NDArray[np.float64]]:
