@@ -12,7 +12,7 @@ preset                      what
                             opposite and back, radius 0.3 m at 1 m/s, in an open 12 x 12 m
                             room; the robot crosses the circle from (0, -4) to (0, 4)
 :func:`corridor`            a 2.4 m wide, 14 m long corridor: the robot walks its length while
-                            4 people come the other way in two lanes
+                            4 people come the other way in two lanes 0.3 m off its line
 :func:`doorway`             two 6 x 6 m rooms joined by a 1.2 m door: the robot goes through
                             the door while 4 people come through it the other way
 :func:`igibson_density`     iGibson's social navigation density, 1 pedestrian per 8 m² of
@@ -86,12 +86,13 @@ def circle_crossing(humans: int = 5, circle_radius: float = 4.0, seed: int = 0, 
 
 
 def corridor(humans: int = 4, width: float = 2.4, length: float = 14.0, **pedestrians: Any) -> Scenario:
-    """A corridor ``width`` x ``length`` m along x: the robot from one end to the other, and
-    ``humans`` coming the other way in two lanes, 1.5 m apart along it, then walking back."""
+    """A corridor ``width`` x ``length`` m along x: the robot from one end to the other along
+    its middle, and ``humans`` coming the other way in two lanes a quarter of the width
+    apart about the middle, 1.5 m apart along it, then walking back."""
     rows, cols = round((width + 0.2) / RESOLUTION), round((length + 0.2) / RESOLUTION)
     scene = _walled(np.ones((rows, cols), dtype=bool), (-(length + 0.2) / 2, -(width + 0.2) / 2))
     end = length / 2 - 1.0
-    lanes = (-width / 4, width / 4)
+    lanes = (-width / 8, width / 8)  # near the robot's line: they must give way
     starts = [[end - 1.5 * (k // 2), lanes[k % 2]] for k in range(humans)]
     goals = [[[-end, y], [x, y]] for x, y in starts]
     task = {"initial_pos": [-end, 0.0], "initial_quat": _facing(0.0), "goal_pos": [end, 0.0]}
