@@ -207,8 +207,9 @@ class PointNavEnv(gym.Env[Any, np.ndarray]):
     pedestrian) that walk at `speed` m/s (`(0.5, 1.0)`) along the scene's exact shortest
     paths between goals drawn on their part of the floor, with `behaviour` `"orca"`
     (the default: RVO2's ORCA among the pedestrians and, with `sees_robots=True`, the
-    robot), `"social_force"` (pysocialforce's model), `"static"` or a callable. They start clear of the walls, the robot and each
-    other, never enter a wall, and are drawn from the reset's seed. The scan and the local
+    robot), `"social_force"` (pysocialforce's model), `"static"` or a callable. They start
+    clear of the walls, the robot and each other, never enter a wall, and are drawn from
+    the reset's seed; `starts` and `goals` fix them (`pointnav_core.crowds.presets`). The scan and the local
     map (code 4) see them and `render()` draws them, grey with a heading tick. The robot is
     not pushed by them: a step on which its disc overlaps a pedestrian's adds one to
     `info["pedestrian_collisions"]` (not to `collisions`), and with
