@@ -23,9 +23,11 @@ from gymnasium import spaces
 from numpy.typing import NDArray
 
 from pointnav_core import scenes
+from pointnav_core.backends.protocol import float_twin
 from pointnav_core.backends.robot_spec import RobotSpec
 from pointnav_core.errors import ArgumentError
 from pointnav_core.task import PointNavigationTask
+from pointnav_core.transforms import quat2yaw
 from pointnav_core.utils import validation
 
 __all__ = [
@@ -408,14 +410,19 @@ def robot_discs(env: Any) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     """``(M, 3)`` discs ``(x, y, radius)`` and ``(M, 2)`` planar velocities of the env's
     robots present on its crowd's floor (m, m/s)."""
     backend, floor = env.backend, env.crowd.floor
+    # The float twins give the same numbers without building two arrays per robot per step.
+    pose, velocity = float_twin(backend, "get_pose_floats"), float_twin(backend, "get_velocity_floats")
     discs, velocities = [], []
     for j, spec in enumerate(env.robots):
         if not backend.is_present(j) or backend.get_robot_floor(j) != floor:
             continue
-        position, _ = backend.get_pose(j)
-        linear, _ = backend.get_velocity(j)
-        discs.append((position[0], position[1], spec.radius))
-        velocities.append((linear[0], linear[1]))
+        if pose is not None and velocity is not None:
+            x, y = pose(j)[:2]
+            vx, vy = velocity(j)[:2]
+        else:
+            (x, y), (vx, vy) = backend.get_pose(j)[0][:2].tolist(), backend.get_velocity(j)[0][:2].tolist()
+        discs.append((x, y, spec.radius))
+        velocities.append((vx, vy))
     return np.array(discs, dtype=np.float64).reshape(-1, 3), np.array(velocities, dtype=np.float64).reshape(-1, 2)
 
 
@@ -441,10 +448,14 @@ class CrowdTrack:
 
     def record(self, env: Any) -> None:
         """Add the env's positions now (after a control step, or at the reset)."""
-        from pointnav_core.transforms import quat2yaw
-
-        position, quat = env.backend.get_pose(env.task.robot_idn)
-        self.robot.append((float(position[0]), float(position[1])))
+        idn = env.task.robot_idn
+        pose = float_twin(env.backend, "get_pose_floats")
+        if pose is not None:  # the same numbers as get_pose, without its arrays
+            x, y, _, *quat = pose(idn)
+        else:
+            position, quat = env.backend.get_pose(idn)
+            x, y = position[:2].tolist()
+        self.robot.append((x, y))
         self.heading.append(float(quat2yaw(quat)))
         self.pedestrians.append(env.crowd.positions.copy())
 
