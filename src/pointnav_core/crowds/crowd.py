@@ -274,7 +274,7 @@ class Crowd:
         fn(self.positions, self.velocities, self.radius, self.speed, self.goals, self._paths, self._next, self._last,
            robots, robot_velocities, len(robots) if cfg.sees_robots else 0, float(dt), cfg.neighbor_dist,
            cfg.max_neighbors, cfg.time_horizon, GOAL_REACHED, self._walls(collision), new_pos, new_vel, flags, contacts)
-        self._moved(new_pos, new_vel, (flags & 1) != 0, (flags & 4) != 0, (flags & 2) != 0)
+        self._moved(new_pos, new_vel, flags & 4, np.flatnonzero(flags & 3), flags & 2)
         return contacts
 
     def _walls(self, collision: Any) -> tuple[Any, ...]:
@@ -315,16 +315,15 @@ class Crowd:
         new = np.where(blocked[:, None], self.positions, self.positions + vel * dt)
         moving = np.hypot(vel[:, 0], vel[:, 1]) > 1e-9
         arrived = np.linalg.norm(self.goals - new, axis=1) < GOAL_REACHED
-        self._moved(new, vel, blocked, moving, arrived)
+        self._moved(new, vel, moving, np.flatnonzero(blocked | arrived), arrived)
 
-    def _moved(self, positions: NDArray[np.float64], velocities: NDArray[np.float64], blocked: NDArray[np.bool_],
-               moving: NDArray[np.bool_], arrived: NDArray[np.bool_]) -> None:
+    def _moved(self, positions: NDArray[np.float64], velocities: NDArray[np.float64], moving: NDArray[Any],
+               replan: NDArray[np.int64], arrived: NDArray[Any]) -> None:
         """Take a step's new ``(P, 2)`` positions (m) and velocities (m/s): the headings of
-        the ``moving``, and new plans for the ``blocked`` (from where they stand) and the
-        ``arrived`` (to new goals)."""
+        the ``moving`` (a ``(P,)`` mask, nonzero where moving), and new plans for the
+        pedestrians ``replan``: from where they stand, to a new goal where ``arrived``."""
         self.positions, self.velocities = positions, velocities
         self.headings = np.where(moving, np.arctan2(velocities[:, 1], velocities[:, 0]), self.headings)
-        replan = np.flatnonzero(blocked | arrived)
         if len(replan):
             paths = [self._plan(int(i), new_goal=bool(arrived[i])) for i in replan]
             self._set_paths(replan, paths)

@@ -406,12 +406,21 @@ def add_pedestrian_termination(task: Any, crowd: Any, name: str = "task") -> Any
     return {**task, "termination_conditions": [*given, PedestrianCollision()]}
 
 
-def robot_discs(env: Any) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+def pose_twins(backend: Any) -> tuple[Any, Any]:
+    """``backend``'s bound ``get_pose_floats`` and ``get_velocity_floats`` twins, each None
+    where it must not be read (:func:`~pointnav_core.backends.protocol.float_twin`). The env
+    binds them at each reset, as the task binds its own at load: finding them costs more
+    than reading them."""
+    return float_twin(backend, "get_pose_floats"), float_twin(backend, "get_velocity_floats")
+
+
+def robot_discs(env: Any, twins: tuple[Any, Any] | None = None) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     """``(M, 3)`` discs ``(x, y, radius)`` and ``(M, 2)`` planar velocities of the env's
-    robots present on its crowd's floor (m, m/s)."""
+    robots present on its crowd's floor (m, m/s), read through ``twins`` (:func:`pose_twins`
+    of its backend, found here when None)."""
     backend, floor = env.backend, env.crowd.floor
     # The float twins give the same numbers without building two arrays per robot per step.
-    pose, velocity = float_twin(backend, "get_pose_floats"), float_twin(backend, "get_velocity_floats")
+    pose, velocity = pose_twins(backend) if twins is None else twins
     discs, velocities = [], []
     for j, spec in enumerate(env.robots):
         if not backend.is_present(j) or backend.get_robot_floor(j) != floor:
@@ -441,6 +450,8 @@ class CrowdTrack:
     its social metrics (:func:`pointnav_core.task.social_metrics`) at the end."""
 
     def __init__(self, env: Any) -> None:
+        #: The backend's float twins (:func:`pose_twins`), bound for the episode.
+        self.twins = pose_twins(env.backend)
         self.robot: list[tuple[float, float]] = []
         self.heading: list[float] = []
         self.pedestrians: list[NDArray[np.float64]] = []
@@ -449,7 +460,7 @@ class CrowdTrack:
     def record(self, env: Any) -> None:
         """Add the env's positions now (after a control step, or at the reset)."""
         idn = env.task.robot_idn
-        pose = float_twin(env.backend, "get_pose_floats")
+        pose = self.twins[0]
         if pose is not None:  # the same numbers as get_pose, without its arrays
             x, y, _, *quat = pose(idn)
         else:

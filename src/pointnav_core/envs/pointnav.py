@@ -394,7 +394,7 @@ class PointNavEnv(gym.Env[Any, np.ndarray]):
 
     def _step_crowd(self) -> bool:
         """Move the pedestrians one control step beside the robot; whether they touch it."""
-        robots, velocities = _envcommon.robot_discs(self)
+        robots, velocities = _envcommon.robot_discs(self, self._track.twins)  # type: ignore[union-attr]
         # One call steps the crowd and finds its contacts (one compiled call for ORCA).
         contacts = self.crowd.step_contacts(1.0 / self.action_frequency, robots, velocities)  # type: ignore[union-attr]
         self._touched = touched = bool(contacts[0])
