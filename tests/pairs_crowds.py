@@ -22,12 +22,11 @@ from collections.abc import Callable
 from contextlib import AbstractContextManager
 
 import numpy as np
+from crowd_reference import env_in, room
 from hypothesis import given, settings
 from hypothesis import strategies as st
 from orca_reference import preferred, random_crowd
 from social_force_reference import random_crowd as random_pedestrians
-
-from crowd_reference import env_in, room
 
 from pointnav_core import scenes
 from pointnav_core.crowds import orca_step, social_force_step
@@ -124,7 +123,7 @@ def _crowd_rollout(seed: int, house: bool, pedestrians: dict, steps: int) -> np.
         _, _, terminated, truncated, info = env.step(rng.uniform(-1.0, 1.0, 2).astype(np.float32))
         c = env.crowd
         rows.append(np.concatenate([c.positions.ravel(), c.velocities.ravel(), c.headings, c.goals.ravel(),
-                                    c._next, [info["pedestrian_collisions"]]]))  # noqa: SLF001 (the waypoints)
+                                    c._next, [info["pedestrian_collisions"]]]))
         if terminated or truncated:
             env.reset()
     return np.array(rows)
