@@ -20,6 +20,7 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from contextlib import AbstractContextManager
+from unittest import mock
 
 import numpy as np
 from crowd_reference import env_in, room
@@ -31,6 +32,7 @@ from social_force_reference import random_crowd as random_pedestrians
 from pointnav_core import scenes
 from pointnav_core.crowds import orca_step, social_force_step
 from pointnav_core.crowds.crowd import KERNEL as CROWD_KERNEL
+from pointnav_core.crowds.crowd import Crowd
 from pointnav_core.envs.pointnav import PointNavEnv
 from pointnav_core.utils.compiled import kernel
 
@@ -149,7 +151,11 @@ def check_crowd_step(
     """An env's ORCA crowd stepped by its kernel and inside ``plain_paths()``: bit for bit."""
     pedestrians = {"count": count, "radius": (low, low + spread), "speed": tuple(speed), "sees_robots": sees_robots,
                    "orca": {"max_neighbors": max_neighbors, "time_horizon": time_horizon}}
-    got = _crowd_rollout(seed, house, pedestrians, steps)
+    # Every step of the compiled side goes through the kernel (else the check compares the
+    # numpy path with itself).
+    with mock.patch.object(Crowd, "_step_compiled", autospec=True, side_effect=Crowd._step_compiled) as compiled:
+        got = _crowd_rollout(seed, house, pedestrians, steps)
+    assert compiled.call_count == steps
     with plain_paths():
         assert kernel(*CROWD_KERNEL) is None
         want = _crowd_rollout(seed, house, pedestrians, steps)
