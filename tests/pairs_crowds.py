@@ -1,26 +1,39 @@
-"""Plain and compiled paths of :func:`pointnav_core.crowds.orca_step` and
-:func:`pointnav_core.crowds.social_force_step`: the checks of
-``property_tests/test_compiled_paths.py`` for ``crowds._orca_kernel`` and
-``crowds._social_force_kernel``.
+"""Plain and compiled paths of :func:`pointnav_core.crowds.orca_step`,
+:func:`pointnav_core.crowds.social_force_step` and an ORCA crowd's step
+(:meth:`pointnav_core.crowds.Crowd.step_contacts`): the checks of
+``property_tests/test_compiled_paths.py`` for ``crowds._orca_kernel``,
+``crowds._social_force_kernel`` and ``crowds._crowd_kernel``.
 
 Both paths give the same floats, bit for bit, on random crowds in batches of worlds (one
 to 30 agents, more than RVO2's k-d tree leaf of 10), with per-agent radii and speeds, ties of
 distances (agents on a grid) and overlaps, over several steps. Each is also checked against
 RVO2 itself (``tests/test_orca.py``, ``property_tests/test_orca_props.py``).
+
+The crowd's step gives the same floats on both paths, bit for bit, over whole env rollouts:
+random walled rooms with boxes (and the default house, whose furniture is polygons), random
+crowds, radius and speed ranges, ORCA settings, with and without seeing the robot, under
+random actions and resets; every step's positions, velocities, headings, goals, next
+waypoints and contact count are compared.
 """
 
 from __future__ import annotations
 
 from collections.abc import Callable
 from contextlib import AbstractContextManager
+from unittest import mock
 
 import numpy as np
+from crowd_reference import env_in, room
 from hypothesis import given, settings
 from hypothesis import strategies as st
 from orca_reference import preferred, random_crowd
 from social_force_reference import random_crowd as random_pedestrians
 
+from pointnav_core import scenes
 from pointnav_core.crowds import orca_step, social_force_step
+from pointnav_core.crowds.crowd import KERNEL as CROWD_KERNEL
+from pointnav_core.crowds.crowd import Crowd
+from pointnav_core.envs.pointnav import PointNavEnv
 from pointnav_core.utils.compiled import kernel
 
 Plain = Callable[[], AbstractContextManager[None]]
@@ -91,3 +104,60 @@ def check_social_force(
         np.testing.assert_allclose(got[0], want[0], rtol=0, atol=1e-9)
         np.testing.assert_allclose(got[1], want[1], rtol=0, atol=1e-9)
     assert kernel("pointnav_core.crowds._social_force_kernel", "social_force_worlds") is not None
+
+
+_HOUSE: list[scenes.Scene] = []  # the default house, built once
+
+
+def _crowd_rollout(seed: int, house: bool, pedestrians: dict, steps: int) -> np.ndarray:
+    """Every step's crowd state and contact count, one row per step, of an env rollout
+    under random actions (a new episode where one ends)."""
+    if house:
+        if not _HOUSE:
+            _HOUSE.append(scenes.rooms(seed=0))
+        env = PointNavEnv(scene=_HOUSE[0], pedestrians=pedestrians)
+    else:
+        env = env_in(room(60, 40, boxes=seed % 8, seed=seed % 1000), pedestrians=pedestrians)
+    env.reset(seed=seed)
+    rng = np.random.default_rng(seed)
+    rows = []
+    for _ in range(steps):
+        _, _, terminated, truncated, info = env.step(rng.uniform(-1.0, 1.0, 2).astype(np.float32))
+        c = env.crowd
+        rows.append(np.concatenate([c.positions.ravel(), c.velocities.ravel(), c.headings, c.goals.ravel(),
+                                    c._next, [info["pedestrian_collisions"]]]))
+        if terminated or truncated:
+            env.reset()
+    return np.array(rows)
+
+
+@settings(max_examples=15, deadline=None)
+@given(
+    seed=st.integers(0, 2**31 - 1),
+    house=st.booleans(),
+    count=st.integers(1, 12),
+    low=st.floats(0.1, 0.3),
+    spread=st.floats(0.0, 0.15),
+    speed=st.tuples(st.floats(0.0, 1.0), st.floats(0.0, 1.0)).map(sorted),
+    sees_robots=st.booleans(),
+    max_neighbors=st.integers(0, 12),
+    time_horizon=st.floats(0.2, 5.0),
+    steps=st.integers(1, 80),
+)
+def check_crowd_step(
+    seed: int, house: bool, count: int, low: float, spread: float, speed: list[float], sees_robots: bool,
+    max_neighbors: int, time_horizon: float, steps: int, plain_paths: Plain,
+) -> None:
+    """An env's ORCA crowd stepped by its kernel and inside ``plain_paths()``: bit for bit."""
+    pedestrians = {"count": count, "radius": (low, low + spread), "speed": tuple(speed), "sees_robots": sees_robots,
+                   "orca": {"max_neighbors": max_neighbors, "time_horizon": time_horizon}}
+    # Every step of the compiled side goes through the kernel (else the check compares the
+    # numpy path with itself).
+    with mock.patch.object(Crowd, "_step_compiled", autospec=True, side_effect=Crowd._step_compiled) as compiled:
+        got = _crowd_rollout(seed, house, pedestrians, steps)
+    assert compiled.call_count == steps
+    with plain_paths():
+        assert kernel(*CROWD_KERNEL) is None
+        want = _crowd_rollout(seed, house, pedestrians, steps)
+    np.testing.assert_array_equal(got, want)
+    assert kernel(*CROWD_KERNEL) is not None

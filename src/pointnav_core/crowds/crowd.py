@@ -37,6 +37,8 @@ from pointnav_core.crowds.config import CrowdView, PedestrianConfig
 from pointnav_core.crowds.orca import orca_step
 from pointnav_core.crowds.social_force import SocialForceParams, social_force_step
 from pointnav_core.errors import ArgumentError, SamplingError
+from pointnav_core.floor.collision import TOUCH_TOL
+from pointnav_core.utils.compiled import kernel
 
 __all__ = ["Crowd"]
 
@@ -53,6 +55,8 @@ ROBOT_LOOKAHEAD = 10.0
 # pysocialforce's parameters without its stops near the goal: a pedestrian's goal in the
 # model is its next waypoint, and the crowd passes waypoints and draws new goals itself.
 _SOCIAL_FORCE = SocialForceParams(goal_threshold=0.0, stop_distance=0.0)
+#: The compiled step of ORCA crowds (``utils.compiled.kernel``'s module and function).
+KERNEL = ("pointnav_core.crowds._crowd_kernel", "orca_crowd_step")
 
 
 class Crowd:
@@ -83,6 +87,7 @@ class Crowd:
         self.scene = scene
         self.floor = 0
         self._rng = np.random.default_rng(0)
+        self._wall_args: dict[int, tuple[Any, tuple[Any, ...]]] = {}  # _walls', per floor
         self._set_count(0)
 
     def _set_count(self, n: int) -> None:
@@ -257,8 +262,60 @@ class Crowd:
     def step(self, dt: float, robots: NDArray[np.float64], robot_velocities: NDArray[np.float64]) -> None:
         """Advance the crowd by ``dt`` s beside the ``(M, 3)`` robot discs ``robots`` moving
         at ``(M, 2)`` ``robot_velocities`` (see the module notes)."""
-        if not self.n:
-            return
+        if self.n:
+            self._advance(dt, robots, robot_velocities)
+
+    def step_contacts(self, dt: float, robots: NDArray[np.float64],
+                      robot_velocities: NDArray[np.float64]) -> NDArray[np.bool_]:
+        """:meth:`step`, then :meth:`contacts` of the same ``robots``: ``(M,)`` whether each
+        robot's disc overlaps a pedestrian after the step. An ORCA crowd does both in one
+        compiled call where numba is installed (the env's per-step path)."""
+        touched = self._advance(dt, robots, robot_velocities) if self.n else None
+        return self.contacts(robots) if touched is None else touched
+
+    def _advance(self, dt: float, robots: NDArray[np.float64],
+                 robot_velocities: NDArray[np.float64]) -> NDArray[np.bool_] | None:
+        """One step of a crowd of at least one pedestrian: the robots' contacts after it
+        where the compiled path ran (and computed them), else None."""
+        fn = kernel(*KERNEL) if self.config.behaviour == "orca" else None
+        collision = self.scene.floors[self.floor].collision
+        if fn is None or not collision.compiled_polygons:
+            self._step_arrays(dt, robots, robot_velocities)
+            return None
+        return self._step_compiled(fn, collision, dt, robots, robot_velocities)
+
+    def _step_compiled(self, fn: Any, collision: Any, dt: float, robots: NDArray[np.float64],
+                       robot_velocities: NDArray[np.float64]) -> NDArray[np.bool_]:
+        """An ORCA step by the compiled kernel ``fn`` (``_crowd_kernel.orca_crowd_step``): the
+        same floats as :meth:`_step_arrays` without its dozen array operations per step."""
+        cfg, n = self.config, self.n
+        robots = np.ascontiguousarray(robots, dtype=np.float64).reshape(-1, 3)
+        robot_velocities = np.ascontiguousarray(robot_velocities, dtype=np.float64).reshape(-1, 2)
+        new_pos, new_vel = np.empty((n, 2)), np.empty((n, 2))
+        flags, contacts = np.empty(n, np.int8), np.empty(len(robots), np.bool_)
+        fn(self.positions, self.velocities, self.radius, self.speed, self.goals, self._paths, self._next, self._last,
+           robots, robot_velocities, len(robots) if cfg.sees_robots else 0, float(dt), cfg.neighbor_dist,
+           cfg.max_neighbors, cfg.time_horizon, GOAL_REACHED, self._walls(collision), new_pos, new_vel, flags, contacts)
+        self._moved(new_pos, new_vel, flags & 4, np.flatnonzero(flags & 3), flags & 2)
+        return contacts
+
+    def _walls(self, collision: Any) -> tuple[Any, ...]:
+        """The compiled wall test's arguments for a disc of the crowd's largest radius on
+        ``collision`` (``floor._collision_kernel.segment_hits``' after the segment), kept per
+        floor. ``rho`` and ``reach`` are derived as ``FloorCollision`` derives them for its
+        own compiled tests (the property test of the two paths holds them equal)."""
+        kept = self._wall_args.get(self.floor)
+        if kept is None or kept[0] is not collision:
+            ox, oy, res, rowcum, outside, *edges, use_polygons = collision.kernel_geometry()
+            radius = self.config.radius[1]
+            inv = 1.0 / res
+            rho = max(radius - TOUCH_TOL, TOUCH_TOL) * inv
+            reach = max(radius - 2 * TOUCH_TOL, TOUCH_TOL / 2)
+            kept = self._wall_args[self.floor] = (collision, (ox, oy, inv, rho, rowcum, outside, reach, *edges, use_polygons))
+        return kept[1]
+
+    def _step_arrays(self, dt: float, robots: NDArray[np.float64], robot_velocities: NDArray[np.float64]) -> None:
+        """A step on the general path: numpy, any behaviour."""
         cfg = self.config
         pref = self.preferred(dt)
         if cfg.behaviour == "static":
@@ -277,13 +334,18 @@ class Crowd:
             vel[blocked] = pref[blocked]
             blocked &= ~np.asarray(tmap.is_usable(self.positions + vel * dt, cfg.radius[1]))
             vel[blocked] = 0.0
-        new = self.positions + vel * dt
-        self.positions = np.where(blocked[:, None], self.positions, new)
-        self.velocities = vel
+        new = np.where(blocked[:, None], self.positions, self.positions + vel * dt)
         moving = np.hypot(vel[:, 0], vel[:, 1]) > 1e-9
-        self.headings = np.where(moving, np.arctan2(vel[:, 1], vel[:, 0]), self.headings)
-        arrived = np.linalg.norm(self.goals - self.positions, axis=1) < GOAL_REACHED
-        replan = np.flatnonzero(blocked | arrived)
+        arrived = np.linalg.norm(self.goals - new, axis=1) < GOAL_REACHED
+        self._moved(new, vel, moving, np.flatnonzero(blocked | arrived), arrived)
+
+    def _moved(self, positions: NDArray[np.float64], velocities: NDArray[np.float64], moving: NDArray[Any],
+               replan: NDArray[np.int64], arrived: NDArray[Any]) -> None:
+        """Take a step's new ``(P, 2)`` positions (m) and velocities (m/s): the headings of
+        the ``moving`` (a ``(P,)`` mask, nonzero where moving), and new plans for the
+        pedestrians ``replan``: from where they stand, to a new goal where ``arrived``."""
+        self.positions, self.velocities = positions, velocities
+        self.headings = np.where(moving, np.arctan2(velocities[:, 1], velocities[:, 0]), self.headings)
         if len(replan):
             paths = [self._plan(int(i), new_goal=bool(arrived[i])) for i in replan]
             self._set_paths(replan, paths)

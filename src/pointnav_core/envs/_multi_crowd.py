@@ -48,9 +48,9 @@ class FleetCrowd:
 
     def step(self, env: Any) -> None:
         """Move the crowd one control step beside the robots; note who touches a pedestrian."""
-        ids, discs, velocities = _envcommon.crowd_robots(env)
-        self.crowd.step(1.0 / env.action_frequency, discs, velocities)
-        for i, hit in zip(ids, self.crowd.contacts(discs).tolist()):
+        ids, discs, velocities = _envcommon.crowd_robots(env, self.tracks[0].twins)
+        hits = self.crowd.step_contacts(1.0 / env.action_frequency, discs, velocities)
+        for i, hit in zip(ids, hits.tolist()):
             self.touched[i] = self.touched[i] or hit
         for track in self.tracks:
             track.record(env)

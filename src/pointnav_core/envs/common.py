@@ -23,9 +23,11 @@ from gymnasium import spaces
 from numpy.typing import NDArray
 
 from pointnav_core import scenes
+from pointnav_core.backends.protocol import float_twin
 from pointnav_core.backends.robot_spec import RobotSpec
 from pointnav_core.errors import ArgumentError
 from pointnav_core.task import PointNavigationTask
+from pointnav_core.transforms import quat2yaw
 from pointnav_core.utils import validation
 
 __all__ = [
@@ -415,25 +417,41 @@ def add_pedestrian_termination(task: Any, crowd: Any, name: str = "task") -> Any
     ))
 
 
-def crowd_robots(env: Any) -> tuple[list[int], NDArray[np.float64], NDArray[np.float64]]:
+def pose_twins(backend: Any) -> tuple[Any, Any]:
+    """``backend``'s bound ``get_pose_floats`` and ``get_velocity_floats`` twins, each None
+    where it must not be read (:func:`~pointnav_core.backends.protocol.float_twin`). The env
+    binds them at each reset, as the task binds its own at load: finding them costs more
+    than reading them."""
+    return float_twin(backend, "get_pose_floats"), float_twin(backend, "get_velocity_floats")
+
+
+def crowd_robots(
+    env: Any, twins: tuple[Any, Any] | None = None
+) -> tuple[list[int], NDArray[np.float64], NDArray[np.float64]]:
     """The env's robots present on its crowd's floor: their indices, ``(M, 3)`` discs
-    ``(x, y, radius)`` and ``(M, 2)`` planar velocities (m, m/s)."""
+    ``(x, y, radius)`` and ``(M, 2)`` planar velocities (m, m/s), read through ``twins``
+    (:func:`pose_twins` of its backend, found here when None)."""
     backend, floor = env.backend, env.crowd.floor
+    # The float twins give the same numbers without building two arrays per robot per step.
+    pose, velocity = pose_twins(backend) if twins is None else twins
     ids, discs, velocities = [], [], []
     for j, spec in enumerate(env.robots):
         if not backend.is_present(j) or backend.get_robot_floor(j) != floor:
             continue
-        position, _ = backend.get_pose(j)
-        linear, _ = backend.get_velocity(j)
+        if pose is not None and velocity is not None:
+            x, y = pose(j)[:2]
+            vx, vy = velocity(j)[:2]
+        else:
+            (x, y), (vx, vy) = backend.get_pose(j)[0][:2].tolist(), backend.get_velocity(j)[0][:2].tolist()
         ids.append(j)
-        discs.append((position[0], position[1], spec.radius))
-        velocities.append((linear[0], linear[1]))
+        discs.append((x, y, spec.radius))
+        velocities.append((vx, vy))
     return ids, np.array(discs, dtype=np.float64).reshape(-1, 3), np.array(velocities, dtype=np.float64).reshape(-1, 2)
 
 
-def robot_discs(env: Any) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+def robot_discs(env: Any, twins: tuple[Any, Any] | None = None) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     """:func:`crowd_robots`' discs and velocities."""
-    _, discs, velocities = crowd_robots(env)
+    _, discs, velocities = crowd_robots(env, twins)
     return discs, velocities
 
 
@@ -455,6 +473,8 @@ class CrowdTrack:
 
     def __init__(self, env: Any, idn: int | None = None) -> None:
         self.idn = env.task.robot_idn if idn is None else idn
+        #: The backend's float twins (:func:`pose_twins`), bound for the episode.
+        self.twins = pose_twins(env.backend)
         self.robot: list[tuple[float, float]] = []
         self.heading: list[float] = []
         self.pedestrians: list[NDArray[np.float64]] = []
@@ -462,10 +482,13 @@ class CrowdTrack:
 
     def record(self, env: Any) -> None:
         """Add the env's positions now (after a control step, or at the reset)."""
-        from pointnav_core.transforms import quat2yaw
-
-        position, quat = env.backend.get_pose(self.idn)
-        self.robot.append((float(position[0]), float(position[1])))
+        pose = self.twins[0]
+        if pose is not None:  # the same numbers as get_pose, without its arrays
+            x, y, _, *quat = pose(self.idn)
+        else:
+            position, quat = env.backend.get_pose(self.idn)
+            x, y = position[:2].tolist()
+        self.robot.append((x, y))
         self.heading.append(float(quat2yaw(quat)))
         self.pedestrians.append(env.crowd.positions.copy())
 
