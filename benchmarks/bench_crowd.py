@@ -28,11 +28,11 @@ from collections.abc import Callable
 for _name in ("OMP_NUM_THREADS", "NUMBA_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
     os.environ.setdefault(_name, "1")
 
-import numpy as np  # noqa: E402
-from bench_vector import _rate, _vmas  # noqa: E402
+import numpy as np
+from bench_vector import _rate, _vmas
 
-from pointnav_core.envs.pointnav import PointNavEnv  # noqa: E402
-from pointnav_core.vector import VectorPointNavEnv  # noqa: E402
+from pointnav_core.envs.pointnav import PointNavEnv
+from pointnav_core.vector import VectorPointNavEnv
 
 
 def _batched(worlds: int, robots: int, rays: int) -> Callable[[], None]:
@@ -79,7 +79,7 @@ def main() -> None:
     worlds, rounds = (16, 1) if args.quick else (args.worlds, args.rounds)
     batch_steps, single_steps = (3, 50) if args.quick else (30, 2000)
     agents = worlds * args.robots
-    none = lambda: None  # noqa: E731 (no device to wait for)
+    none = lambda: None
     batched = {"batched engine, 12-ray scan".replace("12", str(args.rays)): _batched(worlds, args.robots, args.rays)}
     vmas = _vmas(worlds, args.robots, "cpu")
     if vmas is not None:
