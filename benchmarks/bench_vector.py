@@ -33,6 +33,7 @@ from collections.abc import Callable
 from typing import Any
 
 import numpy as np
+from benchkit import steps_per_second, vmas_navigation
 
 from pointnav_core.vector import VectorPointNavEnv
 
@@ -60,42 +61,6 @@ def _ours(scene: Any, worlds: int, robots: int, device: str, scan: bool, pool_si
     return step, built
 
 
-def _vmas(num_envs: int, n_agents: int, device: str) -> Callable[[], None] | None:
-    try:
-        import vmas
-    except ImportError:
-        return None
-    import torch
-
-    env = vmas.make_env("navigation", num_envs=num_envs, device=device, continuous_actions=True, n_agents=n_agents, seed=0)
-    env.reset()
-    gen = torch.Generator(device=device).manual_seed(0)
-    actions = [
-        [2 * torch.rand((num_envs, env.get_agent_action_size(a)), generator=gen, device=device) - 1 for a in env.agents]
-        for _ in range(8)
-    ]
-    state = {"i": 0}
-
-    def step() -> None:
-        _, _, dones, _ = env.step(actions[state["i"] % len(actions)])
-        done = dones.nonzero().flatten()
-        for index in done.tolist():  # VMAS resets finished worlds one by one
-            env.reset_at(index)
-        state["i"] += 1
-
-    return step
-
-
-def _rate(step: Callable[[], None], steps: int, agents: int, sync: Callable[[], None]) -> float:
-    step()  # warm up
-    sync()
-    start = time.perf_counter()
-    for _ in range(steps):
-        step()
-    sync()
-    return steps * agents / (time.perf_counter() - start)
-
-
 def _table(scene: Any, worlds: int, robots: int, device: str, steps: int, rounds: int, pool_size: int) -> dict[str, float]:
     """One size: our runners and VMAS at ``worlds x robots`` agents, best of ``rounds``."""
     import torch
@@ -112,14 +77,14 @@ def _table(scene: Any, worlds: int, robots: int, device: str, steps: int, rounds
                 key = ("pointnav-core " + ("numpy" if engine == "numpy" else f"torch {engine}"), f"{w:,} x {r}",
                        "32 rays" if scan else "none")
                 runners[key], builds[key] = _ours(scene, w, r, engine, scan, pool_size)
-    vmas_step = _vmas(worlds, robots, device)
+    vmas_step = vmas_navigation(worlds, robots, device)
     vmas_key = (f"VMAS navigation (torch {device})", f"{worlds:,} x {robots}", "none")
     if vmas_step is not None:
         runners[vmas_key] = vmas_step
     best = dict.fromkeys(runners, 0.0)
     for _ in range(rounds):
         for key, step in runners.items():
-            best[key] = max(best[key], _rate(step, steps, agents, sync))
+            best[key] = max(best[key], steps_per_second(step, steps, agents, sync))
     print(f"\n{agents:,} agent-steps a step on {device}, best of {rounds} rounds of {steps} steps:\n")
     print("| engine                          | worlds x robots | scan    | agent-steps/s | / VMAS | built (s) |")
     print("|---------------------------------|----------------:|---------|--------------:|-------:|----------:|")

@@ -1,4 +1,4 @@
-"""Shared pieces of the benchmarks: the machine, the MovingAI maps, and measuring a job alone.
+"""Shared pieces of the benchmarks: the machine, the MovingAI maps, measuring a job alone, VMAS.
 
 :func:`measure` runs one job in a child process and returns its wall time and peak memory,
 so that C allocations (scipy, pyastar2d, numpy) count and one job's garbage does not weigh
@@ -6,6 +6,10 @@ on the next. Children are forked from a ``forkserver`` started by :func:`start_c
 while the benchmark is still small: a child forked from a large parent would inherit the
 parent's size in ``ru_maxrss`` (Linux keeps the pre-``exec`` high-water mark), and the
 figures would say more about the parent than about the job.
+
+:func:`vmas_navigation` and :func:`steps_per_second` are the VMAS reference that
+``bench_vector.py`` and ``bench_crowd.py`` both measure against, stepped and counted the
+same way in both.
 """
 
 from __future__ import annotations
@@ -23,7 +27,10 @@ from multiprocessing import forkserver
 from pathlib import Path
 from typing import Any
 
-__all__ = ["MOVINGAI_DIR", "Measurement", "machine", "measure", "movingai_maps", "start_children"]
+__all__ = [
+    "MOVINGAI_DIR", "Measurement", "machine", "measure", "movingai_maps", "start_children", "steps_per_second",
+    "vmas_navigation",
+]
 
 #: Where the MovingAI maps are looked for by default (optional: most checkouts lack it).
 MOVINGAI_DIR = Path(os.environ.get("POINTNAV_MOVINGAI", "/work/shared/data/movingai"))
@@ -199,3 +206,110 @@ def measure(
         proc.join()
         recv.close()
     return out
+
+
+def steps_per_second(step: Callable[[], None], steps: int, agents: int, sync: Callable[[], None]) -> float:
+    """Agent-steps per second of ``steps`` calls of ``step``, after one call to warm up.
+
+    Parameters
+    ----------
+    step : callable
+        One step of every world (resets included, as the runner does them).
+    steps : int
+        Calls timed.
+    agents : int
+        Agent-steps one call counts (worlds x robots; 1 for a single env).
+    sync : callable
+        Waits for the device (``torch.cuda.synchronize``; a no-op on the CPU).
+    """
+    step()  # warm up
+    sync()
+    start = time.perf_counter()
+    for _ in range(steps):
+        step()
+    sync()
+    return steps * agents / (time.perf_counter() - start)
+
+
+def _vmas_crowd(pedestrians: int) -> Any:
+    """VMAS's navigation scenario with ``pedestrians`` more agents that carry no lidar.
+
+    Each pedestrian is a VMAS agent as the robots are (a 0.1 m disc with its own goal, in
+    VMAS's physics, colliding with the robots and each other, in the robots' lidar, whose
+    filter takes every agent) but senses nothing: its observation is its position,
+    velocity and goal offset. The rewards and ``done`` still take every agent, as
+    navigation's do.
+    """
+    import torch
+    from vmas.scenarios.navigation import Scenario
+    from vmas.simulator.core import Agent, Landmark, Sphere
+
+    class Crowd(Scenario):
+        def make_world(self, batch_dim: int, device: Any, **kwargs: Any) -> Any:
+            world = super().make_world(batch_dim, device, **kwargs)
+            for i in range(pedestrians):
+                walker = Agent(name=f"pedestrian_{i}", collide=self.collisions, color=(0.5, 0.5, 0.5),
+                               shape=Sphere(radius=self.agent_radius))
+                walker.pos_rew = torch.zeros(batch_dim, device=device)
+                walker.agent_collision_rew = walker.pos_rew.clone()
+                world.add_agent(walker)
+                walker.goal = Landmark(name=f"pedestrian goal {i}", collide=False, color=(0.5, 0.5, 0.5))
+                world.add_landmark(walker.goal)
+            return world
+
+        def observation(self, agent: Any) -> Any:
+            if agent.sensors:
+                return super().observation(agent)
+            return torch.cat([agent.state.pos, agent.state.vel, agent.state.pos - agent.goal.state.pos], dim=-1)
+
+    return Crowd()
+
+
+def vmas_navigation(num_envs: int, n_agents: int, device: str, pedestrians: int = 0) -> Callable[[], None] | None:
+    """One step of VMAS's ``navigation`` scenario, with random continuous actions.
+
+    The actions (eight sets, in turn) are drawn before the clock starts; worlds whose
+    ``done`` is set are reset one by one with ``reset_at``, as VMAS does. Every agent carries
+    navigation's default lidar (12 rays, 0.35 m, seeing the other agents).
+
+    Parameters
+    ----------
+    num_envs : int
+        Worlds.
+    n_agents : int
+        Robots per world (navigation's ``n_agents``).
+    device : str
+        Torch device.
+    pedestrians : int
+        More agents per world without a lidar (see :func:`_vmas_crowd`), driven by random
+        actions as the robots are; 0 for navigation itself.
+
+    Returns
+    -------
+    callable or None
+        The step, or None when VMAS is not installed.
+    """
+    try:
+        import vmas
+    except ImportError:
+        return None
+    import torch
+
+    scenario = _vmas_crowd(pedestrians) if pedestrians else "navigation"
+    env = vmas.make_env(scenario, num_envs=num_envs, device=device, continuous_actions=True, n_agents=n_agents, seed=0)
+    env.reset()
+    gen = torch.Generator(device=device).manual_seed(0)
+    actions = [
+        [2 * torch.rand((num_envs, env.get_agent_action_size(a)), generator=gen, device=device) - 1 for a in env.agents]
+        for _ in range(8)
+    ]
+    state = {"i": 0}
+
+    def step() -> None:
+        _, _, dones, _ = env.step(actions[state["i"] % len(actions)])
+        done = dones.nonzero().flatten()
+        for index in done.tolist():  # VMAS resets finished worlds one by one
+            env.reset_at(index)
+        state["i"] += 1
+
+    return step
