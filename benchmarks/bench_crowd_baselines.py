@@ -23,7 +23,7 @@ import numpy as np
 
 from pointnav_core.crowds import presets
 from pointnav_core.envs.pointnav import PointNavEnv
-from pointnav_core.evaluation.run import make_policy
+from pointnav_core.evaluation.policy_specs import make_policy
 
 POLICIES = ("oracle", "orca_robot", "dwa")
 

@@ -22,7 +22,7 @@ from pointnav_core.policies.oracle import ShortestPathFollower
 
 def _checked(follower: ShortestPathFollower, tmap: Any, seen: list[int]) -> None:
     """Make ``follower`` check each untested decision against its tested path."""
-    carrot, arc_step = follower._carrot, follower._arc_step
+    carrot, arc_step = follower.carrot, follower._arc_step
 
     def checked_carrot(xy: np.ndarray) -> Any:
         out = carrot(xy)
@@ -44,7 +44,7 @@ def _checked(follower: ShortestPathFollower, tmap: Any, seen: list[int]) -> None
             seen[1] += 1
         return out
 
-    follower._carrot, follower._arc_step = checked_carrot, checked_arc
+    follower.carrot, follower._arc_step = checked_carrot, checked_arc
 
 
 @settings(max_examples=4, deadline=None)

@@ -14,7 +14,7 @@ import numpy as np
 import pytest
 from crowd_reference import env_in, room
 
-from pointnav_core.evaluation.run import make_policy
+from pointnav_core.evaluation.policy_specs import make_policy
 
 START = {"initial_pos": [1.0, 2.0], "initial_quat": [0.0, 0.0, 0.0, 1.0], "goal_pos": [5.0, 2.0]}
 

@@ -24,7 +24,8 @@ from pointnav_core.evaluation.report import (
     summarize,
     write_results,
 )
-from pointnav_core.evaluation.run import evaluate, make_policy, select_episodes
+from pointnav_core.evaluation.policy_specs import make_policy
+from pointnav_core.evaluation.run import evaluate, select_episodes
 
 # 9 x 7 m at 0.5 m per character: two rooms joined by a door, and a pillar.
 MAP = """type octile

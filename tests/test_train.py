@@ -23,7 +23,8 @@ from map_data import PILLAR_ROOM
 from pointnav_core.cli import main
 from pointnav_core.envs.config import EnvConfig
 from pointnav_core.evaluation.report import read_results
-from pointnav_core.evaluation.run import evaluate, make_policy
+from pointnav_core.evaluation.policy_specs import make_policy
+from pointnav_core.evaluation.run import evaluate
 from pointnav_core.policies.checkpoint import load_checkpoint, save_checkpoint
 from pointnav_core.policies.network import ActorCritic, RunningNorm
 

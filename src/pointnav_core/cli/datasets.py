@@ -193,12 +193,8 @@ def _eval(args: argparse.Namespace) -> int:
     from pointnav_core.evaluation.config import check_robot_radius
     from pointnav_core.evaluation.log import ResultsLog
     from pointnav_core.evaluation.report import plot_results, summary_path
-    from pointnav_core.evaluation.run import (
-        check_scene_ids,
-        evaluate,
-        make_policy,
-        select_episodes,
-    )
+    from pointnav_core.evaluation.policy_specs import make_policy
+    from pointnav_core.evaluation.run import check_scene_ids, evaluate, select_episodes
     from pointnav_core.utils.outputs import check_output
 
     if os.getcwd() not in sys.path:  # MODULE:CALLABLE from here, as `python -m` would find it

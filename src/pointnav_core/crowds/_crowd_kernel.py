@@ -67,6 +67,53 @@ def _preferred(pos, speed, paths, nxt, last, dt, walls, pref):  # pragma: no cov
 
 
 @_jit
+def _orca_velocities(pos, vel, pref, radius, speed, robots, robot_vel, m, dt, neighbor_dist, max_neighbors,
+                     time_horizon):  # pragma: no cover
+    """ORCA's new velocities, ``(1, P + m, 2)`` float32, among the pedestrians and the first
+    ``m`` robots."""
+    n = pos.shape[0]
+    # ORCA among the pedestrians and the seen robots in float32, as Crowd._orca hands them to
+    # orca_step: the robots keep their velocities and their speeds are their limits.
+    a = n + m
+    pos32 = np.empty((1, a, 2), np.float32)
+    vel32 = np.empty((1, a, 2), np.float32)
+    pref32 = np.empty((1, a, 2), np.float32)
+    radius32 = np.empty((1, a), np.float32)
+    top32 = np.empty((1, a), np.float32)
+    for i in range(n):
+        pos32[0, i, 0], pos32[0, i, 1] = pos[i, 0], pos[i, 1]
+        vel32[0, i, 0], vel32[0, i, 1] = vel[i, 0], vel[i, 1]
+        pref32[0, i, 0], pref32[0, i, 1] = pref[i, 0], pref[i, 1]
+        radius32[0, i], top32[0, i] = radius[i], speed[i]
+    for j in range(m):
+        pos32[0, n + j, 0], pos32[0, n + j, 1] = robots[j, 0], robots[j, 1]
+        vel32[0, n + j, 0], vel32[0, n + j, 1] = robot_vel[j, 0], robot_vel[j, 1]
+        pref32[0, n + j, 0], pref32[0, n + j, 1] = robot_vel[j, 0], robot_vel[j, 1]
+        radius32[0, n + j], top32[0, n + j] = robots[j, 2], np.hypot(robot_vel[j, 0], robot_vel[j, 1])
+    params = np.empty(3, np.float32)  # orca_step's: (dt, neighbour distance squared, 1 / horizon)
+    params[0] = dt
+    reach32 = np.float32(neighbor_dist)
+    params[1] = reach32 * reach32
+    params[2] = np.float32(1.0) / np.float32(time_horizon)
+    orca_worlds(pos32, vel32, pref32, radius32, top32, params, max_neighbors)
+    return vel32
+
+
+@_jit
+def _contacts(robots, new_pos, radius, contacts):  # pragma: no cover
+    """Fill ``contacts`` with whether each robot's disc overlaps a pedestrian's at ``new_pos``."""
+    n = new_pos.shape[0]
+    for j in range(robots.shape[0]):
+        touch = False
+        for i in range(n):
+            d = np.hypot(robots[j, 0] - new_pos[i, 0], robots[j, 1] - new_pos[i, 1])
+            if d < robots[j, 2] + radius[i]:
+                touch = True
+                break
+        contacts[j] = touch
+
+
+@_jit
 def orca_crowd_step(pos, vel, radius, speed, goals, paths, nxt, last, robots, robot_vel, seen, dt, neighbor_dist,
                     max_neighbors, time_horizon, goal_reached, walls, new_pos, new_vel, flags, contacts):  # pragma: no cover
     """One control step of an ORCA crowd (``Crowd.step`` and ``Crowd.contacts``), without the
@@ -105,30 +152,8 @@ def orca_crowd_step(pos, vel, radius, speed, goals, paths, nxt, last, robots, ro
     n, m = pos.shape[0], seen
     pref = np.empty((n, 2))
     _preferred(pos, speed, paths, nxt, last, dt, walls, pref)
-    # ORCA among the pedestrians and the seen robots in float32, as Crowd._orca hands them to
-    # orca_step: the robots keep their velocities and their speeds are their limits.
-    a = n + m
-    pos32 = np.empty((1, a, 2), np.float32)
-    vel32 = np.empty((1, a, 2), np.float32)
-    pref32 = np.empty((1, a, 2), np.float32)
-    radius32 = np.empty((1, a), np.float32)
-    top32 = np.empty((1, a), np.float32)
-    for i in range(n):
-        pos32[0, i, 0], pos32[0, i, 1] = pos[i, 0], pos[i, 1]
-        vel32[0, i, 0], vel32[0, i, 1] = vel[i, 0], vel[i, 1]
-        pref32[0, i, 0], pref32[0, i, 1] = pref[i, 0], pref[i, 1]
-        radius32[0, i], top32[0, i] = radius[i], speed[i]
-    for j in range(m):
-        pos32[0, n + j, 0], pos32[0, n + j, 1] = robots[j, 0], robots[j, 1]
-        vel32[0, n + j, 0], vel32[0, n + j, 1] = robot_vel[j, 0], robot_vel[j, 1]
-        pref32[0, n + j, 0], pref32[0, n + j, 1] = robot_vel[j, 0], robot_vel[j, 1]
-        radius32[0, n + j], top32[0, n + j] = robots[j, 2], np.hypot(robot_vel[j, 0], robot_vel[j, 1])
-    params = np.empty(3, np.float32)  # orca_step's: (dt, neighbour distance squared, 1 / horizon)
-    params[0] = dt
-    reach32 = np.float32(neighbor_dist)
-    params[1] = reach32 * reach32
-    params[2] = np.float32(1.0) / np.float32(time_horizon)
-    orca_worlds(pos32, vel32, pref32, radius32, top32, params, max_neighbors)
+    vel32 = _orca_velocities(pos, vel, pref, radius, speed, robots, robot_vel, m, dt, neighbor_dist,
+                             max_neighbors, time_horizon)
     # The wall rule: ORCA's velocity, else the preferred one, else stand still.
     for i in range(n):
         px, py = pos[i, 0], pos[i, 1]
@@ -152,11 +177,4 @@ def orca_crowd_step(pos, vel, radius, speed, goals, paths, nxt, last, robots, ro
         if np.sqrt(gx * gx + gy * gy) < goal_reached:
             bit |= 2
         flags[i] = bit
-    for j in range(robots.shape[0]):
-        touch = False
-        for i in range(n):
-            d = np.hypot(robots[j, 0] - new_pos[i, 0], robots[j, 1] - new_pos[i, 1])
-            if d < robots[j, 2] + radius[i]:
-                touch = True
-                break
-        contacts[j] = touch
+    _contacts(robots, new_pos, radius, contacts)

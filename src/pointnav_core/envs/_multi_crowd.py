@@ -8,10 +8,11 @@ social metrics are its own, as in the single env (:mod:`pointnav_core.crowds`).
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+import functools
+from collections.abc import Callable, Mapping
 from typing import Any
 
-from pointnav_core.envs import common as _envcommon
+from pointnav_core.envs import _crowd
 
 __all__ = ["FleetCrowd"]
 
@@ -33,22 +34,27 @@ class FleetCrowd:
         self.n = n_robots
         self.touched = [False] * n_robots
         self.counts = [0] * n_robots
-        self.tracks: list[_envcommon.CrowdTrack] = []
+        self.tracks: list[_crowd.CrowdTrack] = []
 
-    def reset(self, env: Any) -> None:
-        """Place the crowd for new episodes (after the robots' resets)."""
-        _envcommon.spawn_crowd(env)
+    def reset(self, env: Any, infos: list[dict[str, Any]]) -> None:
+        """Place the crowd for new episodes (after the robots' resets, whose ``infos`` get
+        their contact counts, 0)."""
+        _crowd.spawn_crowd(env)
+        for info in infos:
+            info["pedestrian_collisions"] = 0
         self.touched = [False] * self.n
         self.counts = [0] * self.n
-        self.tracks = [_envcommon.CrowdTrack(env, i) for i in range(self.n)]
+        self.tracks = [_crowd.CrowdTrack(env, i) for i in range(self.n)]
 
-    def begin(self) -> None:
-        """Start an action: no robot has touched a pedestrian yet."""
+    def begin(self, env: Any) -> Callable[[], None]:
+        """Start an action (no robot has touched a pedestrian yet); the call that walks the
+        crowd after each of its control steps."""
         self.touched = [False] * self.n
+        return functools.partial(self.step, env)
 
     def step(self, env: Any) -> None:
         """Move the crowd one control step beside the robots; note who touches a pedestrian."""
-        ids, discs, velocities = _envcommon.crowd_robots(env, self.tracks[0].twins)
+        ids, discs, velocities = _crowd.crowd_robots(env, self.tracks[0].twins)
         hits = self.crowd.step_contacts(1.0 / env.action_frequency, discs, velocities)
         for i, hit in zip(ids, hits.tolist()):
             self.touched[i] = self.touched[i] or hit

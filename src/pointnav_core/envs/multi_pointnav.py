@@ -63,11 +63,9 @@ config=None)``; ``config`` (an :class:`~pointnav_core.envs.config.EnvConfig`) se
 | `discrete_actions` | **dict** or `None`          | `None`            | step, angle, STOP      |
 | `pedestrians`      | **dict** or `None`          | `None`            | a crowd (`PointNavEnv`)|
 
-``pedestrians`` puts one crowd on the first robot's floor, with the keys and rules of
-:class:`~pointnav_core.envs.pointnav.PointNavEnv`'s: it starts clear of every robot, avoids
-every robot present there (``sees_robots``), and each robot's contacts
-(``info["pedestrian_collisions"]``, ``end_on_collision``) and social metrics
-(``info["social"]`` when its episode ends) are its own.
+``pedestrians`` (keys and rules as :class:`~pointnav_core.envs.pointnav.PointNavEnv`'s) puts
+one crowd on the first robot's floor, clear of and beside every robot; each robot's contacts
+and social metrics (``info["pedestrian_collisions"]``, ``info["social"]``) are its own.
 
 ``task`` entries are :class:`~pointnav_core.task.PointNavigationTask` keyword arguments
 (a list may also hold ready tasks); the env sets ``robot_idn`` (an entry that gives one must
@@ -179,12 +177,9 @@ Version History
 
 from __future__ import annotations
 
-import functools
-
 from collections.abc import Mapping, Sequence
 from typing import Any
 
-import gymnasium
 import numpy as np
 from gymnasium import spaces
 from gymnasium.utils import seeding
@@ -195,9 +190,10 @@ from pettingzoo.utils.conversions import parallel_to_aec, parallel_to_aec_wrappe
 from pointnav_core import scenes
 from pointnav_core.backends.protocol import Backend, make_backend
 from pointnav_core.backends.robot_spec import RobotSpec
-from pointnav_core.envs import _multi_actions, _multi_agents
+from pointnav_core.envs import _crowd, _multi_actions, _multi_agents
 from pointnav_core.envs import common as _envcommon
 from pointnav_core.envs._multi_crowd import FleetCrowd
+from pointnav_core.envs._multi_render import render_frame
 from pointnav_core.envs._multi_state import global_state, state_space
 from pointnav_core.envs.config import EnvConfig, multi_robot_arguments, takes_config
 from pointnav_core.envs.fleet import (
@@ -297,11 +293,10 @@ class MultiPointNavEnv(ParallelEnv[str, Any, np.ndarray]):
         self.robots = make_robots(robot, n)
         derive = derived_path_ranges(task, n)
         self.discrete_actions = make_discrete_actions(action_space, discrete_actions)
-        crowd = _envcommon.make_crowd(pedestrians, scene)
+        crowd = _crowd.make_crowd(pedestrians, scene)
         task = _envcommon.add_stop(_envcommon.add_sensors(task, sensors), self.discrete_actions)
-        tasks = make_tasks(_envcommon.add_pedestrian_termination(task, crowd), n)
-        #: The pedestrians (:class:`~pointnav_core.crowds.Crowd`), or None without them.
-        self.crowd = crowd
+        tasks = make_tasks(_crowd.add_pedestrian_termination(task, crowd), n)
+        self.crowd = crowd  #: The pedestrians (:class:`~pointnav_core.crowds.Crowd`), or None.
         self._fleet_crowd = None if crowd is None else FleetCrowd(crowd, n)
 
         self.scene = scene
@@ -391,9 +386,7 @@ class MultiPointNavEnv(ParallelEnv[str, Any, np.ndarray]):
         self.backend.reset()
         infos = _multi_agents.reset_tasks(self, self.tasks, self.reset_order, self.separation, given)
         if self._fleet_crowd is not None:
-            self._fleet_crowd.reset(self)
-            for info in infos:
-                info["pedestrian_collisions"] = 0
+            self._fleet_crowd.reset(self, infos)
         self._active = [True] * len(self.tasks)
         self._cycles = 0
         self.agents = self.possible_agents[:]
@@ -417,10 +410,7 @@ class MultiPointNavEnv(ParallelEnv[str, Any, np.ndarray]):
         plans = self._plans
         commands, todo = _multi_actions.check_actions(agents, actions, self._slots, plans, self._index)
         fleet = self._fleet_crowd
-        after = None
-        if fleet is not None:
-            fleet.begin()
-            after = functools.partial(fleet.step, self)  # the crowd walks every control step
+        after = None if fleet is None else fleet.begin(self)  # the crowd walks every control step
         if plans is None:
             try:
                 self.backend.step(commands)
@@ -450,8 +440,7 @@ class MultiPointNavEnv(ParallelEnv[str, Any, np.ndarray]):
         return returns
 
     def pedestrian_contact(self, idn: int) -> bool:
-        """Whether robot ``idn`` touched a pedestrian during the last action (for
-        :class:`~pointnav_core.task.terminations.PedestrianCollision`)."""
+        """Whether robot ``idn`` touched a pedestrian during the last action."""
         return self._fleet_crowd is not None and self._fleet_crowd.touched[idn]
 
     def _finish(self, i: int) -> None:
@@ -481,28 +470,7 @@ class MultiPointNavEnv(ParallelEnv[str, Any, np.ndarray]):
 
         ``mode``, if given, must be the ``render_mode`` chosen at construction.
         """
-        if mode is not None and mode != self.render_mode:
-            raise ArgumentError(
-                f"render() draws in the render_mode given at construction "
-                f"({self.render_mode!r}), got mode={mode!r}"
-            )
-        if self.render_mode is None:
-            gymnasium.logger.warn(
-                "You are calling render method without specifying any render mode. "
-                "You can specify the render_mode at initialization, e.g. "
-                'parallel_env(render_mode="rgb_array")'
-            )
-            return None
-        if self.render_mode == "human":
-            raise NotImplementedError(
-                'render_mode="human" is not supported (pointnav-core opens no window): use '
-                'render_mode="rgb_array" and show or save the frames '
-                "(pointnav_core.render.recording.save_gif)"
-            )
-        # Imported here: drawing is only needed when rendering.
-        from pointnav_core.render.recording import render_env
-
-        return render_env(self, renderers=self._renderers)
+        return render_frame(self, mode, self._renderers)
 
     def close(self) -> None:
         """Release the backend's resources (if it holds any)."""

@@ -12,6 +12,7 @@ from numpy.typing import NDArray
 from pointnav_core import scenes
 from pointnav_core.backends.protocol import Backend, make_backend
 from pointnav_core.backends.robot_spec import RobotSpec
+from pointnav_core.envs import _crowd
 from pointnav_core.envs import common as _envcommon
 from pointnav_core.envs.config import EnvConfig, takes_config
 from pointnav_core.errors import ArgumentError
@@ -266,11 +267,11 @@ class PointNavEnv(gym.Env[Any, np.ndarray]):
         self._derive_path_range = _envcommon.derives_path_range(task)
         self.discrete_actions = make_discrete_actions(action_space, discrete_actions)
         #: The pedestrians (:class:`~pointnav_core.crowds.Crowd`), or None without them.
-        self.crowd = _envcommon.make_crowd(pedestrians, scene)
+        self.crowd = _crowd.make_crowd(pedestrians, scene)
         self._touched, self._pedestrian_steps = False, 0
-        self._track: _envcommon.CrowdTrack | None = None
+        self._track: _crowd.CrowdTrack | None = None
         task = _envcommon.add_stop(_envcommon.add_sensors(task, sensors), self.discrete_actions)
-        task = _envcommon.add_pedestrian_termination(task, self.crowd)
+        task = _crowd.add_pedestrian_termination(task, self.crowd)
         self.task = _envcommon.make_task(task)
         self.scene = scene
         self.robots = (self.robot,)
@@ -308,9 +309,9 @@ class PointNavEnv(gym.Env[Any, np.ndarray]):
         self.backend.reset()
         info = self.task.reset(self, episode=(options or {}).get("episode"))
         if self.crowd is not None:
-            _envcommon.spawn_crowd(self)
+            _crowd.spawn_crowd(self)
             self._touched, self._pedestrian_steps = False, 0
-            self._track = _envcommon.CrowdTrack(self)
+            self._track = _crowd.CrowdTrack(self)
             info["pedestrian_collisions"] = 0
         return self._get_obs(), info
 
@@ -395,7 +396,7 @@ class PointNavEnv(gym.Env[Any, np.ndarray]):
 
     def _step_crowd(self) -> bool:
         """Move the pedestrians one control step beside the robot; whether they touch it."""
-        robots, velocities = _envcommon.robot_discs(self, self._track.twins)  # type: ignore[union-attr]
+        robots, velocities = _crowd.robot_discs(self, self._track.twins)  # type: ignore[union-attr]
         # One call steps the crowd and finds its contacts (one compiled call for ORCA).
         contacts = self.crowd.step_contacts(1.0 / self.action_frequency, robots, velocities)  # type: ignore[union-attr]
         self._touched = touched = bool(contacts.any())  # none when the robot left the floor

@@ -23,7 +23,7 @@ from collections.abc import Callable, Mapping, Sequence
 from types import MappingProxyType, ModuleType
 from typing import Any
 
-__all__ = ["ENV_IDS", "VECTOR_ENV_IDS", "PARALLEL_ENV_IDS", "AEC_ENV_IDS", "register_envs", "register_when_imported"]
+__all__ = ["AEC_ENV_IDS", "ENV_IDS", "PARALLEL_ENV_IDS", "VECTOR_ENV_IDS", "register_envs", "register_when_imported"]
 
 #: The Gymnasium (single-robot) ids, each with its lazy ``"module:Class"`` entry point.
 ENV_IDS: Mapping[str, str] = MappingProxyType(

@@ -8,7 +8,8 @@ from pointnav_core.evaluation.report import (
     summarize,
     write_results,
 )
-from pointnav_core.evaluation.run import evaluate, make_policy
+from pointnav_core.evaluation.policy_specs import make_policy
+from pointnav_core.evaluation.run import evaluate
 
 __all__ = [
     "EpisodeResult",

@@ -1,0 +1,140 @@
+"""The envs' side of a crowd (:mod:`pointnav_core.crowds`): building it from the
+``pedestrians`` argument, the termination it adds, placing it at a reset, the robots it
+walks beside, and the positions kept for an episode's social metrics. The single and the
+multi-robot envs share it."""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from pointnav_core.backends.protocol import float_twin
+from pointnav_core.envs.common import edit_task
+from pointnav_core.transforms import quat2yaw
+
+__all__ = [
+    "CrowdTrack", "add_pedestrian_termination", "crowd_robots", "make_crowd", "pose_twins", "robot_discs", "spawn_crowd",
+]
+
+def make_crowd(pedestrians: Any, scene: Any) -> Any:
+    """The env's :class:`~pointnav_core.crowds.Crowd` for ``pedestrians={...}``, or None."""
+    from pointnav_core.crowds import Crowd, make_pedestrians
+
+    config = make_pedestrians(pedestrians)
+    return None if config is None else Crowd(config, scene)
+
+
+def add_pedestrian_termination(task: Any, crowd: Any, name: str = "task") -> Any:
+    """``task`` (None, a dict, or a list of them) with
+    :class:`~pointnav_core.task.PedestrianCollision` among its ``termination_conditions``
+    when the crowd's contacts end episodes."""
+    from pointnav_core.task import PedestrianCollision
+
+    if crowd is None or not crowd.config.end_on_collision:
+        return task
+
+    def edit(entry: Mapping[str, Any], where: str) -> Mapping[str, Any]:
+        given = list(entry.get("termination_conditions") or ())
+        if any(getattr(term, "name", None) == PedestrianCollision.name for term in given):
+            return entry
+        return {**entry, "termination_conditions": [*given, PedestrianCollision()]}
+
+    return edit_task(task, name, edit, (
+        "pedestrians['end_on_collision'] cannot change a ready PointNavigationTask ({name}): pass "
+        "the task as a dict of its arguments, or put PedestrianCollision() in its termination_conditions"
+    ))
+
+
+def pose_twins(backend: Any) -> tuple[Any, Any]:
+    """``backend``'s bound ``get_pose_floats`` and ``get_velocity_floats`` twins, each None
+    where it must not be read (:func:`~pointnav_core.backends.protocol.float_twin`). The env
+    binds them at each reset, as the task binds its own at load: finding them costs more
+    than reading them."""
+    return float_twin(backend, "get_pose_floats"), float_twin(backend, "get_velocity_floats")
+
+
+def crowd_robots(
+    env: Any, twins: tuple[Any, Any] | None = None
+) -> tuple[list[int], NDArray[np.float64], NDArray[np.float64]]:
+    """The env's robots present on its crowd's floor: their indices, ``(M, 3)`` discs
+    ``(x, y, radius)`` and ``(M, 2)`` planar velocities (m, m/s), read through ``twins``
+    (:func:`pose_twins` of its backend, found here when None)."""
+    backend, floor = env.backend, env.crowd.floor
+    # The float twins give the same numbers without building two arrays per robot per step.
+    pose, velocity = pose_twins(backend) if twins is None else twins
+    ids, discs, velocities = [], [], []
+    for j, spec in enumerate(env.robots):
+        if not backend.is_present(j) or backend.get_robot_floor(j) != floor:
+            continue
+        if pose is not None and velocity is not None:
+            x, y = pose(j)[:2]
+            vx, vy = velocity(j)[:2]
+        else:
+            (x, y), (vx, vy) = backend.get_pose(j)[0][:2].tolist(), backend.get_velocity(j)[0][:2].tolist()
+        ids.append(j)
+        discs.append((x, y, spec.radius))
+        velocities.append((vx, vy))
+    return ids, np.array(discs, dtype=np.float64).reshape(-1, 3), np.array(velocities, dtype=np.float64).reshape(-1, 2)
+
+
+def robot_discs(env: Any, twins: tuple[Any, Any] | None = None) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """:func:`crowd_robots`' discs and velocities."""
+    _, discs, velocities = crowd_robots(env, twins)
+    return discs, velocities
+
+
+def spawn_crowd(env: Any) -> None:
+    """Place the env's pedestrians for a new episode on its task's floor, clear of its
+    robots, from a generator drawn from ``env.np_random`` (so the reset seed fixes the crowd)."""
+    task = env.task if hasattr(env, "task") else env.tasks[0]
+    env.crowd.floor = task.floor
+    seed = int(env.np_random.integers(2**63))
+    robots, _ = robot_discs(env)
+    env.crowd.spawn(task.floor, np.random.default_rng(seed), robots)
+
+
+class CrowdTrack:
+    """A robot's and the pedestrians' positions at every control step of its episode, for
+    its social metrics (:func:`pointnav_core.task.social_metrics`) at the end.
+
+    ``idn`` is the robot's index (default: the single env's robot)."""
+
+    def __init__(self, env: Any, idn: int | None = None) -> None:
+        self.idn = env.task.robot_idn if idn is None else idn
+        #: The backend's float twins (:func:`pose_twins`), bound for the episode.
+        self.twins = pose_twins(env.backend)
+        self.robot: list[tuple[float, float]] = []
+        self.heading: list[float] = []
+        self.pedestrians: list[NDArray[np.float64]] = []
+        self.record(env)
+
+    def record(self, env: Any) -> None:
+        """Add the env's positions now (after a control step, or at the reset)."""
+        pose = self.twins[0]
+        if pose is not None:  # the same numbers as get_pose, without its arrays
+            x, y, _, *quat = pose(self.idn)
+        else:
+            position, quat = env.backend.get_pose(self.idn)
+            x, y = position[:2].tolist()
+        self.robot.append((x, y))
+        self.heading.append(float(quat2yaw(quat)))
+        self.pedestrians.append(env.crowd.positions.copy())
+
+    def metrics(self, env: Any, info: Mapping[str, Any]) -> dict[str, float | None]:
+        """The episode's social metrics, from what was recorded and the task's ``info``."""
+        from pointnav_core.task import social_metrics
+
+        robot = np.array(self.robot)
+        if len(robot) < 2:  # an episode that ended before any control step ran
+            robot, self.heading, self.pedestrians = np.repeat(robot, 2, axis=0), self.heading * 2, self.pedestrians * 2
+        spec = env.robots[self.idn]
+        task = env.tasks[self.idn] if hasattr(env, "tasks") else env.task
+        return social_metrics(
+            robot, np.array(self.heading), np.array(self.pedestrians).reshape(len(robot), env.crowd.n, 2),
+            dt=1.0 / env.action_frequency, robot_radius=spec.radius, pedestrian_radii=env.crowd.radius,
+            success=bool(info["success"]), geodesic_dist=float(info["geodesic_dist"]),
+            max_speed=spec.max_linear_velocity, goal=task.get_goal_pos()[:2],
+        )
