@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 from PIL import Image
@@ -47,3 +48,27 @@ def bookstore(rows: slice = slice(None), cols: slice = slice(None)) -> Scene:
     codes = bookstore_codes()
     r0, c0 = rows.start or 0, cols.start or 0
     return Scene.from_array(codes[rows, cols], 0.05, origin=(-10.0 + 0.05 * c0, -10.0 + 0.05 * r0))
+
+
+def pillar_room_dataset(folder: Any, episodes: int) -> Any:
+    """Write ``PILLAR_ROOM`` as ``folder/room.map`` and an ``episodes``-episode dataset on it
+    as ``folder/val.json.gz`` (``pointnav dataset generate``, geodesics up to 4 m); its path.
+
+    It runs from inside the folder, so that the scene ids (``movingai:./room.map``), and with
+    them the episodes drawn, do not depend on where the folder is."""
+    import os
+
+    from pointnav_core.cli import main
+
+    folder = Path(folder)
+    (folder / "room.map").write_text(PILLAR_ROOM)
+    out = folder / "val.json.gz"
+    args = ["dataset", "generate", "--scenes", ".", "--split", "train", "--episodes", str(episodes),
+            "--max-geodesic", "4", "--out", str(out), "--quiet"]
+    here = os.getcwd()
+    os.chdir(folder)
+    try:
+        assert main(args) == 0
+    finally:
+        os.chdir(here)
+    return out

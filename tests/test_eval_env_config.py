@@ -2,10 +2,8 @@
 
 from __future__ import annotations
 
-import os
-
 import pytest
-from map_data import PILLAR_ROOM
+from map_data import pillar_room_dataset
 
 from pointnav_core.cli import main
 from pointnav_core.datasets import EpisodeDataset
@@ -24,18 +22,7 @@ SCAN = EnvConfig(
 def data(tmp_path_factory):
     """A 3-episode dataset on the room, and the scan config saved as YAML."""
     folder = tmp_path_factory.mktemp("room")
-    (folder / "room.map").write_text(PILLAR_ROOM)
-    out = folder / "val.json.gz"
-    # From inside the folder: the scene ids ("movingai:./room.map"), and with them the
-    # episodes drawn, do not depend on where the temporary folder is.
-    args = ["dataset", "generate", "--scenes", ".", "--split", "train", "--episodes", "3",
-            "--max-geodesic", "4", "--out", str(out), "--quiet"]
-    here = os.getcwd()
-    os.chdir(folder)
-    try:
-        assert main(args) == 0
-    finally:
-        os.chdir(here)
+    pillar_room_dataset(folder, 3)
     SCAN.save(folder / "scan.yaml")
     return folder
 

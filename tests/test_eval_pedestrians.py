@@ -4,10 +4,8 @@ and any number of workers (issue 33, points 3, 4 and must-show 4)."""
 
 from __future__ import annotations
 
-import os
-
 import pytest
-from map_data import PILLAR_ROOM
+from map_data import pillar_room_dataset
 
 from pointnav_core.cli import main
 from pointnav_core.datasets import EpisodeDataset
@@ -22,16 +20,7 @@ CROWD = EnvConfig(pedestrians={"count": 3, "radius": 0.15}, flatten_obs=False, m
 def data(tmp_path_factory):
     """A 4-episode dataset on the pillar room, and the crowd config saved as YAML."""
     folder = tmp_path_factory.mktemp("room")
-    (folder / "room.map").write_text(PILLAR_ROOM)
-    out = folder / "val.json.gz"
-    args = ["dataset", "generate", "--scenes", ".", "--split", "train", "--episodes", "4",
-            "--max-geodesic", "4", "--out", str(out), "--quiet"]
-    here = os.getcwd()
-    os.chdir(folder)
-    try:
-        assert main(args) == 0
-    finally:
-        os.chdir(here)
+    pillar_room_dataset(folder, 4)
     CROWD.save(folder / "crowd.yaml")
     return folder
 

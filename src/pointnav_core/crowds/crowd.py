@@ -37,7 +37,7 @@ from pointnav_core.crowds.config import CrowdView, PedestrianConfig
 from pointnav_core.crowds.orca import orca_step
 from pointnav_core.crowds.social_force import SocialForceParams, social_force_step
 from pointnav_core.errors import ArgumentError, SamplingError
-from pointnav_core.floor.collision import TOUCH_TOL
+from pointnav_core.floor.draw import nearest_usable
 from pointnav_core.utils.compiled import kernel
 
 __all__ = ["Crowd"]
@@ -87,7 +87,6 @@ class Crowd:
         self.scene = scene
         self.floor = 0
         self._rng = np.random.default_rng(0)
-        self._wall_args: dict[int, tuple[Any, tuple[Any, ...]]] = {}  # _walls', per floor
         self._set_count(0)
 
     def _set_count(self, n: int) -> None:
@@ -204,16 +203,7 @@ class Crowd:
         tmap, radius = self.scene.floors[self.floor], self.config.plan_radius
         if tmap.is_usable(here, radius):
             return here
-        usable = tmap.usable(radius)
-        row, col = (int(v) for v in tmap.world_to_cell(here))
-        rows, cols = np.mgrid[max(row - 3, 0): row + 4, max(col - 3, 0): col + 4]
-        inside = (rows < usable.shape[0]) & (cols < usable.shape[1])
-        rows, cols = rows[inside], cols[inside]
-        ok = usable[rows, cols]
-        if not ok.any():
-            return None
-        centres = tmap.cell_to_world(np.column_stack([rows[ok], cols[ok]]))
-        return centres[int(np.argmin(np.linalg.norm(centres - here, axis=1)))]
+        return nearest_usable(tmap, here, radius)
 
     def set_route(self, i: int, points: Any) -> None:
         """Send pedestrian ``i`` along the polyline ``points`` ``(N, 2)`` (m) to its last
@@ -295,24 +285,10 @@ class Crowd:
         flags, contacts = np.empty(n, np.int8), np.empty(len(robots), np.bool_)
         fn(self.positions, self.velocities, self.radius, self.speed, self.goals, self._paths, self._next, self._last,
            robots, robot_velocities, len(robots) if cfg.sees_robots else 0, float(dt), cfg.neighbor_dist,
-           cfg.max_neighbors, cfg.time_horizon, GOAL_REACHED, self._walls(collision), new_pos, new_vel, flags, contacts)
+           cfg.max_neighbors, cfg.time_horizon, GOAL_REACHED, collision.kernel_arguments(cfg.radius[1]),
+           new_pos, new_vel, flags, contacts)
         self._moved(new_pos, new_vel, flags & 4, np.flatnonzero(flags & 3), flags & 2)
         return contacts
-
-    def _walls(self, collision: Any) -> tuple[Any, ...]:
-        """The compiled wall test's arguments for a disc of the crowd's largest radius on
-        ``collision`` (``floor._collision_kernel.segment_hits``' after the segment), kept per
-        floor. ``rho`` and ``reach`` are derived as ``FloorCollision`` derives them for its
-        own compiled tests (the property test of the two paths holds them equal)."""
-        kept = self._wall_args.get(self.floor)
-        if kept is None or kept[0] is not collision:
-            ox, oy, res, rowcum, outside, *edges, use_polygons = collision.kernel_geometry()
-            radius = self.config.radius[1]
-            inv = 1.0 / res
-            rho = max(radius - TOUCH_TOL, TOUCH_TOL) * inv
-            reach = max(radius - 2 * TOUCH_TOL, TOUCH_TOL / 2)
-            kept = self._wall_args[self.floor] = (collision, (ox, oy, inv, rho, rowcum, outside, reach, *edges, use_polygons))
-        return kept[1]
 
     def _step_arrays(self, dt: float, robots: NDArray[np.float64], robot_velocities: NDArray[np.float64]) -> None:
         """A step on the general path: numpy, any behaviour."""

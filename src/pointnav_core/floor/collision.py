@@ -98,7 +98,7 @@ class FloorCollision:
         self.polygons = tuple(polygons)
         self._poly_tree = shapely.STRtree(list(self.polygons)) if self.polygons else None
         self._poly_edges = _polygon_edges(self.polygons)
-        self._radius_args: dict[float, tuple[Any, ...]] = {}  # _kernel_radius's, per radius
+        self._radius_args: dict[float, tuple[Any, ...]] = {}  # kernel_arguments', per radius
 
     @classmethod
     def from_map(cls, tmap: Any) -> FloorCollision:
@@ -155,9 +155,9 @@ class FloorCollision:
             return bool(self.segments_clear(np.array([ax, ay]), np.array([bx, by]), radius))
         if not (math.isfinite(ax) and math.isfinite(ay) and math.isfinite(bx) and math.isfinite(by)):
             return False
-        return not kernel(float(ax), float(ay), float(bx), float(by), *self._kernel_radius(float(radius)))
+        return not kernel(float(ax), float(ay), float(bx), float(by), *self.kernel_arguments(float(radius)))
 
-    def _kernel_radius(self, radius: float) -> tuple[Any, ...]:
+    def kernel_arguments(self, radius: float) -> tuple[Any, ...]:
         """:func:`~pointnav_core.floor._collision_kernel.segment_hits`' arguments after the segment,
         for a disc of ``radius`` m (``rho`` and ``reach`` as ``_cells_hit`` and
         ``_polygons_hit`` derive them); kept per radius, as a step's tests ask for one or two."""
@@ -218,7 +218,7 @@ class FloorCollision:
             # Both tests in one compiled loop: the oracle asks about a few segments at a time,
             # where the array set-up cost more than the tests.
             out = np.empty(len(a), dtype=np.bool_)
-            kernel(np.ascontiguousarray(a), np.ascontiguousarray(b), *self._kernel_radius(float(radius)), out)
+            kernel(np.ascontiguousarray(a), np.ascontiguousarray(b), *self.kernel_arguments(float(radius)), out)
             return out.reshape(shape)
         ok = np.isfinite(a).all(axis=1) & np.isfinite(b).all(axis=1)
         out = np.zeros(len(a), dtype=bool)

@@ -1,4 +1,5 @@
-"""Uniform draws of a floor's usable cells within reach of a point, without a distance per cell."""
+"""Usable cells near a point: uniform draws within reach (without a distance per cell), and
+the nearest one."""
 
 from __future__ import annotations
 
@@ -10,7 +11,7 @@ from numpy.typing import NDArray
 from pointnav_core.floor.maps import TraversableMap
 from pointnav_core.utils import compiled as _compiled
 
-__all__ = ["draw_cell"]
+__all__ = ["draw_cell", "nearest_usable"]
 
 
 def draw_cell(
@@ -96,3 +97,17 @@ def _row_spans(
     start = np.searchsorted(flat, rows * w + lo)
     counts = np.where(lo <= hi, np.searchsorted(flat, rows * w + hi, side="right") - start, 0)
     return start, counts
+
+
+def nearest_usable(tmap: TraversableMap, xy: NDArray[np.float64], radius: float, reach: int = 3) -> NDArray[np.float64] | None:
+    """Centre (m) of the nearest cell within ``reach`` cells of ``xy`` whose centre a disc of
+    ``radius`` m fits at; None if there is none."""
+    usable = tmap.usable(radius)
+    row, col = (int(v) for v in tmap.world_to_cell(xy))
+    h, w = usable.shape
+    r0, r1, c0, c1 = max(row - reach, 0), min(row + reach + 1, h), max(col - reach, 0), min(col + reach + 1, w)
+    cells = np.argwhere(usable[r0:r1, c0:c1]) + (r0, c0)
+    if not len(cells):
+        return None
+    centres = tmap.cell_to_world(cells)
+    return centres[int(np.argmin(np.hypot(*(centres - xy).T)))]

@@ -16,6 +16,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from pointnav_core.errors import ArgumentError
+from pointnav_core.floor.draw import nearest_usable
 from pointnav_core.geodesic.paths import resample_path
 from pointnav_core.transforms import quat2yaw
 
@@ -69,19 +70,6 @@ def _ring(centre: NDArray[np.float64], radius: float) -> NDArray[np.float64]:
     """``_OUT_DIRECTIONS`` points evenly round a circle of ``radius`` (m) about ``centre``."""
     angles = np.linspace(0.0, 2.0 * math.pi, _OUT_DIRECTIONS, endpoint=False)
     return centre + radius * np.stack([np.cos(angles), np.sin(angles)], axis=1)
-
-
-def _nearest_usable(tmap: Any, xy: NDArray[np.float64], radius: float, reach: int = 3) -> NDArray[np.float64] | None:
-    """Centre of the nearest cell within ``reach`` cells whose centre the disc fits at."""
-    usable = tmap.usable(radius)
-    row, col = (int(v) for v in tmap.world_to_cell(xy))
-    h, w = usable.shape
-    r0, r1, c0, c1 = max(row - reach, 0), min(row + reach + 1, h), max(col - reach, 0), min(col + reach + 1, w)
-    cells = np.argwhere(usable[r0:r1, c0:c1]) + (r0, c0)
-    if not len(cells):
-        return None
-    centres = tmap.cell_to_world(cells)
-    return centres[int(np.argmin(np.hypot(*(centres - xy).T)))]
 
 
 def _off_segment(p: NDArray[np.float64], a: NDArray[np.float64], b: NDArray[np.float64]) -> float:
@@ -305,7 +293,7 @@ class ShortestPathFollower:
                 if (out := self._step_out(xy, exact, field, radius)) is not None:
                     return out
         if path is None:
-            centre = _nearest_usable(tmap, xy, spec.radius)
+            centre = nearest_usable(tmap, xy, spec.radius)
             if centre is None:
                 return None
             path, _ = env.scene.goal_field(task.floor, goal, robot=spec.radius).path(centre)
