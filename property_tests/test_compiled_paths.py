@@ -54,6 +54,7 @@ PAIRS: dict[Entry, tuple[Callable[..., None], ...]] = {
     ("pointnav_core.geodesic._sight_kernel", "misses_full"): (pairs_floor.check_fully_blocked_samples,),
     ("pointnav_core.geodesic._edges_kernel", "edge_pairs"): (pairs_floor.check_edges,),
     ("pointnav_core.geodesic._search_kernel", "seeded_dijkstra"): (pairs_geodesic.check_goal_search,),
+    ("pointnav_core.geodesic._search_kernel", "seeded_astar"): (pairs_geodesic.check_point_search,),
     ("pointnav_core.geodesic._roots_kernel", "arc_tables"): (pairs_geodesic.check_arc_tables,),
     ("pointnav_core.geodesic._roots_kernel", "point_links"): (pairs_geodesic.check_point_links,),
     ("pointnav_core.geodesic._roots_kernel", "best_links"): (

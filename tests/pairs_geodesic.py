@@ -12,7 +12,8 @@ Each check takes ``plain_paths``, the context its plain side runs in (``numpy_pa
   ``_way`` picks its root.
 - Larger floors (20-60 cells a side, random boxes and long walls with slits, radius/cell from
   0.3 to 5, 0.05-0.5 m per cell): the compiled goal search equals scipy's, the compiled point
-  links the numpy ones, and the compiled exact query the one-point search.
+  links the numpy ones, the compiled exact query the one-point search, and the compiled
+  point-to-point A* on the whole graph the plain one.
 - ``ArcTables`` (the labels grouped by arc) equal, array for array, compiled and not.
 """
 
@@ -209,6 +210,24 @@ def check_goal_search(floor, seed, plain_paths: Plain) -> None:
     assert np.array_equal(np.isfinite(fast.cost), np.isfinite(plain.cost))
     ok = np.isfinite(fast.cost)
     np.testing.assert_allclose(fast.cost[ok], plain.cost[ok], rtol=1e-12, atol=1e-12)
+
+
+@settings(max_examples=30, deadline=None, suppress_health_check=[HealthCheck.too_slow, HealthCheck.filter_too_much])
+@given(floor=slit_floors(), seed=st.integers(0, 2**31 - 1))
+def check_point_search(floor, seed, plain_paths: Plain) -> None:
+    """A point-to-point search on the whole graph: numba's A* gives the plain A*'s lengths
+    (1e-9 m) and reachability, and its path's ends."""
+    scene, radius = floor
+    planner = scene.planner(0, radius)
+    pts = usable_points(scene, radius, np.random.default_rng(seed), 8)
+    for a, b in zip(pts[::2], pts[1::2]):
+        got_path, got = planner.shortest_path(a, b)
+        with plain_paths():
+            want_path, want = planner.shortest_path(a, b)
+        assert (got is None) == (want is None)
+        if got is not None:
+            assert abs(got - want) <= 1e-9
+            assert np.allclose(got_path[[0, -1]], want_path[[0, -1]])
 
 
 @settings(max_examples=30, deadline=None, suppress_health_check=[HealthCheck.too_slow, HealthCheck.filter_too_much])

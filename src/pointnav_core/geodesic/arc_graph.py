@@ -94,7 +94,86 @@ class ArcGraph:
         self._w = np.concatenate(wts) + _EPS_W
         # The graph once, for the compiled search (which seeds the source's arrivals itself).
         csr = sparse.csr_matrix((self._w, (self._rows, self._cols)), shape=(n_v, n_v))
-        self._indptr, self._indices, self._data = csr.indptr.astype(np.int64), csr.indices.astype(np.int64), csr.data
+        self.indptr, self.indices, self.data = csr.indptr.astype(np.int64), csr.indices.astype(np.int64), csr.data
+        self._vertex_xy: tuple[NDArray[np.float64], NDArray[np.float64]] | None = None
+
+    def arc_range(self, node: int, side: int) -> tuple[int, int]:
+        """The vertices ``[lo, hi)`` on the arc of ``node`` winding ``side``, by position."""
+        gi = 2 * node + (side < 0)
+        return int(self.grp_start[gi]), int(self.grp_end[gi])
+
+    def points(
+        self, node: NDArray[np.integer], side: NDArray[np.integer], pos: NDArray[np.float64]
+    ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+        """World points (m) of arc positions ``pos`` (rad) of ``node`` winding ``side``."""
+        p = self.p
+        node = np.asarray(node, dtype=np.int64)
+        ccw = np.where(np.asarray(side) > 0, pos, p.span[node] - pos)
+        ang = p.phi0[node] + ccw
+        return p.cx[node] + p.radius * np.cos(ang), p.cy[node] + p.radius * np.sin(ang)
+
+    def vertex_points(self) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+        """Every vertex's world point (m), computed once (a point search's heuristic)."""
+        if self._vertex_xy is None:
+            self._vertex_xy = self.points(self.node, self.side, self.pos)
+        return self._vertex_xy
+
+    def locate(
+        self, node: NDArray[np.integer], side: NDArray[np.integer], q: NDArray[np.float64], after: bool
+    ) -> tuple[NDArray[np.int64], NDArray[np.int64], NDArray[np.int64]]:
+        """For each arc position ``q`` (rad) of ``node`` winding ``side``, the first vertex of
+        that arc at or after ``q`` (``after``: strictly after), with the arc's ``[lo, hi)``:
+        ``np.searchsorted`` within each arc, for all of them at once."""
+        g = 2 * np.asarray(node, dtype=np.int64) + (np.asarray(side) < 0)
+        lo, hi = self.grp_start[g], self.grp_end[g]
+        a, b = lo.copy(), hi.copy()
+        last = max(len(self.pos) - 1, 0)
+        while True:
+            active = a < b
+            if not active.any():
+                return a, lo, hi
+            mid = (a + b) // 2
+            at = self.pos[np.minimum(mid, last)]
+            go = active & ((at <= q) if after else (at < q))
+            a = np.where(go, mid + 1, a)
+            b = np.where(active & ~go, mid, b)
+
+    def arrival_steps(
+        self, x_node: NDArray[np.integer], x_side: NDArray[np.integer], x_pos: NDArray[np.float64]
+    ) -> tuple[NDArray[np.int64], NDArray[np.float64]]:
+        """Where each arrival at ``(x_node, x_side, x_pos)`` continues along its arc: the
+        first vertex at or after it (-1 where none is, or the arc there is blocked), and
+        the arc's cost to it (m, with the graph's zero-weight offset)."""
+        p = self.p
+        j, _, hi = self.locate(x_node, x_side, x_pos - ANG_TOL, after=False)
+        to = np.minimum(j, max(self.n_vertices - 1, 0))
+        ok = j < hi
+        x_node = np.asarray(x_node, dtype=np.int64)
+        x_side = np.asarray(x_side, dtype=np.int64)
+        ok[ok] = p.arcs_free(x_node[ok], x_side[ok], x_pos[ok], self.pos[to[ok]])
+        x_to = np.where(ok, j, -1).astype(np.int64)
+        x_w = np.zeros(len(j))
+        x_w[ok] = p.radius * np.maximum(self.pos[to[ok]] - x_pos[ok], 0.0) + _EPS_W
+        return x_to, x_w
+
+    def departure_steps(
+        self, f_node: NDArray[np.integer], f_side: NDArray[np.integer], f_pos: NDArray[np.float64]
+    ) -> tuple[NDArray[np.int64], NDArray[np.float64]]:
+        """Where a path leaving at ``(f_node, f_side, f_pos)`` is entered from: the last
+        vertex of its arc at or before it (-1 where none is, or the arc there is blocked),
+        and the arc's cost from it (m)."""
+        p = self.p
+        j, lo, _ = self.locate(f_node, f_side, f_pos + ANG_TOL, after=True)
+        j = j - 1
+        frm = np.maximum(j, 0)
+        ok = j >= lo
+        f_node = np.asarray(f_node, dtype=np.int64)
+        f_side = np.asarray(f_side, dtype=np.int64)
+        ok[ok] = p.arcs_free(f_node[ok], f_side[ok], self.pos[frm[ok]], f_pos[ok])
+        f_from = np.where(ok, j, -1).astype(np.int64)
+        f_w = np.zeros(len(j))
+        f_w[ok] = p.radius * np.maximum(f_pos[ok] - self.pos[frm[ok]], 0.0)
+        return f_from, f_w
 
     def _arcs_free(self, i: NDArray[np.int64], j: NDArray[np.int64]) -> NDArray[np.bool_]:
         """Whether the arc between vertices ``i`` and ``j`` (same arc, ``pos_i <= pos_j``) is clear."""
@@ -114,7 +193,6 @@ class ArcGraph:
         the search runs compiled on the graph built once (:func:`seeded_dijkstra`); without
         it, scipy's Dijkstra runs on the graph with a source vertex added. Same distances.
         """
-        p = self.p
         n_v = self.n_vertices
         n_x = len(links)
         x_node = np.array([c for c, _, _, _ in links], dtype=np.int32)
@@ -122,20 +200,12 @@ class ArcGraph:
         x_pos = np.array([q for _, _, q, _ in links], dtype=np.float64)
         x_len = np.array([ln for _, _, _, ln in links], dtype=np.float64)
         # Each arrival continues to the first vertex at or after it on its arc.
-        x_to = np.full(n_x, -1, dtype=np.int64)
-        x_w = np.zeros(n_x)
-        for k, (c, s, q, _) in enumerate(links):
-            gi = 2 * c + (s < 0)
-            lo, hi = int(self.grp_start[gi]), int(self.grp_end[gi])
-            j = lo + int(np.searchsorted(self.pos[lo:hi], q - ANG_TOL, side="left"))
-            if j < hi and p.arc_free(c, s, q, float(self.pos[j])):
-                x_to[k] = j
-                x_w[k] = p.radius * max(float(self.pos[j]) - q, 0.0) + _EPS_W
+        x_to, x_w = self.arrival_steps(x_node, x_side, x_pos)
         kernel = _compiled.kernel("pointnav_core.geodesic._search_kernel", "seeded_dijkstra")
         if kernel is not None:
             dist = np.full(n_v + n_x, np.inf)
             pred = np.full(n_v + n_x, -9999, dtype=np.int64)
-            kernel(self._indptr, self._indices, self._data, n_v, x_len + _EPS_W, x_to, x_w, dist, pred)
+            kernel(self.indptr, self.indices, self.data, n_v, x_len + _EPS_W, x_to, x_w, dist, pred)
             return FieldLabels(self, dist, pred, x_node, x_side, x_pos)
         src = n_v + n_x
         has = np.flatnonzero(x_to >= 0)

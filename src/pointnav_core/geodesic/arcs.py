@@ -21,7 +21,7 @@ from pointnav_core.geodesic.tangents import ANG_TOL, TWO_PI
 if TYPE_CHECKING:
     from pointnav_core.geodesic.planner import Planner
 
-__all__ = ["ARC_PIECE", "arc_points"]
+__all__ = ["ARC_PIECE", "arc_points", "draw_arcs"]
 
 #: Largest angle (rad) of one piece of a drawn arc.
 ARC_PIECE = math.radians(2.0)
@@ -39,36 +39,64 @@ def arc_points(p: Planner, node: int, s: int, pos_from: float, pos_to: float, sp
     """
     out = _drawn_arc(p, node, s, pos_from, pos_to)
     if len(out) <= 2 or splits <= 0:
-        return out
-    inner = np.array(out[1:-1])
-    bad = np.flatnonzero(~p.geo.points_clear(inner, p.radius))
+        return list(out)
+    return _split_pinched(p, node, s, pos_from, pos_to, out, p.geo.points_clear(out[1:-1], p.radius), splits)
+
+
+def draw_arcs(p: Planner, arcs: list[tuple[int, int, float, float]]) -> NDArray[np.float64]:
+    """The drawn arcs ``(node, side, pos_from, pos_to)`` one after another, shape (M, 2):
+    what :func:`arc_points` gives for each, with one clearance test for all of their
+    vertices rather than one per arc (a path's arcs are drawn together)."""
+    drawn = [_drawn_arc(p, node, s, a, b) for node, s, a, b in arcs]
+    inner = [d[1:-1] for d in drawn if len(d) > 2]
+    if not inner:
+        return np.concatenate(drawn) if drawn else np.zeros((0, 2))
+    clear = p.geo.points_clear(np.concatenate(inner), p.radius)
+    if clear.all():
+        return np.concatenate(drawn)
+    out, at = [], 0
+    for (node, s, a, b), d in zip(arcs, drawn):
+        if len(d) > 2:
+            ok = clear[at : at + len(d) - 2]
+            at += len(d) - 2
+            if not ok.all():
+                d = np.array(_split_pinched(p, node, s, a, b, d, ok, 4))
+        out.append(d)
+    return np.concatenate(out)
+
+
+def _split_pinched(
+    p: Planner, node: int, s: int, pos_from: float, pos_to: float, out: NDArray[np.float64], clear: NDArray[np.bool_], splits: int
+) -> list[NDArray[np.float64]]:
+    """:func:`arc_points`' split at a passage as wide as the robot, given the drawn arc
+    ``out`` and whether each of its inner vertices is clear."""
+    bad = np.flatnonzero(~clear)
     if not len(bad):
-        return out
-    pos = _pinch_position(p, node, s, inner[bad[0]])
+        return list(out)
+    pos = _pinch_position(p, node, s, out[1:-1][bad[0]])
     if pos is None or not pos_to + ANG_TOL < pos < pos_from - ANG_TOL:
-        return out
+        return list(out)
     first = arc_points(p, node, s, pos_from, pos, splits - 1)
     return first + arc_points(p, node, s, pos, pos_to, splits - 1)[1:]
 
 
-def _drawn_arc(p: Planner, node: int, s: int, pos_from: float, pos_to: float) -> list[NDArray[np.float64]]:
+def _drawn_arc(p: Planner, node: int, s: int, pos_from: float, pos_to: float) -> NDArray[np.float64]:
     """The arc's ends on the circle and, between them, vertices of pieces of at most
-    :data:`ARC_PIECE` tangent to it (each at ``r / cos(piece / 2)`` from the corner)."""
+    :data:`ARC_PIECE` tangent to it (each at ``r / cos(piece / 2)`` from the corner), (k, 2)."""
     a = p.node_point(node, s, pos_from)
     delta = pos_from - pos_to
-    out = [np.array(a)]
     if delta <= ANG_TOL or p.radius == 0.0:
-        return out
+        return np.array([a])
     n = max(1, math.ceil(delta / ARC_PIECE))
     piece = delta / n
     reach = p.radius / math.cos(piece / 2)
-    cx, cy = p.cx_list[node], p.cy_list[node]
-    for k in range(n):
-        pos = pos_from - piece * (k + 0.5)
-        ccw = pos if s > 0 else p.span_list[node] - pos
-        ang = p.phi0_list[node] + ccw
-        out.append(np.array([cx + reach * math.cos(ang), cy + reach * math.sin(ang)]))
-    out.append(np.array(p.node_point(node, s, pos_to)))
+    pos = pos_from - piece * (np.arange(n) + 0.5)
+    ang = p.phi0_list[node] + (pos if s > 0 else p.span_list[node] - pos)
+    out = np.empty((n + 2, 2))
+    out[0] = a
+    out[1:-1, 0] = p.cx_list[node] + reach * np.cos(ang)
+    out[1:-1, 1] = p.cy_list[node] + reach * np.sin(ang)
+    out[-1] = p.node_point(node, s, pos_to)
     return out
 
 

@@ -55,7 +55,7 @@ from pointnav_core.geodesic.edges import build_edges
 from pointnav_core.geodesic.field import GoalField
 from pointnav_core.geodesic.links import point_links
 from pointnav_core.geodesic.nodes import corner_arcs
-from pointnav_core.geodesic.point_search import PointSearch
+from pointnav_core.geodesic.point_search import shortest_path
 from pointnav_core.geodesic.sight import NodeBalls, node_sights
 from pointnav_core.geodesic.tangents import ANG_TOL
 from pointnav_core.geodesic.usable import nearest_usable, usable_cells
@@ -73,6 +73,10 @@ _EDGE_BATCH = 256
 _PROGRESS_NODES = 20_000
 #: Side (cells) of the square tiles whose nodes get their edges built together.
 _TILE = 32
+#: Floors with at most this many nodes get their whole graph at the first point-to-point
+#: query, which then searches it in compiled code (a house has a few hundred nodes; its
+#: whole graph builds in tens of milliseconds, as much as a few lazy queries).
+WHOLE_GRAPH_NODES = 4096
 #: Smallest radius (m) the planner uses.
 MIN_RADIUS = 1e-6
 #: Byte budget of the goal fields a planner keeps.
@@ -115,6 +119,9 @@ class Planner(ThawOnUnpickle):
 
     field_cache_bytes: int = FIELD_CACHE_BYTES
     geometry_bytes: int = GEOMETRY_BYTES
+    #: Whether :meth:`shortest_path` searches the whole graph once it exists (the fast
+    #: path); False keeps the lazy search (the general path a property test compares).
+    whole_graph_search: bool = True
 
     def __init__(self, collision: FloorCollision, radius: float) -> None:
         self.geo = collision
@@ -435,30 +442,14 @@ class Planner(ThawOnUnpickle):
     ) -> tuple[NDArray[np.float64], float] | tuple[None, None]:
         """Exact shortest path between two world points by A*, without building a field.
 
-        Returns the drawn path (N, 2) and its exact length in metres, or ``(None, None)``.
+        Once the floor's whole graph exists (:meth:`arc_graph`; a goal field builds it, and
+        so does this on floors of at most :data:`WHOLE_GRAPH_NODES` nodes), the search runs
+        on it in compiled code (:mod:`pointnav_core.geodesic.arc_search`); before, it
+        builds the edges it needs tile by tile (:mod:`.point_search`). Returns the drawn
+        path (N, 2) and its exact length in metres, or ``(None, None)``.
         """
-        src = np.asarray(source, dtype=np.float64)[:2]
-        tgt = np.asarray(target, dtype=np.float64)[:2]
-        sx, sy, tx, ty = float(src[0]), float(src[1]), float(tgt[0]), float(tgt[1])
-        if not (self.is_clear(sx, sy) and self.is_clear(tx, ty)):
-            return None, None
-        if self.segment_clear(src, tgt):
-            return np.array([src, tgt]), math.hypot(tx - sx, ty - sy)
-        # Links into the target, seen from the target: reversed, they leave a node.
-        finish: dict[tuple[int, int], list[tuple[float, float]]] = {}
-        for c, s, pos, length in self.point_links(tx, ty):
-            finish.setdefault((c, -s), []).append((self.span_list[c] - pos, length))
-        search = PointSearch(self, heuristic_to=(tx, ty))
-        for c, s, pos, length in self.point_links(sx, sy):
-            search.push(length, c, s, pos, -1, 0.0)
-        best = search.run(finish)
-        if best is None:
-            return None, None
-        cost, label, dep = best
-        pts = [np.array([tx, ty])]
-        pts += search.trace(label, dep)
-        pts.append(np.array([sx, sy]))
-        return np.array(pts[::-1]), cost
+        whole = self.whole_graph_search and (self._arc_graph is not None or self.n_nodes <= WHOLE_GRAPH_NODES)
+        return shortest_path(self, source, target, self.arc_graph() if whole else None)
 
     @property
     def usable(self) -> NDArray[np.bool_]:

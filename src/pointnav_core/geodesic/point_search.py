@@ -1,8 +1,11 @@
 """The exact shortest path between two points on the tangent graph, without a goal field.
 
-:meth:`Planner.shortest_path <pointnav_core.geodesic.planner.Planner.shortest_path>` runs
-:class:`PointSearch`, a label-setting search (A* towards the target) over the planner's
-tangent edges, built lazily tile by tile. Everything is in world metres and radians.
+:func:`shortest_path` (what :meth:`Planner.shortest_path
+<pointnav_core.geodesic.planner.Planner.shortest_path>` calls) joins the two points straight
+where it can; otherwise it searches the whole graph in compiled code when the planner has
+it (:mod:`pointnav_core.geodesic.arc_search`), or runs :class:`PointSearch`, a label-setting
+search (A* towards the target) over the planner's tangent edges, built lazily tile by tile.
+Everything is in world metres and radians.
 """
 
 from __future__ import annotations
@@ -13,15 +16,53 @@ import math
 from typing import TYPE_CHECKING
 
 import numpy as np
-from numpy.typing import NDArray
+from numpy.typing import ArrayLike, NDArray
 
-from pointnav_core.geodesic.arcs import arc_points
+from pointnav_core.geodesic.arc_search import arc_graph_path
+from pointnav_core.geodesic.arcs import draw_arcs
 from pointnav_core.geodesic.tangents import ANG_TOL, COST_TOL
 
 if TYPE_CHECKING:
+    from pointnav_core.geodesic.arc_graph import ArcGraph
     from pointnav_core.geodesic.planner import Planner
 
-__all__ = ["PointSearch"]
+__all__ = ["PointSearch", "shortest_path"]
+
+
+def shortest_path(
+    planner: Planner, source: ArrayLike, target: ArrayLike, graph: ArcGraph | None
+) -> tuple[NDArray[np.float64], float] | tuple[None, None]:
+    """The exact shortest path from ``source`` to ``target`` (world m): the drawn path (N, 2)
+    and its length (m), or ``(None, None)``; on ``graph`` (the planner's whole graph) if
+    given, else by the lazy :class:`PointSearch`."""
+    p = planner
+    src = np.asarray(source, dtype=np.float64)[:2]
+    tgt = np.asarray(target, dtype=np.float64)[:2]
+    sx, sy, tx, ty = float(src[0]), float(src[1]), float(tgt[0]), float(tgt[1])
+    if not (p.is_clear(sx, sy) and p.is_clear(tx, ty)):
+        return None, None
+    if p.segment_clear(src, tgt):
+        return np.array([src, tgt]), math.hypot(tx - sx, ty - sy)
+    # Links into the target, seen from the target: reversed, they leave a node.
+    finish: dict[tuple[int, int], list[tuple[float, float]]] = {}
+    for c, s, pos, length in p.point_links(tx, ty):
+        finish.setdefault((c, -s), []).append((p.span_list[c] - pos, length))
+    if graph is not None:
+        found = arc_graph_path(graph, (sx, sy), (tx, ty), p.point_links(sx, sy),
+                               [(c, s, pos, length) for (c, s), deps in finish.items() for pos, length in deps])
+        if found is None:
+            return None, None
+        pts, cost = found
+        return pts[::-1].copy(), cost
+    search = PointSearch(p, heuristic_to=(tx, ty))
+    for c, s, pos, length in p.point_links(sx, sy):
+        search.push(length, c, s, pos, -1, 0.0)
+    best = search.run(finish)
+    if best is None:
+        return None, None
+    cost, label, dep = best
+    pts = [np.array([tx, ty]), *search.trace(label, dep), np.array([sx, sy])]
+    return np.array(pts[::-1]), cost
 
 
 class PointSearch:
@@ -106,11 +147,9 @@ class PointSearch:
 
     def trace(self, label: int, dep: float) -> list[NDArray[np.float64]]:
         """Points from the departure at ``dep`` on ``label``'s arc back to the first node."""
-        p = self.p
-        pts: list[NDArray[np.float64]] = []
+        arcs = []
         while label >= 0:
-            node, s = self.node[label], self.side[label]
-            pts += arc_points(p, node, s, dep, self.pos[label])
+            arcs.append((self.node[label], self.side[label], dep, self.pos[label]))
             dep = self.parent_dep[label]
             label = self.parent[label]
-        return pts
+        return list(draw_arcs(self.p, arcs))
