@@ -51,6 +51,29 @@ def test_a_rebuilt_floor_reads_the_same_graph_back(folder) -> None:
     assert _distances(second) == _distances(first)
 
 
+def test_a_cached_floor_reads_each_node_s_edges_when_first_asked(folder) -> None:
+    """A floor from the cache makes a node's edge lists when a search reads them, and they
+    are the lists the build made; the counts hold before anything is read, and a pickled
+    planner carries every edge."""
+    import pickle
+
+    first = _built(_geo())
+    second = Planner(_geo(), 0.18)
+    store = second.edge_store
+    n_first = sum(len(v[0]) for v in first.edge_store.values())
+    assert dict.__len__(store) == 0  # nothing made yet
+    assert len(store) == len(first.edge_store) and store.n_edges() == n_first
+    some = sorted(first.edge_store)[:: max(1, len(first.edge_store) // 7)]
+    for key in some:
+        assert key in store and store[key] == first.edge_store[key]
+        assert store.get(key) == first.edge_store[key]
+    assert dict.__len__(store) == len(some) and store.n_edges() == n_first
+    assert (10**6, 1) not in store and store.get((10**6, 1)) is None
+    copy = pickle.loads(pickle.dumps(second))
+    assert dict(copy.edge_store.items()) == dict(first.edge_store.items())
+    assert _distances(copy) == _distances(first)
+
+
 def test_a_changed_map_radius_or_version_misses(folder, monkeypatch) -> None:
     _built(_geo())
     keys = {cache.floor_key(_geo(), 0.18), cache.floor_key(_geo(shift=1), 0.18), cache.floor_key(_geo(), 0.2)}

@@ -39,7 +39,7 @@ from pointnav_core.errors import ArgumentError
 if TYPE_CHECKING:
     from pointnav_core.floor.collision import FloorCollision
 
-__all__ = ["ENV_VAR", "MIN_SECONDS", "cache_dir", "edge_arrays", "edges_from_arrays", "floor_key", "load", "save"]
+__all__ = ["ENV_VAR", "MIN_SECONDS", "cache_dir", "edge_arrays", "floor_key", "load", "save"]
 
 ENV_VAR = "POINTNAV_CACHE_DIR"
 #: Builds (s) shorter than this are not written to the cache.
@@ -139,15 +139,4 @@ def edge_arrays(store: dict[tuple[int, int], tuple[list[Any], ...]]) -> dict[str
         "to_side": np.array([x for v in lists for x in v[2]], dtype=np.int8),
         "arr": np.array([x for v in lists for x in v[3]], dtype=np.float64),
         "length": np.array([x for v in lists for x in v[4]], dtype=np.float64),
-    }
-
-
-def edges_from_arrays(stored: dict[str, NDArray[Any]]) -> dict[tuple[int, int], tuple[list[Any], ...]]:
-    """The edges :func:`edge_arrays` flattened, as lists again."""
-    ends = np.cumsum(stored["count"])
-    starts = ends - stored["count"]
-    cols = [stored[k].tolist() for k in ("dep", "to", "to_side", "arr", "length")]
-    return {
-        (node, side): tuple(c[i:j] for c in cols)
-        for node, side, i, j in zip(stored["node"].tolist(), stored["side"].tolist(), starts.tolist(), ends.tolist())
     }

@@ -49,7 +49,8 @@ from pointnav_core.errors import ArgumentError
 from pointnav_core.floor.collision import FloorCollision
 from pointnav_core.geodesic import cache
 from pointnav_core.geodesic.arc_graph import ArcGraph
-from pointnav_core.geodesic.cache import edge_arrays, edges_from_arrays
+from pointnav_core.geodesic.cache import edge_arrays
+from pointnav_core.geodesic.edge_store import EdgeStore
 from pointnav_core.geodesic.cell_links import CellLinks
 from pointnav_core.geodesic.edges import build_edges
 from pointnav_core.geodesic.field import GoalField
@@ -131,7 +132,7 @@ class Planner(ThawOnUnpickle):
         started = time.perf_counter()
         self._build_nodes()
         # (node, side) -> departure positions, targets, target sides, arrivals, lengths.
-        self.edge_store: dict[tuple[int, int], tuple[list[float], list[int], list[int], list[float], list[float]]] = {}
+        self.edge_store = EdgeStore()
         # The per-floor build from the disk cache, if an earlier process kept it (geodesic.cache).
         self._cache_key = cache.floor_key(collision, self.radius) if cache.cache_dir() is not None else None
         stored = cache.load(self._cache_key, self.n_nodes) if self._cache_key is not None else None
@@ -144,7 +145,7 @@ class Planner(ThawOnUnpickle):
         if stored is not None:
             self.sights = stored["sights"].astype(np.float64)
             self.sight_profile = stored["sight_profile"].astype(np.float32)
-            self.edge_store.update(edges_from_arrays(stored))
+            self.edge_store.attach(stored)  # each node's lists made when first read
             self._check_geometry_bytes()
             self._cell_links = CellLinks.stored(stored, collision.shape[0] * collision.shape[1], self.n_nodes)
         else:
@@ -164,6 +165,11 @@ class Planner(ThawOnUnpickle):
         self._field_bytes = 0
 
     # ------------------------------------------------------------------ nodes
+    def __setstate__(self, state: dict[str, Any]) -> None:
+        super().__setstate__(state)
+        if not isinstance(self.edge_store, EdgeStore):  # thawing copies dicts as plain ones
+            self.edge_store = EdgeStore.of(self.edge_store)
+
     def _build_nodes(self) -> None:
         geo = self.geo
         res = geo.resolution
@@ -303,7 +309,7 @@ class Planner(ThawOnUnpickle):
         """Approximate memory (bytes) of this floor's geometry for this radius: nodes, sight
         bounds, tangent edges, arc graph and cell links (the goal fields not included)."""
         arrays = sum(a.nbytes for a in (self.cx, self.cy, self.phi0, self.span, self.sights, self.sight_profile))
-        n_edges = sum(len(v[0]) for v in self.edge_store.values())
+        n_edges = self.edge_store.n_edges()
         links = self._cell_links.nbytes if isinstance(self._cell_links, CellLinks) else 0
         return int(arrays + n_edges * _EDGE_BYTES + links)
 
