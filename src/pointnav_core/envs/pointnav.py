@@ -267,7 +267,7 @@ class PointNavEnv(gym.Env[Any, np.ndarray]):
         self._derive_path_range = _envcommon.derives_path_range(task)
         self.discrete_actions = make_discrete_actions(action_space, discrete_actions)
         #: The pedestrians (:class:`~pointnav_core.crowds.Crowd`), or None without them.
-        self.crowd = _crowd.make_crowd(pedestrians, scene)
+        self.crowd = self._own_crowd = _crowd.make_crowd(pedestrians, scene)
         self._touched, self._pedestrian_steps = False, 0
         self._track: _crowd.CrowdTrack | None = None
         task = _envcommon.add_stop(_envcommon.add_sensors(task, sensors), self.discrete_actions)
@@ -301,15 +301,19 @@ class PointNavEnv(gym.Env[Any, np.ndarray]):
         """Start a new episode; the same ``seed`` gives the same episode.
 
         ``options={"episode": episode}`` plays a dataset episode (its start, orientation and
-        goal; see :mod:`pointnav_core.datasets.playback`); other options are not used.
+        goal, and its recorded crowd if it has one, with the env's pedestrian settings or
+        the defaults; see :mod:`pointnav_core.datasets.playback`); other options are not used.
         """
         super().reset(seed=seed)
         if options is not None and not isinstance(options, Mapping):
             raise ArgumentError(f"options must be None or a dict, got {options!r}")
         self.backend.reset()
-        info = self.task.reset(self, episode=(options or {}).get("episode"))
+        episode = (options or {}).get("episode")
+        info = self.task.reset(self, episode=episode)
+        # An episode's recorded crowd is placed as recorded, in an env without pedestrians too.
+        self.crowd = _crowd.episode_crowd(self._own_crowd, episode, self.scene)
         if self.crowd is not None:
-            _crowd.spawn_crowd(self)
+            _crowd.spawn_crowd(self, getattr(episode, "pedestrians", None))
             self._touched, self._pedestrian_steps = False, 0
             self._track = _crowd.CrowdTrack(self)
             info["pedestrian_collisions"] = 0
