@@ -163,14 +163,19 @@ class Crowd:
         robots = np.asarray(robots, dtype=np.float64).reshape(-1, 3)
         for i in range(n):
             if record is not None:
-                self.positions[i] = self._fixed(i, robots, record[i].start, f"pedestrians[{i}].start")
+                # Its own disc must fit: the crowd's paths start from the nearest cell they fit.
+                self.positions[i] = self._fixed(i, robots, record[i].start, f"pedestrians[{i}].start", record[i].radius)
             elif given.starts is not None:
-                self.positions[i] = self._fixed(i, robots, given.starts[i], f"pedestrians['starts'][{i}]")
+                self.positions[i] = self._fixed(
+                    i, robots, given.starts[i], f"pedestrians['starts'][{i}]", self.config.plan_radius
+                )
             else:
                 self.positions[i] = self._place(i, robots)
-        paths = [self._plan(i, True, rng) for i in range(n)]
+        # A drawn crowd's first goals come from ``rng`` and are recorded; a recorded crowd
+        # without goals draws its first from its own generators, as later ones.
+        paths = [self._plan(i, True, rng if record is None else self._rngs[i]) for i in range(n)]
         self._set_paths(range(n), paths)
-        self._record = tuple(
+        self._record = record if record is not None else tuple(
             PedestrianRecord(
                 start=(float(x), float(y)), loop=self._loops[i], seed=self._seeds[i],
                 goals=self._walks[i] if self._walks[i] or not self._drawn[i] else (tuple(self.goals[i].tolist()),),
@@ -213,17 +218,18 @@ class Crowd:
             f"the walls, the robots and the pedestrians before it in {PLACE_TRIES} tries; ask for fewer"
         )
 
-    def _fixed(self, i: int, robots: NDArray[np.float64], start: Any, name: str) -> NDArray[np.float64]:
-        """Pedestrian ``i``'s fixed or recorded ``start`` (m), checked: its disc must fit there
-        and overlap no robot and no pedestrian before it; errors name the field ``name``."""
+    def _fixed(self, i: int, robots: NDArray[np.float64], start: Any, name: str, clearance: float) -> NDArray[np.float64]:
+        """Pedestrian ``i``'s fixed or recorded ``start`` (m), checked: a disc of ``clearance`` m
+        must fit there, and its own overlap no robot and no pedestrian before it; errors name
+        the field ``name``."""
         point = np.array(start, dtype=np.float64)
         others = np.concatenate([robots, self.discs()[:i]])
         gap = np.hypot(others[:, 0] - point[0], others[:, 1] - point[1]) - others[:, 2] - self.radius[i]
         tmap = self.scene.floors[self.floor]
-        if not tmap.is_usable(point, self.config.plan_radius) or (len(gap) and gap.min() < 0.0):
+        if not tmap.is_usable(point, clearance) or (len(gap) and gap.min() < 0.0):
             raise SamplingError(
                 f"{name} {point.tolist()} is not clear on floor {self.floor}: a disc of "
-                f"{self.config.plan_radius} m must fit there, apart from the robots and the pedestrians before it"
+                f"{clearance} m must fit there, apart from the robots and the pedestrians before it"
             )
         return point
 
