@@ -240,26 +240,34 @@ def generate_episodes(
                 f"could not generate episode {len(episodes)} on scene {scene_id!r}: no acceptable "
                 f"start for {config.max_goals_per_episode} goals in a row ({detail})"
             )
-        floor, goal, start, geodesic = pair
         yaw = float(rng.uniform(0.0, 2.0 * math.pi))
-        z = scene.floors[floor].height
-        if crowd is not None:  # clear of the robot at its start, as the env's reset places it
-            crowd.spawn(floor, crowd_rng, np.array([[start[0], start[1], radius]]))
-        episodes.append(
-            PointNavEpisode(
-                episode_id=f"{id_prefix}{first_id + len(episodes)}",
-                scene_id=scene_id,
-                floor=floor,
-                start_position=(float(start[0]), float(start[1]), z),
-                start_rotation=(0.0, 0.0, math.sin(0.5 * yaw), math.cos(0.5 * yaw)),
-                goal_position=(float(goal[0]), float(goal[1]), z),
-                goal_radius=config.goal_radius,
-                geodesic_distance=float(geodesic),
-                robot_radius=radius,
-                pedestrians=None if crowd is None else crowd.record(),
-            )
-        )
+        episode_id = f"{id_prefix}{first_id + len(episodes)}"
+        episodes.append(_episode(scene, scene_id, episode_id, pair, yaw, config, crowd, crowd_rng))
     return episodes
+
+
+def _episode(
+    scene: Scene, scene_id: str, episode_id: str, pair: tuple[int, NDArray[np.float64], NDArray[np.float64], float],
+    yaw: float, config: GeneratorConfig, crowd: Crowd | None, crowd_rng: np.random.Generator,
+) -> PointNavEpisode:
+    """The episode of a drawn ``(floor, goal, start, geodesic)`` ``pair`` (m) and heading
+    ``yaw`` (rad), with a crowd drawn from ``crowd_rng`` when ``crowd`` is given."""
+    floor, goal, start, geodesic = pair
+    z = scene.floors[floor].height
+    if crowd is not None:  # clear of the robot at its start, as the env's reset places it
+        crowd.spawn(floor, crowd_rng, np.array([[start[0], start[1], config.robot_radius]]))
+    return PointNavEpisode(
+        episode_id=episode_id,
+        scene_id=scene_id,
+        floor=floor,
+        start_position=(float(start[0]), float(start[1]), z),
+        start_rotation=(0.0, 0.0, math.sin(0.5 * yaw), math.cos(0.5 * yaw)),
+        goal_position=(float(goal[0]), float(goal[1]), z),
+        goal_radius=config.goal_radius,
+        geodesic_distance=float(geodesic),
+        robot_radius=config.robot_radius,
+        pedestrians=None if crowd is None else crowd.record(),
+    )
 
 
 #: Appended to the seed's spawn key for the crowds' generator ("crowd" in ASCII).
