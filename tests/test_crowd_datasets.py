@@ -307,3 +307,16 @@ def test_the_record_of_a_crowd_the_env_drew_replays_it_step_for_step():
     replay = room_env(pedestrians={"count": 4})
     replay.reset(seed=5, options={"episode": played})
     np.testing.assert_array_equal(rollout(drew, 300), rollout(replay, 300))
+
+
+def test_the_multi_robot_env_places_the_first_robots_recorded_crowd():
+    from pointnav_core.envs.multi_pointnav import MultiPointNavEnv
+
+    scene = scenes.Scene.from_array(GRID, RES)
+    scene.scene_id = "room"
+    other = PointNavEpisode("e2", "room", 0, (5.4, 2.0, 0.0), (0.0, 0.0, 0.0, 1.0), (0.6, 1.0, 0.0), 0.5, 5.0, 0.18)
+    env = MultiPointNavEnv(scene=scene, n_robots=2, pedestrians={"count": 6})
+    env.reset(seed=1, options={"episodes": [episode(), other]})
+    np.testing.assert_array_equal(env.crowd.positions, [[1.25, 0.75], [4.75, 3.3], [3.1, 1.9]])
+    env.reset(seed=1)
+    assert env.crowd.n == 6
