@@ -210,7 +210,9 @@ class PointNavEnv(gym.Env[Any, np.ndarray]):
     (the default: RVO2's ORCA among the pedestrians and, with `sees_robots=True`, the
     robot), `"social_force"` (pysocialforce's model), `"static"` or a callable. They start
     clear of the walls, the robot and each other, never enter a wall, and are drawn from
-    the reset's seed; `starts` and `goals` fix them (`pointnav_core.crowds.presets`). The scan and the local
+    the reset's seed; `starts` and `goals` fix them (`pointnav_core.crowds.presets`), and a
+    dataset episode that records a crowd places exactly it (with the default settings in an
+    env built without `pedestrians`; `pointnav_core.datasets.format`). The scan and the local
     map (code 4) see them and `render()` draws them, grey with a heading tick. The robot is
     not pushed by them: a step on which its disc overlaps a pedestrian's adds one to
     `info["pedestrian_collisions"]` (not to `collisions`), and with
