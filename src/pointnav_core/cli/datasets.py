@@ -2,6 +2,8 @@
 
 ``pointnav dataset generate --scenes SET --split val --episodes N --out FILE`` writes an
 episode dataset (:mod:`pointnav_core.datasets`); the same arguments give the same bytes.
+``--pedestrians '{"count": 5}'`` (the envs' ``pedestrians`` dict as JSON) or
+``--pedestrians igibson`` (iGibson's density) records a crowd in every episode.
 
 ``pointnav eval --dataset FILE --policy oracle|MODULE:CALLABLE|CHECKPOINT.pt|MODEL.zip`` (a
 ``.zip`` with ``--trust-policy-file``: loading one runs the code pickled in it; a checkpoint
@@ -50,16 +52,45 @@ def _dataset_generate(args: argparse.Namespace) -> int:
     from pointnav_core.utils.outputs import check_output
 
     check_output("--out", args.out)
+    pedestrians = _pedestrians(args.pedestrians)
     scenes = scene_set(args.scenes, seed=args.seed)
     with tqdm(total=args.episodes, disable=args.quiet, desc="episodes", unit="ep") as bar:
         dataset = generate_split(
-            scenes, args.split, args.episodes, seed=args.seed, config=config, progress=bar.update
+            scenes, args.split, args.episodes, seed=args.seed, config=config, progress=bar.update,
+            pedestrians=pedestrians,
         )
     dataset.save(args.out, frame="habitat" if args.habitat_frame else "z-up")
     print(
         f"wrote {args.out}: {len(dataset)} episodes on {len(dataset.scene_ids)} scenes of {args.scenes!r} ({args.split})"
     )
     return 0
+
+
+#: ``--pedestrians`` presets by name.
+PEDESTRIAN_PRESETS = ("igibson",)
+
+
+def _pedestrians(text: str | None) -> dict[str, Any] | None:
+    """``--pedestrians``: a preset name or a JSON object of the envs' ``pedestrians`` keys."""
+    import json
+
+    from pointnav_core.crowds import make_pedestrians, presets
+
+    if text is None:
+        return None
+    if text == "igibson":
+        return presets.igibson_density()
+    try:
+        value = json.loads(text)
+    except json.JSONDecodeError:
+        value = None
+    if not isinstance(value, dict):
+        raise ArgumentError(
+            f"--pedestrians must be a JSON object of the pedestrians keys (e.g. '{{\"count\": 5}}') "
+            f"or one of {list(PEDESTRIAN_PRESETS)}, got {text!r}"
+        )
+    make_pedestrians(value, "--pedestrians")  # a bad key is named before any scene is built
+    return value
 
 
 def _default_output(dataset: str, suffix: str) -> str:
@@ -385,6 +416,12 @@ def _add_generate(sub: Any, positive_int: Callable[[str], int]) -> None:
         default=1.5,
         metavar="M",
         help="reject starts on smaller islands",
+    )
+    gen.add_argument(
+        "--pedestrians",
+        default=None,
+        metavar="JSON_OR_PRESET",
+        help="record a crowd in every episode: a pedestrians dict as JSON ('{\"count\": 5}') or igibson",
     )
     gen.add_argument("--habitat-frame", action="store_true", help="write Habitat's y-up frame")
     gen.add_argument("--quiet", action="store_true", help="no progress bar")

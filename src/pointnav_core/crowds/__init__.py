@@ -6,6 +6,8 @@
   :func:`~pointnav_core.crowds.config.make_pedestrians`: an env's ``pedestrians={...}``.
 - :class:`~pointnav_core.crowds.crowd.Crowd`: the pedestrians of one env, placed, planned
   and stepped.
+- :mod:`~pointnav_core.crowds.record`: a crowd as placed, one record per pedestrian (start,
+  goals, own seed, radius, speed), which a dataset episode stores and a spawn replays.
 - :mod:`~pointnav_core.crowds.presets`: standard scenarios (CrowdNav's circle crossing, a
   corridor, a doorway, iGibson's density) with fixed starts and goals.
 - :func:`~pointnav_core.crowds.social_force.social_force_step`: one step of the social force

@@ -20,6 +20,12 @@ crowd's largest radius), and advances them one control step at a time:
    neighbour is undone by the new plan);
 4. a pedestrian within 0.1 m of its goal gets a new goal and path.
 
+Each pedestrian draws from its own generator (its seed is drawn at :meth:`Crowd.spawn`):
+its radius, speed and heading, and every goal after its first (see
+:mod:`pointnav_core.crowds.record`), so one pedestrian's replans never shift another's
+draws. :meth:`Crowd.record` is the crowd as placed; :meth:`Crowd.spawn` with a record
+places exactly that crowd again.
+
 Robots are not pushed by pedestrians (there is no physics): a robot's disc that overlaps a
 pedestrian's is a *pedestrian contact*, which the env counts apart from its collisions, as
 iGibson's social navigation task and CrowdNav do.
@@ -27,7 +33,9 @@ iGibson's social navigation task and CrowdNav do.
 
 from __future__ import annotations
 
+import dataclasses
 import math
+from collections.abc import Sequence
 from typing import Any
 
 import numpy as np
@@ -35,6 +43,7 @@ from numpy.typing import NDArray
 
 from pointnav_core.crowds.config import CrowdView, PedestrianConfig
 from pointnav_core.crowds.orca import orca_step
+from pointnav_core.crowds.record import SEED_LIMIT, PedestrianRecord
 from pointnav_core.crowds.social_force import SocialForceParams, social_force_step
 from pointnav_core.errors import ArgumentError, SamplingError
 from pointnav_core.floor.draw import nearest_usable
@@ -65,6 +74,8 @@ class Crowd:
     Parameters
     ----------
     config : PedestrianConfig
+        The crowd's settings; a spawn from a record widens its radius range to the
+        recorded radii for that episode.
     scene : Scene
         The scene they walk; pedestrians are on one floor at a time (the robot's).
 
@@ -83,11 +94,12 @@ class Crowd:
     """
 
     def __init__(self, config: PedestrianConfig, scene: Any) -> None:
-        self.config = config
+        self.config = self._given = config
         self.scene = scene
         self.floor = 0
         self._rng = np.random.default_rng(0)
         self._set_count(0)
+        self._record: tuple[PedestrianRecord, ...] = ()
 
     def _set_count(self, n: int) -> None:
         self.positions = np.zeros((n, 2))
@@ -100,6 +112,11 @@ class Crowd:
         self._last = np.zeros(n, dtype=np.int64)  # index of each path's last point
         self._next = np.zeros(n, dtype=np.int64)  # index of each one's next waypoint
         self._goal_index = np.full(n, -1, dtype=np.int64)  # in each one's fixed goal list
+        self._rngs = [np.random.default_rng(0)] * n  # each one's own draws
+        self._seeds = [0] * n
+        self._walks: list[tuple[tuple[float, float], ...]] = [()] * n  # each one's fixed goals
+        self._loops = [False] * n  # whether each walks its fixed goals round and round
+        self._drawn = np.zeros(n, dtype=bool)  # whether each one's goal was drawn
 
     @property
     def n(self) -> int:
@@ -111,30 +128,80 @@ class Crowd:
         return np.column_stack([self.positions, self.radius])
 
     # ------------------------------------------------------------------ placing
-    def spawn(self, floor: int, rng: np.random.Generator, robots: NDArray[np.float64]) -> None:
-        """Place a new crowd on ``floor``, clear of the ``(M, 3)`` robot discs ``robots``.
+    def spawn(self, floor: int, rng: np.random.Generator, robots: NDArray[np.float64],
+              record: Sequence[PedestrianRecord] | None = None) -> None:
+        """Place a new crowd on ``floor``, clear of the ``(M, 3)`` robot discs ``robots``:
+        drawn from ``rng`` (each pedestrian's seed, where it stands, its first goal), or
+        exactly the crowd of ``record`` (:meth:`record`'s) when given.
 
         Raises
         ------
         SamplingError
             When the crowd's count does not fit: naming the count and the pedestrian that
-            found no place after :data:`PLACE_TRIES` tries.
+            found no place after :data:`PLACE_TRIES` tries; or when a fixed or recorded
+            start is not clear, naming it.
         """
-        cfg, scene = self.config, self.scene
+        given, scene = self._given, self.scene
         self.floor, self._rng = int(floor), rng
-        tmap = scene.floors[self.floor]
-        n = cfg.number(float(tmap.free.sum()) * tmap.resolution**2)
+        if record is None:
+            tmap = scene.floors[self.floor]
+            n = given.number(float(tmap.free.sum()) * tmap.resolution**2)
+            self.config = given
+            seeds = rng.integers(SEED_LIMIT, size=n).tolist()
+            walks = list(given.goals) if given.goals is not None else [()] * n
+            loops = [given.goals is not None] * n
+        else:
+            record = tuple(record)
+            n, seeds = len(record), [r.seed for r in record]
+            walks, loops = [r.goals for r in record], [r.loop for r in record]
+            widest = max([r.radius for r in record], default=0.0)
+            # The walls are kept from the largest radius: widened to the recorded ones.
+            self.config = given if widest <= given.radius[1] else dataclasses.replace(given, radius=(given.radius[0], widest))
         self._set_count(n)
-        lo, hi = cfg.radius
-        self.radius[:] = rng.uniform(lo, hi, n) if hi > lo else lo
-        lo, hi = cfg.speed
-        self.speed[:] = rng.uniform(lo, hi, n) if hi > lo else lo
+        self._seeds, self._walks, self._loops = [int(v) for v in seeds], walks, loops
+        self._draw_own(record)
         robots = np.asarray(robots, dtype=np.float64).reshape(-1, 3)
         for i in range(n):
-            self.positions[i] = self._place(i, robots) if cfg.starts is None else self._fixed(i, robots)
-        self.headings[:] = rng.uniform(-math.pi, math.pi, n)
-        paths = [self._plan(i, new_goal=True) for i in range(n)]
+            if record is not None:
+                # Its own disc must fit: the crowd's paths start from the nearest cell they fit.
+                self.positions[i] = self._fixed(i, robots, record[i].start, f"pedestrians[{i}].start", record[i].radius)
+            elif given.starts is not None:
+                self.positions[i] = self._fixed(
+                    i, robots, given.starts[i], f"pedestrians['starts'][{i}]", self.config.plan_radius
+                )
+            else:
+                self.positions[i] = self._place(i, robots)
+        # A drawn crowd's first goals come from ``rng`` and are recorded; a recorded crowd
+        # without goals draws its first from its own generators, as later ones.
+        paths = [self._plan(i, True, rng if record is None else self._rngs[i]) for i in range(n)]
         self._set_paths(range(n), paths)
+        self._record = record if record is not None else tuple(
+            PedestrianRecord(
+                start=(float(x), float(y)), loop=self._loops[i], seed=self._seeds[i],
+                goals=self._walks[i] if self._walks[i] or not self._drawn[i] else (tuple(self.goals[i].tolist()),),
+                radius=float(self.radius[i]), speed=float(self.speed[i]),
+            ) for i, (x, y) in enumerate(self.positions.tolist())
+        )
+
+    def _draw_own(self, record: Sequence[PedestrianRecord] | None) -> None:
+        """Each pedestrian's generator from its seed and its first three draws: radius and
+        speed in the config's ranges (a record's own instead), heading in [-pi, pi)."""
+        (r_lo, r_hi), (s_lo, s_hi) = self.config.radius, self.config.speed
+        for i, seed in enumerate(self._seeds):
+            self._rngs[i] = own = np.random.default_rng(seed)
+            u_radius, u_speed, u_heading = own.random(3).tolist()
+            if record is None:
+                self.radius[i] = r_lo + (r_hi - r_lo) * u_radius
+                self.speed[i] = s_lo + (s_hi - s_lo) * u_speed
+            else:
+                self.radius[i], self.speed[i] = record[i].radius, record[i].speed
+            self.headings[i] = -math.pi + 2.0 * math.pi * u_heading
+
+    def record(self) -> tuple[PedestrianRecord, ...]:
+        """The crowd as the last :meth:`spawn` placed it: one record per pedestrian (its
+        start, fixed goals or first drawn goal, seed, radius and speed), which
+        ``spawn(..., record=...)`` places again exactly."""
+        return self._record
 
     def _place(self, i: int, robots: NDArray[np.float64]) -> NDArray[np.float64]:
         """A usable point for pedestrian ``i`` that overlaps no robot and no pedestrian before it."""
@@ -151,41 +218,44 @@ class Crowd:
             f"the walls, the robots and the pedestrians before it in {PLACE_TRIES} tries; ask for fewer"
         )
 
-    def _fixed(self, i: int, robots: NDArray[np.float64]) -> NDArray[np.float64]:
-        """Pedestrian ``i``'s fixed start, checked: its disc must fit there and overlap no
-        robot and no pedestrian before it."""
-        point = np.array(self.config.starts[i], dtype=np.float64)  # type: ignore[index]
+    def _fixed(self, i: int, robots: NDArray[np.float64], start: Any, name: str, clearance: float) -> NDArray[np.float64]:
+        """Pedestrian ``i``'s fixed or recorded ``start`` (m), checked: a disc of ``clearance`` m
+        must fit there, and its own overlap no robot and no pedestrian before it; errors name
+        the field ``name``."""
+        point = np.array(start, dtype=np.float64)
         others = np.concatenate([robots, self.discs()[:i]])
         gap = np.hypot(others[:, 0] - point[0], others[:, 1] - point[1]) - others[:, 2] - self.radius[i]
         tmap = self.scene.floors[self.floor]
-        if not tmap.is_usable(point, self.config.plan_radius) or (len(gap) and gap.min() < 0.0):
+        if not tmap.is_usable(point, clearance) or (len(gap) and gap.min() < 0.0):
             raise SamplingError(
-                f"pedestrians['starts'][{i}] {point.tolist()} is not clear on floor {self.floor}: a disc of "
-                f"{self.config.plan_radius} m must fit there, apart from the robots and the pedestrians before it"
+                f"{name} {point.tolist()} is not clear on floor {self.floor}: a disc of "
+                f"{clearance} m must fit there, apart from the robots and the pedestrians before it"
             )
         return point
 
     # ------------------------------------------------------------------ paths
-    def _plan(self, i: int, new_goal: bool) -> NDArray[np.float64]:
+    def _plan(self, i: int, new_goal: bool, rng: np.random.Generator) -> NDArray[np.float64]:
         """Pedestrian ``i``'s path from where it stands to its goal (a new one if asked, or
-        if the old one cannot be reached); a one-point path when none is reachable."""
+        if the old one cannot be reached); a one-point path when none is reachable. A new
+        goal is the next of its fixed list while there is one, else drawn from ``rng``."""
         scene, floor, radius = self.scene, self.floor, self.config.plan_radius
         here = self.positions[i]
         start = self._anchor(here)
         if start is None:
             return here[None].copy()
-        fixed = self.config.goals
+        walk, loop = self._walks[i], self._loops[i]
         for attempt in range(10):
-            if fixed is not None:  # the next goal of its list, round and round
-                if new_goal:
-                    self._goal_index[i] += 1
-                walk = fixed[i]
-                self.goals[i] = walk[int(self._goal_index[i]) % len(walk)]
+            if new_goal:
+                self._goal_index[i] += 1
+            k = int(self._goal_index[i])
+            if walk and (loop or k < len(walk)):  # the next goal of its list (round and round)
+                self.goals[i] = walk[k % len(walk)]
                 new_goal = True  # an unreachable fixed goal: try the next one
             elif new_goal or attempt:
                 goal = start
+                self._drawn[i] = True
                 for _ in range(10):
-                    _, goal = scene.get_random_point(floor, reference_point=start, robot=radius, rng=self._rng)
+                    _, goal = scene.get_random_point(floor, reference_point=start, robot=radius, rng=rng)
                     goal = goal[:2]
                     if math.dist(goal, start) >= MIN_GOAL_DISTANCE:
                         break
@@ -323,7 +393,7 @@ class Crowd:
         self.positions, self.velocities = positions, velocities
         self.headings = np.where(moving, np.arctan2(velocities[:, 1], velocities[:, 0]), self.headings)
         if len(replan):
-            paths = [self._plan(int(i), new_goal=bool(arrived[i])) for i in replan]
+            paths = [self._plan(int(i), bool(arrived[i]), self._rngs[int(i)]) for i in replan]
             self._set_paths(replan, paths)
 
     def _orca(self, pref: NDArray[np.float64], dt: float, robots: NDArray[np.float64],

@@ -7,6 +7,8 @@ module                 what it holds
 ``generator``          :func:`generate_episodes`: Habitat's sampling rules, seeded
 ``scene_sets``         named scene sets with train / val / test splits, ``scene_id`` lookup
 ``playback``           :class:`EpisodeSchedule`: a dataset's episodes in order or shuffled
+``crowd_records``      an episode's recorded crowd in the file (``info["pedestrians"]``)
+``presets``            the crowd presets as a dataset (:func:`presets.dataset`)
 =====================  ===================================================================
 
 Nothing here imports Gymnasium, PettingZoo or a backend.

@@ -12,6 +12,11 @@ top-level key)::
 The floor index and the robot radius the episode was made for live in ``info``, a free-form
 dict in Habitat (its episode class takes no other extra keys).
 
+An episode may record its crowd (:attr:`PointNavEpisode.pedestrians`, issue 33): then
+``info["pedestrians"]`` holds one object per pedestrian, its start, goal list, its own seed,
+radius and speed (:mod:`pointnav_core.datasets.crowd_records`), and an env that plays the
+episode places exactly that crowd. Without one the key is absent and the file is as before.
+
 Frames
 ------
 A dataset is stored in pointnav-core's frame (x, y on the floor, z up, a yaw about +z as
@@ -38,6 +43,8 @@ from collections.abc import Iterable, Iterator, Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
+from pointnav_core.crowds.record import PedestrianRecord
+from pointnav_core.datasets.crowd_records import records_from_json, records_to_json
 from pointnav_core.errors import ArgumentError
 from pointnav_core.utils import validation
 
@@ -86,6 +93,9 @@ class PointNavEpisode:
         Shortest-path length (m) from start to goal for a disc of ``robot_radius``.
     robot_radius : float
         Radius (m) of the robot the episode was made for.
+    pedestrians : tuple of PedestrianRecord or None
+        The crowd at the episode's start, one record per pedestrian (start, goals, seed,
+        radius, speed; :mod:`pointnav_core.crowds.record`), or None: no recorded crowd.
     """
 
     episode_id: str
@@ -97,6 +107,7 @@ class PointNavEpisode:
     goal_radius: float | None
     geodesic_distance: float
     robot_radius: float
+    pedestrians: tuple[PedestrianRecord, ...] | None = None
 
     @property
     def start_xy(self) -> tuple[float, float]:
@@ -120,17 +131,20 @@ class PointNavEpisode:
         if frame == "habitat":
             start, goal = to_habitat_position(start), to_habitat_position(goal)
             rotation = to_habitat_rotation(self.start_yaw)
+        info: dict[str, Any] = {
+            "geodesic_distance": self.geodesic_distance,
+            "floor": self.floor,
+            "robot_radius": self.robot_radius,
+        }
+        if self.pedestrians is not None:  # absent otherwise: older files stay byte for byte
+            info["pedestrians"] = records_to_json(self.pedestrians, frame, self.start_position[2])
         return {
             "episode_id": self.episode_id,
             "scene_id": self.scene_id,
             "start_position": list(start),
             "start_rotation": list(rotation),
             "goals": [{"position": list(goal), "radius": self.goal_radius}],
-            "info": {
-                "geodesic_distance": self.geodesic_distance,
-                "floor": self.floor,
-                "robot_radius": self.robot_radius,
-            },
+            "info": info,
         }
 
 
@@ -262,6 +276,7 @@ def _episode_from_json(raw: Any, index: int, source: str, frame: str) -> PointNa
     if isinstance(floor, bool) or not isinstance(floor, int) or floor < 0:
         raise where.error("info.floor", "an integer >= 0", floor)
     robot_radius = _number(where, info, "robot_radius", "info.robot_radius", minimum=0.0)
+    crowd = records_from_json(info["pedestrians"], frame, where.error) if "pedestrians" in info else None
 
     norm = math.sqrt(sum(v * v for v in rotation))
     if abs(norm - 1.0) > _QUAT_TOL:
@@ -288,6 +303,7 @@ def _episode_from_json(raw: Any, index: int, source: str, frame: str) -> PointNa
         goal_radius=radius,
         geodesic_distance=geodesic,
         robot_radius=robot_radius,
+        pedestrians=crowd,
     )
 
 

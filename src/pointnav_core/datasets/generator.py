@@ -16,6 +16,12 @@ floor; a (start, goal) pair is kept when
 
 The start heading is uniform in [0, 2 pi). Every random draw comes from one numpy
 ``Generator`` seeded with ``seed``, so the same arguments give the same episodes.
+
+With ``pedestrians={...}`` (the envs' argument, :mod:`pointnav_core.crowds.config`) each
+episode also records a crowd (:attr:`PointNavEpisode.pedestrians`), drawn as the env draws
+one at a reset (:meth:`Crowd.spawn <pointnav_core.crowds.Crowd.spawn>`, on the episode's
+floor, clear of the robot's disc at its start) from a second generator of the same seed,
+so the episodes themselves are the same with or without pedestrians.
 """
 
 from __future__ import annotations
@@ -23,13 +29,14 @@ from __future__ import annotations
 import hashlib
 import math
 import weakref
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import asdict, dataclass
 from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
 
+from pointnav_core.crowds import Crowd, make_pedestrians
 from pointnav_core.datasets.format import EpisodeDataset, PointNavEpisode
 from pointnav_core.datasets.scene_sets import SceneSet, load_scene
 from pointnav_core.errors import ArgumentError, SamplingError
@@ -174,6 +181,7 @@ def generate_episodes(
     id_prefix: str = "",
     first_id: int = 0,
     stats: dict[str, Any] | None = None,
+    pedestrians: Any = None,
 ) -> list[PointNavEpisode]:
     """Generate ``n_episodes`` episodes on ``scene`` with Habitat's rules (module notes).
 
@@ -195,6 +203,8 @@ def generate_episodes(
         If given, filled with what happened: ``"rejected"`` (rule -> count over the whole
         run) and ``"ratio_trials"``, a list of ``(ratio, kept)`` for every pair that met
         the ratio filter (for measuring it).
+    pedestrians : dict, optional
+        Record a crowd of these settings in every episode (module notes).
 
     Returns
     -------
@@ -203,12 +213,15 @@ def generate_episodes(
     Raises
     ------
     SamplingError
-        When ``max_goals_per_episode`` goals in a row gave no acceptable pair; the message
-        counts the rejections by rule.
+        When ``max_goals_per_episode`` goals in a row gave no acceptable pair (the message
+        counts the rejections by rule), or an episode's crowd does not fit.
     """
     config = config or GeneratorConfig()
     if isinstance(n_episodes, bool) or not isinstance(n_episodes, int) or n_episodes < 0:
         raise ArgumentError(f"n_episodes must be an integer >= 0, got {n_episodes!r}")
+    crowd_config = make_pedestrians(pedestrians)
+    crowd = None if crowd_config is None else Crowd(crowd_config, scene)
+    crowd_rng = np.random.default_rng(_crowd_seed(seed))
     rng = np.random.default_rng(seed)
     radius = config.robot_radius
     floor_p = _floor_weights(scene, scene_id, radius)
@@ -227,23 +240,45 @@ def generate_episodes(
                 f"could not generate episode {len(episodes)} on scene {scene_id!r}: no acceptable "
                 f"start for {config.max_goals_per_episode} goals in a row ({detail})"
             )
-        floor, goal, start, geodesic = pair
         yaw = float(rng.uniform(0.0, 2.0 * math.pi))
-        z = scene.floors[floor].height
-        episodes.append(
-            PointNavEpisode(
-                episode_id=f"{id_prefix}{first_id + len(episodes)}",
-                scene_id=scene_id,
-                floor=floor,
-                start_position=(float(start[0]), float(start[1]), z),
-                start_rotation=(0.0, 0.0, math.sin(0.5 * yaw), math.cos(0.5 * yaw)),
-                goal_position=(float(goal[0]), float(goal[1]), z),
-                goal_radius=config.goal_radius,
-                geodesic_distance=float(geodesic),
-                robot_radius=radius,
-            )
-        )
+        episode_id = f"{id_prefix}{first_id + len(episodes)}"
+        episodes.append(_episode(scene, scene_id, episode_id, pair, yaw, config, crowd, crowd_rng))
     return episodes
+
+
+def _episode(
+    scene: Scene, scene_id: str, episode_id: str, pair: tuple[int, NDArray[np.float64], NDArray[np.float64], float],
+    yaw: float, config: GeneratorConfig, crowd: Crowd | None, crowd_rng: np.random.Generator,
+) -> PointNavEpisode:
+    """The episode of a drawn ``(floor, goal, start, geodesic)`` ``pair`` (m) and heading
+    ``yaw`` (rad), with a crowd drawn from ``crowd_rng`` when ``crowd`` is given."""
+    floor, goal, start, geodesic = pair
+    z = scene.floors[floor].height
+    if crowd is not None:  # clear of the robot at its start, as the env's reset places it
+        crowd.spawn(floor, crowd_rng, np.array([[start[0], start[1], config.robot_radius]]))
+    return PointNavEpisode(
+        episode_id=episode_id,
+        scene_id=scene_id,
+        floor=floor,
+        start_position=(float(start[0]), float(start[1]), z),
+        start_rotation=(0.0, 0.0, math.sin(0.5 * yaw), math.cos(0.5 * yaw)),
+        goal_position=(float(goal[0]), float(goal[1]), z),
+        goal_radius=config.goal_radius,
+        geodesic_distance=float(geodesic),
+        robot_radius=config.robot_radius,
+        pedestrians=None if crowd is None else crowd.record(),
+    )
+
+
+#: Appended to the seed's spawn key for the crowds' generator ("crowd" in ASCII).
+_CROWD_KEY = 0x63726F7764
+
+
+def _crowd_seed(seed: int | np.random.SeedSequence | None) -> np.random.SeedSequence:
+    """The seed of the crowds' generator: the episodes' ``seed`` with its own spawn key."""
+    if isinstance(seed, np.random.SeedSequence):
+        return np.random.SeedSequence(seed.entropy, spawn_key=(*seed.spawn_key, _CROWD_KEY))
+    return np.random.SeedSequence(seed, spawn_key=(_CROWD_KEY,))
 
 
 def _floor_weights(scene: Scene, scene_id: str, radius: float) -> NDArray[np.float64]:
@@ -347,6 +382,7 @@ def generate_split(
     config: GeneratorConfig | None = None,
     root: str | None = None,
     progress: Callable[[int], None] | None = None,
+    pedestrians: Any = None,
 ) -> EpisodeDataset:
     """Generate ``n_episodes`` episodes spread evenly over the scenes of one split.
 
@@ -365,8 +401,12 @@ def generate_split(
         Folder relative scene paths are read from.
     progress : callable, optional
         Called with the number of episodes generated for each scene.
+    pedestrians : dict, optional
+        Record a crowd of these settings in every episode (:func:`generate_episodes`); the
+        dict is kept in the metadata.
     """
     config = config or GeneratorConfig()
+    make_pedestrians(pedestrians)  # refused before any scene is built
     ids = scene_set.scene_ids(split)
     if not ids:
         raise ArgumentError(f"split {split!r} of scene set {scene_set.name!r} has no scenes")
@@ -385,6 +425,7 @@ def generate_split(
             seed=scene_seed(seed, scene_id),
             config=config,
             first_id=len(episodes),
+            pedestrians=pedestrians,
         )
         if progress is not None:
             progress(count)
@@ -394,4 +435,6 @@ def generate_split(
         "seed": int(seed),
         "generator": {**asdict(config), "geodesic_range": list(config.geodesic_range)},
     }
+    if isinstance(pedestrians, Mapping):
+        metadata["pedestrians"] = dict(pedestrians)
     return EpisodeDataset(episodes, metadata)

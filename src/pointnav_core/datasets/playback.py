@@ -10,7 +10,9 @@ Both environments take a dataset episode at reset::
     obs, infos = multi.reset(options={"episodes": schedule.take(2)})  # one per robot
 
 The episode's start, start orientation and goal replace the task's for that episode; the
-task keeps its own ``goal_tolerance``, rewards and limits. An env holds one scene, so a
+task keeps its own ``goal_tolerance``, rewards and limits. An episode that records a crowd
+(:attr:`PointNavEpisode.pedestrians`) has exactly that crowd placed, with the env's
+pedestrian settings (the defaults in a single-robot env built without them). An env holds one scene, so a
 schedule is usually restricted to one ``scene_id`` (the env cannot tell scenes apart).
 :func:`episode_poses` checks an episode against the env and names the episode and the field
 in every error.

@@ -15,6 +15,9 @@ scene_id                       scene
 ``ros:<path>``                 ROS map_server ``map.yaml`` (:meth:`Scene.from_ros_map`)
 ``procthor:<path>``            ProcTHOR ``house.json`` (:meth:`Scene.from_procthor`)
 ``houseexpo:<path>``           HouseExpo ``<id>.json`` (:meth:`Scene.from_houseexpo`)
+``preset:<name>``              a crowd preset's scene, built with the preset's default
+                               arguments (:data:`PRESET_SCENES`: ``circle_crossing``,
+                               ``corridor``, ``doorway``; :mod:`pointnav_core.crowds.presets`)
 =============================  ==========================================================
 
 Relative paths are read relative to ``root`` (the working directory by default); with a
@@ -41,11 +44,13 @@ from typing import Any
 import numpy as np
 
 from pointnav_core import scenes
+from pointnav_core.crowds import presets
 from pointnav_core.errors import ArgumentError
 from pointnav_core.floor.maps import BoundedCache
 from pointnav_core.scenes import Scene
 
 __all__ = [
+    "PRESET_SCENES",
     "SCENE_SETS",
     "SPLITS",
     "SceneSet",
@@ -68,6 +73,8 @@ FILE_SCHEMES = {
     "houseexpo": Scene.from_houseexpo,
     "trav": Scene.from_png,
 }
+#: Crowd presets whose scene a ``preset:<name>`` scene_id builds (default arguments).
+PRESET_SCENES = {"circle_crossing": presets.circle_crossing, "corridor": presets.corridor, "doorway": presets.doorway}
 _TRAV = re.compile(r"floor_trav_(\d+)\.png$")
 
 
@@ -242,14 +249,14 @@ def _named(scene: Scene, scene_id: str) -> Scene:
 
 _FORMS = (
     "rooms:<seed>, maze:<seed>, clutter:<seed>, movingai:<path>, trav:<path>, ros:<path>, "
-    "procthor:<path>, houseexpo:<path>, or a .map/.png/.yaml/.json/folder path"
+    "procthor:<path>, houseexpo:<path>, preset:<name>, or a .map/.png/.yaml/.json/folder path"
 )
 
 
 def locate_scene(scene_id: Any, root: str | os.PathLike[str] | None = None) -> tuple[str, str | None]:
     """Check a ``scene_id`` without building its scene: ``(scheme, path)``.
 
-    ``scheme`` is a generator name (``rooms``, ...; ``path`` None), a file scheme of
+    ``scheme`` is a generator name (``rooms``, ...; ``path`` None), ``preset`` (``path`` None), a file scheme of
     :data:`FILE_SCHEMES`, or ``""`` (a plain path). With ``root``, a path is resolved (links
     followed) and must stay under ``root``: a dataset cannot make the reader open files
     elsewhere.
@@ -267,6 +274,10 @@ def locate_scene(scene_id: Any, root: str | os.PathLike[str] | None = None) -> t
     if scheme in GENERATORS:
         if not re.fullmatch(r"-?\d+", rest):
             raise ArgumentError(f"unknown scene_id {scene_id!r}: {scheme}: takes an integer seed")
+        return scheme, None
+    if scheme == "preset":
+        if rest not in PRESET_SCENES:
+            raise ArgumentError(f"unknown scene_id {scene_id!r}: preset: takes one of {sorted(PRESET_SCENES)}")
         return scheme, None
     if scheme in FILE_SCHEMES and rest:
         path = rest
@@ -289,6 +300,8 @@ def locate_scene(scene_id: Any, root: str | os.PathLike[str] | None = None) -> t
 
 def _build(scene_id: Any, root: str | os.PathLike[str] | None) -> Scene:
     scheme, path = locate_scene(scene_id, root)
+    if scheme == "preset":
+        return PRESET_SCENES[scene_id.partition(":")[2]]().scene
     if path is None:
         return GENERATORS[scheme](seed=int(scene_id.partition(":")[2]))
     if not scheme and os.path.isfile(path):

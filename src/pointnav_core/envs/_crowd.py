@@ -16,7 +16,8 @@ from pointnav_core.envs.common import edit_task
 from pointnav_core.transforms import quat2yaw
 
 __all__ = [
-    "CrowdTrack", "add_pedestrian_termination", "crowd_robots", "make_crowd", "pose_twins", "robot_discs", "spawn_crowd",
+    "CrowdTrack", "add_pedestrian_termination", "crowd_robots", "episode_crowd", "make_crowd", "pose_twins", "robot_discs",
+    "spawn_crowd",
 ]
 
 def make_crowd(pedestrians: Any, scene: Any) -> Any:
@@ -86,14 +87,26 @@ def robot_discs(env: Any, twins: tuple[Any, Any] | None = None) -> tuple[NDArray
     return discs, velocities
 
 
-def spawn_crowd(env: Any) -> None:
+def spawn_crowd(env: Any, record: Any = None) -> None:
     """Place the env's pedestrians for a new episode on its task's floor, clear of its
-    robots, from a generator drawn from ``env.np_random`` (so the reset seed fixes the crowd)."""
+    robots: exactly the crowd of ``record`` (a dataset episode's ``pedestrians``) when given,
+    else drawn from a generator drawn from ``env.np_random`` (so the reset seed fixes the crowd)."""
     task = env.task if hasattr(env, "task") else env.tasks[0]
     env.crowd.floor = task.floor
-    seed = int(env.np_random.integers(2**63))
+    # A recorded crowd draws nothing here: the env's stream is the same with or without it.
+    seed = 0 if record is not None else int(env.np_random.integers(2**63))
     robots, _ = robot_discs(env)
-    env.crowd.spawn(task.floor, np.random.default_rng(seed), robots)
+    env.crowd.spawn(task.floor, np.random.default_rng(seed), robots, record)
+
+
+def episode_crowd(given: Any, episode: Any, scene: Any) -> Any:
+    """The crowd an env plays ``episode`` with: its own (``given``, from ``pedestrians=...``;
+    None without), or, for an episode that records a crowd in an env without one, a crowd
+    of the default pedestrian settings (docs/decisions.md, "Crowds")."""
+    record = getattr(episode, "pedestrians", None)
+    if given is not None or record is None:
+        return given
+    return make_crowd({"count": len(record)}, scene)
 
 
 class CrowdTrack:

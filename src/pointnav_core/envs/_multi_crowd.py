@@ -36,10 +36,11 @@ class FleetCrowd:
         self.counts = [0] * n_robots
         self.tracks: list[_crowd.CrowdTrack] = []
 
-    def reset(self, env: Any, infos: list[dict[str, Any]]) -> None:
+    def reset(self, env: Any, infos: list[dict[str, Any]], record: Any = None) -> None:
         """Place the crowd for new episodes (after the robots' resets, whose ``infos`` get
-        their contact counts, 0)."""
-        _crowd.spawn_crowd(env)
+        their contact counts, 0): the first robot's dataset episode's recorded crowd
+        ``record`` when it has one (on its floor), else drawn."""
+        _crowd.spawn_crowd(env, record)
         for info in infos:
             info["pedestrian_collisions"] = 0
         self.touched = [False] * self.n

@@ -386,7 +386,7 @@ class MultiPointNavEnv(ParallelEnv[str, Any, np.ndarray]):
         self.backend.reset()
         infos = _multi_agents.reset_tasks(self, self.tasks, self.reset_order, self.separation, given)
         if self._fleet_crowd is not None:
-            self._fleet_crowd.reset(self, infos)
+            self._fleet_crowd.reset(self, infos, getattr(given[0], "pedestrians", None))  # robot 0's record
         self._active = [True] * len(self.tasks)
         self._cycles = 0
         self.agents = self.possible_agents[:]

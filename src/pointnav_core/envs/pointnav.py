@@ -210,7 +210,9 @@ class PointNavEnv(gym.Env[Any, np.ndarray]):
     (the default: RVO2's ORCA among the pedestrians and, with `sees_robots=True`, the
     robot), `"social_force"` (pysocialforce's model), `"static"` or a callable. They start
     clear of the walls, the robot and each other, never enter a wall, and are drawn from
-    the reset's seed; `starts` and `goals` fix them (`pointnav_core.crowds.presets`). The scan and the local
+    the reset's seed; `starts` and `goals` fix them (`pointnav_core.crowds.presets`), and a
+    dataset episode that records a crowd places exactly it (with the default settings in an
+    env built without `pedestrians`; `pointnav_core.datasets.format`). The scan and the local
     map (code 4) see them and `render()` draws them, grey with a heading tick. The robot is
     not pushed by them: a step on which its disc overlaps a pedestrian's adds one to
     `info["pedestrian_collisions"]` (not to `collisions`), and with
@@ -267,7 +269,7 @@ class PointNavEnv(gym.Env[Any, np.ndarray]):
         self._derive_path_range = _envcommon.derives_path_range(task)
         self.discrete_actions = make_discrete_actions(action_space, discrete_actions)
         #: The pedestrians (:class:`~pointnav_core.crowds.Crowd`), or None without them.
-        self.crowd = _crowd.make_crowd(pedestrians, scene)
+        self.crowd = self._own_crowd = _crowd.make_crowd(pedestrians, scene)
         self._touched, self._pedestrian_steps = False, 0
         self._track: _crowd.CrowdTrack | None = None
         task = _envcommon.add_stop(_envcommon.add_sensors(task, sensors), self.discrete_actions)
@@ -301,15 +303,19 @@ class PointNavEnv(gym.Env[Any, np.ndarray]):
         """Start a new episode; the same ``seed`` gives the same episode.
 
         ``options={"episode": episode}`` plays a dataset episode (its start, orientation and
-        goal; see :mod:`pointnav_core.datasets.playback`); other options are not used.
+        goal, and its recorded crowd if it has one, with the env's pedestrian settings or
+        the defaults; see :mod:`pointnav_core.datasets.playback`); other options are not used.
         """
         super().reset(seed=seed)
         if options is not None and not isinstance(options, Mapping):
             raise ArgumentError(f"options must be None or a dict, got {options!r}")
         self.backend.reset()
-        info = self.task.reset(self, episode=(options or {}).get("episode"))
+        episode = (options or {}).get("episode")
+        info = self.task.reset(self, episode=episode)
+        # An episode's recorded crowd is placed as recorded, in an env without pedestrians too.
+        self.crowd = _crowd.episode_crowd(self._own_crowd, episode, self.scene)
         if self.crowd is not None:
-            _crowd.spawn_crowd(self)
+            _crowd.spawn_crowd(self, getattr(episode, "pedestrians", None))
             self._touched, self._pedestrian_steps = False, 0
             self._track = _crowd.CrowdTrack(self)
             info["pedestrian_collisions"] = 0
