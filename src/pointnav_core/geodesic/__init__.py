@@ -12,10 +12,13 @@ The API (the model, its accuracy and cost: ``docs/geodesic.md``):
   change them), the lookup table's block side.
 
 Inside, one module per step: ``tangents`` (the shared constructions and tolerances),
-``sight`` (strict sight bounds), ``edges`` (common tangents), ``cell_links`` (each cell's
+``sight`` (strict sight bounds), ``edges`` (common tangents), ``edge_store`` (a node's edges
+as lists, made from the disk cache's arrays when first read), ``cell_links`` (each cell's
 clear links, once per floor), ``arcs`` (drawing arcs),
 ``arc_graph`` (the graph solved by Dijkstra), ``roots`` (exact cell roots), ``field``,
-``point_search`` (one exact path between two points) and ``planner``.
+``point_search`` (one exact path between two points: lazily, tile by tile) and
+``arc_search`` (the same on the whole graph, compiled), ``cache`` (the disk cache) and
+``planner``.
 """
 
 from pointnav_core.geodesic.field import BLOCK, LOOKUP_BOUND, GoalField
