@@ -320,3 +320,21 @@ def test_the_multi_robot_env_places_the_first_robots_recorded_crowd():
     np.testing.assert_array_equal(env.crowd.positions, [[1.25, 0.75], [4.75, 3.3], [3.1, 1.9]])
     env.reset(seed=1)
     assert env.crowd.n == 6
+
+
+def test_the_multi_robot_env_without_pedestrians_walks_a_recorded_crowd_for_that_episode_only():
+    from pointnav_core.envs.multi_pointnav import MultiPointNavEnv
+
+    scene = scenes.Scene.from_array(GRID, RES)
+    scene.scene_id = "room"
+    other = PointNavEpisode("e2", "room", 0, (5.4, 2.0, 0.0), (0.0, 0.0, 0.0, 1.0), (0.6, 1.0, 0.0), 0.5, 5.0, 0.18)
+    env = MultiPointNavEnv(scene=scene, n_robots=2)
+    _, infos = env.reset(seed=1, options={"episodes": [episode(), other]})
+    np.testing.assert_array_equal(env.crowd.positions, [[1.25, 0.75], [4.75, 3.3], [3.1, 1.9]])
+    assert env.crowd.config.behaviour == "orca" and env.crowd.config.radius == (0.2, 0.3)  # the defaults
+    assert all(info["pedestrian_collisions"] == 0 for info in infos.values())
+    before = env.crowd.positions.copy()
+    env.step({agent: np.zeros(2, dtype=np.float32) for agent in env.agents})
+    assert not np.array_equal(env.crowd.positions, before)  # it walks
+    _, infos = env.reset(seed=1)
+    assert env.crowd is None and all("pedestrian_collisions" not in info for info in infos.values())

@@ -99,11 +99,11 @@ def spawn_crowd(env: Any, record: Any = None) -> None:
     env.crowd.spawn(task.floor, np.random.default_rng(seed), robots, record)
 
 
-def episode_crowd(given: Any, episode: Any, scene: Any) -> Any:
-    """The crowd an env plays ``episode`` with: its own (``given``, from ``pedestrians=...``;
-    None without), or, for an episode that records a crowd in an env without one, a crowd
-    of the default pedestrian settings (docs/decisions.md, "Crowds")."""
-    record = getattr(episode, "pedestrians", None)
+def episode_crowd(given: Any, record: Any, scene: Any) -> Any:
+    """The crowd an env plays an episode with: its own (``given``, from ``pedestrians=...``;
+    None without), or, for an episode that records a crowd (``record``, its
+    ``pedestrians``) in an env without one, a crowd of the default pedestrian settings
+    (docs/decisions.md, "Crowds")."""
     if given is not None or record is None:
         return given
     return make_crowd({"count": len(record)}, scene)

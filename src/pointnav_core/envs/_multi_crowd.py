@@ -14,7 +14,7 @@ from typing import Any
 
 from pointnav_core.envs import _crowd
 
-__all__ = ["FleetCrowd"]
+__all__ = ["FleetCrowd", "episode_fleet", "reset_fleet"]
 
 
 class FleetCrowd:
@@ -72,3 +72,24 @@ class FleetCrowd:
             info["pedestrian_collisions"] = self.counts[i]
             if terminations[agent] or truncations[agent]:
                 info["social"] = self.tracks[i].metrics(env, info)
+
+
+def episode_fleet(own: FleetCrowd | None, record: Any, scene: Any, n_robots: int) -> FleetCrowd | None:
+    """The crowd a multi-robot env plays an episode with: its own (``own``), or, for a
+    first robot's episode that records a crowd (``record``) in an env without one, a crowd
+    of the default pedestrian settings, as the single env's (:func:`_crowd.episode_crowd`)."""
+    if own is not None or record is None:
+        return own
+    return FleetCrowd(_crowd.episode_crowd(None, record, scene), n_robots)
+
+
+def reset_fleet(env: Any, own: FleetCrowd | None, episode: Any, infos: list[dict[str, Any]]) -> FleetCrowd | None:
+    """Place the crowd of a new episode (after the robots' resets, whose ``infos`` get their
+    contact counts): the env's own (``own``) or :func:`episode_fleet`'s for the first
+    robot's dataset ``episode`` (None: drawn), which becomes ``env.crowd``. Returns it."""
+    record = getattr(episode, "pedestrians", None)
+    fleet = episode_fleet(own, record, env.scene, len(env.tasks))
+    env.crowd = None if fleet is None else fleet.crowd
+    if fleet is not None:
+        fleet.reset(env, infos, record)
+    return fleet

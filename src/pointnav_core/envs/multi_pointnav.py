@@ -192,7 +192,7 @@ from pointnav_core.backends.protocol import Backend, make_backend
 from pointnav_core.backends.robot_spec import RobotSpec
 from pointnav_core.envs import _crowd, _multi_actions, _multi_agents
 from pointnav_core.envs import common as _envcommon
-from pointnav_core.envs._multi_crowd import FleetCrowd
+from pointnav_core.envs._multi_crowd import FleetCrowd, reset_fleet
 from pointnav_core.envs._multi_render import render_frame
 from pointnav_core.envs._multi_state import global_state, state_space
 from pointnav_core.envs.config import EnvConfig, multi_robot_arguments, takes_config
@@ -297,7 +297,7 @@ class MultiPointNavEnv(ParallelEnv[str, Any, np.ndarray]):
         task = _envcommon.add_stop(_envcommon.add_sensors(task, sensors), self.discrete_actions)
         tasks = make_tasks(_crowd.add_pedestrian_termination(task, crowd), n)
         self.crowd = crowd  #: The pedestrians (:class:`~pointnav_core.crowds.Crowd`), or None.
-        self._fleet_crowd = None if crowd is None else FleetCrowd(crowd, n)
+        self._fleet_crowd = self._own_fleet = None if crowd is None else FleetCrowd(crowd, n)
 
         self.scene = scene
         self.render_mode = render_mode
@@ -385,8 +385,7 @@ class MultiPointNavEnv(ParallelEnv[str, Any, np.ndarray]):
         self._started = True
         self.backend.reset()
         infos = _multi_agents.reset_tasks(self, self.tasks, self.reset_order, self.separation, given)
-        if self._fleet_crowd is not None:
-            self._fleet_crowd.reset(self, infos, getattr(given[0], "pedestrians", None))  # robot 0's record
+        self._fleet_crowd = reset_fleet(self, self._own_fleet, given[0], infos)  # robot 0's episode's crowd
         self._active = [True] * len(self.tasks)
         self._cycles = 0
         self.agents = self.possible_agents[:]

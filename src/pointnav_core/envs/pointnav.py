@@ -313,7 +313,7 @@ class PointNavEnv(gym.Env[Any, np.ndarray]):
         episode = (options or {}).get("episode")
         info = self.task.reset(self, episode=episode)
         # An episode's recorded crowd is placed as recorded, in an env without pedestrians too.
-        self.crowd = _crowd.episode_crowd(self._own_crowd, episode, self.scene)
+        self.crowd = _crowd.episode_crowd(self._own_crowd, getattr(episode, "pedestrians", None), self.scene)
         if self.crowd is not None:
             _crowd.spawn_crowd(self, getattr(episode, "pedestrians", None))
             self._touched, self._pedestrian_steps = False, 0
