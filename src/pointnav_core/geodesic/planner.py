@@ -116,12 +116,14 @@ class Planner(ThawOnUnpickle):
         Byte budget of the floor's geometry for this radius (default :data:`GEOMETRY_BYTES`,
         1 GiB): building tangent edges past it raises ``ValueError``, and cell links that
         would pass it are not kept. Set it as ``field_cache_bytes``.
+    whole_graph_search : bool
+        Whether :meth:`shortest_path` searches the whole graph in compiled code once it
+        exists (default True); False keeps the lazy search, tile by tile.
     """
 
     field_cache_bytes: int = FIELD_CACHE_BYTES
     geometry_bytes: int = GEOMETRY_BYTES
-    #: Whether :meth:`shortest_path` searches the whole graph once it exists (the fast
-    #: path); False keeps the lazy search (the general path a property test compares).
+    # The fast path; False keeps the general one, which a property test compares with it.
     whole_graph_search: bool = True
 
     def __init__(self, collision: FloorCollision, radius: float) -> None:
