@@ -22,6 +22,7 @@ from collections.abc import Callable
 from typing import Any
 
 from pointnav_core.errors import ArgumentError
+from pointnav_core.utils import validation
 
 __all__ = ["SEED_LIMIT", "PedestrianRecord", "make_record"]
 
@@ -66,8 +67,7 @@ def _argument_error(field: str, must: str, got: Any) -> Exception:
 
 
 def _number(error: Error, name: str, value: Any, strict: bool = False, minimum: float = -math.inf) -> float:
-    # bool is an int subclass and a string is not a number: both are refused.
-    ok = isinstance(value, (int, float)) and not isinstance(value, bool) and math.isfinite(value)
+    ok = validation.is_real(value) and math.isfinite(value)  # not a bool, not a string
     if not ok or value < minimum or (strict and value == minimum):
         raise error(name, "a finite number" + (f" {'>' if strict else '>='} {minimum}" if minimum > -math.inf else ""), value)
     return float(value)

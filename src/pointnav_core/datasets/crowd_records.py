@@ -17,6 +17,7 @@ from collections.abc import Callable, Mapping, Sequence
 from typing import Any
 
 from pointnav_core.crowds.record import PedestrianRecord, make_record
+from pointnav_core.utils import validation
 
 __all__ = ["KEYS", "records_from_json", "records_to_json"]
 
@@ -65,7 +66,7 @@ def records_from_json(
                 raise error(field, f"a list of {size} finite numbers", value)
             if size == 2:
                 return value
-            if not all(isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v) for v in value):
+            if not all(validation.is_real(v) and math.isfinite(v) for v in value):
                 raise error(field, "a list of 3 finite numbers", value)
             return [value[0], -value[2]]  # Habitat's (x, h, -y) back to our (x, y)
 

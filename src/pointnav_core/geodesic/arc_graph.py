@@ -144,16 +144,8 @@ class ArcGraph:
         """Where each arrival at ``(x_node, x_side, x_pos)`` continues along its arc: the
         first vertex at or after it (-1 where none is, or the arc there is blocked), and
         the arc's cost to it (m, with the graph's zero-weight offset)."""
-        p = self.p
-        j, _, hi = self.locate(x_node, x_side, x_pos - ANG_TOL, after=False)
-        to = np.minimum(j, max(self.n_vertices - 1, 0))
-        ok = j < hi
-        x_node = np.asarray(x_node, dtype=np.int64)
-        x_side = np.asarray(x_side, dtype=np.int64)
-        ok[ok] = p.arcs_free(x_node[ok], x_side[ok], x_pos[ok], self.pos[to[ok]])
-        x_to = np.where(ok, j, -1).astype(np.int64)
-        x_w = np.zeros(len(j))
-        x_w[ok] = p.radius * np.maximum(self.pos[to[ok]] - x_pos[ok], 0.0) + _EPS_W
+        x_to, x_w = self._arc_steps(x_node, x_side, x_pos, forward=True)
+        x_w[x_to >= 0] += _EPS_W
         return x_to, x_w
 
     def departure_steps(
@@ -162,18 +154,30 @@ class ArcGraph:
         """Where a path leaving at ``(f_node, f_side, f_pos)`` is entered from: the last
         vertex of its arc at or before it (-1 where none is, or the arc there is blocked),
         and the arc's cost from it (m)."""
-        p = self.p
-        j, lo, _ = self.locate(f_node, f_side, f_pos + ANG_TOL, after=True)
-        j = j - 1
-        frm = np.maximum(j, 0)
-        ok = j >= lo
-        f_node = np.asarray(f_node, dtype=np.int64)
-        f_side = np.asarray(f_side, dtype=np.int64)
-        ok[ok] = p.arcs_free(f_node[ok], f_side[ok], self.pos[frm[ok]], f_pos[ok])
-        f_from = np.where(ok, j, -1).astype(np.int64)
-        f_w = np.zeros(len(j))
-        f_w[ok] = p.radius * np.maximum(f_pos[ok] - self.pos[frm[ok]], 0.0)
-        return f_from, f_w
+        return self._arc_steps(f_node, f_side, f_pos, forward=False)
+
+    def _arc_steps(
+        self, node: NDArray[np.integer], side: NDArray[np.integer], q: NDArray[np.float64], forward: bool
+    ) -> tuple[NDArray[np.int64], NDArray[np.float64]]:
+        """The vertex each arc position ``q`` goes on to (``forward``: the first at or after
+        it) or comes from (the last at or before it), -1 where none is or the arc between
+        them is blocked, and that arc's cost (m)."""
+        if forward:
+            j, _, hi = self.locate(node, side, q - ANG_TOL, after=False)
+            ok = j < hi
+        else:
+            j, lo, _ = self.locate(node, side, q + ANG_TOL, after=True)
+            j = j - 1
+            ok = j >= lo
+        node = np.asarray(node, dtype=np.int64)
+        side = np.asarray(side, dtype=np.int64)
+        at = self.pos[j[ok]]
+        first, then = (q[ok], at) if forward else (at, q[ok])
+        ok[ok] = self.p.arcs_free(node[ok], side[ok], first, then)
+        cost = np.zeros(len(j))
+        at, here = self.pos[j[ok]], q[ok]
+        cost[ok] = self.p.radius * np.maximum(at - here if forward else here - at, 0.0)
+        return np.where(ok, j, -1).astype(np.int64), cost
 
     def _arcs_free(self, i: NDArray[np.int64], j: NDArray[np.int64]) -> NDArray[np.bool_]:
         """Whether the arc between vertices ``i`` and ``j`` (same arc, ``pos_i <= pos_j``) is clear."""
@@ -294,8 +298,7 @@ class FieldLabels:
 
     def on_arc(self, node: int, side: int) -> list[int]:
         """Reached vertices on the arc of ``node`` winding ``side``."""
-        gi = 2 * node + (side < 0)
-        lo, hi = int(self.graph.grp_start[gi]), int(self.graph.grp_end[gi])
+        lo, hi = self.graph.arc_range(node, side)
         out = [lo + i for i in np.flatnonzero(np.isfinite(self.cost[lo:hi])).tolist()]
         extra = self._extra.get((node, side))
         if extra:
