@@ -192,6 +192,11 @@ class _Runner:
         )
 
 
+def _floor_of(ep: PointNavEpisode) -> tuple[str, int, float]:
+    """The floor geometry an episode needs: a worker keeps to one while it has episodes."""
+    return ep.scene_id, ep.floor, ep.robot_radius
+
+
 def _play(runner: _Runner, ep: PointNavEpisode) -> tuple[str, Any]:
     """A worker's task (module level, so that ``spawn`` can find it)."""
     return runner.outcome(ep)
@@ -377,7 +382,7 @@ def _play_all(
     elif episodes:
         with WorkerPool(n_workers, _Runner, args, _play) as pool:
             try:
-                for i, (kind, payload) in pool.imap_unordered(enumerate(episodes)):
+                for i, (kind, payload) in pool.imap_unordered(enumerate(episodes), group=_floor_of):
                     record(i, kind, payload)  # type: ignore[arg-type]
             except WorkerError as err:
                 if err.key is None:

@@ -19,6 +19,7 @@ import os
 import signal
 import threading
 import time
+from collections import deque
 from collections.abc import Callable, Hashable, Iterable, Iterator
 from contextlib import contextmanager
 from multiprocessing import connection, get_context
@@ -175,15 +176,28 @@ class WorkerPool:
     def __exit__(self, *exc: object) -> None:
         self.close()
 
-    def imap_unordered(self, items: Iterable[tuple[Hashable, Any]]) -> Iterator[tuple[Hashable, Any]]:
+    def imap_unordered(
+        self, items: Iterable[tuple[Hashable, Any]], group: Callable[[Any], Hashable] | None = None
+    ) -> Iterator[tuple[Hashable, Any]]:
         """Run every ``(key, item)``; yield ``(key, task's return)`` as each finishes.
+
+        Parameters
+        ----------
+        items : iterable of (key, item)
+            Sent in this order, one to each worker as it becomes free (without ``group``).
+        group : callable, optional
+            ``group(item)`` names the state an item needs (an evaluation's scene): a free
+            worker takes the next item of the group it last ran, else the first group no
+            other worker is on, else the largest group left (see :class:`_GroupedQueue`),
+            so that each worker builds a group's state once rather than every worker
+            building every group's.
 
         Raises
         ------
         WorkerError
             When a worker raises or ends before returning, naming the item it held.
         """
-        todo = iter(items)
+        todo: Any = iter(items) if group is None else _GroupedQueue(items, group)
         held: dict[int, Hashable | None] = dict.fromkeys(range(len(self._procs)))  # None: starting
         while held:
             connection.wait([self._conns[k] for k in held] + [self._procs[k].sentinel for k in held])
@@ -199,7 +213,7 @@ class WorkerPool:
                         raise WorkerError(key, out)
                     if kind == "done":
                         yield key, out
-                    nxt = next(todo, None)
+                    nxt = next(todo, None) if group is None else todo.take(k)
                     if nxt is None:
                         del held[k]
                         continue
@@ -229,3 +243,31 @@ class WorkerPool:
         for conn in self._conns:
             conn.close()
         self._procs, self._conns = [], []
+
+
+class _GroupedQueue:
+    """Items waiting for workers, kept by group (see :meth:`WorkerPool.imap_unordered`)."""
+
+    def __init__(self, items: Iterable[tuple[Hashable, Any]], group: Callable[[Any], Hashable]) -> None:
+        self._groups: dict[Hashable, deque[tuple[Hashable, Any]]] = {}  # first-seen order
+        for entry in items:
+            self._groups.setdefault(group(entry[1]), deque()).append(entry)
+        self._on: dict[int, Hashable] = {}  # worker -> the group it last took from
+
+    def take(self, worker: int) -> tuple[Hashable, Any] | None:
+        """The next ``(key, item)`` for ``worker``; None when none are left."""
+        if not self._groups:
+            return None
+        mine = self._on.get(worker)
+        if mine not in self._groups:
+            others = {g for w, g in self._on.items() if w != worker}
+            free = [g for g in self._groups if g not in others]
+            # Every group left has a worker on it: help with the largest, so that the last
+            # items are shared rather than queued behind one worker.
+            mine = free[0] if free else max(self._groups, key=lambda g: len(self._groups[g]))
+            self._on[worker] = mine
+        queue = self._groups[mine]
+        entry = queue.popleft()
+        if not queue:
+            del self._groups[mine]
+        return entry
