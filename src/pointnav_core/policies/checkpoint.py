@@ -35,6 +35,7 @@ import torch
 from pointnav_core.envs.config import EnvConfig
 from pointnav_core.errors import ArgumentError
 from pointnav_core.policies.network import ActorCritic, RunningNorm
+from pointnav_core.policies.recurrent import RecurrentActorCritic
 
 __all__ = ["CHECKPOINT_SUFFIX", "FORMAT", "FORMAT_VERSION", "Checkpoint", "load_checkpoint", "save_checkpoint"]
 
@@ -43,6 +44,8 @@ CHECKPOINT_SUFFIX = ".pt"
 #: What a checkpoint's ``format`` entry says, and the layout's version.
 FORMAT, FORMAT_VERSION = "pointnav_core.checkpoint", 1
 _NETWORK_KEYS = ("n_obs", "n_actions", "width", "continuous")
+#: A recurrent network's shape adds its LSTM's units (files without it are feed-forward).
+_RECURRENT_KEYS = (*_NETWORK_KEYS, "memory")
 
 
 @dataclasses.dataclass(frozen=True)
@@ -53,14 +56,15 @@ class Checkpoint:
     ----------
     path : str
         The file it was read from.
-    agent : ActorCritic
+    agent : ActorCritic or RecurrentActorCritic
         The network, with its weights (evaluation mode).
     obs_norm : RunningNorm
         The observation statistics the network was trained with.
     env_config : EnvConfig
         The env config it was trained with.
     network : dict
-        ``n_obs``, ``n_actions``, ``width``, ``continuous``.
+        ``n_obs``, ``n_actions``, ``width``, ``continuous``, and a recurrent network's
+        ``memory`` (its LSTM's units).
     step : int
         Env steps trained.
     version : str
@@ -72,7 +76,7 @@ class Checkpoint:
     """
 
     path: str
-    agent: ActorCritic
+    agent: Any
     obs_norm: RunningNorm
     env_config: EnvConfig
     network: dict[str, Any]
@@ -84,7 +88,7 @@ class Checkpoint:
 
 def save_checkpoint(
     path: str | os.PathLike[str],
-    agent: ActorCritic,
+    agent: Any,
     obs_norm: RunningNorm,
     env_config: EnvConfig,
     step: int,
@@ -96,7 +100,7 @@ def save_checkpoint(
     Parameters
     ----------
     path : str or os.PathLike
-    agent : ActorCritic
+    agent : ActorCritic or RecurrentActorCritic
     obs_norm : RunningNorm
     env_config : EnvConfig
     step : int
@@ -166,11 +170,12 @@ def load_checkpoint(path: str | os.PathLike[str]) -> Checkpoint:
     if missing:
         raise bad(f"entries {missing} are missing")
     network = data["network"]
-    if not isinstance(network, dict) or sorted(network) != sorted(_NETWORK_KEYS):
-        raise bad(f"'network' must hold {list(_NETWORK_KEYS)}, got {network!r}")
+    if not isinstance(network, dict) or sorted(network) not in (sorted(_NETWORK_KEYS), sorted(_RECURRENT_KEYS)):
+        raise bad(f"'network' must hold {list(_NETWORK_KEYS)} (and 'memory', when recurrent), got {network!r}")
     try:
         config = EnvConfig.from_dict(json.loads(data["env_config"]))
-        agent = ActorCritic(network["n_obs"], network["n_actions"], network["width"], network["continuous"])
+        shape = (network["n_obs"], network["n_actions"], network["width"], network["continuous"])
+        agent: Any = RecurrentActorCritic(*shape, network["memory"]) if "memory" in network else ActorCritic(*shape)
         agent.load_state_dict(data["state_dict"])
         obs_norm = RunningNorm((int(network["n_obs"]),))
         obs_norm.load_state_dict(data["obs_norm"])

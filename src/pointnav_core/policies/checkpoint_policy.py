@@ -3,7 +3,8 @@
 :class:`CheckpointPolicy` is the policy factory :func:`pointnav_core.evaluation.run.evaluate`
 plays a checkpoint with: its env config is the checkpoint's own (unless the caller gives
 one), and it acts deterministically (the most likely discrete action, or the Gaussian's
-mean). The file is read once per process; the factory itself pickles as its path, so
+mean). A recurrent network starts each episode with a zero state and carries it from step
+to step. The file is read once per process; the factory itself pickles as its path, so
 worker processes load it themselves.
 """
 
@@ -85,11 +86,17 @@ class CheckpointPolicy:
 
         ckpt = self.checkpoint
         agent, norm, continuous = ckpt.agent, ckpt.obs_norm, ckpt.network["continuous"]
+        # A recurrent network's memory of this episode (a factory call is one episode).
+        memory = {"state": agent.initial_state(1), "first": torch.ones(1, dtype=torch.bool)} if "memory" in ckpt.network else None
 
         def act(obs: Any) -> Any:
-            x = torch.as_tensor(np.asarray(obs, dtype=np.float32)).reshape(1, -1)
+            x = norm.normalize(torch.as_tensor(np.asarray(obs, dtype=np.float32)).reshape(1, -1))
             with torch.no_grad():
-                action = agent.greedy(norm.normalize(x))[0]
+                if memory is None:
+                    action = agent.greedy(x)[0]
+                else:
+                    out, memory["state"] = agent.greedy(x, memory["state"], memory["first"])
+                    action, memory["first"] = out[0], torch.zeros(1, dtype=torch.bool)
             return action.numpy().astype(np.float32) if continuous else int(action)
 
         return act

@@ -4,8 +4,9 @@
 tanh layers of ``width`` units, orthogonal initialisation. With discrete actions the actor
 gives the logits of a categorical distribution; with continuous ones the mean of a
 diagonal Gaussian whose log standard deviation is a learned vector that does not depend on
-the observation (CleanRL's and SB3's choice). It is feed-forward, without memory: see
-``docs/decisions.md``, "Issue 32: training".
+the observation (CleanRL's and SB3's choice). It is feed-forward, without memory; the
+recurrent one is :class:`~pointnav_core.policies.recurrent.RecurrentActorCritic` (see
+``docs/decisions.md``, "Issue 32: training").
 
 :class:`RunningNorm` keeps the running mean and variance of observations (and of the
 discounted return, for the reward scale), as SB3's ``VecNormalize`` does.
@@ -21,7 +22,7 @@ from torch import nn
 
 from pointnav_core.errors import ArgumentError
 
-__all__ = ["ActorCritic", "RunningNorm", "as_tensor", "layer"]
+__all__ = ["ActorCritic", "RunningNorm", "action_distribution", "as_tensor", "greedy_action", "layer"]
 
 
 class RunningNorm:
@@ -106,11 +107,7 @@ class ActorCritic(nn.Module):
 
     def distribution(self, obs: torch.Tensor) -> torch.distributions.Distribution:
         """The policy's action distribution at each (normalised) observation."""
-        out = self.actor(obs)
-        if self.continuous:
-            normal = torch.distributions.Normal(out, self.log_std.exp().expand_as(out))
-            return torch.distributions.Independent(normal, 1)
-        return torch.distributions.Categorical(logits=out)
+        return action_distribution(self.actor(obs), self.log_std if self.continuous else None)
 
     def act(self, obs: torch.Tensor, action: torch.Tensor | None = None) -> tuple[torch.Tensor, ...]:
         """A sampled (or the given) action, its log-probability, the entropy and the value."""
@@ -122,8 +119,23 @@ class ActorCritic(nn.Module):
     def greedy(self, obs: torch.Tensor) -> torch.Tensor:
         """The deterministic action: the most likely one (discrete), or the Gaussian's mean
         clipped to the action bounds ``[-1, 1]`` (continuous)."""
-        out = self.actor(obs)
-        return out.clamp(-1.0, 1.0) if self.continuous else out.argmax(-1)
+        return greedy_action(self.actor(obs), self.continuous)
+
+
+def action_distribution(out: torch.Tensor, log_std: torch.Tensor | None) -> torch.distributions.Distribution:
+    """The actor's output ``out`` as a distribution: a diagonal Gaussian of mean ``out`` and
+    log standard deviation ``log_std`` (continuous actions), or a categorical over the
+    logits ``out`` (``log_std`` None)."""
+    if log_std is not None:
+        normal = torch.distributions.Normal(out, log_std.exp().expand_as(out))
+        return torch.distributions.Independent(normal, 1)
+    return torch.distributions.Categorical(logits=out)
+
+
+def greedy_action(out: torch.Tensor, continuous: bool) -> torch.Tensor:
+    """The deterministic action of the actor's output: the mean clipped to ``[-1, 1]``
+    (continuous), or the most likely action."""
+    return out.clamp(-1.0, 1.0) if continuous else out.argmax(-1)
 
 
 def as_tensor(x: Any) -> torch.Tensor:

@@ -8,6 +8,13 @@ transition, so it is left out of the losses, and a truncated episode bootstraps 
 value of its final observation. Discrete actions (Habitat's) are a categorical; continuous
 ones (velocity commands, clipped to ``[-1, 1]`` by the env) a diagonal Gaussian.
 
+With ``memory`` > 0 the policy is recurrent
+(:class:`~pointnav_core.policies.recurrent.RecurrentActorCritic`, DD-PPO's LSTM core), as in
+CleanRL's ``ppo_atari_lstm``: the rollout carries each world's LSTM state and marks each
+episode's first observation (the one the engine's autoreset step returns), and the update
+replays whole worlds' sequences from the state they started the rollout with, so that
+minibatches are sets of worlds rather than of samples.
+
 :class:`PPO` keeps what training needs between rollouts (the network, the optimiser, the
 statistics, the step count) so that ``pointnav train`` can save it and resume;
 :func:`train` runs it to a step budget (``examples/ppo_vector.py`` calls it).
@@ -25,6 +32,7 @@ from torch import nn
 
 from pointnav_core.errors import ArgumentError
 from pointnav_core.policies.network import ActorCritic, RunningNorm, as_tensor
+from pointnav_core.policies.recurrent import RecurrentActorCritic
 from pointnav_core.utils import validation
 
 __all__ = ["PPO", "PPOSettings", "train"]
@@ -54,6 +62,9 @@ class PPOSettings:
         Gradient norm clip.
     width : int
         Units per hidden layer of the actor and of the critic.
+    memory : int
+        Units of the recurrent policy's LSTM; 0 (the default): the feed-forward MLP. A
+        recurrent update's minibatches are ``max(1, minibatch // num_steps)`` worlds.
     seed : int
         Seeds the network, the sampling and the env.
     """
@@ -70,13 +81,14 @@ class PPOSettings:
     vf_coef: float = 0.5
     max_grad_norm: float = 0.5
     width: int = 256
+    memory: int = 0
     seed: int = 0
 
     def __post_init__(self) -> None:
         for f in dataclasses.fields(self):
             value = getattr(self, f.name)
             if f.type == "int":
-                minimum = 0 if f.name == "seed" else 1
+                minimum = 0 if f.name in ("seed", "memory") else 1
                 setattr(self, f.name, validation.integer(f.name, value, minimum=minimum))
             else:
                 strict = f.name in ("lr", "clip", "max_grad_norm")
@@ -104,7 +116,11 @@ class PPO:
         space = env.single_action_space
         continuous = not hasattr(space, "n")
         n_actions = int(space.shape[0]) if continuous else int(space.n)
-        self.agent = ActorCritic(n_obs, n_actions, settings.width, continuous)
+        self.recurrent = settings.memory > 0
+        self.agent: Any = (
+            RecurrentActorCritic(n_obs, n_actions, settings.width, continuous, settings.memory)
+            if self.recurrent else ActorCritic(n_obs, n_actions, settings.width, continuous)
+        )
         self.opt = torch.optim.Adam(self.agent.parameters(), lr=settings.lr, eps=1e-5)
         self.obs_norm, self.ret_norm = RunningNorm((n_obs,)), RunningNorm(())
         self.steps = 0
@@ -130,11 +146,17 @@ class PPO:
         buf = {k: torch.zeros((t_len, n)) for k in ("logp", "value", "reward", "term", "done", "valid")}
         buf["obs"] = torch.zeros((t_len, n, n_obs))
         ended = {"n": 0.0, "success": 0.0, "spl": 0.0, "return": 0.0}
+        if self.recurrent:  # the state each world starts the rollout with, to replay it from
+            buf["first"], buf["state"] = torch.zeros((t_len, n)), tuple(x.clone() for x in self.state)
         for t in range(t_len):
             self.obs_norm.update(obs)
             buf["obs"][t] = obs
             with torch.no_grad():
-                action, logp, _, value = agent.act(self.obs_norm.normalize(obs))
+                if self.recurrent:
+                    buf["first"][t] = self.first.float()
+                    action, logp, _, value, self.state = agent.act(self.obs_norm.normalize(obs), self.state, self.first)
+                else:
+                    action, logp, _, value = agent.act(self.obs_norm.normalize(obs))
             if t == 0:
                 buf["action"] = torch.zeros((t_len, *action.shape), dtype=action.dtype)
             sent = action.to(env.arrays.device) if env.arrays.is_torch else action.numpy()
@@ -143,6 +165,7 @@ class PPO:
             reward, term, trunc = as_tensor(reward).double(), as_tensor(term), as_tensor(trunc)
             done = term | trunc
             valid_now = ~as_tensor(info["autoreset"])
+            self.first = ~valid_now  # an autoreset step returns the next episode's first observation
             self.ret = torch.where(valid_now, self.ret * cfg.gamma + reward, self.ret)
             self.ep_ret = torch.where(valid_now, self.ep_ret + reward, self.ep_ret)
             self.ret_norm.update(self.ret[valid_now] if valid_now.any() else self.ret)
@@ -166,8 +189,12 @@ class PPO:
         t_len, n, n_obs = buf["obs"].shape
         with torch.no_grad():
             norm_all = self.obs_norm.normalize(buf["obs"].reshape(-1, n_obs)).reshape(t_len, n, n_obs)
-            values = self.agent.value(norm_all)
-            next_value = self.agent.value(self.obs_norm.normalize(obs))
+            if self.recurrent:
+                _, _, values, state = self.agent.evaluate(norm_all, buf["state"], buf["first"], buf["action"])
+                next_value = self.agent.value(self.obs_norm.normalize(obs), state, self.first)
+            else:
+                values = self.agent.value(norm_all)
+                next_value = self.agent.value(self.obs_norm.normalize(obs))
         adv = torch.zeros((t_len, n))
         gae = torch.zeros(n)
         for t in reversed(range(t_len)):
@@ -179,6 +206,9 @@ class PPO:
 
     def learn(self, buf: dict[str, Any], norm_all: torch.Tensor, adv: torch.Tensor, returns: torch.Tensor) -> None:
         """PPO's clipped-objective epochs over the rollout's valid transitions."""
+        if self.recurrent:
+            self._learn_sequences(buf, norm_all, adv, returns)
+            return
         cfg, agent = self.settings, self.agent
         n_obs = norm_all.shape[-1]
         keep = buf["valid"].reshape(-1) > 0  # a reset step carries no transition
@@ -191,16 +221,41 @@ class PPO:
             for i in range(0, size, cfg.minibatch):
                 mb = perm[i : i + cfg.minibatch]
                 _, logp, entropy, value = agent.act(b_obs[mb], b_act[mb])
-                ratio = torch.exp(logp - b_logp[mb])
-                a = b_adv[mb]
-                a = (a - a.mean()) / (a.std() + 1e-8)
-                pg = torch.max(-a * ratio, -a * ratio.clamp(1 - cfg.clip, 1 + cfg.clip)).mean()
-                v_loss = 0.5 * ((value - b_ret[mb]) ** 2).mean()
-                loss = pg + cfg.vf_coef * v_loss - cfg.ent_coef * entropy.mean()
-                self.opt.zero_grad()
-                loss.backward()
-                nn.utils.clip_grad_norm_(agent.parameters(), cfg.max_grad_norm)
-                self.opt.step()
+                self._gradient_step(logp, entropy, value, b_logp[mb], b_adv[mb], b_ret[mb])
+
+    def _learn_sequences(self, buf: dict[str, Any], norm_all: torch.Tensor, adv: torch.Tensor,
+                         returns: torch.Tensor) -> None:
+        """:meth:`learn` for the recurrent policy: minibatches of whole worlds, each replayed
+        from its rollout's first state, the losses over its valid transitions."""
+        cfg, n = self.settings, norm_all.shape[1]
+        worlds = max(1, cfg.minibatch // cfg.num_steps)
+        h0, c0 = buf["state"]
+        for _ in range(cfg.epochs):
+            perm = torch.randperm(n)
+            for i in range(0, n, worlds):
+                mb = perm[i : i + worlds]
+                keep = buf["valid"][:, mb] > 0
+                if not keep.any():
+                    continue
+                logp, entropy, value, _ = self.agent.evaluate(
+                    norm_all[:, mb], (h0[:, mb], c0[:, mb]), buf["first"][:, mb], buf["action"][:, mb]
+                )
+                self._gradient_step(logp[keep], entropy[keep], value[keep], buf["logp"][:, mb][keep],
+                                    adv[:, mb][keep], returns[:, mb][keep])
+
+    def _gradient_step(self, logp: torch.Tensor, entropy: torch.Tensor, value: torch.Tensor, old_logp: torch.Tensor,
+                       adv: torch.Tensor, ret: torch.Tensor) -> None:
+        """One Adam step on PPO's loss over a minibatch (the advantages standardised in it)."""
+        cfg = self.settings
+        ratio = torch.exp(logp - old_logp)
+        a = (adv - adv.mean()) / (adv.std() + 1e-8)
+        pg = torch.max(-a * ratio, -a * ratio.clamp(1 - cfg.clip, 1 + cfg.clip)).mean()
+        v_loss = 0.5 * ((value - ret) ** 2).mean()
+        loss = pg + cfg.vf_coef * v_loss - cfg.ent_coef * entropy.mean()
+        self.opt.zero_grad()
+        loss.backward()
+        nn.utils.clip_grad_norm_(self.agent.parameters(), cfg.max_grad_norm)
+        self.opt.step()
 
     def start(self, env: Any, seed: int | None = None) -> torch.Tensor:
         """Reset ``env`` (seeded with ``seed``, default the settings' seed) and the
@@ -208,6 +263,9 @@ class PPO:
         obs, _ = env.reset(seed=self.settings.seed if seed is None else seed)
         self.ret = torch.zeros(env.num_envs, dtype=torch.float64)  # discounted, for the reward scale
         self.ep_ret = torch.zeros(env.num_envs, dtype=torch.float64)  # undiscounted, reported
+        self.first = torch.ones(env.num_envs, dtype=torch.bool)  # each world's observation begins an episode
+        if self.recurrent:
+            self.state = self.agent.initial_state(env.num_envs)
         return as_tensor(obs).float()
 
     def update(self, env: Any, obs: torch.Tensor) -> tuple[torch.Tensor, dict[str, float]]:
@@ -223,8 +281,8 @@ class PPO:
 
 
 def train(
-    env: Any, cfg: PPOSettings, log: Callable[[dict[str, float], ActorCritic, RunningNorm], bool] | None = None
-) -> tuple[ActorCritic, RunningNorm]:
+    env: Any, cfg: PPOSettings, log: Callable[[dict[str, float], Any, RunningNorm], bool] | None = None
+) -> tuple[Any, RunningNorm]:
     """Train a PPO agent on a ``VectorPointNavEnv`` for ``cfg.total_steps`` steps.
 
     Parameters
@@ -239,7 +297,8 @@ def train(
     Returns
     -------
     agent, obs_norm
-        The policy and the observation statistics it was trained with.
+        The policy (an ``ActorCritic``, or a ``RecurrentActorCritic`` with ``cfg.memory``)
+        and the observation statistics it was trained with.
     """
     ppo = PPO(env, cfg)
     obs = ppo.start(env)
