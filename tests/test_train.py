@@ -266,7 +266,8 @@ def test_evaluate_plays_a_checkpoint_with_its_own_config(scan_run, room) -> None
         evaluate(episodes, best, scenes_root=str(room), max_steps=50)
 
 
-def test_the_example_config_reads_and_fits_the_shipped_validation_set(monkeypatch) -> None:
+@pytest.mark.parametrize(("name", "memory"), [("train_scan.yaml", 0), ("train_scan_lstm.yaml", 128)])
+def test_the_example_config_reads_and_fits_the_shipped_validation_set(monkeypatch, name, memory) -> None:
     from pathlib import Path
 
     from pointnav_core.training.config import TrainConfig
@@ -274,6 +275,7 @@ def test_the_example_config_reads_and_fits_the_shipped_validation_set(monkeypatc
 
     root = Path(__file__).resolve().parents[1]
     monkeypatch.chdir(root)  # its paths are relative to the repository's root
-    config = TrainConfig.load(root / "examples" / "train_scan.yaml")
+    config = TrainConfig.load(root / "examples" / name)
     assert config.policy_config().sensors == {"scan": {"n_rays": 64}} and config.path_range == (1.0, 30.0)
+    assert config.ppo.memory == memory
     assert len(heldout_episodes(config)) == 60  # every 5th of the 300, the robot radius checked
