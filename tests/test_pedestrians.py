@@ -91,6 +91,28 @@ def test_pedestrians_walk_and_never_enter_a_wall(behaviour: str) -> None:
     assert len(goals) > 8  # and draw new goals when they arrive
 
 
+@pytest.mark.parametrize("behaviour", ["orca", "static_velocity"])
+def test_a_waypoint_nearer_than_a_step_is_landed_on_not_overshot_into_a_wall(behaviour: str) -> None:
+    """Beside the east wall (free for a 0.2 m disc up to x = 5.7 m), a pedestrian 0.05 m from
+    its next waypoint, whose following one it cannot see, walks at 1 m/s: its preferred
+    velocity would carry it 0.1 m, into the wall. It lands on the waypoint instead (half its
+    speed for the step), keeping its path, rather than standing still to plan again."""
+    chosen = "orca" if behaviour == "orca" else (lambda view: view.preferred)
+    env = env_in(room(60, 40, boxes=0), pedestrians={"count": 1, "speed": 1.0, "radius": 0.2, "behaviour": chosen,
+                                                      "sees_robots": False},
+                 task={"initial_pos": [1.0, 2.0], "initial_quat": [0.0, 0.0, 0.0, 1.0], "goal_pos": [3.0, 2.0]})
+    env.reset(seed=0)
+    crowd_of_one(env, (5.64, 2.0), 0.2)
+    crowd = env.crowd
+    crowd.speed = np.array([1.0])
+    waypoint, hidden = (5.69, 2.0), (5.95, 2.0)  # the one after it lies in the wall: never in sight
+    crowd.set_route(0, [(5.64, 2.0), waypoint, hidden])
+    env.step(np.zeros(2))
+    np.testing.assert_allclose(crowd.positions[0], waypoint, atol=1e-12)
+    np.testing.assert_allclose(crowd.velocities[0], [0.5, 0.0], atol=1e-12)
+    assert tuple(crowd.goals[0]) == hidden  # no new plan, no new goal
+
+
 # ---------------------------------------------------------------------- the robot's side
 def crowd_of_one(env: PointNavEnv, xy: tuple[float, float], radius: float) -> None:
     """Make the env's crowd one standing pedestrian at ``xy``."""

@@ -5,7 +5,7 @@ Imported only through ``utils.compiled.kernel``, so the package imports without 
 call does what the crowd's numpy path does in a dozen array operations and three calls of
 other compiled functions, each with its Python set-up: passing waypoints (the wall test of
 ``floor._collision_kernel``), the preferred velocities, ORCA (``crowds._orca_kernel``, in
-RVO2's float32), the wall rule, the new positions, the arrivals and the robots' contacts.
+RVO2's float32), the wall rule (with its landing on the next waypoint), the new positions, the arrivals and the robots' contacts.
 Every statement is the numpy path's in the same order and precision, so the two give the
 same floats (``tests/pairs_crowds.py``); the headings (``atan2``) are left to numpy, whose
 ``arctan2`` and the C library's can differ in the last bit.
@@ -64,6 +64,17 @@ def _preferred(pos, speed, paths, nxt, last, dt, walls, pref):  # pragma: no cov
         else:
             pref[i, 0] = 0.0
             pref[i, 1] = 0.0
+
+
+@_jit
+def _landing(px, py, wx, wy, speed, dt):  # pragma: no cover
+    # Crowd.landing for one pedestrian: toward (wx, wy), no faster than reaches it in dt.
+    dx, dy = wx - px, wy - py
+    dist = np.sqrt(dx * dx + dy * dy)
+    if not dist > 0:
+        return 0.0, 0.0
+    s = min(speed, dist / dt)
+    return dx * (s / dist), dy * (s / dist)
 
 
 @_jit
@@ -154,7 +165,8 @@ def orca_crowd_step(pos, vel, radius, speed, goals, paths, nxt, last, robots, ro
     _preferred(pos, speed, paths, nxt, last, dt, walls, pref)
     vel32 = _orca_velocities(pos, vel, pref, radius, speed, robots, robot_vel, m, dt, neighbor_dist,
                              max_neighbors, time_horizon)
-    # The wall rule: ORCA's velocity, else the preferred one, else stand still.
+    # The wall rule: ORCA's velocity, else the preferred one, else onto the next waypoint
+    # and no farther (Crowd.landing), else stand still.
     for i in range(n):
         px, py = pos[i, 0], pos[i, 1]
         vx, vy = np.float64(vel32[0, i, 0]), np.float64(vel32[0, i, 1])
@@ -164,7 +176,10 @@ def orca_crowd_step(pos, vel, radius, speed, goals, paths, nxt, last, robots, ro
             vx, vy = pref[i, 0], pref[i, 1]
             qx, qy = px + vx * dt, py + vy * dt
             if not _clear(qx, qy, qx, qy, walls):
-                vx, vy, bit = 0.0, 0.0, 1
+                vx, vy = _landing(px, py, paths[i, nxt[i], 0], paths[i, nxt[i], 1], speed[i], dt)
+                qx, qy = px + vx * dt, py + vy * dt
+                if not _clear(qx, qy, qx, qy, walls):
+                    vx, vy, bit = 0.0, 0.0, 1
         new_vel[i, 0], new_vel[i, 1] = vx, vy
         if bit:
             new_pos[i, 0], new_pos[i, 1] = px, py

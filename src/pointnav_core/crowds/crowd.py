@@ -13,8 +13,11 @@ crowd's largest radius), and advances them one control step at a time:
    the social force model (:func:`social_force_step`, pysocialforce's, pulled toward the
    next waypoint), ``"static"`` (they never move) or the user's callable;
 3. every pedestrian moves by its velocity for the step, unless that would take a disc of the
-   crowd's largest radius into a wall: then it takes its preferred velocity instead, and if
-   that too is blocked it stands still for the step and plans again from where it is (ORCA
+   crowd's largest radius into a wall: then it takes its preferred velocity instead; if
+   that too is blocked, a step onto its next waypoint and no farther (the preferred
+   velocity overshoots a waypoint nearer than a step, which it may not pass while the one
+   after is out of sight, as at a corner's arc); and if that too is blocked it stands
+   still for the step and plans again from where it is (ORCA
    here has no wall lines; the paths keep that radius plus
    :data:`~pointnav_core.crowds.config.PATH_MARGIN` from the walls, and a push by a
    neighbour is undone by the new plan);
@@ -319,6 +322,15 @@ class Crowd:
         with np.errstate(invalid="ignore", divide="ignore"):
             return np.where(dist[:, None] > 0, delta * (speed / dist)[:, None], 0.0)
 
+    def landing(self, dt: float) -> NDArray[np.float64]:
+        """``(P, 2)`` velocities (m/s) toward each next waypoint at the preferred speeds, but
+        no faster than reaches it in ``dt`` s: the wall rule's last try before standing."""
+        delta = self._paths[np.arange(self.n), self._next] - self.positions
+        dist = np.linalg.norm(delta, axis=1)
+        speed = np.minimum(self.speed, dist / dt)
+        with np.errstate(invalid="ignore", divide="ignore"):
+            return np.where(dist[:, None] > 0, delta * (speed / dist)[:, None], 0.0)
+
     def step(self, dt: float, robots: NDArray[np.float64], robot_velocities: NDArray[np.float64]) -> None:
         """Advance the crowd by ``dt`` s beside the ``(M, 3)`` robot discs ``robots`` moving
         at ``(M, 2)`` ``robot_velocities`` (see the module notes)."""
@@ -378,6 +390,9 @@ class Crowd:
         blocked = ~np.asarray(tmap.is_usable(self.positions + vel * dt, cfg.radius[1]))
         if blocked.any():  # ORCA knows no walls: its way there is the path's way
             vel[blocked] = pref[blocked]
+            blocked &= ~np.asarray(tmap.is_usable(self.positions + vel * dt, cfg.radius[1]))
+        if blocked.any():  # onto the next waypoint, no farther
+            vel[blocked] = self.landing(dt)[blocked]
             blocked &= ~np.asarray(tmap.is_usable(self.positions + vel * dt, cfg.radius[1]))
             vel[blocked] = 0.0
         new = np.where(blocked[:, None], self.positions, self.positions + vel * dt)
