@@ -153,11 +153,31 @@ def check_crowd_step(
                    "orca": {"max_neighbors": max_neighbors, "time_horizon": time_horizon}}
     # Every step of the compiled side goes through the kernel (else the check compares the
     # numpy path with itself).
-    with mock.patch.object(Crowd, "_step_compiled", autospec=True, side_effect=Crowd._step_compiled) as compiled:
+    plan, plans = Crowd._plan, []
+
+    def recorded(crowd: Crowd, i: int, *args: object) -> np.ndarray:
+        plans.append((i, path := plan(crowd, i, *args)))
+        return path
+
+    with mock.patch.object(Crowd, "_step_compiled", autospec=True, side_effect=Crowd._step_compiled) as compiled, \
+            mock.patch.object(Crowd, "_plan", recorded):
         got = _crowd_rollout(seed, house, pedestrians, steps)
     assert compiled.call_count == steps
-    with plain_paths():
+
+    # The plain side plans with the plain geometry, whose drawn paths may differ from the
+    # compiled ones in the last bit (pairs_geodesic holds them within 1e-9 m), and a
+    # pedestrian can land exactly on a waypoint: it walks the compiled side's plans, once
+    # they are checked equal to its own, so that the crowd's step is compared bit for bit.
+    def replayed(crowd: Crowd, i: int, *args: object) -> np.ndarray:
+        own = plan(crowd, i, *args)
+        j, path = plans.pop(0)
+        assert j == i and own.shape == path.shape
+        np.testing.assert_allclose(own, path, rtol=0, atol=1e-9)
+        return path.copy()
+
+    with plain_paths(), mock.patch.object(Crowd, "_plan", replayed):
         assert kernel(*CROWD_KERNEL) is None
         want = _crowd_rollout(seed, house, pedestrians, steps)
+    assert plans == []
     np.testing.assert_array_equal(got, want)
     assert kernel(*CROWD_KERNEL) is not None

@@ -5,7 +5,8 @@ Imported only through ``utils.compiled.kernel``, so the package imports without 
 call does what the crowd's numpy path does in a dozen array operations and three calls of
 other compiled functions, each with its Python set-up: passing waypoints (the wall test of
 ``floor._collision_kernel``), the preferred velocities, ORCA (``crowds._orca_kernel``, in
-RVO2's float32), the wall rule (with its landing on the next waypoint), the new positions, the arrivals and the robots' contacts.
+RVO2's float32), the wall rule (with its landing on the next waypoint), the new positions,
+the arrivals and the robots' contacts.
 Every statement is the numpy path's in the same order and precision, so the two give the
 same floats (``tests/pairs_crowds.py``); the headings (``atan2``) are left to numpy, whose
 ``arctan2`` and the C library's can differ in the last bit.

@@ -87,7 +87,9 @@ class CheckpointPolicy:
         ckpt = self.checkpoint
         agent, norm, continuous = ckpt.agent, ckpt.obs_norm, ckpt.network["continuous"]
         # A recurrent network's memory of this episode (a factory call is one episode).
-        memory = {"state": agent.initial_state(1), "first": torch.ones(1, dtype=torch.bool)} if "memory" in ckpt.network else None
+        memory = None
+        if "memory" in ckpt.network:
+            memory = {"state": agent.initial_state(1), "first": torch.ones(1, dtype=torch.bool)}
 
         def act(obs: Any) -> Any:
             x = norm.normalize(torch.as_tensor(np.asarray(obs, dtype=np.float32)).reshape(1, -1))
