@@ -316,18 +316,19 @@ class Crowd:
             # path must not cut a corner into a wall.
             ahead = self._paths[near, self._next[near] + 1]
             self._next[near] += collision.segments_clear(self.positions[near], ahead, radius)
-        delta = self._paths[rows, self._next] - self.positions
-        dist = np.linalg.norm(delta, axis=1)
-        speed = np.where(self._next == self._last, np.minimum(self.speed, dist / dt), self.speed)
-        with np.errstate(invalid="ignore", divide="ignore"):
-            return np.where(dist[:, None] > 0, delta * (speed / dist)[:, None], 0.0)
+        return self._toward_next(dt, self._next == self._last)
 
     def landing(self, dt: float) -> NDArray[np.float64]:
         """``(P, 2)`` velocities (m/s) toward each next waypoint at the preferred speeds, but
         no faster than reaches it in ``dt`` s: the wall rule's last try before standing."""
+        return self._toward_next(dt, True)
+
+    def _toward_next(self, dt: float, stop: Any) -> NDArray[np.float64]:
+        """Velocities (m/s) toward each next waypoint at the preferred speeds, no faster than
+        reaches it in ``dt`` s where ``stop`` (a ``(P,)`` mask, or True for all)."""
         delta = self._paths[np.arange(self.n), self._next] - self.positions
         dist = np.linalg.norm(delta, axis=1)
-        speed = np.minimum(self.speed, dist / dt)
+        speed = np.where(stop, np.minimum(self.speed, dist / dt), self.speed)
         with np.errstate(invalid="ignore", divide="ignore"):
             return np.where(dist[:, None] > 0, delta * (speed / dist)[:, None], 0.0)
 

@@ -313,9 +313,10 @@ class PointNavEnv(gym.Env[Any, np.ndarray]):
         episode = (options or {}).get("episode")
         info = self.task.reset(self, episode=episode)
         # An episode's recorded crowd is placed as recorded, in an env without pedestrians too.
-        self.crowd = _crowd.episode_crowd(self._own_crowd, getattr(episode, "pedestrians", None), self.scene)
+        record = getattr(episode, "pedestrians", None)
+        self.crowd = _crowd.episode_crowd(self._own_crowd, record, self.scene)
         if self.crowd is not None:
-            _crowd.spawn_crowd(self, getattr(episode, "pedestrians", None))
+            _crowd.spawn_crowd(self, record)
             self._touched, self._pedestrian_steps = False, 0
             self._track = _crowd.CrowdTrack(self)
             info["pedestrian_collisions"] = 0

@@ -171,11 +171,11 @@ class ArcGraph:
             ok = j >= lo
         node = np.asarray(node, dtype=np.int64)
         side = np.asarray(side, dtype=np.int64)
-        at = self.pos[j[ok]]
-        first, then = (q[ok], at) if forward else (at, q[ok])
-        ok[ok] = self.p.arcs_free(node[ok], side[ok], first, then)
-        cost = np.zeros(len(j))
         at, here = self.pos[j[ok]], q[ok]
+        free = self.p.arcs_free(node[ok], side[ok], *((here, at) if forward else (at, here)))
+        ok[ok] = free
+        cost = np.zeros(len(j))
+        at, here = at[free], here[free]
         cost[ok] = self.p.radius * np.maximum(at - here if forward else here - at, 0.0)
         return np.where(ok, j, -1).astype(np.int64), cost
 
