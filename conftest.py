@@ -10,6 +10,7 @@ else ``dev``.
 import os
 import tempfile
 
+import pytest
 from hypothesis import HealthCheck, settings
 
 # The suite's geometry cache is its own, fresh each run: never a user's, never a stale one.
@@ -27,3 +28,10 @@ settings.register_profile(
 settings.load_profile(
     os.environ.get("HYPOTHESIS_PROFILE", "ci" if os.environ.get("CI") else "dev")
 )
+
+
+def pytest_collection_modifyitems(items: list[pytest.Item]) -> None:
+    """Tests marked ``long`` run first: queued late, one of them ran alone on one worker for
+    minutes at the end of the run while the other core idled (stable sort: the rest keep
+    their order)."""
+    items.sort(key=lambda item: item.get_closest_marker("long") is None)

@@ -213,7 +213,15 @@ CHECKS = {check: [entry for entry, checks in PAIRS.items() if check in checks]
           for checks in PAIRS.values() for check in checks}
 
 
-@pytest.mark.parametrize("check", [pytest.param(check, id=check_id(check)) for check in CHECKS])
+#: The checks that take tens of seconds on CI's cores (``--durations``), run first.
+LONG = {pairs_geodesic.check_way, pairs_geodesic.check_settle, pairs_geodesic.check_exact_query,
+        pairs_scan.check_big_floor, pairs_scan.check_open_scenes}
+
+
+@pytest.mark.parametrize("check", [
+    pytest.param(check, id=check_id(check), marks=[pytest.mark.long] if check in LONG else [])
+    for check in CHECKS
+])
 def test_the_compiled_path_equals_the_plain_one(check: Callable[..., None]) -> None:
     pytest.importorskip("numba", reason="the compiled paths are the `fast` extra")
     check(plain_paths=guarded_plain_paths)

@@ -231,4 +231,4 @@ class MultiRobotEpisodes(RuleBasedStateMachine):
 MultiRobotEpisodes.TestCase.settings = settings(
     MultiRobotEpisodes.TestCase.settings, deadline=None, stateful_step_count=25
 )
-TestMultiRobotEpisodes = MultiRobotEpisodes.TestCase
+TestMultiRobotEpisodes = pytest.mark.long(MultiRobotEpisodes.TestCase)

@@ -106,6 +106,7 @@ def _valid_log(path: Path) -> int:
     return sum(1 for line in lines[1:] if json.loads(line)["episode_id"] is not None)
 
 
+@pytest.mark.long
 @pytest.mark.skipif(not Path("/proc/self/stat").exists(), reason="reads /proc")
 def test_signals_at_random_moments_lose_nothing(work, tmp_path):
     """SIGINT (to the process group, as Ctrl-C), SIGTERM and SIGKILL, with 1 and 2 workers,
@@ -164,13 +165,15 @@ def test_signals_at_random_moments_lose_nothing(work, tmp_path):
             if r["proc"].stderr is not None:
                 with r["proc"].stderr as pipe:
                     err = pipe.read()
+            # A signal in the interpreter's last moments, after the work is done and Python has
+            # put the default handlers back, ends it by that signal (-sig), not by 130.
             if "old" in r:  # dataset generate: the old file, or the whole new one
-                assert rc in (0, 130, -9), r["ready"].read_text()
+                assert rc in (0, 130, -9, -r["sig"]), r["ready"].read_text()
                 EpisodeDataset.load(r["old"])
-                if rc != 0:
+                if rc == 130:
                     assert r["old"].read_bytes() == dataset.read_bytes()
                 continue
-            assert rc in ((-9,) if r["sig"] == signal.SIGKILL else (130,)) or rc == 0, err
+            assert rc in ((-9,) if r["sig"] == signal.SIGKILL else (130, -r["sig"])) or rc == 0, err
             if rc == 130 and r["ready"].exists():  # else the signal came after the results were written
                 assert err.count("\n") == 1 and f"interrupted by {r['sig'].name}" in err and "--resume" in err
             if r["ready"].exists():
