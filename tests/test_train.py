@@ -221,6 +221,23 @@ def test_train_then_eval_continuous_and_resume(room, monkeypatch, capsys) -> Non
     assert load_checkpoint(room / "cont_run" / "latest.pt").step == 768
 
 
+@pytest.mark.parametrize("building", [False, True])
+def test_refresh_every_starts_a_refresh_only_when_none_is_building(room, tmp_path, monkeypatch, building) -> None:
+    """``engine.refresh_every: 256`` over 1,024 steps, 256 an update (16 worlds x 16 steps):
+    a refresh after each of the 4 updates, or only the first while a build never finishes
+    (the learner does not wait for it)."""
+    from pointnav_core.vector.env import VectorPointNavEnv
+
+    calls = []
+    monkeypatch.setattr(VectorPointNavEnv, "refresh_pool", lambda self, wait=False: calls.append(wait))
+    monkeypatch.setattr(VectorPointNavEnv, "refresh_pending", property(lambda self: building and bool(calls)))
+    monkeypatch.chdir(room)
+    config = _train_config(str(tmp_path / "run"), SCAN, total_steps=1024, eval_every=1024)
+    config["engine"]["refresh_every"] = 256
+    assert main(["train", "--config", _write(tmp_path / "r.yaml", config), "--quiet"]) == 0
+    assert calls == ([False] if building else [False] * 4)
+
+
 def test_bad_input_is_refused_naming_what_is_wrong(scan_run, room, monkeypatch, capsys) -> None:
     monkeypatch.chdir(room)
     capsys.readouterr()

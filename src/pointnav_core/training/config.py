@@ -58,7 +58,8 @@ class EngineSettings:
         Episodes per pool goal (default 32).
     refresh_every : int
         Refresh the episode pools (fresh goals, in the background) every this many env
-        steps; 0 never (default).
+        steps, skipping a tick while the last refresh still builds (the learner never
+        waits for a pool); 0 never (default).
     workers : int or None
         Processes that build the pools (default: the engine's choice).
     torch_threads : int

@@ -246,7 +246,9 @@ def _loop(run: _Run, env: Any, bar: Any, echo: Callable[[str], None] | None) -> 
             bar.update(ppo.steps - before)
             n = max(run.acc["n"], 1.0)  # the training episodes since the last evaluation
             bar.set_postfix(train_success=f"{run.acc['success'] / n:.2f}", refresh=False)
-            if refresh and ppo.steps // refresh > before // refresh:
+            # A refresh still building is left to finish: refresh_pool() would wait for it,
+            # and the learner never waits for a pool (the next tick starts the next one).
+            if refresh and ppo.steps // refresh > before // refresh and not env.refresh_pending:
                 env.refresh_pool()
             if ppo.steps // every > before // every or ppo.steps >= config.ppo.total_steps:
                 row = run.evaluate(run.wall0 + time.perf_counter() - start)
