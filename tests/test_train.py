@@ -238,6 +238,27 @@ def test_refresh_every_starts_a_refresh_only_when_none_is_building(room, tmp_pat
     assert calls == ([False] if building else [False] * 4)
 
 
+def test_a_run_with_sampled_actions_evaluates_the_same_with_no_other_argument(room, monkeypatch, capsys) -> None:
+    """``eval_actions: sampled``: the checkpoints carry it, and ``pointnav eval`` of
+    ``best.pt`` gives the trainer's held-out results to the episode, with 1 worker and 2."""
+    monkeypatch.chdir(room)
+    config = _train_config("sampled_run", SCAN, eval_actions="sampled")
+    assert main(["train", "--config", _write(room / "sampled.yaml", config), "--quiet"]) == 0
+    run = room / "sampled_run"
+    assert load_checkpoint(run / "best.pt").actions == "sampled" == load_checkpoint(run / "latest.pt").actions
+    for workers in ("1", "2"):
+        out = f"sampled{workers}.jsonl"
+        assert main(["eval", "--policy", "sampled_run/best.pt", "--dataset", "val.json.gz", "--workers", workers,
+                     "--results", out, "--plot", f"sampled{workers}.png", "--quiet"]) == 0
+        _same_as_trainer(run, room / out)
+    capsys.readouterr()
+    assert main(["eval", "--policy", "oracle", "--dataset", "val.json.gz", "--actions", "sampled", "--quiet"]) == 2
+    assert "sets how a checkpoint .pt acts; policy 'oracle' is not one" in capsys.readouterr().err
+    config["eval_actions"] = "random"
+    assert main(["train", "--config", _write(room / "bad.yaml", config), "--quiet"]) == 2
+    assert "eval_actions must be one of ['greedy', 'sampled'], got 'random'" in capsys.readouterr().err
+
+
 def test_bad_input_is_refused_naming_what_is_wrong(scan_run, room, monkeypatch, capsys) -> None:
     monkeypatch.chdir(room)
     capsys.readouterr()

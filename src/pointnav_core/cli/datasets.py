@@ -129,7 +129,7 @@ def _run_settings(args: argparse.Namespace, scenes_dir: str) -> dict[str, Any]:
     settings = {
         "version": __version__,
         "dataset": os.path.abspath(args.dataset), "dataset_sha256": _sha256(args.dataset),
-        "policy": args.policy, "sb3_algo": args.sb3_algo, "backend": args.backend,
+        "policy": args.policy, "actions": args.actions, "sb3_algo": args.sb3_algo, "backend": args.backend,
         "drive": args.drive, "max_steps": args.max_steps, "scenes_dir": os.path.abspath(scenes_dir),
         "limit": args.limit, "stride": args.stride,
         "env_config": None if args.config is None else args.config.to_dict(),
@@ -231,7 +231,7 @@ def _eval(args: argparse.Namespace) -> int:
     if os.getcwd() not in sys.path:  # MODULE:CALLABLE from here, as `python -m` would find it
         sys.path.insert(0, os.getcwd())
     args.limit, args.stride = _count("--limit", args.limit), _count("--stride", args.stride)
-    factory = make_policy(args.policy, args.sb3_algo, args.trust_policy_file)
+    factory = make_policy(args.policy, args.sb3_algo, args.trust_policy_file, args.actions)
     _env_config(args, factory)
     inputs = [args.dataset] + ([args.policy] if args.policy.endswith((".zip", ".pt")) else [])
     inputs += [args.env_config] if args.env_config is not None else []
@@ -256,7 +256,7 @@ def _eval(args: argparse.Namespace) -> int:
     try:
         evaluate(
             [ep for ep in episodes if ep.episode_id not in done],
-            args.policy,
+            args.policy if args.actions is None else factory,  # the factory carries --actions
             **settings,
             workers=args.workers,
             scenes_root=scenes_dir,
@@ -439,6 +439,11 @@ def _add_eval(sub: Any, positive_int: Callable[[str], int]) -> None:
     )
     ev.add_argument(
         "--sb3-algo", default="PPO", help="algorithm class of an SB3 .zip (default PPO)"
+    )
+    ev.add_argument(
+        "--actions", choices=("greedy", "sampled"), default=None,
+        help="how a checkpoint .pt acts: its most likely action, or one drawn from its distribution with a "
+        "generator seeded by the episode (default: the checkpoint's own, set by pointnav train's eval_actions)",
     )
     ev.add_argument(
         "--env-config",

@@ -96,8 +96,13 @@ class _SB3Policy:
         return lambda obs: model.predict(obs, deterministic=True)[0]
 
 
-def make_policy(spec: str, sb3_algo: str = "PPO", trust_policy_file: bool = False) -> PolicyFactory:
+def make_policy(
+    spec: str, sb3_algo: str = "PPO", trust_policy_file: bool = False, actions: str | None = None
+) -> PolicyFactory:
     """The policy factory named by ``spec`` (see the module notes).
+
+    ``actions`` (``"greedy"`` or ``"sampled"``) sets how a checkpoint ``.pt`` acts, in place
+    of the checkpoint's own setting; it is refused for any other policy.
 
     ``trust_policy_file`` must be True for an SB3 ``.zip``: loading one unpickles Python
     objects stored in it, which can run any code (see the module notes). A checkpoint
@@ -112,6 +117,8 @@ def make_policy(spec: str, sb3_algo: str = "PPO", trust_policy_file: bool = Fals
     """
     if not isinstance(spec, str) or not spec:
         raise ArgumentError(f"policy must be {POLICY_FORMS}, got {spec!r}")
+    if actions is not None and not spec.endswith(CHECKPOINT_SUFFIX):
+        raise ArgumentError(f"actions ({actions!r}) sets how a checkpoint .pt acts; policy {spec!r} is not one")
     if spec in BUILT_IN:
         return BUILT_IN[spec]
     if spec.endswith(CHECKPOINT_SUFFIX):
@@ -121,7 +128,7 @@ def make_policy(spec: str, sb3_algo: str = "PPO", trust_policy_file: bool = Fals
             from pointnav_core.policies.checkpoint_policy import CheckpointPolicy
         except ImportError:
             raise ArgumentError(f"policy {spec!r}: a checkpoint needs torch (pip install 'pointnav-core[vector]')") from None
-        return CheckpointPolicy(spec)
+        return CheckpointPolicy(spec, actions)
     if spec.endswith(".zip"):
         if not os.path.isfile(spec):
             raise ArgumentError(f"policy {spec!r}: no such SB3 .zip file")

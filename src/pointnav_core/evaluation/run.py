@@ -20,8 +20,10 @@ Policies (``policy`` argument, or ``pointnav eval --policy``):
 - a path to a Stable-Baselines3 ``.zip``: the model (``sb3_algo``, PPO by default) acts
   deterministically; it gets the flat observation when its observation space is a ``Box``;
 - a path to a checkpoint ``.pt`` (``pointnav train``'s,
-  :mod:`pointnav_core.policies.checkpoint`): its network acts deterministically (the most
-  likely action, or the mean), in envs built from the env config it carries, unless
+  :mod:`pointnav_core.policies.checkpoint`): its network acts as the checkpoint says,
+  deterministically (the most likely action, or the mean) or by draws seeded with the
+  episode's seed (:mod:`pointnav_core.policies.checkpoint_policy`; ``pointnav eval
+  --actions`` overrides it), in envs built from the env config it carries, unless
   ``env_config`` is given. Loading one runs no code, so it needs no trust flag.
 
 ``limit`` and ``stride`` (``--limit N``, ``--stride K``) play a subset: every ``K``-th

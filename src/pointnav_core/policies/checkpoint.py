@@ -34,6 +34,7 @@ import torch
 
 from pointnav_core.envs.config import EnvConfig
 from pointnav_core.errors import ArgumentError
+from pointnav_core.policies.checkpoint_policy import ACTIONS, check_actions
 from pointnav_core.policies.network import ActorCritic, RunningNorm
 from pointnav_core.policies.recurrent import RecurrentActorCritic
 
@@ -73,6 +74,8 @@ class Checkpoint:
         The optimiser and return statistics (``latest.pt`` of a run), for resuming.
     metrics : dict
         Figures recorded with it (the held-out evaluation's success, SPL, ...).
+    actions : {"greedy", "sampled"}
+        How it acts when played (:data:`~pointnav_core.policies.checkpoint_policy.ACTIONS`; "greedy" for files without the entry).
     """
 
     path: str
@@ -84,6 +87,7 @@ class Checkpoint:
     version: str
     training: dict[str, Any] | None
     metrics: dict[str, float]
+    actions: str = "greedy"
 
 
 def save_checkpoint(
@@ -94,6 +98,7 @@ def save_checkpoint(
     step: int,
     training: Mapping[str, Any] | None = None,
     metrics: Mapping[str, float] | None = None,
+    actions: str = "greedy",
 ) -> None:
     """Write a checkpoint to ``path`` atomically (a reader sees the old file or the new).
 
@@ -109,12 +114,15 @@ def save_checkpoint(
         :meth:`~pointnav_core.training.ppo.PPO.training_state`, for resuming.
     metrics : dict, optional
         Figures to keep with it (plain numbers).
+    actions : {"greedy", "sampled"}
+        How it acts when played (:data:`~pointnav_core.policies.checkpoint_policy.ACTIONS`).
     """
     from pointnav_core import __version__
     from pointnav_core.utils.outputs import atomic_writer
 
     if not isinstance(env_config, EnvConfig):
         raise ArgumentError(f"env_config must be an EnvConfig, got {env_config!r}")
+    check_actions("actions", actions)
     data = {
         "format": FORMAT,
         "format_version": FORMAT_VERSION,
@@ -126,6 +134,7 @@ def save_checkpoint(
         "step": int(step),
         "training": None if training is None else dict(training),
         "metrics": {k: float(v) for k, v in (metrics or {}).items()},
+        "actions": actions,
     }
     with atomic_writer(path, "wb") as fh:
         torch.save(data, fh)
@@ -181,9 +190,12 @@ def load_checkpoint(path: str | os.PathLike[str]) -> Checkpoint:
         obs_norm.load_state_dict(data["obs_norm"])
     except (ValueError, TypeError, KeyError, RuntimeError) as err:
         raise bad(f"{type(err).__name__}: {str(err).splitlines()[0] if str(err) else ''}") from None
+    if data.get("actions", "greedy") not in ACTIONS:
+        raise bad(f"'actions' must be one of {list(ACTIONS)}, got {data.get('actions')!r}")
     agent.eval()
     return Checkpoint(
         path=path, agent=agent, obs_norm=obs_norm, env_config=config, network=dict(network),
         step=int(data["step"]), version=str(data.get("library_version")),
         training=data.get("training"), metrics=dict(data.get("metrics") or {}),
+        actions=data.get("actions", "greedy"),
     )

@@ -2,9 +2,15 @@
 
 :class:`CheckpointPolicy` is the policy factory :func:`pointnav_core.evaluation.run.evaluate`
 plays a checkpoint with: its env config is the checkpoint's own (unless the caller gives
-one), and it acts deterministically (the most likely discrete action, or the Gaussian's
-mean). A recurrent network starts each episode with a zero state and carries it from step
-to step. The file is read once per process; the factory itself pickles as its path, so
+one), and it acts as the checkpoint says (``actions``, which a training run's
+``eval_actions`` sets, or as the caller asks): ``"greedy"``, deterministically (the most
+likely discrete action, or the Gaussian's mean), or ``"sampled"``, an action drawn from the
+policy's distribution by a generator seeded with the episode's seed (the env's
+``np_random_seed``, which :func:`~pointnav_core.evaluation.run.evaluate` sets from the
+episode's ids), so that a sampled episode plays the same in any order, process or worker
+count. A deterministic policy can stall for good where one step of another action would
+free it (docs/decisions.md, "Sampled actions"). A recurrent network starts each episode
+with a zero state and carries it from step to step. The file is read once per process; the factory itself pickles as its path, so
 worker processes load it themselves.
 """
 
@@ -16,8 +22,19 @@ from typing import Any
 import numpy as np
 
 from pointnav_core.envs.config import EnvConfig
+from pointnav_core.errors import ArgumentError
 
-__all__ = ["CheckpointPolicy"]
+__all__ = ["ACTIONS", "CheckpointPolicy", "check_actions"]
+
+#: How a checkpoint acts when played (see the module notes).
+ACTIONS = ("greedy", "sampled")
+
+
+def check_actions(name: str, actions: object) -> str:
+    """``actions`` if it is one of :data:`ACTIONS`; ValueError naming ``name`` otherwise."""
+    if not isinstance(actions, str) or actions not in ACTIONS:
+        raise ArgumentError(f"{name} must be one of {list(ACTIONS)}, got {actions!r}")
+    return actions
 
 
 class CheckpointPolicy:
@@ -27,6 +44,8 @@ class CheckpointPolicy:
     ----------
     path : str
         A checkpoint written by :func:`~pointnav_core.policies.checkpoint.save_checkpoint`.
+    actions : {"greedy", "sampled"}, optional
+        How to act (:data:`ACTIONS`); default: as the checkpoint says.
 
     Raises
     ------
@@ -37,12 +56,13 @@ class CheckpointPolicy:
     #: The checkpoint's networks read the flat observation.
     flat = True
 
-    def __init__(self, path: str) -> None:
+    def __init__(self, path: str, actions: str | None = None) -> None:
         self.path = path
+        self.actions = None if actions is None else check_actions("actions", actions)
         self._checkpoint: Any = None
 
     def __getstate__(self) -> dict[str, Any]:
-        return {"path": self.path, "_checkpoint": None}
+        return {"path": self.path, "actions": self.actions, "_checkpoint": None}
 
     @property
     def checkpoint(self) -> Any:
@@ -86,6 +106,15 @@ class CheckpointPolicy:
 
         ckpt = self.checkpoint
         agent, norm, continuous = ckpt.agent, ckpt.obs_norm, ckpt.network["continuous"]
+        generator = None
+        if (self.actions or ckpt.actions) == "sampled":
+            seed = getattr(getattr(env, "unwrapped", env), "np_random_seed", None)
+            if not isinstance(seed, int) or seed < 0:
+                raise ArgumentError(
+                    f"checkpoint {self.path!r} with sampled actions needs an env reset with an integer "
+                    f"seed (its np_random_seed seeds the draws), got {seed!r}"
+                )
+            generator = torch.Generator().manual_seed(seed)
         # A recurrent network's memory of this episode (a factory call is one episode).
         memory = None
         if "memory" in ckpt.network:
@@ -95,9 +124,10 @@ class CheckpointPolicy:
             x = norm.normalize(torch.as_tensor(np.asarray(obs, dtype=np.float32)).reshape(1, -1))
             with torch.no_grad():
                 if memory is None:
-                    action = agent.greedy(x)[0]
+                    action = agent.greedy(x)[0] if generator is None else agent.sample(x, generator)[0]
                 else:
-                    out, memory["state"] = agent.greedy(x, memory["state"], memory["first"])
+                    step = (memory["state"], memory["first"])
+                    out, memory["state"] = agent.greedy(x, *step) if generator is None else agent.sample(x, *step, generator)
                     action, memory["first"] = out[0], torch.zeros(1, dtype=torch.bool)
             return action.numpy().astype(np.float32) if continuous else int(action)
 

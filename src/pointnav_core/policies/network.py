@@ -22,7 +22,7 @@ from torch import nn
 
 from pointnav_core.errors import ArgumentError
 
-__all__ = ["ActorCritic", "RunningNorm", "action_distribution", "as_tensor", "greedy_action", "layer"]
+__all__ = ["ActorCritic", "RunningNorm", "action_distribution", "as_tensor", "greedy_action", "layer", "sampled_action"]
 
 
 class RunningNorm:
@@ -121,6 +121,11 @@ class ActorCritic(nn.Module):
         clipped to the action bounds ``[-1, 1]`` (continuous)."""
         return greedy_action(self.actor(obs), self.continuous)
 
+    def sample(self, obs: torch.Tensor, generator: torch.Generator) -> torch.Tensor:
+        """An action drawn from the policy's distribution with ``generator`` (see
+        :func:`sampled_action`)."""
+        return sampled_action(self.actor(obs), self.log_std if self.continuous else None, generator)
+
 
 def action_distribution(out: torch.Tensor, log_std: torch.Tensor | None) -> torch.distributions.Distribution:
     """The actor's output ``out`` as a distribution: a diagonal Gaussian of mean ``out`` and
@@ -136,6 +141,16 @@ def greedy_action(out: torch.Tensor, continuous: bool) -> torch.Tensor:
     """The deterministic action of the actor's output: the mean clipped to ``[-1, 1]``
     (continuous), or the most likely action."""
     return out.clamp(-1.0, 1.0) if continuous else out.argmax(-1)
+
+
+def sampled_action(out: torch.Tensor, log_std: torch.Tensor | None, generator: torch.Generator) -> torch.Tensor:
+    """An action of :func:`action_distribution` ``(out, log_std)`` drawn with ``generator``
+    (``Distribution.sample`` takes none): a category with the softmax's probabilities, or
+    the Gaussian's draw clipped to ``[-1, 1]`` as the env clips it."""
+    if log_std is None:
+        return torch.multinomial(torch.softmax(out, -1), 1, generator=generator).squeeze(-1)
+    noise = torch.randn(out.shape, generator=generator, dtype=out.dtype)
+    return (out + log_std.exp() * noise).clamp(-1.0, 1.0)
 
 
 def as_tensor(x: Any) -> torch.Tensor:

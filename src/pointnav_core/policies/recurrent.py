@@ -17,7 +17,7 @@ from __future__ import annotations
 import torch
 from torch import nn
 
-from pointnav_core.policies.network import action_distribution, greedy_action, layer
+from pointnav_core.policies.network import action_distribution, greedy_action, layer, sampled_action
 
 __all__ = ["RecurrentActorCritic", "State"]
 
@@ -105,6 +105,14 @@ class RecurrentActorCritic(nn.Module):
         and the new state."""
         out, state = self.features(obs[None], state, first[None])
         return greedy_action(self.actor(out[0]), self.continuous), state
+
+    def sample(
+        self, obs: torch.Tensor, state: State, first: torch.Tensor, generator: torch.Generator
+    ) -> tuple[torch.Tensor, State]:
+        """An action of one step drawn with ``generator`` (see
+        :func:`~pointnav_core.policies.network.sampled_action`) and the new state."""
+        out, state = self.features(obs[None], state, first[None])
+        return sampled_action(self.actor(out[0]), self.log_std if self.continuous else None, generator), state
 
     def _heads(
         self, out: torch.Tensor, action: torch.Tensor | None

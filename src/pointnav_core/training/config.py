@@ -17,6 +17,10 @@ A YAML or JSON file (:meth:`TrainConfig.load`) with these sections, every field 
     through :func:`pointnav_core.evaluation.run.evaluate` (``pointnav eval``'s code), its subset
     (as ``--limit`` and ``--stride``), worker processes, and the folder its scene paths are
     read from (default the current one, as ``pointnav eval --scenes-dir``).
+``eval_actions``
+    How the checkpoints act when played, in the held-out evaluation and by ``pointnav
+    eval`` (which reads it from the checkpoint): ``"greedy"`` (default) or ``"sampled"``
+    (:mod:`pointnav_core.policies.checkpoint_policy`).
 ``out``
     The output folder (default ``runs/pointnav``).
 ``ppo``
@@ -36,6 +40,7 @@ from typing import Any
 
 from pointnav_core.envs.config import EnvConfig, read_config_file
 from pointnav_core.errors import ArgumentError
+from pointnav_core.policies.checkpoint_policy import check_actions
 from pointnav_core.training.ppo import PPOSettings
 from pointnav_core.utils import validation
 
@@ -111,6 +116,7 @@ class TrainConfig:
     eval_limit: int | None = None
     eval_stride: int = 1
     eval_workers: int = 1
+    eval_actions: str = "greedy"
     scenes_dir: str = "."
     out: str = "runs/pointnav"
     ppo: PPOSettings = dataclasses.field(default_factory=PPOSettings)
@@ -127,6 +133,7 @@ class TrainConfig:
                 raise ArgumentError(f"{name} must be a non-empty string, got {getattr(self, name)!r}")
         for name in ("eval_every", "eval_stride", "eval_workers"):
             validation.integer(name, getattr(self, name), minimum=1)
+        check_actions("eval_actions", self.eval_actions)
         for name in ("max_scenes", "eval_limit"):
             if getattr(self, name) is not None:
                 validation.integer(name, getattr(self, name), minimum=1)

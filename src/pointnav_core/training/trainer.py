@@ -118,7 +118,7 @@ class _Run:
     def save_latest(self) -> None:
         p = self.ppo
         save_checkpoint(self.paths["latest"], p.agent, p.obs_norm, self.config.policy_config(), p.steps,
-                        training=p.training_state())
+                        training=p.training_state(), actions=self.config.eval_actions)
 
     def evaluate(self, wall: float) -> dict[str, Any]:
         """Save ``latest.pt``, play the held-out episodes with it, keep the row and the best."""
@@ -146,7 +146,7 @@ class _Run:
             metrics = {k: row[k] for k in ("heldout_success", "heldout_spl", "heldout_soft_spl")}
             p = self.ppo
             save_checkpoint(self.paths["best"], p.agent, p.obs_norm, self.config.policy_config(), step,
-                            metrics=metrics)
+                            metrics=metrics, actions=self.config.eval_actions)
         self.rows.append(row)
         self.acc = dict.fromkeys(self.acc, 0.0)
         write_curve(self.rows, self.paths["curve"])
