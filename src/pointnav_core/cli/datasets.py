@@ -33,6 +33,7 @@ from collections.abc import Callable
 from typing import Any
 
 from pointnav_core.errors import ArgumentError
+from pointnav_core.policies.checkpoint_policy import ACTIONS
 
 __all__ = ["add_commands", "reporting"]
 
@@ -441,7 +442,7 @@ def _add_eval(sub: Any, positive_int: Callable[[str], int]) -> None:
         "--sb3-algo", default="PPO", help="algorithm class of an SB3 .zip (default PPO)"
     )
     ev.add_argument(
-        "--actions", choices=("greedy", "sampled"), default=None,
+        "--actions", choices=ACTIONS, default=None,
         help="how a checkpoint .pt acts: its most likely action, or one drawn from its distribution with a "
         "generator seeded by the episode (default: the checkpoint's own, set by pointnav train's eval_actions)",
     )

@@ -75,7 +75,8 @@ class Checkpoint:
     metrics : dict
         Figures recorded with it (the held-out evaluation's success, SPL, ...).
     actions : {"greedy", "sampled"}
-        How it acts when played (:data:`~pointnav_core.policies.checkpoint_policy.ACTIONS`; "greedy" for files without the entry).
+        How it acts when played (:data:`~pointnav_core.policies.checkpoint_policy.ACTIONS`;
+        "greedy" for files without the entry).
     """
 
     path: str

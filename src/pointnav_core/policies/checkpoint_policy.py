@@ -10,8 +10,8 @@ policy's distribution by a generator seeded with the episode's seed (the env's
 episode's ids), so that a sampled episode plays the same in any order, process or worker
 count. A deterministic policy can stall for good where one step of another action would
 free it (docs/decisions.md, "Sampled actions"). A recurrent network starts each episode
-with a zero state and carries it from step to step. The file is read once per process; the factory itself pickles as its path, so
-worker processes load it themselves.
+with a zero state and carries it from step to step. The file is read once per process;
+the factory itself pickles as its path, so worker processes load it themselves.
 """
 
 from __future__ import annotations
@@ -126,8 +126,8 @@ class CheckpointPolicy:
                 if memory is None:
                     action = agent.greedy(x)[0] if generator is None else agent.sample(x, generator)[0]
                 else:
-                    step = (memory["state"], memory["first"])
-                    out, memory["state"] = agent.greedy(x, *step) if generator is None else agent.sample(x, *step, generator)
+                    step = (x, memory["state"], memory["first"])
+                    out, memory["state"] = agent.greedy(*step) if generator is None else agent.sample(*step, generator)
                     action, memory["first"] = out[0], torch.zeros(1, dtype=torch.bool)
             return action.numpy().astype(np.float32) if continuous else int(action)
 
