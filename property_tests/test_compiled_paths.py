@@ -45,6 +45,7 @@ PAIRS: dict[Entry, tuple[Callable[..., None], ...]] = {
     ("pointnav_core.crowds._orca_kernel", "orca_worlds"): (pairs_crowds.check_orca,),
     ("pointnav_core.crowds._social_force_kernel", "social_force_worlds"): (pairs_crowds.check_social_force,),
     ("pointnav_core.crowds._crowd_kernel", "orca_crowd_step"): (pairs_crowds.check_crowd_step,),
+    ("pointnav_core.crowds._crowd_kernel", "orca_crowd_worlds"): (pairs_crowds.check_crowd_worlds,),
     ("pointnav_core.floor._collision_kernel", "cells_hit"): (pairs_floor.check_cell_test,),
     ("pointnav_core.floor._collision_kernel", "segments_clear"): (pairs_floor.check_cell_test,),
     ("pointnav_core.floor._collision_kernel", "segment_hits"): (pairs_floor.check_cell_test,),

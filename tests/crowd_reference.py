@@ -3,11 +3,13 @@ wall cells by brute force over every cell square, and the no-overlap rule of a c
 
 from __future__ import annotations
 
+import math
 from typing import Any
 
 import numpy as np
 
 from pointnav_core import scenes
+from pointnav_core.datasets.format import PointNavEpisode
 from pointnav_core.envs.pointnav import PointNavEnv
 
 RES = 0.1
@@ -54,3 +56,17 @@ def spawn_is_clear(grid: np.ndarray, env: PointNavEnv) -> None:
     assert (gaps[off_diagonal] >= need[off_diagonal]).all()
     lo, hi = crowd.config.radius
     assert ((crowd.radius >= lo) & (crowd.radius <= hi)).all()
+
+
+def world_episode(venv: Any, w: int) -> PointNavEpisode:
+    """World ``w`` of a batched engine with pedestrians: its current episode and crowd as a
+    dataset episode, which a single env's reset plays exactly."""
+    st = venv.state
+    yaw = float(st.yaw[w])
+    return PointNavEpisode(
+        episode_id=str(w), scene_id="here", floor=0, start_position=(float(st.x[w]), float(st.y[w]), 0.0),
+        start_rotation=(0.0, 0.0, math.sin(yaw / 2), math.cos(yaw / 2)),
+        goal_position=(float(st.goal_x[w]), float(st.goal_y[w]), 0.0), goal_radius=None,
+        geodesic_distance=float(st.start_distance[w]), robot_radius=venv.robot.radius,
+        pedestrians=venv.crowd.record(w),
+    )

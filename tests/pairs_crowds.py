@@ -23,7 +23,7 @@ from contextlib import AbstractContextManager
 from unittest import mock
 
 import numpy as np
-from crowd_reference import env_in, room
+from crowd_reference import env_in, room, world_episode
 from hypothesis import given, settings
 from hypothesis import strategies as st
 from orca_reference import preferred, random_crowd
@@ -35,6 +35,7 @@ from pointnav_core.crowds.crowd import KERNEL as CROWD_KERNEL
 from pointnav_core.crowds.crowd import Crowd
 from pointnav_core.envs.pointnav import PointNavEnv
 from pointnav_core.utils.compiled import kernel
+from pointnav_core.vector import VectorPointNavEnv
 
 Plain = Callable[[], AbstractContextManager[None]]
 
@@ -181,3 +182,67 @@ def check_crowd_step(
     assert plans == []
     np.testing.assert_array_equal(got, want)
     assert kernel(*CROWD_KERNEL) is not None
+
+
+@settings(max_examples=10, deadline=None)
+@given(
+    seed=st.integers(0, 2**31 - 1),
+    count=st.integers(1, 10),
+    worlds=st.integers(1, 4),
+    sees_robots=st.booleans(),
+    steps=st.integers(1, 60),
+)
+def check_crowd_worlds(seed: int, count: int, worlds: int, sees_robots: bool, steps: int, plain_paths: Plain) -> None:
+    """The batched engine's crowds (``orca_crowd_worlds``, all worlds in one call) against
+    one single env per world on the plain path: bit for bit, step for step. The single
+    envs are placed from the worlds' records (on the compiled path, as the engine placed
+    them) and walk the engine's plans of each step, once checked within 1e-9 m of their
+    own (the plain geometry's paths may differ in the last bits; see ``check_crowd_step``)."""
+    import pointnav_core.vector.crowd as batched
+
+    grid = room(60, 40, boxes=seed % 6, seed=seed % 1000)
+    scene = scenes.Scene.from_array(np.where(grid, 0, 1).astype(np.uint8), 0.1)
+    pedestrians = {"count": count, "sees_robots": sees_robots}
+    venv = VectorPointNavEnv(worlds, scene=scene, seed=seed, pedestrians=pedestrians, pool_size=2)
+    venv.reset(seed=seed)
+    singles = []
+    for w in range(worlds):
+        env = PointNavEnv(scene=scene, flatten_obs=True, pedestrians=pedestrians)
+        env.reset(seed=w, options={"episode": world_episode(venv, w)})
+        singles.append(env)
+    # This step's plans, by where the pedestrian stood (worlds of one episode plan alike).
+    plans: dict[bytes, list[np.ndarray]] = {}
+    walk = batched.plan_walk
+
+    def recorded(*args: object) -> object:
+        planned = walk(*args)
+        plans.setdefault(np.asarray(args[3]).tobytes(), []).append(planned.points)
+        return planned
+
+    plan = Crowd._plan
+
+    def replayed(crowd: Crowd, i: int, *args: object) -> np.ndarray:
+        own, key = plan(crowd, i, *args), crowd.positions[i].tobytes()
+        path = plans[key].pop(0)
+        if not plans[key]:
+            del plans[key]
+        np.testing.assert_allclose(own, path, rtol=0, atol=1e-9)
+        return path.copy()
+
+    actions = np.random.default_rng(seed).uniform(-1.0, 1.0, (steps, worlds, 2)).astype(np.float32)
+    live = [True] * worlds
+    for t, act in enumerate(actions):
+        with mock.patch.object(batched, "plan_walk", recorded):
+            venv.step(act)
+        with plain_paths(), mock.patch.object(Crowd, "_plan", replayed):
+            assert kernel(*CROWD_KERNEL) is None
+            for w, env in enumerate(singles):
+                if live[w]:
+                    _, _, terminated, truncated, _ = env.step(act[w])
+                    live[w] = not (terminated or truncated)
+                    k, where = env.crowd.n, f"world {w}, step {t}"
+                    np.testing.assert_array_equal(venv.crowd.positions[w, :k], env.crowd.positions, err_msg=where)
+                    np.testing.assert_array_equal(venv.crowd.velocities[w, :k], env.crowd.velocities, err_msg=where)
+        if all(live):
+            assert plans == {}, "a plan of the engine's that no single env made"
+        plans.clear()

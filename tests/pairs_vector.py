@@ -59,28 +59,29 @@ def random_grid(rng: np.random.Generator, rows: int, cols: int, density: float) 
     return grid
 
 
-def _paths(plain_paths, scenes, tables_np, scene, x, y, yaw, present, radius, angles, max_range):
+def _paths(plain_paths, scenes, tables_np, scene, x, y, yaw, present, radius, angles, max_range, crowd=None):
     """Ranges by every available path: array (numpy), numba, torch array, torch numba."""
     with plain_paths():
-        out = {"array": cast_batch(tables_np, scene, x, y, yaw, present, radius, angles, max_range, "array")}
+        out = {"array": cast_batch(tables_np, scene, x, y, yaw, present, radius, angles, max_range, "array", crowd)}
     if compiled_available():
-        out["numba"] = cast_batch(tables_np, scene, x, y, yaw, present, radius, angles, max_range, "numba")
+        out["numba"] = cast_batch(tables_np, scene, x, y, yaw, present, radius, angles, max_range, "numba", crowd)
     if HAS_TORCH:
         import torch
 
         tables_t = ScanTables(scenes, 0, make_arrays("cpu"))
         rad = radius if isinstance(radius, float) else torch.as_tensor(radius)
         args = (torch.as_tensor(scene), *(torch.as_tensor(v) for v in (x, y, yaw, present)), rad, angles, max_range)
+        crowd_t = None if crowd is None else tuple(torch.as_tensor(v) for v in crowd)
         with plain_paths():
-            out["torch"] = cast_batch(tables_t, *args, "array").numpy()
+            out["torch"] = cast_batch(tables_t, *args, "array", crowd_t).numpy()
         if compiled_available():  # torch on the CPU goes through the kernel, on views
-            out["torch numba"] = cast_batch(tables_t, *args, "numba").numpy()
+            out["torch numba"] = cast_batch(tables_t, *args, "numba", crowd_t).numpy()
     return out
 
 
-def _check_scenes(plain_paths, scenes, x, y, yaw, present, scene, radius, angles, max_range):
+def _check_scenes(plain_paths, scenes, x, y, yaw, present, scene, radius, angles, max_range, crowd=None):
     tables = ScanTables(scenes, 0, make_arrays("numpy"))
-    results = _paths(plain_paths, scenes, tables, scene, x, y, yaw, present, radius, angles, max_range)
+    results = _paths(plain_paths, scenes, tables, scene, x, y, yaw, present, radius, angles, max_range, crowd)
     ref = results["array"]
     for name, got in results.items():
         assert got.shape == x.shape + (len(angles),)
@@ -99,6 +100,8 @@ def _check_scenes(plain_paths, scenes, x, y, yaw, present, scene, radius, angles
                 continue
             rad = np.broadcast_to(radius, x.shape)  # one radius, or each robot's own
             discs = [(x[w, m], y[w, m], rad[w, m]) for m in range(r_n) if m != i and present[w, m]]
+            if crowd is not None:  # the world's pedestrians: its first qn[w] discs
+                discs += [(crowd[0][w, q], crowd[1][w, q], crowd[2][w, q]) for q in range(int(crowd[3][w]))]
             loose, strict = reference_ranges(shapes[k], (x[w, i], y[w, i]), yaw[w, i] + angles, max_range, discs)
             for got in results.values():
                 assert_within(got[w, i], loose, strict, ATOL)
@@ -114,9 +117,12 @@ def _check_scenes(plain_paths, scenes, x, y, yaw, present, scene, radius, angles
     n_rays=st.integers(1, 24),
     max_range=st.floats(0.3, 4.0),
     own_radii=st.booleans(),
+    walkers=st.integers(-1, 6),
 )
-def check_batched_scan(seed, n_worlds, n_robots, ratio, res, n_rays, max_range, own_radii, plain_paths: Plain) -> None:
-    """Random scenes of floors of different cell sizes: every path equal, and against shapely."""
+def check_batched_scan(seed, n_worlds, n_robots, ratio, res, n_rays, max_range, own_radii, walkers,
+                       plain_paths: Plain) -> None:
+    """Random scenes of floors of different cell sizes, maybe with pedestrians (``walkers``
+    discs a world at most; -1: none given): every path equal, and against shapely."""
     rng = np.random.default_rng(seed)
     scenes = []
     for cell in (res, float(rng.choice([0.05, 0.1, 0.25]))):  # worlds on floors of different cell sizes
@@ -140,7 +146,14 @@ def check_batched_scan(seed, n_worlds, n_robots, ratio, res, n_rays, max_range, 
     radius = ratio * float(scenes[0].floors[0].resolution)
     if own_radii:  # each robot its own radius, down to a fifth of the drawn one
         radius = radius * rng.uniform(0.2, 1.0, (n_worlds, n_robots))
-    _check_scenes(plain_paths, scenes, x, y, yaw, present, scene, radius, angles, max_range)
+    crowd = None
+    if walkers >= 0:  # discs near the robots (some over them), each world its own count
+        q = max(walkers, 0)
+        near = rng.integers(0, n_robots, (n_worlds, q))
+        qx = np.take_along_axis(x, near, 1) + rng.uniform(-1.5, 1.5, (n_worlds, q)) * max_range
+        qy = np.take_along_axis(y, near, 1) + rng.uniform(-1.5, 1.5, (n_worlds, q)) * max_range
+        crowd = (qx, qy, rng.uniform(0.05, 0.4, (n_worlds, q)), rng.integers(0, q + 1, n_worlds))
+    _check_scenes(plain_paths, scenes, x, y, yaw, present, scene, radius, angles, max_range, crowd)
 
 
 @settings(max_examples=3, deadline=None, suppress_health_check=[HealthCheck.too_slow])

@@ -267,7 +267,7 @@ def test_the_episode_end_carries_its_social_metrics_measured_on_its_own_position
 
 def test_an_env_config_carries_the_crowd() -> None:
     """``EnvConfig(pedestrians=...)`` round-trips, builds the crowd, names a bad key, and the
-    batched engine (no pedestrians yet) refuses it by name."""
+    batched engine walks an ORCA crowd from it and refuses the social force by name."""
     from pointnav_core.envs.config import EnvConfig
     from pointnav_core.vector import VectorPointNavEnv
 
@@ -281,5 +281,11 @@ def test_an_env_config_carries_the_crowd() -> None:
         EnvConfig(pedestrians={"density": -1.0})
     with pytest.raises(ValueError, match="pedestrians"):
         EnvConfig(pedestrians={"count": 2, "behaviour": print})  # a callable cannot be saved
-    with pytest.raises(ValueError, match="config.pedestrians"):
+    with pytest.raises(ValueError, match=re_escape("pedestrians['behaviour']")):
         VectorPointNavEnv(num_envs=2, config=config)
+    orca = EnvConfig(pedestrians={"count": 3}, flatten_obs=True)
+    venv = VectorPointNavEnv(num_envs=2, config=orca)
+    venv.reset(seed=0)
+    assert venv.crowd.count.tolist() == [3, 3]
+    with pytest.raises(ValueError, match="config.pedestrians"):
+        VectorPointNavEnv(num_envs=2, n_robots=2, config=orca)

@@ -22,7 +22,7 @@ import numpy as np
 from pointnav_core.crowds._orca_kernel import orca_worlds
 from pointnav_core.floor._collision_kernel import segment_hits
 
-__all__ = ["orca_crowd_step"]
+__all__ = ["orca_crowd_step", "orca_crowd_worlds"]
 
 _jit = numba.njit(cache=True, nogil=True, error_model="numpy")
 
@@ -194,3 +194,19 @@ def orca_crowd_step(pos, vel, radius, speed, goals, paths, nxt, last, robots, ro
             bit |= 2
         flags[i] = bit
     _contacts(robots, new_pos, radius, contacts)
+
+
+@_jit
+def orca_crowd_worlds(worlds, count, pos, vel, radius, speed, goals, paths, nxt, last, robots, robot_vel, seen, dt,
+                      neighbor_dist, max_neighbors, time_horizon, goal_reached, walls, new_pos, new_vel, flags,
+                      contacts):  # pragma: no cover
+    """:func:`orca_crowd_step` for each world of ``worlds`` (all on one floor, whose walls are
+    ``walls``): every array has a leading world axis, world ``w`` has ``count[w]``
+    pedestrians (the first rows) and ``seen[w]`` robots that ORCA avoids. One definition:
+    world by world, the single env's step."""
+    for j in range(worlds.shape[0]):
+        w = worlds[j]
+        k = count[w]
+        orca_crowd_step(pos[w, :k], vel[w, :k], radius[w, :k], speed[w, :k], goals[w, :k], paths[w, :k], nxt[w, :k],
+                        last[w, :k], robots[w], robot_vel[w], seen[w], dt, neighbor_dist, max_neighbors,
+                        time_horizon, goal_reached, walls, new_pos[w, :k], new_vel[w, :k], flags[w, :k], contacts[w])

@@ -39,7 +39,7 @@ from __future__ import annotations
 import dataclasses
 import math
 from collections.abc import Sequence
-from typing import Any
+from typing import Any, NamedTuple
 
 import numpy as np
 from numpy.typing import NDArray
@@ -48,18 +48,16 @@ from pointnav_core.crowds.config import CrowdView, PedestrianConfig
 from pointnav_core.crowds.orca import orca_step
 from pointnav_core.crowds.record import SEED_LIMIT, PedestrianRecord
 from pointnav_core.crowds.social_force import SocialForceParams, social_force_step
+from pointnav_core.crowds.walks import Walk, plan_walk
 from pointnav_core.errors import ArgumentError, SamplingError
-from pointnav_core.floor.draw import nearest_usable
 from pointnav_core.utils.compiled import kernel
 
-__all__ = ["Crowd"]
+__all__ = ["Crowd", "CrowdStart"]
 
 #: Tries to place one pedestrian before the crowd is declared not to fit.
 PLACE_TRIES = 200
 #: How near (m) a pedestrian must come to its goal to draw the next one.
 GOAL_REACHED = 0.1
-#: Goals nearer than this (m) to the pedestrian are drawn again (up to 10 times).
-MIN_GOAL_DISTANCE = 1.0
 #: Social force: the speed limit over the preferred speed (pysocialforce's 1.3).
 MAX_SPEED_FACTOR = 1.3
 #: Social force: a robot's goal is where its velocity takes it in this many seconds.
@@ -69,6 +67,24 @@ ROBOT_LOOKAHEAD = 10.0
 _SOCIAL_FORCE = SocialForceParams(goal_threshold=0.0, stop_distance=0.0)
 #: The compiled step of ORCA crowds (``utils.compiled.kernel``'s module and function).
 KERNEL = ("pointnav_core.crowds._crowd_kernel", "orca_crowd_step")
+
+
+class CrowdStart(NamedTuple):
+    """A freshly placed crowd of ``P`` pedestrians, as :meth:`Crowd.start` gives it (m, rad, m/s)."""
+
+    positions: NDArray[np.float64]  #: (P, 2)
+    headings: NDArray[np.float64]  #: (P,)
+    radius: NDArray[np.float64]  #: (P,)
+    speed: NDArray[np.float64]  #: (P,)
+    goals: NDArray[np.float64]  #: (P, 2)
+    paths: NDArray[np.float64]  #: (P, L, 2), each padded with its last point
+    next: NDArray[np.int64]  #: (P,) each one's next waypoint
+    last: NDArray[np.int64]  #: (P,) each path's last point
+    goal_index: NDArray[np.int64]  #: (P,) where each is in its fixed goal list
+    walks: tuple[tuple[tuple[float, float], ...], ...]  #: each one's fixed goals
+    loops: tuple[bool, ...]  #: whether each walks them round and round
+    draws: tuple[dict[str, Any], ...]  #: each one's own generator's state (``bit_generator.state``)
+    record: tuple[PedestrianRecord, ...]  #: :meth:`Crowd.record`
 
 
 class Crowd:
@@ -114,11 +130,9 @@ class Crowd:
         self._paths = np.zeros((n, 1, 2))  # each path padded with its last point
         self._last = np.zeros(n, dtype=np.int64)  # index of each path's last point
         self._next = np.zeros(n, dtype=np.int64)  # index of each one's next waypoint
-        self._goal_index = np.full(n, -1, dtype=np.int64)  # in each one's fixed goal list
         self._rngs = [np.random.default_rng(0)] * n  # each one's own draws
         self._seeds = [0] * n
-        self._walks: list[tuple[tuple[float, float], ...]] = [()] * n  # each one's fixed goals
-        self._loops = [False] * n  # whether each walks its fixed goals round and round
+        self._walks = [Walk((), False, -1, self.goals[i]) for i in range(n)]  # each one's fixed goals
         self._drawn = np.zeros(n, dtype=bool)  # whether each one's goal was drawn
 
     @property
@@ -161,7 +175,8 @@ class Crowd:
             # The walls are kept from the largest radius: widened to the recorded ones.
             self.config = given if widest <= given.radius[1] else dataclasses.replace(given, radius=(given.radius[0], widest))
         self._set_count(n)
-        self._seeds, self._walks, self._loops = [int(v) for v in seeds], walks, loops
+        self._seeds = [int(v) for v in seeds]
+        self._walks = [Walk(tuple(walk), bool(loop), -1, self.goals[i]) for i, (walk, loop) in enumerate(zip(walks, loops))]
         self._draw_own(record)
         robots = np.asarray(robots, dtype=np.float64).reshape(-1, 3)
         for i in range(n):
@@ -180,8 +195,8 @@ class Crowd:
         self._set_paths(range(n), paths)
         self._record = record if record is not None else tuple(
             PedestrianRecord(
-                start=(float(x), float(y)), loop=self._loops[i], seed=self._seeds[i],
-                goals=self._walks[i] if self._walks[i] or not self._drawn[i] else (tuple(self.goals[i].tolist()),),
+                start=(float(x), float(y)), loop=self._walks[i].loop, seed=self._seeds[i],
+                goals=self._walks[i].walk if self._walks[i].walk or not self._drawn[i] else (tuple(self.goals[i].tolist()),),
                 radius=float(self.radius[i]), speed=float(self.speed[i]),
             ) for i, (x, y) in enumerate(self.positions.tolist())
         )
@@ -205,6 +220,16 @@ class Crowd:
         start, fixed goals or first drawn goal, seed, radius and speed), which
         ``spawn(..., record=...)`` places again exactly."""
         return self._record
+
+    def start(self) -> CrowdStart:
+        """The crowd as the last :meth:`spawn` placed it, as arrays (copies): where the
+        batched engine's worlds start theirs (:mod:`pointnav_core.vector.crowd`)."""
+        return CrowdStart(
+            self.positions.copy(), self.headings.copy(), self.radius.copy(), self.speed.copy(), self.goals.copy(),
+            self._paths.copy(), self._next.copy(), self._last.copy(), np.array([w.index for w in self._walks], np.int64),
+            tuple(w.walk for w in self._walks), tuple(w.loop for w in self._walks),
+            tuple(rng.bit_generator.state for rng in self._rngs), self.record(),
+        )
 
     def _place(self, i: int, robots: NDArray[np.float64]) -> NDArray[np.float64]:
         """A usable point for pedestrian ``i`` that overlaps no robot and no pedestrian before it."""
@@ -238,45 +263,13 @@ class Crowd:
 
     # ------------------------------------------------------------------ paths
     def _plan(self, i: int, new_goal: bool, rng: np.random.Generator) -> NDArray[np.float64]:
-        """Pedestrian ``i``'s path from where it stands to its goal (a new one if asked, or
-        if the old one cannot be reached); a one-point path when none is reachable. A new
-        goal is the next of its fixed list while there is one, else drawn from ``rng``."""
-        scene, floor, radius = self.scene, self.floor, self.config.plan_radius
-        here = self.positions[i]
-        start = self._anchor(here)
-        if start is None:
-            return here[None].copy()
-        walk, loop = self._walks[i], self._loops[i]
-        for attempt in range(10):
-            if new_goal:
-                self._goal_index[i] += 1
-            k = int(self._goal_index[i])
-            if walk and (loop or k < len(walk)):  # the next goal of its list (round and round)
-                self.goals[i] = walk[k % len(walk)]
-                new_goal = True  # an unreachable fixed goal: try the next one
-            elif new_goal or attempt:
-                goal = start
-                self._drawn[i] = True
-                for _ in range(10):
-                    _, goal = scene.get_random_point(floor, reference_point=start, robot=radius, rng=rng)
-                    goal = goal[:2]
-                    if math.dist(goal, start) >= MIN_GOAL_DISTANCE:
-                        break
-                self.goals[i] = goal
-            points, _ = scene.get_shortest_path(floor, start, self.goals[i], entire_path=True, robot=radius)
-            if points is not None:
-                points = np.asarray(points, dtype=np.float64)
-                return points if start is here else np.concatenate([here[None], points])
-        return here[None].copy()
-
-    def _anchor(self, here: NDArray[np.float64]) -> NDArray[np.float64] | None:
-        """Where to plan from: ``here`` when the paths' radius fits there, else the nearest
-        cell centre within 3 cells where it does (a neighbour's push can leave a pedestrian
-        a little nearer a wall than its path runs); None if there is none."""
-        tmap, radius = self.scene.floors[self.floor], self.config.plan_radius
-        if tmap.is_usable(here, radius):
-            return here
-        return nearest_usable(tmap, here, radius)
+        """Pedestrian ``i``'s path from where it stands to its goal (:func:`plan_walk`)."""
+        walk = self._walks[i]
+        walk.goal = self.goals[i].copy()  # set_route may have changed it
+        planned = plan_walk(self.scene, self.floor, self.config.plan_radius, self.positions[i], walk, new_goal, rng)
+        self.goals[i] = walk.goal
+        self._drawn[i] |= planned.drawn
+        return planned.points
 
     def set_route(self, i: int, points: Any) -> None:
         """Send pedestrian ``i`` along the polyline ``points`` ``(N, 2)`` (m) to its last

@@ -3,7 +3,7 @@
 Imported only when the compiled path runs, so the package imports without numba. One loop
 over worlds, robots and rays, inside the kernel; each ray is the single env's crossing walk
 (``sensors._raycast_kernel.grid_range``) on its world's grid, then the discs of the world's
-other present robots, with the same expressions as the array path, then its floor's
+other present robots and of its pedestrians, with the same expressions as the array path, then its floor's
 obstacle-polygon edges by the single kernel's ``polygon_range``.
 """
 
@@ -23,14 +23,16 @@ _jit = numba.njit(cache=True, nogil=True, error_model="numpy")
 
 
 @_jit
-def cast_worlds(scene, x, y, cyaw, syaw, ca, sa, present, radius, max_range, meta, lookup, clear, edges, out):  # pragma: no cover
+def cast_worlds(scene, x, y, cyaw, syaw, ca, sa, present, radius, max_range, meta, lookup, clear, edges, qx, qy, qr, qn,
+                out):  # pragma: no cover
     n_worlds, n_robots = x.shape
     n_rays = ca.shape[0]
-    # radius (W, R): each robot's disc (m).
+    # radius (W, R): each robot's disc (m); qx, qy, qr (W, Q): other discs every robot sees
+    # (pedestrians), the first qn[w] of world w.
     c = np.empty(n_rays)
     s = np.empty(n_rays)
     phi = np.empty(n_rays)
-    near = np.empty(n_robots, np.int64)
+    near = np.empty(n_robots + qx.shape[1], np.int64)
     for w in range(n_worlds):
         k = scene[w]
         loff = int(meta[k, 0])
@@ -74,20 +76,29 @@ def cast_worlds(scene, x, y, cyaw, syaw, ca, sa, present, radius, max_range, met
             n_near = 0
             for m in range(n_robots):
                 if m != i and present[w, m]:
-                    fx = px - x[w, m]
-                    fy = py - y[w, m]
+                    fx, fy = px - x[w, m], py - y[w, m]
                     # Farther than this (m^2, with a margin for rounding) the disc is out of every ray's reach.
                     reach2 = ((max_range + radius[w, m]) * (1.0 + 1e-9) + 1e-12) ** 2
                     if fx * fx + fy * fy <= reach2:
                         near[n_near] = m
                         n_near += 1
+            n_robot_near = n_near
+            for m in range(qn[w]):
+                fx, fy = px - qx[w, m], py - qy[w, m]
+                reach2 = ((max_range + qr[w, m]) * (1.0 + 1e-9) + 1e-12) ** 2
+                if fx * fx + fy * fy <= reach2:
+                    near[n_near] = m
+                    n_near += 1
             for r in range(n_rays):
                 dx = c[r]
                 dy = s[r]
                 best = min(grid_range(gx, gy, dx, dy, fhp, fwp, plane, look, clr, e, n_cross, reach) * res, max_range)
-                for j in range(n_near):
+                for j in range(n_robot_near):
                     m = near[j]
                     best = min(best, disc_range(px - x[w, m], py - y[w, m], dx, dy, radius[w, m] * radius[w, m]))
+                for j in range(n_robot_near, n_near):
+                    m = near[j]
+                    best = min(best, disc_range(px - qx[w, m], py - qy[w, m], dx, dy, qr[w, m] * qr[w, m]))
                 out[w, i, r] = best
             if own_edges.shape[0]:  # the single scan's polygon edges (origins inside: the caller)
                 polygon_range(px, py, c, s, phi, own_edges, max_range, out[w, i])

@@ -19,7 +19,7 @@ from pointnav_core.task.rewards import CollisionReward, PointGoalReward, Potenti
 from pointnav_core.task.terminations import Falling, MaxCollision, Timeout
 from pointnav_core.vector.state import Motion
 
-__all__ = ["BatchedTask", "TaskStep", "custom_rewards", "task_step"]
+__all__ = ["BatchedTask", "TaskStep", "custom_rewards", "read_task", "task_step"]
 
 #: The built-in reward terms' names (the engine computes them itself, from their ``value``).
 BUILT_IN_REWARDS = ("potential", "collision", "pointgoal")
@@ -136,3 +136,27 @@ def custom_rewards(task: Any) -> list[tuple[str, Any]]:
     has a ``batched(task)`` method (:func:`~pointnav_core.vector.arguments.task_arguments`
     refuses the others)."""
     return [(name, term) for name, term in task.reward_functions.items() if name not in BUILT_IN_REWARDS]
+
+
+def read_task(engine: Any, t: Any, action_frequency: float) -> None:
+    """Set on ``engine`` the task ``t``'s settings that the batched step reads (both
+    engines). Any control rate: a step near something is cut into the backend's sub-steps
+    (:func:`~pointnav_core.vector.drive.sub_steps`)."""
+    engine.action_frequency = action_frequency
+    engine.dt = 1.0 / action_frequency
+    engine.task = t
+    cfg, rcfg = t.termination_config, t.reward_config
+    engine.max_steps, engine.max_collisions = int(cfg["max_steps"]), int(cfg["max_collisions"])
+    engine.fall_height, engine.goal_tolerance = float(cfg["fall_height"]), t.goal_tolerance
+    engine.r_potential, engine.r_collision, engine.r_pointgoal = (
+        float(rcfg[k]) for k in ("r_potential", "r_collision", "r_pointgoal")
+    )
+    engine.geodesic_reward = t.reward_type == "geodesic"
+    engine.custom_rewards = custom_rewards(t)
+    engine.goal_in_polar = bool(t.goal_in_polar)
+    spec = engine.robot
+    engine.holonomic = spec.drive == "holonomic"
+    # A chord is never longer than its arc (a holonomic one: the diagonal of its two
+    # top speeds); the margin covers rounding.
+    top = spec.max_linear_velocity * (math.sqrt(2.0) if engine.holonomic else 1.0)
+    engine.max_travel = top * engine.dt * (1.0 + 1e-9) + 1e-12

@@ -12,7 +12,7 @@ from pointnav_core import scenes
 from pointnav_core.errors import ArgumentError
 from pointnav_core.utils import validation
 
-__all__ = ["as_scene_list", "check_real_actions", "default_scene", "grid_scene", "task_arguments"]
+__all__ = ["as_scene_list", "check_continuous_actions", "check_real_actions", "default_scene", "grid_scene", "task_arguments"]
 
 
 def grid_scene(scene: scenes.Scene, floor: int = 0) -> scenes.Scene:
@@ -71,3 +71,19 @@ def check_real_actions(actions: Any) -> None:
     if not validation.is_real_array(actions):
         kind = getattr(actions, "dtype", type(actions).__name__)
         raise ArgumentError(f"actions must be real numbers in [-1, 1] (an integer or float array), got {kind}")
+
+
+def check_continuous_actions(actions: Any, n: int, robot: Any, arrays: Any) -> Any:
+    """The one-robot engine's continuous ``actions`` as a float64 array ``(n, action_dim)``
+    (2 for a differential drive, 3 for a holonomic one); ValueError naming ``actions`` if bad."""
+    shape = tuple(getattr(actions, "shape", np.shape(actions)))
+    dim = robot.action_dim
+    if shape not in ((n, dim), (n, 1, dim)):
+        raise ArgumentError(
+            f"actions must have shape ({n}, {dim}) or ({n}, 1, {dim}) for a {robot.drive} drive, got {shape}"
+        )
+    check_real_actions(actions)
+    arr = arrays.asarray(actions).reshape(n, dim)
+    if not bool(arrays.xp.isfinite(arr).all()):
+        raise ArgumentError("actions must be finite (no NaN or infinity)")
+    return arr

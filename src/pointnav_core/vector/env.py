@@ -10,7 +10,6 @@ The same code runs on numpy (``device="numpy"``) and on torch (``"cpu"``, ``"cud
 
 from __future__ import annotations
 
-import math
 from collections.abc import Mapping, Sequence
 from typing import Any, Self
 
@@ -24,15 +23,20 @@ from pointnav_core.envs.config import EnvConfig, takes_config, vector_arguments
 from pointnav_core.errors import ArgumentError, TaskStateError
 from pointnav_core.utils import validation
 from pointnav_core.vector import contacts_jit
-from pointnav_core.vector.accounting import custom_rewards, task_step
+from pointnav_core.vector.accounting import read_task, task_step
 from pointnav_core.vector.arguments import (
     as_scene_list,
-    check_real_actions,
+    check_continuous_actions,
     task_arguments,
+)
+from pointnav_core.vector.crowd import (
+    VectorCrowd,
+    check_vector_pedestrians,
+    recorded_crowds,
 )
 from pointnav_core.vector.discrete import DiscretePlan
 from pointnav_core.vector.drive_step import drive_worlds
-from pointnav_core.vector.episodes import EpisodePool, fixed_pose
+from pointnav_core.vector.episodes import EpisodePool, episode_reach, fixed_pose
 from pointnav_core.vector.floors import FloorTables
 from pointnav_core.vector.local_map import VectorLocalMap, local_map_term
 from pointnav_core.vector.observe import low_dim, step_info
@@ -126,6 +130,12 @@ class VectorPointNavEnv(PoolRefreshing, VectorEnv):
         its entry point (``if __name__ == "__main__":``), as for any spawned process.
     progress : bool, optional
         A tqdm bar over the pool's scenes on stderr; default: from 4 scenes on, on a terminal.
+    pedestrians : dict, optional
+        A crowd in every world, as the single env's ``pedestrians`` (``"orca"`` or
+        ``"static"``; numpy with numba, continuous actions, one robot per world, no local
+        map): each world's crowd is the one a single env walks beside the same robot
+        (:mod:`pointnav_core.vector.crowd`); the scan sees it, and ``info`` counts
+        ``pedestrian_collisions`` (with ``end_on_collision``, a touch ends the episode).
 
     Notes
     -----
@@ -201,6 +211,7 @@ class VectorPointNavEnv(PoolRefreshing, VectorEnv):
 
     metadata = {"autoreset_mode": AutoresetMode.NEXT_STEP, "render_modes": []}
     _pool_class: Any = EpisodePool  # the episodes prepared ahead (the fleet's have a robot axis)
+    crowd: Any = None  # the fleet's worlds have none
 
     def __new__(cls, *args: Any, **kwargs: Any) -> Self:
         # Several robots per world are their own engine (vector.fleet_env), built from here.
@@ -208,6 +219,9 @@ class VectorPointNavEnv(PoolRefreshing, VectorEnv):
             n_robots = kwargs.get("n_robots", args[1] if len(args) > 1 else 1)
             if isinstance(n_robots, (int, np.integer)) and not isinstance(n_robots, bool) and n_robots > 1:
                 from pointnav_core.vector.fleet_env import VectorFleetEnv
+
+                if kwargs.get("pedestrians") is not None:  # the fleet's worlds have no crowds yet
+                    raise ArgumentError(f"pedestrians need one robot per world in the batched engine, got n_robots={n_robots}")
 
                 return super().__new__(VectorFleetEnv)
             for name in ("max_cycles", "finished"):
@@ -235,7 +249,9 @@ class VectorPointNavEnv(PoolRefreshing, VectorEnv):
         config: EnvConfig | None = None,
         workers: int | None = None,
         progress: bool | None = None,
+        pedestrians: Mapping[str, Any] | None = None,
     ) -> None:
+        from pointnav_core.crowds import make_pedestrians
         from pointnav_core.envs.pointnav import PointNavEnv
 
         #: The :class:`~pointnav_core.envs.config.EnvConfig` these worlds were built from, or None.
@@ -246,6 +262,8 @@ class VectorPointNavEnv(PoolRefreshing, VectorEnv):
             raise ArgumentError(f"n_robots must be 1 here, got {n_robots}: VectorPointNavEnv builds the multi-robot engine")
         scan_term = requested_scan(sensors)
         task = task_arguments(task)
+        crowd = make_pedestrians(pedestrians)
+        check_vector_pedestrians(crowd, device, action_space, sensors)
         self.pool_size = validation.integer("pool_size", pool_size, minimum=1)
         self.starts_per_goal = validation.integer("starts_per_goal", starts_per_goal, minimum=1)
         self.arrays = make_arrays(device)
@@ -262,7 +280,7 @@ class VectorPointNavEnv(PoolRefreshing, VectorEnv):
             for env in self._samplers:  # sets the task's max_steps and refits a derived path_range
                 env.max_episode_steps = max_episode_steps
         first = self._samplers[0]
-        self._read_task(first.task, first.action_frequency)
+        read_task(self, first.task, first.action_frequency)
         t, spec, a = self.task, self.robot, self.arrays
         acts = first.discrete_actions
         self._discrete = None if acts is None else DiscretePlan(acts, spec, self.action_frequency, a)
@@ -281,6 +299,8 @@ class VectorPointNavEnv(PoolRefreshing, VectorEnv):
         self.world_scene = a.asarray(np.arange(self.num_envs) % len(scene_list), a.i64)
         self.pool: EpisodePool | None = None  # sampled at the first reset that needs it
         self._allocate((self.num_envs,), scan_term, sensors)
+        #: Every world's pedestrians (:class:`~pointnav_core.vector.crowd.VectorCrowd`), or None.
+        self.crowd = None if crowd is None else VectorCrowd(crowd, self._samplers, a.numpy(self.world_scene))
 
     def _allocate(self, shape: tuple[int, ...], scan_term: Any, sensors: Mapping[str, Any] | None) -> None:
         """The state arrays of ``shape`` (one entry per world, or per robot), the per-world
@@ -299,37 +319,11 @@ class VectorPointNavEnv(PoolRefreshing, VectorEnv):
         map_term = local_map_term(sensors)
         self.local_map = None if map_term is None else VectorLocalMap(map_term, self.floors)
 
-    def _read_task(self, t: Any, action_frequency: float) -> None:
-        """The task's settings the batched step reads (both engines). Any control rate: a
-        step near something is cut into the backend's sub-steps (:func:`~pointnav_core.vector.drive.sub_steps`)."""
-        self.action_frequency = action_frequency
-        self.dt = 1.0 / action_frequency
-        self.task = t
-        cfg, rcfg = t.termination_config, t.reward_config
-        self.max_steps, self.max_collisions = int(cfg["max_steps"]), int(cfg["max_collisions"])
-        self.fall_height, self.goal_tolerance = float(cfg["fall_height"]), t.goal_tolerance
-        self.r_potential, self.r_collision, self.r_pointgoal = (float(rcfg[k]) for k in ("r_potential", "r_collision", "r_pointgoal"))
-        self.geodesic_reward = t.reward_type == "geodesic"
-        self.custom_rewards = custom_rewards(t)
-        self.goal_in_polar = bool(t.goal_in_polar)
-        spec = self.robot
-        self.holonomic = spec.drive == "holonomic"
-        # A chord is never longer than its arc (a holonomic one: the diagonal of its two
-        # top speeds); the margin covers rounding.
-        top = spec.max_linear_velocity * (math.sqrt(2.0) if self.holonomic else 1.0)
-        self.max_travel = top * self.dt * (1.0 + 1e-9) + 1e-12
-
     # ------------------------------------------------------------------ pools
     @property
     def _reach(self) -> float:
-        """How far (m) a robot's centre can get from its start in one episode: its steps (the
-        most of any robot's ``max_steps``, and at most ``max_cycles`` with several robots)
-        times the longest chord of a step (of each of a discrete action's control steps).
-        Goal fields keep only the cells within it of their starts (``FieldTables``)."""
-        steps = self.max_steps if isinstance(self.max_steps, int) else int(self.arrays.numpy(self.max_steps).max())
-        steps = min(steps, getattr(self, "max_cycles", steps))
-        per_step = self.max_travel * (1 if self._discrete is None else self._discrete.max_steps)
-        return steps * per_step
+        """How far (m) a robot's centre can get from its start in one episode (:func:`episode_reach`)."""
+        return episode_reach(self, self._discrete)
 
     def _build_pool(self, fixed: Sequence[tuple[Any, float, Any, int]]) -> None:
         size = 0 if fixed else self.pool_size
@@ -339,6 +333,8 @@ class VectorPointNavEnv(PoolRefreshing, VectorEnv):
                                                self._reach, self._pool_workers, self._pool_progress)
         self.pool = self._pool_class(self._samplers, size, seeds, self.arrays, fixed, self.starts_per_goal, self._reach,
                                      parts=parts)
+        if self.crowd is not None:  # the pool's crowds are drawn anew
+            self.crowd.seed(int(self._rng.integers(2**63)))
 
     # ------------------------------------------------------------------ Gymnasium API
     def reset(self, *, seed: int | None = None, options: dict[str, Any] | None = None) -> tuple[Any, dict[str, Any]]:
@@ -376,9 +372,11 @@ class VectorPointNavEnv(PoolRefreshing, VectorEnv):
             fixed = [self._fixed_episode(i, episode, int(scene_of[i])) for i, episode in enumerate(episodes)]
             self._build_pool(fixed)
             self._fixed = a.asarray(self.pool.n_sampled + np.arange(self.num_envs), a.i64)
+            recorded_crowds(self, {self.pool.n_sampled + i: getattr(ep, "pedestrians", None) for i, ep in enumerate(episodes)})
         elif self.pool is None or seed is not None or self._fixed is not None:
             self._fixed = None
             self._build_pool(())
+            recorded_crowds(self, {})
 
     def _fixed_episode(self, i: int, episode: Any, s: int) -> tuple[Any, float, Any, int]:
         """World ``i``'s given episode on scene ``s``, checked; ValueError naming it."""
@@ -397,6 +395,8 @@ class VectorPointNavEnv(PoolRefreshing, VectorEnv):
         height = self.floors.height[self.world_scene[idx]]  # (k,); each robot of a fleet's world
         st.start_episodes(xp, idx, self.pool, ep[idx], height, self.geodesic_reward)
         self._needs_reset[idx] = False
+        if self.crowd is not None:
+            self.crowd.start_worlds(a.numpy(idx), a.numpy(ep[idx]), self.pool, self.robot.radius)
         if self.scan is not None:  # the worlds' episode counts key the scan's noise
             self.scan.begin(mask, n)
 
@@ -404,20 +404,9 @@ class VectorPointNavEnv(PoolRefreshing, VectorEnv):
         """``actions`` as a float64 array ``(num_envs, action_dim)`` (2 for a differential
         drive, 3 for a holonomic one), or with discrete actions an int64 array
         ``(num_envs,)``; ValueError naming ``actions`` if bad."""
-        a = self.arrays
         if self._discrete is not None:
             return self._discrete.check(actions, self.num_envs)
-        shape = tuple(getattr(actions, "shape", np.shape(actions)))
-        n, dim = self.num_envs, self.robot.action_dim
-        if shape not in ((n, dim), (n, 1, dim)):
-            raise ArgumentError(
-                f"actions must have shape ({n}, {dim}) or ({n}, 1, {dim}) for a {self.robot.drive} drive, got {shape}"
-            )
-        check_real_actions(actions)
-        arr = a.asarray(actions).reshape(n, dim)
-        if not bool(a.xp.isfinite(arr).all()):
-            raise ArgumentError("actions must be finite (no NaN or infinity)")
-        return arr
+        return check_continuous_actions(actions, self.num_envs, self.robot, self.arrays)
 
     def step(self, actions: Any) -> tuple[Any, Any, Any, Any, dict[str, Any]]:
         """Advance every world one control step (worlds that ended last step reset instead)."""
@@ -435,7 +424,9 @@ class VectorPointNavEnv(PoolRefreshing, VectorEnv):
             stopped = None
         else:
             moved, contact, stopped = self._discrete.run(self, act)
-        return self._account(moved, contact, stopped)
+        crowd = self.crowd  # it walks beside the moved robots
+        touched = None if crowd is None else crowd.step(moved.x, moved.y, moved.vx, moved.vy, self.robot.radius, self.dt)
+        return self._account(moved, contact, stopped, touched)
 
     def drive(self, act: Any, state: Motion) -> tuple[Motion, Any]:
         """One control step of every world from ``state`` under commands ``act``
@@ -444,12 +435,16 @@ class VectorPointNavEnv(PoolRefreshing, VectorEnv):
         (:func:`~pointnav_core.vector.falls.apply_falls`)."""
         return drive_worlds(self, act, state)  # a method: the fleet has its own, the discrete plan calls either
 
-    def _account(self, moved: Motion, contact: Any, stopped: Any) -> tuple[Any, Any, Any, Any, dict[str, Any]]:
+    def _account(self, moved: Motion, contact: Any, stopped: Any,
+                 touched: Any = None) -> tuple[Any, Any, Any, Any, dict[str, Any]]:
         """The task's step over the worlds' moves from the committed state: rewards, ends, info,
-        then the commit and the next-step autoresets. ``stopped``: the worlds that called STOP."""
+        then the commit and the next-step autoresets. ``stopped``: the worlds that called STOP;
+        ``touched``: those whose robot touched a pedestrian."""
         a, xp = self.arrays, self.arrays.xp
         t = task_step(self, moved, contact, stopped)  # PointNavigationTask.step's accounting
         reward, terminated, truncated, success = t.reward, t.terminated, t.truncated, t.success
+        if touched is not None and self.crowd.config.end_on_collision:  # PedestrianCollision
+            terminated = terminated | touched
         r_pot, r_col, r_goal, r_custom = t.r_pot, t.r_col, t.r_goal, t.r_custom
         # Commit, then reset the worlds that ended on the previous step (next-step autoreset).
         self.state = self.state.moved(moved, path_length=t.path, goal_distance=t.dist, potential=t.pot, steps=t.steps,
@@ -486,7 +481,7 @@ class VectorPointNavEnv(PoolRefreshing, VectorEnv):
         xp, st = self.arrays.xp, self.state
         yaw, one = xp.arctan2(s, c)[:, None], xp.ones_like(c)[:, None] > 0.0  # the single env's frame heading
         return self.scan.readings(self.world_scene, st.x[:, None], st.y[:, None], yaw, one, self.robot.radius,
-                                  st.steps[:, None])[:, 0]
+                                  st.steps[:, None], None if self.crowd is None else self.crowd.discs())[:, 0]
 
     def _map_values(self) -> Any:
         """The local map's codes, ``(num_envs, cells * cells)`` float32 (one robot: no discs)."""
@@ -496,4 +491,7 @@ class VectorPointNavEnv(PoolRefreshing, VectorEnv):
                                      self.robot.radius)[:, 0]
 
     def _info(self, success: Any, r_pot: Any, r_col: Any, r_goal: Any, contact: Any, resetting: Any) -> dict[str, Any]:
-        return step_info(self.arrays.xp, self.state, success, r_pot, r_col, r_goal, contact, resetting)
+        info = step_info(self.arrays.xp, self.state, success, r_pot, r_col, r_goal, contact, resetting)
+        if self.crowd is not None:  # counted after this step's autoresets, as the single env's reset gives 0
+            info["pedestrian_collisions"] = self.crowd.collisions.copy()
+        return info

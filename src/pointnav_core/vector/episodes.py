@@ -37,7 +37,19 @@ from pointnav_core.vector.fields import (
 )
 from pointnav_core.vector.xp import Arrays
 
-__all__ = ["EpisodePool", "ScenePart", "assemble_parts", "fixed_pose", "sampler_field", "settle_part"]
+__all__ = ["EpisodePool", "ScenePart", "assemble_parts", "episode_reach", "fixed_pose", "sampler_field", "settle_part"]
+
+
+def episode_reach(engine: Any, discrete: Any) -> float:
+    """How far (m) a robot's centre can get from its start in one episode of ``engine`` (a
+    batched engine, with its ``discrete`` plan or None): its steps (the most of any robot's ``max_steps``, and at most
+    ``max_cycles`` with several robots) times the longest chord of a step (of each of a
+    discrete action's control steps). Goal fields keep only the cells within it of their
+    starts (:class:`~pointnav_core.vector.fields.FieldTables`)."""
+    steps = engine.max_steps if isinstance(engine.max_steps, int) else int(engine.arrays.numpy(engine.max_steps).max())
+    steps = min(steps, getattr(engine, "max_cycles", steps))
+    per_step = engine.max_travel * (1 if discrete is None else discrete.max_steps)
+    return steps * per_step
 
 
 def fixed_pose(where: str, episode: Any, scene: Any, floor: int, robot: Any) -> tuple[Any, float, Any]:

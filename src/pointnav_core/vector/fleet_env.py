@@ -31,7 +31,7 @@ from pointnav_core.envs.fleet import check_finished
 from pointnav_core.errors import ArgumentError, TaskStateError
 from pointnav_core.utils import validation
 from pointnav_core.vector import contacts_jit
-from pointnav_core.vector.accounting import task_step
+from pointnav_core.vector.accounting import read_task, task_step
 from pointnav_core.vector.arguments import as_scene_list, check_real_actions
 from pointnav_core.vector.contacts import advance
 from pointnav_core.vector.contacts_jit import advance_compiled
@@ -148,7 +148,7 @@ class VectorFleetEnv(VectorPointNavEnv):
             for s in scene_list
         ]
         first = self._samplers[0]
-        self._read_task(first.tasks[0], first.action_frequency)  # rate check on the envelope
+        read_task(self, first.tasks[0], first.action_frequency)  # rate check on the envelope
         read_tasks(self, first.tasks, self.robots, a)  # then the per-robot settings, (1, R)
         t = self.task
         acts = first.discrete_actions

@@ -150,6 +150,7 @@ def cast_batch(
     angles: Any,
     max_range: float,
     method: str = "auto",
+    crowd: Any = None,
 ) -> Any:
     """Exact ranges (m) of every present robot's rays, before the min-range rule.
 
@@ -173,6 +174,9 @@ def cast_batch(
         ``"array"``: the array path (numpy or torch); ``"numba"``: the compiled path;
         ``"auto"``: numba for arrays on the CPU (numpy, or torch ``"cpu"``) when installed,
         else the array path.
+    crowd : (qx, qy, qr, qn), optional
+        Discs every robot of a world sees besides the other robots (its pedestrians):
+        centres and radii ``(W, Q)`` (m) and each world's count ``(W,)`` (its first discs).
 
     Returns
     -------
@@ -202,17 +206,20 @@ def cast_batch(
     angles = a.asarray(angles)
     radius = a.xp.zeros_like(x) + radius  # (W, R)
     if cast_worlds is not None:
-        return _cast_compiled(cast_worlds, tables, scene, x, y, yaw, angles, present, radius, float(max_range))
+        return _cast_compiled(cast_worlds, tables, scene, x, y, yaw, angles, present, radius, float(max_range), crowd)
     c, s = directions(a, yaw, angles)
     best = _grid_ranges(tables, scene, x, y, c, s, float(max_range))
     best = a.xp.minimum(best, _disc_ranges(a, x, y, c, s, present, radius))
+    if crowd is not None:
+        crowd = tuple(a.asarray(v) for v in crowd[:3]) + (a.asarray(crowd[3], a.i64),)
+        best = a.xp.minimum(best, _crowd_ranges(a, x, y, c, s, crowd))
     best = _polygon_ranges(tables, scene, x, y, c, s, float(max_range), best)
     return a.xp.where(present[..., None], best, a.xp.full_like(best, float(max_range)))
 
 
 def _cast_compiled(
     cast_worlds: Any, tables: ScanTables, scene: Any, x: Any, y: Any, yaw: Any, angles: Any, present: Any,
-    radius: Any, max_range: float,
+    radius: Any, max_range: float, crowd: Any = None,
 ) -> Any:
     """:func:`cast_batch`'s compiled path (the kernel ``cast_worlds``), on numpy arrays or
     torch CPU tensors."""
@@ -221,13 +228,19 @@ def _cast_compiled(
     view = (lambda v: v.numpy()) if a.is_torch else (lambda v: v)
     x, y, yaw, angles = view(x), view(y), view(yaw), view(angles)
     w, r = x.shape
+    if crowd is None:
+        qx = qy = qr = np.zeros((w, 0))
+        qn = np.zeros(w, np.int64)
+    else:  # (the engine's crowds are numpy)
+        qx, qy, qr = (np.ascontiguousarray(v, dtype=np.float64) for v in crowd[:3])
+        qn = np.ascontiguousarray(crowd[3], dtype=np.int64)
     out = np.empty((w, r, angles.shape[0]))
     cast_worlds(
         np.ascontiguousarray(view(scene), dtype=np.int64), np.ascontiguousarray(x, dtype=np.float64),
         np.ascontiguousarray(y, dtype=np.float64), np.cos(yaw), np.sin(yaw), np.cos(angles), np.sin(angles),
         np.ascontiguousarray(view(present), dtype=np.bool_), np.ascontiguousarray(view(radius), dtype=np.float64),
         max_range,
-        tables.meta, tables.lookup, tables.clearance, tables.edges, out,
+        tables.meta, tables.lookup, tables.clearance, tables.edges, qx, qy, qr, qn, out,
     )
     _zero_inside(tables, view(scene), x, y, view(present), out)
     return a.asarray(out) if a.is_torch else out
@@ -344,19 +357,35 @@ def _disc_ranges(a: Arrays, x: Any, y: Any, c: Any, s: Any, present: Any, radius
     r = x.shape[1]
     if r == 1:
         return xp.full_like(c, math.inf)
-    # (W, R, 1, M): robot i's rays against robot m's disc.
-    fx = (x[:, :, None] - x[:, None, :])[:, :, None, :]
-    fy = (y[:, :, None] - y[:, None, :])[:, :, None, :]
+    t = _ray_discs(xp, x, y, c, s, x, y, radius)
+    other = a.asarray(~np.eye(r, dtype=bool), a.boolean)
+    seen = (other[None] & present[:, None, :])[:, :, None, :]
+    return _min_last(xp, xp.where(seen, t, math.inf))
+
+
+def _ray_discs(xp: Any, x: Any, y: Any, c: Any, s: Any, dx: Any, dy: Any, dr: Any) -> Any:
+    """``(W, R, n, M)``: how far (m) robot ``i``'s ray ``k`` runs to disc ``m`` of its world
+    (centres ``dx``, ``dy`` and radii ``dr``, ``(W, M)``); inf where it misses, 0 from inside."""
+    fx = (x[:, :, None] - dx[:, None, :])[:, :, None, :]
+    fy = (y[:, :, None] - dy[:, None, :])[:, :, None, :]
     b = fx * c[..., None] + fy * s[..., None]
-    cc = fx * fx + fy * fy - (radius * radius)[:, None, None, :]
+    cc = fx * fx + fy * fy - (dr * dr)[:, None, None, :]
     disc = b * b - cc
     # The nearer root, written without cancellation (raycast._disc_hits).
     denom = xp.sqrt(disc.clip(0.0, None)) - b
     t = xp.where(denom > 0.0, cc / xp.where(denom > 0.0, denom, 1.0), math.inf)
     hit = (disc >= 0.0) & (b <= 0.0)
-    t = xp.where(cc <= 0.0, 0.0, xp.where(hit, t, math.inf))
-    other = a.asarray(~np.eye(r, dtype=bool), a.boolean)
-    seen = (other[None] & present[:, None, :])[:, :, None, :]
+    return xp.where(cc <= 0.0, 0.0, xp.where(hit, t, math.inf))
+
+
+def _crowd_ranges(a: Arrays, x: Any, y: Any, c: Any, s: Any, crowd: Any) -> Any:
+    """Range (m) to the first of each world's ``crowd`` discs ``(qx, qy, qr, qn)`` (inf: none)."""
+    xp = a.xp
+    qx, qy, qr, qn = crowd
+    if not qx.shape[1]:
+        return xp.full_like(c, math.inf)
+    t = _ray_discs(xp, x, y, c, s, qx, qy, qr)
+    seen = (a.asarray(np.arange(qx.shape[1])) < qn[:, None])[:, None, None, :]
     return _min_last(xp, xp.where(seen, t, math.inf))
 
 
@@ -426,13 +455,14 @@ class VectorScan:
         w = np.nonzero(mask)[0]
         self._keys[w] = episode_key(_world_base(self._base, w), self._episodes[w])
 
-    def readings(self, scene: Any, x: Any, y: Any, yaw: Any, present: Any, radius: Any, steps: Any = None) -> Any:
+    def readings(self, scene: Any, x: Any, y: Any, yaw: Any, present: Any, radius: Any, steps: Any = None,
+                 crowd: Any = None) -> Any:
         """The scan's readings (m), ``(W, R, n_rays)`` float64 on the arrays' device;
-        ``radius`` as for :func:`cast_batch`; ``steps`` ``(W, R)`` each robot's step within
+        ``radius`` and ``crowd`` as for :func:`cast_batch`; ``steps`` ``(W, R)`` each robot's step within
         its world's episode (0 at reset), needed with noise or dropout (after :meth:`begin`)."""
         t, a = self.term, self.tables.arrays
         xp = a.xp
-        d = cast_batch(self.tables, scene, x, y, yaw, present, radius, self.angles, t.max_range, self.method)
+        d = cast_batch(self.tables, scene, x, y, yaw, present, radius, self.angles, t.max_range, self.method, crowd)
         top = t.max_range
         if t.min_range > 0.0:
             d = xp.where(d < t.min_range, top, d)

@@ -1,0 +1,76 @@
+"""Where a pedestrian walks next: its goal and the exact path there.
+
+One definition for every engine: the single env's :class:`~pointnav_core.crowds.Crowd`
+plans with :func:`plan_walk` at a spawn and at each arrival or block, and so do the batched
+engine's crowds (:mod:`pointnav_core.vector.crowd`), so a world's pedestrians draw the same
+goals and walk the same paths as a single env's.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any, NamedTuple
+
+import numpy as np
+from numpy.typing import NDArray
+
+from pointnav_core.floor.draw import nearest_usable
+
+__all__ = ["MIN_GOAL_DISTANCE", "Walk", "plan_walk"]
+
+#: Goals nearer than this (m) to the pedestrian are drawn again (up to 10 times).
+MIN_GOAL_DISTANCE = 1.0
+
+
+class Walk:
+    """A pedestrian's goals: the fixed list it walks (``walk``, round and round when
+    ``loop``), where it is in it (``index``, -1 before the first) and its goal now (m)."""
+
+    __slots__ = ("goal", "index", "loop", "walk")
+
+    def __init__(self, walk: tuple[tuple[float, float], ...], loop: bool, index: int, goal: NDArray[np.float64]) -> None:
+        self.walk, self.loop, self.index, self.goal = walk, loop, index, goal
+
+
+class Planned(NamedTuple):
+    """:func:`plan_walk`'s answer."""
+
+    points: NDArray[np.float64]  #: the path ``(N, 2)`` (m) from where it stands (one point: none)
+    drawn: bool  #: whether a goal was drawn (from ``rng``) on the way
+
+
+def plan_walk(scene: Any, floor: int, radius: float, here: NDArray[np.float64], walk: Walk, new_goal: bool,
+              rng: np.random.Generator) -> Planned:
+    """A pedestrian's path from ``here`` (m) to its goal: a new one if ``new_goal``, or if
+    the old one cannot be reached; a one-point path when none is reachable. A new goal is
+    the next of its fixed list while there is one, else drawn from ``rng`` in ``here``'s
+    part of the floor, at least :data:`MIN_GOAL_DISTANCE` away (10 tries). ``walk`` is
+    updated in place; paths keep ``radius`` (m) from the walls."""
+    tmap = scene.floors[floor]
+    # Where to plan from: here, or the nearest cell centre within 3 cells where the paths'
+    # radius fits (a neighbour's push can leave a pedestrian nearer a wall than its path runs).
+    start = here if tmap.is_usable(here, radius) else nearest_usable(tmap, here, radius)
+    if start is None:
+        return Planned(here[None].copy(), False)
+    drawn = False
+    for attempt in range(10):
+        if new_goal:
+            walk.index += 1
+        k = walk.index
+        if walk.walk and (walk.loop or k < len(walk.walk)):  # the next goal of its list (round and round)
+            walk.goal = np.array(walk.walk[k % len(walk.walk)], dtype=np.float64)
+            new_goal = True  # an unreachable fixed goal: try the next one
+        elif new_goal or attempt:
+            goal = start
+            drawn = True
+            for _ in range(10):
+                _, goal = scene.get_random_point(floor, reference_point=start, robot=radius, rng=rng)
+                goal = goal[:2]
+                if math.dist(goal, start) >= MIN_GOAL_DISTANCE:
+                    break
+            walk.goal = np.asarray(goal, dtype=np.float64)
+        points, _ = scene.get_shortest_path(floor, start, walk.goal, entire_path=True, robot=radius)
+        if points is not None:
+            points = np.asarray(points, dtype=np.float64)
+            return Planned(points if start is here else np.concatenate([here[None], points]), drawn)
+    return Planned(here[None].copy(), drawn)

@@ -1,0 +1,272 @@
+"""The pedestrians of a batch of worlds, stepped as arrays: each world's crowd is a single env's.
+
+:class:`VectorCrowd` keeps every world's pedestrians in ``(W, P, ...)`` arrays (a world with
+fewer pedestrians than ``P`` uses its first rows). Each world's crowd is exactly the one a
+:class:`~pointnav_core.envs.pointnav.PointNavEnv` would walk beside the same robot, by one
+definition for both engines:
+
+- **Placing.** An episode's crowd is placed once, the first time a world starts it, by the
+  single env's :meth:`Crowd.spawn <pointnav_core.crowds.Crowd.spawn>` on that episode's
+  scene beside its robot's start: drawn from a generator seeded with ``(engine seed, pool
+  generation, episode)``, or exactly the crowd a dataset episode records. Every later start
+  of the episode gathers the placed crowd (:meth:`Crowd.start
+  <pointnav_core.crowds.Crowd.start>`) as arrays. :meth:`VectorCrowd.record` gives a world's
+  crowd as a dataset episode stores it, which a single env places again exactly.
+- **Stepping.** One compiled call per scene steps all its worlds
+  (``crowds._crowd_kernel.orca_crowd_worlds``), which runs the single env's compiled step
+  (``orca_crowd_step``) world by world: the same floats.
+- **Planning.** A pedestrian that arrives or is blocked plans again with
+  :func:`~pointnav_core.crowds.walks.plan_walk`, the single env's planner, drawing from its
+  own generator (``numpy.random.default_rng(seed)``). These plans
+  are the step's events, as an arrival is in the single env: the exact search is per
+  pedestrian by nature, so they run one by one, and only for the pedestrians that need one.
+  Each pedestrian's own generator is made at its first plan, where the placing left it.
+
+Only ORCA and ``"static"`` crowds, on numpy with numba (the ``fast`` extra), one robot per
+world and continuous actions; the rest is refused by :func:`check_vector_pedestrians`
+(docs/decisions.md, "Crowds in the batched engine").
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from pointnav_core.crowds.config import PedestrianConfig
+from pointnav_core.crowds.crowd import GOAL_REACHED, KERNEL, Crowd, CrowdStart
+from pointnav_core.crowds.walks import Walk, plan_walk
+from pointnav_core.errors import ArgumentError
+from pointnav_core.utils.compiled import kernel
+
+__all__ = ["VectorCrowd", "check_vector_pedestrians", "recorded_crowds"]
+
+
+def check_vector_pedestrians(config: PedestrianConfig | None, device: str, action_space: str, sensors: Any) -> None:
+    """Refuse, naming ``pedestrians``, what the batched engine's crowds do not do yet."""
+    if config is None:
+        return
+    if config.behaviour not in ("orca", "static"):
+        raise ArgumentError(
+            f"pedestrians['behaviour'] is {config.behaviour!r}, but the batched engine's crowds walk by 'orca' "
+            f"or 'static' only: use PointNavEnv or parallel_env for the others"
+        )
+    if device != "numpy":
+        raise ArgumentError(f"pedestrians need device='numpy' in the batched engine, got device={device!r}")
+    if action_space != "continuous":
+        raise ArgumentError(f"pedestrians need action_space='continuous' in the batched engine, got {action_space!r}")
+    if sensors and "local_map" in sensors:
+        raise ArgumentError("pedestrians and sensors['local_map'] cannot be combined in the batched engine yet")
+    if kernel(*KERNEL) is None:
+        raise ArgumentError("pedestrians in the batched engine need numba (pip install 'pointnav-core[fast]')")
+
+
+def recorded_crowds(engine: Any, recorded: dict[int, Any]) -> None:
+    """Hand the crowds that fixed episodes record (pool index -> a dataset episode's
+    ``pedestrians`` or None) to ``engine``'s crowd; ValueError naming the episode when
+    one records a crowd and the engine has none (a single env would walk it with the
+    default settings; here the engine's settings must be given)."""
+    crowd = engine.crowd
+    given = {e: tuple(r) for e, r in recorded.items() if r is not None}
+    if crowd is None:
+        if given:
+            e = min(given)
+            raise ArgumentError(
+                f"options['episodes'][{e - engine.pool.n_sampled}] records a crowd, but this engine was built "
+                f"without pedestrians: pass pedestrians={{...}} (e.g. {{'count': {len(given[e])}}})"
+            )
+        return
+    crowd.record_episodes(given)
+
+
+class VectorCrowd:
+    """Every world's pedestrians (see the module notes).
+
+    Parameters
+    ----------
+    config : PedestrianConfig
+    samplers : sequence of PointNavEnv
+        One per scene (the engine's): their scenes and floors, and their robot.
+    world_scene : ndarray of int, shape (W,)
+        Each world's scene.
+
+    Attributes
+    ----------
+    positions, velocities : ndarray, shape (W, P, 2)
+        Centres (m) and velocities (m/s) after the last step.
+    headings, radius, speed : ndarray, shape (W, P)
+        Walking directions (rad), disc radii (m), preferred speeds (m/s).
+    count : ndarray of int, shape (W,)
+        Each world's pedestrians (its first rows).
+    collisions : ndarray of int, shape (W,)
+        Steps of each world's episode on which its robot touched a pedestrian.
+    """
+
+    def __init__(self, config: PedestrianConfig, samplers: Sequence[Any], world_scene: NDArray[np.int64]) -> None:
+        self.config = config
+        self._samplers = list(samplers)
+        self._crowds = [Crowd(config, env.scene) for env in samplers]  # each scene's placer
+        self.world_scene = np.asarray(world_scene, dtype=np.int64)
+        self._groups = [np.flatnonzero(self.world_scene == s) for s in range(len(samplers))]
+        self._seed, self._generation = 0, 0
+        self._pool: Any = None
+        self._starts: list[CrowdStart] = []
+        self._slot_of: dict[int, int] = {}
+        self._recorded: dict[int, Any] = {}
+        self._resize(len(self.world_scene), 0, 1)
+        self.count = np.zeros(len(self.world_scene), dtype=np.int64)
+        self.collisions = np.zeros(len(self.world_scene), dtype=np.int64)
+        self._slot = np.zeros(len(self.world_scene), dtype=np.int64)
+        self._rngs: dict[tuple[int, int], np.random.Generator] = {}
+
+    def _resize(self, w: int, p: int, length: int) -> None:
+        """Zeroed state arrays for ``w`` worlds of ``p`` pedestrians, paths of ``length`` points."""
+        self.positions, self.velocities, self.goals = np.zeros((w, p, 2)), np.zeros((w, p, 2)), np.zeros((w, p, 2))
+        self.headings, self.radius, self.speed = np.zeros((w, p)), np.zeros((w, p)), np.zeros((w, p))
+        self._paths = np.zeros((w, p, length, 2))
+        self._next, self._last = np.zeros((w, p), np.int64), np.zeros((w, p), np.int64)
+        self._index = np.full((w, p), -1, np.int64)
+
+    # ------------------------------------------------------------------ placing
+    def seed(self, seed: int) -> None:
+        """Key the drawn crowds by ``seed`` (the engine draws it at each seeded reset)."""
+        self._seed, self._pool = int(seed), None
+
+    def record_episodes(self, records: dict[int, Any]) -> None:
+        """The crowds that episodes of the pool fix (pool index -> records; a dataset
+        episode's ``pedestrians``), placed as recorded from the next start on."""
+        self._recorded = dict(records)
+        self._pool = None
+
+    def start_worlds(self, worlds: NDArray[np.int64], episodes: NDArray[np.int64], pool: Any, robot_radius: float) -> None:
+        """Start the crowds of ``worlds`` for their pool ``episodes`` (placed at their first start)."""
+        if pool is not self._pool:  # a new pool (or seed): its episodes' crowds are new ones
+            self._pool, self._generation = pool, self._generation + 1
+            self._starts, self._slot_of = [], {}
+        for e in np.unique(episodes).tolist():
+            if e not in self._slot_of:
+                self._slot_of[e] = self._place(pool, int(e), robot_radius)
+        slots = np.array([self._slot_of[e] for e in episodes.tolist()], dtype=np.int64)
+        self._gather(worlds, slots)
+
+    def _place(self, pool: Any, e: int, robot_radius: float) -> int:
+        """Place episode ``e``'s crowd with its scene's single-env crowd; its slot."""
+        s = int(pool.scene[e])
+        crowd, env = self._crowds[s], self._samplers[s]
+        rng = np.random.default_rng([self._seed, self._generation, e])
+        robots = np.array([[float(pool.sx[e]), float(pool.sy[e]), robot_radius]])
+        crowd.spawn(env.task.floor, rng, robots, self._recorded.get(e))
+        self._starts.append(crowd.start())
+        return len(self._starts) - 1
+
+    def _gather(self, worlds: NDArray[np.int64], slots: NDArray[np.int64]) -> None:
+        """Copy the placed crowds ``slots`` into ``worlds``, widening the arrays if needed."""
+        starts = [self._starts[k] for k in np.unique(slots).tolist()]
+        p = max([len(st.radius) for st in starts] + [self.radius.shape[1]])
+        length = max([st.paths.shape[1] for st in starts] + [self._paths.shape[1]])
+        self._widen(p, length)
+        for w, k in zip(worlds.tolist(), slots.tolist()):
+            st, n = self._starts[k], len(self._starts[k].radius)
+            self.positions[w, :n], self.headings[w, :n] = st.positions, st.headings
+            self.radius[w, :n], self.speed[w, :n], self.goals[w, :n] = st.radius, st.speed, st.goals
+            self._paths[w, :n, : st.paths.shape[1]] = st.paths
+            self._paths[w, :n, st.paths.shape[1]:] = st.paths[:, -1:]
+            self._next[w, :n], self._last[w, :n], self._index[w, :n] = st.next, st.last, st.goal_index
+            self.velocities[w] = 0.0
+            self.count[w] = n
+        self._slot[worlds] = slots
+        self.collisions[worlds] = 0
+        reset = set(worlds.tolist())
+        for key in [key for key in self._rngs if key[0] in reset]:
+            del self._rngs[key]
+
+    def _widen(self, p: int, length: int) -> None:
+        """Room for ``p`` pedestrians a world and paths of ``length`` points."""
+        w, p0, l0 = self._paths.shape[:3]
+        if p <= p0 and length <= l0:
+            return
+        old = (self.positions, self.velocities, self.goals, self.headings, self.radius, self.speed, self._next,
+               self._last, self._index, self._paths)
+        self._resize(w, max(p, p0), max(length, l0))
+        new = (self.positions, self.velocities, self.goals, self.headings, self.radius, self.speed, self._next,
+               self._last, self._index)
+        for dst, src in zip(new, old):
+            dst[:, :p0] = src
+        self._paths[:, :p0, :l0] = old[-1]
+        self._paths[:, :p0, l0:] = old[-1][:, :, -1:]
+
+    def record(self, world: int) -> tuple[Any, ...]:
+        """World ``world``'s crowd as its episode placed it: the records a dataset episode
+        stores (:class:`~pointnav_core.crowds.record.PedestrianRecord`), which a single
+        env's reset with that episode places again exactly."""
+        return self._starts[int(self._slot[world])].record
+
+    # ------------------------------------------------------------------ stepping
+    def step(self, x: NDArray[np.float64], y: NDArray[np.float64], vx: NDArray[np.float64], vy: NDArray[np.float64],
+             robot_radius: float, dt: float) -> NDArray[np.bool_]:
+        """Move every world's pedestrians one control step beside its robot at ``(x, y)``
+        (m, shape ``(W,)``) moving at ``(vx, vy)`` (m/s); whether each robot touches one
+        after it (also counted in :attr:`collisions`)."""
+        w, cfg = len(x), self.config
+        robots = np.stack([x, y, np.full(w, robot_radius)], -1).reshape(w, 1, 3)
+        robot_vel = np.stack([vx, vy], -1).reshape(w, 1, 2)
+        contacts = np.zeros((w, 1), dtype=np.bool_)
+        if cfg.behaviour == "static" or not self.radius.shape[1]:
+            self._touching(robots, contacts)
+        else:
+            self._orca(robots, robot_vel, float(dt), contacts)
+        touched = contacts[:, 0]
+        self.collisions += touched
+        return touched
+
+    def _touching(self, robots: NDArray[np.float64], contacts: NDArray[np.bool_]) -> None:
+        """A static crowd's contacts (it never moves): a robot's disc over a pedestrian's."""
+        present = np.arange(self.radius.shape[1])[None] < self.count[:, None]
+        d = np.hypot(robots[:, :, None, 0] - self.positions[:, None, :, 0], robots[:, :, None, 1] - self.positions[:, None, :, 1])
+        contacts[:] = ((d < robots[:, :, None, 2] + self.radius[:, None]) & present[:, None]).any(-1)
+
+    def _orca(self, robots: NDArray[np.float64], robot_vel: NDArray[np.float64], dt: float,
+              contacts: NDArray[np.bool_]) -> None:
+        """An ORCA step of every world: one compiled call per scene, then the plans."""
+        cfg, fn = self.config, kernel("pointnav_core.crowds._crowd_kernel", "orca_crowd_worlds")
+        new_pos, new_vel = self.positions.copy(), np.zeros_like(self.velocities)
+        flags = np.zeros(self.radius.shape, np.int8)
+        seen = np.full(len(robots), 1 if cfg.sees_robots else 0, np.int64)
+        for s, worlds in enumerate(self._groups):
+            if not len(worlds):
+                continue
+            collision = self._samplers[s].scene.floors[self._samplers[s].task.floor].collision
+            fn(worlds, self.count, self.positions, self.velocities, self.radius, self.speed, self.goals, self._paths,
+               self._next, self._last, robots, robot_vel, seen, dt, cfg.neighbor_dist, cfg.max_neighbors,
+               cfg.time_horizon, GOAL_REACHED, collision.kernel_arguments(cfg.radius[1]), new_pos, new_vel, flags,
+               contacts)
+        moving = (flags & 4) > 0
+        self.headings = np.where(moving, np.arctan2(new_vel[..., 1], new_vel[..., 0]), self.headings)
+        self.positions, self.velocities = new_pos, new_vel
+        for w, i in zip(*(v.tolist() for v in np.nonzero(flags & 3))):
+            self._replan(w, i, bool(flags[w, i] & 2))
+
+    def _replan(self, w: int, i: int, arrived: bool) -> None:
+        """Pedestrian ``i`` of world ``w`` plans again (:func:`plan_walk`, as the single env)."""
+        st = self._starts[int(self._slot[w])]
+        walk = Walk(st.walks[i], st.loops[i], int(self._index[w, i]), self.goals[w, i].copy())
+        rng = self._rngs.get((w, i))
+        if rng is None:  # its own generator, where the placing left it
+            rng = self._rngs[w, i] = np.random.default_rng(0)
+            rng.bit_generator.state = st.draws[i]
+        env = self._samplers[int(self.world_scene[w])]
+        planned = plan_walk(env.scene, env.task.floor, self.config.plan_radius, self.positions[w, i], walk, arrived, rng)
+        self._index[w, i], self.goals[w, i] = walk.index, walk.goal
+        points = planned.points
+        if len(points) > self._paths.shape[2]:
+            self._widen(self._paths.shape[1], max(len(points), 2 * self._paths.shape[2]))
+        self._paths[w, i, : len(points)] = points
+        self._paths[w, i, len(points):] = points[-1]
+        self._last[w, i], self._next[w, i] = len(points) - 1, min(1, len(points) - 1)
+
+    def discs(self) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64], NDArray[np.int64]]:
+        """What the robots' scans see: centres ``x``, ``y`` and radii ``(W, P)`` (m), and
+        each world's count."""
+        return self.positions[..., 0], self.positions[..., 1], self.radius, self.count

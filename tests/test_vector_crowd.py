@@ -1,0 +1,164 @@
+"""Pedestrians in the batched engine (``VectorPointNavEnv(..., pedestrians={...})``).
+
+The reference is one ``PointNavEnv`` per world, playing the world's episode and its crowd
+(the world's record, :meth:`VectorCrowd.record`, or the dataset episode's): step for step
+the pedestrians stand at the same places, the scans read the same, the contacts and the
+episode's ends agree. The scan's sight of a pedestrian is also checked against a range to a
+disc computed by hand.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from crowd_reference import world_episode
+from vector_reference import random_actions
+
+from pointnav_core.datasets import presets
+from pointnav_core.datasets.format import PointNavEpisode
+from pointnav_core.datasets.scene_sets import load_scene
+from pointnav_core.envs.pointnav import PointNavEnv
+from pointnav_core.errors import ArgumentError
+from pointnav_core.scenes import Scene
+from pointnav_core.vector import VectorPointNavEnv
+
+pytest.importorskip("numba")
+
+SCAN = {"scan": {"n_rays": 16, "max_range": 4.0}}
+
+
+def _house() -> Scene:
+    grid = np.zeros((60, 80), np.uint8)  # 8 x 6 m, two rooms and a door
+    grid[[0, -1], :] = grid[:, [0, -1]] = 1
+    grid[:, 40] = 1
+    grid[25:35, 40] = 0
+    grid[10:14, 15:20] = 1
+    return Scene.from_array(grid, 0.1)
+
+
+def _play_alongside(venv: VectorPointNavEnv, singles: list[PointNavEnv], actions: np.ndarray) -> dict[str, int]:
+    """Step the engine and the single envs (each already reset to its world's episode) until
+    each world's first episode ends, checking every step; counts of what happened."""
+    n = venv.num_envs
+    obs = venv.arrays.numpy(venv.reset_obs)
+    sobs = [env.last_obs for env in singles]
+    live = [True] * n
+    seen = {"touches": 0, "ends": 0, "steps": 0, "moved": 0}
+    for w in range(n):
+        np.testing.assert_allclose(obs[w], sobs[w], atol=1e-4, err_msg=f"world {w} at the reset")
+    for t, act in enumerate(actions):
+        before = venv.crowd.positions.copy()
+        obs, reward, term, trunc, info = venv.step(act)
+        for w, env in enumerate(singles):
+            if not live[w]:
+                continue
+            sob, srew, sterm, strunc, sinfo = env.step(act[w])
+            where = f"world {w}, step {t}"
+            k = env.crowd.n
+            np.testing.assert_allclose(venv.crowd.positions[w, :k], env.crowd.positions, atol=1e-9, rtol=0, err_msg=where)
+            np.testing.assert_allclose(venv.crowd.velocities[w, :k], env.crowd.velocities, atol=1e-9, rtol=0, err_msg=where)
+            np.testing.assert_allclose(obs[w], sob, atol=1e-4, err_msg=where)
+            assert abs(float(reward[w]) - srew) <= 1e-5, where
+            assert (bool(term[w]), bool(trunc[w])) == (sterm, strunc), where
+            assert int(info["pedestrian_collisions"][w]) == sinfo["pedestrian_collisions"], where
+            seen["touches"] += int(info["pedestrian_collisions"][w] > 0)
+            seen["moved"] += int(np.abs(venv.crowd.positions[w, :k] - before[w, :k]).max(initial=0.0) > 0)
+            seen["steps"] += 1
+            if sterm or strunc:
+                live[w] = False
+                seen["ends"] += 1
+        if not any(live):
+            break
+    return seen
+
+
+def _singles(venv: VectorPointNavEnv, scene: Scene, pedestrians: dict, task: dict,
+             episodes: list[PointNavEpisode]) -> list[PointNavEnv]:
+    singles = []
+    for w, episode in enumerate(episodes):
+        env = PointNavEnv(scene=scene, flatten_obs=True, sensors=SCAN, task=task, pedestrians=pedestrians)
+        env.last_obs, _ = env.reset(seed=w, options={"episode": episode})
+        singles.append(env)
+    return singles
+
+
+@pytest.mark.parametrize("pedestrians", [
+    {"count": 6, "end_on_collision": False},
+    {"count": 4, "sees_robots": False, "speed": (0.8, 1.3), "end_on_collision": True},
+    {"density": 0.15, "radius": 0.25},
+    {"count": 5, "behaviour": "static"},
+])
+def test_each_world_walks_as_a_single_env(pedestrians: dict) -> None:
+    scene, n = _house(), 6
+    task = {"termination_config": {"max_steps": 120, "max_collisions": 50}}
+    venv = VectorPointNavEnv(n, scene=scene, seed=3, sensors=SCAN, task=task, pedestrians=pedestrians, pool_size=3)
+    obs, _ = venv.reset(seed=3)
+    venv.reset_obs = obs
+    episodes = [world_episode(venv, w) for w in range(n)]
+    singles = _singles(venv, scene, pedestrians, task, episodes)
+    actions = random_actions(np.random.default_rng(0), (140, n))
+    actions[:, :, 0] = np.abs(actions[:, :, 0])  # drive ahead, into the crowd
+    seen = _play_alongside(venv, singles, actions)
+    assert seen["ends"] == n  # every world's episode played to its end
+    if pedestrians.get("behaviour") != "static":
+        assert seen["moved"] > seen["steps"] // 2
+    # The recorded crowds are what the engine placed: each pedestrian clear of the robot.
+    for w, episode in enumerate(episodes):
+        for ped in episode.pedestrians:
+            gap = math.dist(ped.start, episode.start_position[:2]) - ped.radius - venv.robot.radius
+            assert gap >= 0.0, f"world {w}: a pedestrian starts on the robot"
+
+
+def test_a_dataset_crowd_is_placed_as_recorded() -> None:
+    # Circle crossing: the preset's fixed starts and goals, walked round and round.
+    episodes = list(presets.dataset(["circle_crossing"], episodes_per=3, seed=1).episodes)
+    scene = load_scene("preset:circle_crossing")
+    pedestrians = {"count": len(episodes[0].pedestrians)}
+    task = {"termination_config": {"max_steps": 80}}
+    venv = VectorPointNavEnv(3, scene=scene, seed=0, sensors=SCAN, task=task, pedestrians=pedestrians)
+    obs, _ = venv.reset(options={"episodes": episodes})
+    venv.reset_obs = obs
+    for w, episode in enumerate(episodes):
+        assert venv.crowd.record(w) == episode.pedestrians
+        np.testing.assert_array_equal(venv.crowd.positions[w, :5], [p.start for p in episode.pedestrians])
+    singles = _singles(venv, scene, pedestrians, task, episodes)
+    seen = _play_alongside(venv, singles, np.tile([[0.6, 0.0]], (80, 3, 1)))
+    assert seen["ends"] == 3 and seen["moved"] > 0
+
+
+def test_scan_sees_a_pedestrian_at_the_hand_computed_range() -> None:
+    # One pedestrian of radius 0.25 m fixed 2 m ahead of the robot, walking nowhere (static).
+    grid = np.zeros((40, 60), np.uint8)
+    grid[[0, -1], :] = grid[:, [0, -1]] = 1
+    scene = Scene.from_array(grid, 0.1)
+    ped = {"count": 1, "behaviour": "static", "radius": 0.25, "starts": [[3.5, 2.0]], "goals": [[[3.5, 1.0]]]}
+    venv = VectorPointNavEnv(1, scene=scene, seed=0, pedestrians=ped,
+                             sensors={"scan": {"n_rays": 4, "max_range": 5.0}})
+    obs, _ = venv.reset(options={"episodes": [((1.5, 2.0), 0.0, (5.0, 3.0))]})
+    behind, ahead = obs[0, 8], obs[0, 10]  # rays at -pi and 0 (scan_angles)
+    # The ray from (1.5, 2.0) along +x meets the disc centred 2 m ahead at 2 - 0.25 m.
+    assert ahead == pytest.approx(1.75, abs=1e-6)
+    # Behind (-x): the wall's cell edge at x = 0.1 m, 1.4 m away.
+    assert behind == pytest.approx(1.4, abs=1e-6)
+
+
+@pytest.mark.parametrize(("kwargs", "names"), [
+    ({"pedestrians": {"count": 2, "behaviour": "social_force"}}, "pedestrians['behaviour']"),
+    ({"pedestrians": {"count": 2}, "action_space": "discrete"}, "action_space"),
+    ({"pedestrians": {"count": 2}, "sensors": {"local_map": {}}}, "local_map"),
+    ({"pedestrians": {"density": -1.0}}, "pedestrians['density']"),
+    ({"pedestrians": {"count": 2, "behavior": "orca"}}, "unknown key 'behavior'"),
+    ({"pedestrians": {"count": 2}, "n_robots": 2}, "n_robots=2"),
+])
+def test_what_the_engine_cannot_walk_is_refused(kwargs: dict, names: str) -> None:
+    with pytest.raises(ArgumentError, match=names.replace("[", r"\[").replace("]", r"\]")):
+        VectorPointNavEnv(2, scene=_house(), **kwargs)
+
+
+def test_a_recorded_crowd_needs_pedestrians() -> None:
+    episodes = list(presets.dataset(["corridor"], episodes_per=1).episodes)
+    venv = VectorPointNavEnv(1, scene=load_scene("preset:corridor"), seed=0)
+    with pytest.raises(ArgumentError, match=r"options\['episodes'\]\[0\] records a crowd"):
+        venv.reset(options={"episodes": episodes})
