@@ -70,3 +70,18 @@ def world_episode(venv: Any, w: int) -> PointNavEpisode:
         geodesic_distance=float(st.start_distance[w]), robot_radius=venv.robot.radius,
         pedestrians=venv.crowd.record(w),
     )
+
+
+def fleet_episode(venv: Any, w: int, k: int) -> PointNavEpisode:
+    """Robot ``k`` of world ``w`` of a batched engine with several robots a world: its
+    episode as a dataset episode, the first robot's carrying the world's crowd (the
+    multi-robot env places the first robot's recorded crowd)."""
+    st = venv.state
+    yaw = float(st.yaw[w, k])
+    return PointNavEpisode(
+        episode_id=f"{w}_{k}", scene_id="here", floor=0, start_position=(float(st.x[w, k]), float(st.y[w, k]), 0.0),
+        start_rotation=(0.0, 0.0, math.sin(yaw / 2), math.cos(yaw / 2)),
+        goal_position=(float(st.goal_x[w, k]), float(st.goal_y[w, k]), 0.0), goal_radius=None,
+        geodesic_distance=float(st.start_distance[w, k]), robot_radius=venv.robots[k].radius,
+        pedestrians=venv.crowd.record(w) if k == 0 else None,
+    )

@@ -28,7 +28,7 @@ def test_the_quick_run_prints_every_row() -> None:
     rows = [line for line in run.stdout.splitlines() if line.startswith("| ")]
     expected = [
         "batched engine, 12-ray scan (16 x 4) |",
-        "batched engine, 12-ray scan, 10 pedestrians per world (16 x 4) | not built |",
+        "batched engine, 12-ray scan, 10 pedestrians per world (16 x 4) | ",
         "single env, no pedestrians |",
         "single env, 10 ORCA pedestrians |",
         "single env, 10 social-force pedestrians |",

@@ -287,5 +287,6 @@ def test_an_env_config_carries_the_crowd() -> None:
     venv = VectorPointNavEnv(num_envs=2, config=orca)
     venv.reset(seed=0)
     assert venv.crowd.count.tolist() == [3, 3]
-    with pytest.raises(ValueError, match="config.pedestrians"):
-        VectorPointNavEnv(num_envs=2, n_robots=2, config=orca)
+    fleet = VectorPointNavEnv(num_envs=2, n_robots=2, config=orca)
+    fleet.reset(seed=0)
+    assert fleet.crowd.count.tolist() == [3, 3] and fleet.crowd.collisions.shape == (2, 2)

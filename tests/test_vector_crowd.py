@@ -13,12 +13,13 @@ import math
 
 import numpy as np
 import pytest
-from crowd_reference import world_episode
+from crowd_reference import fleet_episode, world_episode
 from vector_reference import random_actions
 
 from pointnav_core.datasets import presets
 from pointnav_core.datasets.format import PointNavEpisode
 from pointnav_core.datasets.scene_sets import load_scene
+from pointnav_core.envs.multi_pointnav import parallel_env
 from pointnav_core.envs.pointnav import PointNavEnv
 from pointnav_core.errors import ArgumentError
 from pointnav_core.scenes import Scene
@@ -150,7 +151,6 @@ def test_scan_sees_a_pedestrian_at_the_hand_computed_range() -> None:
     ({"pedestrians": {"count": 2}, "sensors": {"local_map": {}}}, "local_map"),
     ({"pedestrians": {"density": -1.0}}, "pedestrians['density']"),
     ({"pedestrians": {"count": 2, "behavior": "orca"}}, "unknown key 'behavior'"),
-    ({"pedestrians": {"count": 2}, "n_robots": 2}, "n_robots=2"),
 ])
 def test_what_the_engine_cannot_walk_is_refused(kwargs: dict, names: str) -> None:
     with pytest.raises(ArgumentError, match=names.replace("[", r"\[").replace("]", r"\]")):
@@ -162,3 +162,50 @@ def test_a_recorded_crowd_needs_pedestrians() -> None:
     venv = VectorPointNavEnv(1, scene=load_scene("preset:corridor"), seed=0)
     with pytest.raises(ArgumentError, match=r"options\['episodes'\]\[0\] records a crowd"):
         venv.reset(options={"episodes": episodes})
+
+
+@pytest.mark.parametrize(("finished", "pedestrians"), [
+    ("park", {"count": 6}),
+    ("remove", {"count": 5, "end_on_collision": True, "speed": (0.9, 1.3)}),
+])
+def test_several_robots_walk_beside_one_crowd_as_in_the_multi_robot_env(finished: str, pedestrians: dict) -> None:
+    scene, n, r = _house(), 4, 3
+    task = {"termination_config": {"max_steps": 90, "max_collisions": 50}}
+    venv = VectorPointNavEnv(n, n_robots=r, scene=scene, seed=5, sensors=SCAN, task=task, pedestrians=pedestrians,
+                             pool_size=2, finished=finished)
+    obs, info = venv.reset(seed=5)
+    refs, agents = [], []
+    for w in range(n):
+        episodes = [fleet_episode(venv, w, k) for k in range(r)]
+        env = parallel_env(scene=scene, n_robots=r, task=task, backend="kinematic", sensors=SCAN, finished=finished,
+                           pedestrians=pedestrians)
+        sob, _ = env.reset(seed=w, options={"episodes": episodes})
+        agents = env.possible_agents
+        np.testing.assert_allclose(obs[w], [sob[a] for a in agents], atol=1e-4, err_msg=f"world {w} at the reset")
+        refs.append(env)
+    actions = random_actions(np.random.default_rng(1), (100, n, r))
+    actions[..., 0] = np.abs(actions[..., 0])
+    seen = {"touches": 0, "ends": 0, "parked": 0}
+    for t, act in enumerate(actions):
+        obs, reward, term, trunc, info = venv.step(act)
+        for w, env in enumerate(refs):
+            if not env.agents:
+                continue
+            acting = list(env.agents)
+            sob, srew, sterm, strunc, sinfo = env.step({a: act[w, agents.index(a)] for a in acting})
+            where = f"world {w}, step {t}"
+            k = env.crowd.n
+            np.testing.assert_allclose(venv.crowd.positions[w, :k], env.crowd.positions, atol=1e-9, rtol=0, err_msg=where)
+            seen["parked"] += r - len(acting)
+            for j, a in enumerate(agents):
+                if a not in acting:
+                    continue
+                np.testing.assert_allclose(obs[w, j], sob[a], atol=1e-4, err_msg=f"{where}, robot {j}")
+                assert abs(float(reward[w, j]) - srew[a]) <= 1e-5, f"{where}, robot {j}"
+                assert (bool(term[w, j]), bool(trunc[w, j])) == (sterm[a], strunc[a]), f"{where}, robot {j}"
+                assert int(info["pedestrian_collisions"][w, j]) == sinfo[a]["pedestrian_collisions"], f"{where}, robot {j}"
+                seen["touches"] += int(sinfo[a]["pedestrian_collisions"] > 0)
+                seen["ends"] += sterm[a] or strunc[a]
+        if not any(env.agents for env in refs):
+            break
+    assert seen["ends"] == n * r and seen["touches"] > 0 and seen["parked"] > 0

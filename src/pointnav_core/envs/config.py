@@ -144,7 +144,7 @@ class EnvConfig:
     pedestrians : dict, optional
         The crowd, as the envs' ``pedestrians`` (:mod:`pointnav_core.crowds.config`; a
         callable behaviour cannot be saved); None: no pedestrians. The single and the
-        multi-robot envs take it, and the batched engine with one robot per world
+        multi-robot envs take it, and the batched engine
         (:mod:`pointnav_core.vector.crowd`: ORCA or static crowds).
 
     Raises
@@ -370,11 +370,6 @@ def vector_fleet_arguments(config: EnvConfig, given: Mapping[str, Any]) -> dict[
     """The batched multi-robot engine's arguments: :func:`vector_arguments`, with
     ``max_cycles`` the config's ``max_steps`` unless given (as :func:`multi_robot_arguments`)."""
     out = vector_arguments(config, given)
-    if out.pop("pedestrians", None) is not None:
-        raise ArgumentError(
-            "config.pedestrians is set, but the batched engine's crowds walk beside one robot per world: "
-            "use parallel_env for several robots among pedestrians"
-        )
     if "max_cycles" not in given:
         out["max_cycles"] = config.max_steps
     return out

@@ -22,9 +22,11 @@ definition for both engines:
   pedestrian by nature, so they run one by one, and only for the pedestrians that need one.
   Each pedestrian's own generator is made at its first plan, where the placing left it.
 
-Only ORCA and ``"static"`` crowds, on numpy with numba (the ``fast`` extra), one robot per
-world and continuous actions; the rest is refused by :func:`check_vector_pedestrians`
-(docs/decisions.md, "Crowds in the batched engine").
+Several robots per world walk beside one crowd, as in the multi-robot env: it avoids every
+robot present (with ``sees_robots``), and each robot's contacts are its own. Only ORCA and
+``"static"`` crowds, on numpy with numba (the ``fast`` extra), with continuous actions; the
+rest is refused by :func:`check_vector_pedestrians` (docs/decisions.md, "Crowds in the
+batched engine").
 """
 
 from __future__ import annotations
@@ -87,10 +89,14 @@ class VectorCrowd:
     Parameters
     ----------
     config : PedestrianConfig
-    samplers : sequence of PointNavEnv
-        One per scene (the engine's): their scenes and floors, and their robot.
+    scenes : sequence of Scene
+        The engine's scenes.
+    floor : int
+        The floor the robots navigate.
     world_scene : ndarray of int, shape (W,)
         Each world's scene.
+    robot_radius : ndarray, shape (R,)
+        Each robot's radius (m), the same in every world.
 
     Attributes
     ----------
@@ -100,16 +106,18 @@ class VectorCrowd:
         Walking directions (rad), disc radii (m), preferred speeds (m/s).
     count : ndarray of int, shape (W,)
         Each world's pedestrians (its first rows).
-    collisions : ndarray of int, shape (W,)
-        Steps of each world's episode on which its robot touched a pedestrian.
+    collisions : ndarray of int, shape (W, R)
+        Steps of each robot's episode on which it touched a pedestrian while acting.
     """
 
-    def __init__(self, config: PedestrianConfig, samplers: Sequence[Any], world_scene: NDArray[np.int64]) -> None:
+    def __init__(self, config: PedestrianConfig, scenes: Sequence[Any], floor: int, world_scene: NDArray[np.int64],
+                 robot_radius: NDArray[np.float64]) -> None:
         self.config = config
-        self._samplers = list(samplers)
-        self._crowds = [Crowd(config, env.scene) for env in samplers]  # each scene's placer
+        self.scenes, self.floor = list(scenes), int(floor)
+        self.robot_radius = np.asarray(robot_radius, dtype=np.float64).reshape(-1)
+        self._crowds = [Crowd(config, scene) for scene in scenes]  # each scene's placer
         self.world_scene = np.asarray(world_scene, dtype=np.int64)
-        self._groups = [np.flatnonzero(self.world_scene == s) for s in range(len(samplers))]
+        self._groups = [np.flatnonzero(self.world_scene == s) for s in range(len(scenes))]
         self._seed, self._generation = 0, 0
         self._pool: Any = None
         self._starts: list[CrowdStart] = []
@@ -117,7 +125,7 @@ class VectorCrowd:
         self._recorded: dict[int, Any] = {}
         self._resize(len(self.world_scene), 0, 1)
         self.count = np.zeros(len(self.world_scene), dtype=np.int64)
-        self.collisions = np.zeros(len(self.world_scene), dtype=np.int64)
+        self.collisions = np.zeros((len(self.world_scene), len(self.robot_radius)), dtype=np.int64)
         self._slot = np.zeros(len(self.world_scene), dtype=np.int64)
         self._rngs: dict[tuple[int, int], np.random.Generator] = {}
 
@@ -140,25 +148,25 @@ class VectorCrowd:
         self._recorded = dict(records)
         self._pool = None
 
-    def start_worlds(self, worlds: NDArray[np.int64], episodes: NDArray[np.int64], pool: Any, robot_radius: float) -> None:
+    def start_worlds(self, worlds: NDArray[np.int64], episodes: NDArray[np.int64], pool: Any) -> None:
         """Start the crowds of ``worlds`` for their pool ``episodes`` (placed at their first start)."""
         if pool is not self._pool:  # a new pool (or seed): its episodes' crowds are new ones
             self._pool, self._generation = pool, self._generation + 1
             self._starts, self._slot_of = [], {}
-        for e in np.unique(episodes).tolist():
-            if e not in self._slot_of:
-                self._slot_of[e] = self._place(pool, int(e), robot_radius)
+        for w, e in zip(worlds.tolist(), episodes.tolist()):
+            if e not in self._slot_of:  # (an episode is of its world's scene)
+                self._slot_of[e] = self._place(pool, e, int(self.world_scene[w]))
         slots = np.array([self._slot_of[e] for e in episodes.tolist()], dtype=np.int64)
         self._gather(worlds, slots)
 
-    def _place(self, pool: Any, e: int, robot_radius: float) -> int:
-        """Place episode ``e``'s crowd with its scene's single-env crowd; its slot."""
-        s = int(pool.scene[e])
-        crowd, env = self._crowds[s], self._samplers[s]
+    def _place(self, pool: Any, e: int, s: int) -> int:
+        """Place episode ``e``'s crowd with scene ``s``'s single-env crowd, beside its robots'
+        starts; its slot."""
         rng = np.random.default_rng([self._seed, self._generation, e])
-        robots = np.array([[float(pool.sx[e]), float(pool.sy[e]), robot_radius]])
-        crowd.spawn(env.task.floor, rng, robots, self._recorded.get(e))
-        self._starts.append(crowd.start())
+        x, y = np.asarray(pool.sx[e], dtype=np.float64).reshape(-1), np.asarray(pool.sy[e], dtype=np.float64).reshape(-1)
+        robots = np.column_stack([x, y, self.robot_radius])
+        self._crowds[s].spawn(self.floor, rng, robots, self._recorded.get(e))
+        self._starts.append(self._crowds[s].start())
         return len(self._starts) - 1
 
     def _gather(self, worlds: NDArray[np.int64], slots: NDArray[np.int64]) -> None:
@@ -205,21 +213,31 @@ class VectorCrowd:
 
     # ------------------------------------------------------------------ stepping
     def step(self, x: NDArray[np.float64], y: NDArray[np.float64], vx: NDArray[np.float64], vy: NDArray[np.float64],
-             robot_radius: float, dt: float) -> NDArray[np.bool_]:
-        """Move every world's pedestrians one control step beside its robot at ``(x, y)``
-        (m, shape ``(W,)``) moving at ``(vx, vy)`` (m/s); whether each robot touches one
-        after it (also counted in :attr:`collisions`)."""
-        w, cfg = len(x), self.config
-        robots = np.stack([x, y, np.full(w, robot_radius)], -1).reshape(w, 1, 3)
-        robot_vel = np.stack([vx, vy], -1).reshape(w, 1, 2)
-        contacts = np.zeros((w, 1), dtype=np.bool_)
+             dt: float, present: NDArray[np.bool_] | None = None, acting: NDArray[np.bool_] | None = None) -> NDArray[np.bool_]:
+        """Move every world's pedestrians one control step beside its robots at ``(x, y)``
+        (m, shape ``(W,)`` or ``(W, R)``) moving at ``(vx, vy)`` (m/s), of which ``present``
+        ``(W, R)`` (default: all) are in the world; whether each robot touches a pedestrian
+        after it, in the shape of ``x`` (those ``acting``, default all, count it in
+        :attr:`collisions`)."""
+        w, r, cfg = x.shape[0], len(self.robot_radius), self.config
+        robots = np.stack([x.reshape(w, r), y.reshape(w, r), np.broadcast_to(self.robot_radius, (w, r))], -1)
+        robot_vel = np.stack([vx.reshape(w, r), vy.reshape(w, r)], -1)
+        present = np.ones((w, r), np.bool_) if present is None else np.asarray(present).reshape(w, r)
+        order = None
+        if not present.all():  # the kernel takes the robots present first (the multi-robot env's list)
+            order = np.argsort(~present, axis=1, kind="stable")
+            robots, robot_vel = np.take_along_axis(robots, order[..., None], 1), np.take_along_axis(robot_vel, order[..., None], 1)
+        seen = present.sum(1) if cfg.sees_robots else np.zeros(w, np.int64)
+        contacts = np.zeros((w, r), dtype=np.bool_)
         if cfg.behaviour == "static" or not self.radius.shape[1]:
             self._touching(robots, contacts)
         else:
-            self._orca(robots, robot_vel, float(dt), contacts)
-        touched = contacts[:, 0]
-        self.collisions += touched
-        return touched
+            self._orca(robots, robot_vel, seen.astype(np.int64), float(dt), contacts)
+        if order is not None:  # back to the robots' order
+            np.put_along_axis(contacts, order, contacts.copy(), 1)
+        touched = contacts & present
+        self.collisions += touched if acting is None else touched & np.asarray(acting).reshape(w, r)
+        return touched.reshape(x.shape)
 
     def _touching(self, robots: NDArray[np.float64], contacts: NDArray[np.bool_]) -> None:
         """A static crowd's contacts (it never moves): a robot's disc over a pedestrian's."""
@@ -227,17 +245,16 @@ class VectorCrowd:
         d = np.hypot(robots[:, :, None, 0] - self.positions[:, None, :, 0], robots[:, :, None, 1] - self.positions[:, None, :, 1])
         contacts[:] = ((d < robots[:, :, None, 2] + self.radius[:, None]) & present[:, None]).any(-1)
 
-    def _orca(self, robots: NDArray[np.float64], robot_vel: NDArray[np.float64], dt: float,
+    def _orca(self, robots: NDArray[np.float64], robot_vel: NDArray[np.float64], seen: NDArray[np.int64], dt: float,
               contacts: NDArray[np.bool_]) -> None:
         """An ORCA step of every world: one compiled call per scene, then the plans."""
         cfg, fn = self.config, kernel("pointnav_core.crowds._crowd_kernel", "orca_crowd_worlds")
         new_pos, new_vel = self.positions.copy(), np.zeros_like(self.velocities)
         flags = np.zeros(self.radius.shape, np.int8)
-        seen = np.full(len(robots), 1 if cfg.sees_robots else 0, np.int64)
         for s, worlds in enumerate(self._groups):
             if not len(worlds):
                 continue
-            collision = self._samplers[s].scene.floors[self._samplers[s].task.floor].collision
+            collision = self.scenes[s].floors[self.floor].collision
             fn(worlds, self.count, self.positions, self.velocities, self.radius, self.speed, self.goals, self._paths,
                self._next, self._last, robots, robot_vel, seen, dt, cfg.neighbor_dist, cfg.max_neighbors,
                cfg.time_horizon, GOAL_REACHED, collision.kernel_arguments(cfg.radius[1]), new_pos, new_vel, flags,
@@ -256,8 +273,8 @@ class VectorCrowd:
         if rng is None:  # its own generator, where the placing left it
             rng = self._rngs[w, i] = np.random.default_rng(0)
             rng.bit_generator.state = st.draws[i]
-        env = self._samplers[int(self.world_scene[w])]
-        planned = plan_walk(env.scene, env.task.floor, self.config.plan_radius, self.positions[w, i], walk, arrived, rng)
+        scene = self.scenes[int(self.world_scene[w])]
+        planned = plan_walk(scene, self.floor, self.config.plan_radius, self.positions[w, i], walk, arrived, rng)
         self._index[w, i], self.goals[w, i] = walk.index, walk.goal
         points = planned.points
         if len(points) > self._paths.shape[2]:

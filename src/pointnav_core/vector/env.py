@@ -220,8 +220,6 @@ class VectorPointNavEnv(PoolRefreshing, VectorEnv):
             if isinstance(n_robots, (int, np.integer)) and not isinstance(n_robots, bool) and n_robots > 1:
                 from pointnav_core.vector.fleet_env import VectorFleetEnv
 
-                if kwargs.get("pedestrians") is not None:  # the fleet's worlds have no crowds yet
-                    raise ArgumentError(f"pedestrians need one robot per world in the batched engine, got n_robots={n_robots}")
 
                 return super().__new__(VectorFleetEnv)
             for name in ("max_cycles", "finished"):
@@ -300,7 +298,7 @@ class VectorPointNavEnv(PoolRefreshing, VectorEnv):
         self.pool: EpisodePool | None = None  # sampled at the first reset that needs it
         self._allocate((self.num_envs,), scan_term, sensors)
         #: Every world's pedestrians (:class:`~pointnav_core.vector.crowd.VectorCrowd`), or None.
-        self.crowd = None if crowd is None else VectorCrowd(crowd, self._samplers, a.numpy(self.world_scene))
+        self.crowd = None if crowd is None else VectorCrowd(crowd, scene_list, t.floor, a.numpy(self.world_scene), [spec.radius])
 
     def _allocate(self, shape: tuple[int, ...], scan_term: Any, sensors: Mapping[str, Any] | None) -> None:
         """The state arrays of ``shape`` (one entry per world, or per robot), the per-world
@@ -396,7 +394,7 @@ class VectorPointNavEnv(PoolRefreshing, VectorEnv):
         st.start_episodes(xp, idx, self.pool, ep[idx], height, self.geodesic_reward)
         self._needs_reset[idx] = False
         if self.crowd is not None:
-            self.crowd.start_worlds(a.numpy(idx), a.numpy(ep[idx]), self.pool, self.robot.radius)
+            self.crowd.start_worlds(a.numpy(idx), a.numpy(ep[idx]), self.pool)
         if self.scan is not None:  # the worlds' episode counts key the scan's noise
             self.scan.begin(mask, n)
 
@@ -425,7 +423,7 @@ class VectorPointNavEnv(PoolRefreshing, VectorEnv):
         else:
             moved, contact, stopped = self._discrete.run(self, act)
         crowd = self.crowd  # it walks beside the moved robots
-        touched = None if crowd is None else crowd.step(moved.x, moved.y, moved.vx, moved.vy, self.robot.radius, self.dt)
+        touched = None if crowd is None else crowd.step(moved.x, moved.y, moved.vx, moved.vy, self.dt)
         return self._account(moved, contact, stopped, touched)
 
     def drive(self, act: Any, state: Motion) -> tuple[Motion, Any]:
@@ -493,5 +491,5 @@ class VectorPointNavEnv(PoolRefreshing, VectorEnv):
     def _info(self, success: Any, r_pot: Any, r_col: Any, r_goal: Any, contact: Any, resetting: Any) -> dict[str, Any]:
         info = step_info(self.arrays.xp, self.state, success, r_pot, r_col, r_goal, contact, resetting)
         if self.crowd is not None:  # counted after this step's autoresets, as the single env's reset gives 0
-            info["pedestrian_collisions"] = self.crowd.collisions.copy()
+            info["pedestrian_collisions"] = self.crowd.collisions.reshape(self.state.x.shape).copy()
         return info

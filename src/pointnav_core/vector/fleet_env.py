@@ -32,6 +32,7 @@ from pointnav_core.errors import ArgumentError, TaskStateError
 from pointnav_core.utils import validation
 from pointnav_core.vector import contacts_jit
 from pointnav_core.vector.accounting import read_task, task_step
+from pointnav_core.vector.crowd import VectorCrowd, check_vector_pedestrians
 from pointnav_core.vector.arguments import as_scene_list, check_real_actions
 from pointnav_core.vector.contacts import advance
 from pointnav_core.vector.contacts_jit import advance_compiled
@@ -117,7 +118,9 @@ class VectorFleetEnv(VectorPointNavEnv):
         config: EnvConfig | None = None,
         workers: int | None = None,
         progress: bool | None = None,
+        pedestrians: Mapping[str, Any] | None = None,
     ) -> None:
+        from pointnav_core.crowds import make_pedestrians
         from pointnav_core.envs.multi_pointnav import parallel_env
 
         self.config = config  # applied by takes_config; max_cycles defaults to its max_steps
@@ -127,6 +130,8 @@ class VectorFleetEnv(VectorPointNavEnv):
         self.max_cycles = validation.integer("max_cycles", max_cycles, minimum=1)
         self.finished = check_finished(finished)
         scan_term = requested_scan(sensors)
+        crowd = make_pedestrians(pedestrians)
+        check_vector_pedestrians(crowd, device, action_space, sensors)
         if max_episode_steps is not None:
             max_episode_steps = validation.integer("max_episode_steps", max_episode_steps, minimum=1)
         task = task_arguments(task, self.n_robots, max_episode_steps)  # one dict, or one per robot
@@ -170,6 +175,8 @@ class VectorFleetEnv(VectorPointNavEnv):
         self._present = a.zeros((n, r), a.boolean)
         self._seen = self._present  # the robots the scans see at the next observation
         self._cycles = a.zeros(n, a.i64)
+        radii = [s.radius for s in self.robots]
+        self.crowd = None if crowd is None else VectorCrowd(crowd, scene_list, t.floor, a.numpy(self.world_scene), radii)
 
     def _make_spaces(self, first: Any) -> None:
         """The observation bounds of every (scene, robot) and the batched spaces, from the
@@ -243,7 +250,10 @@ class VectorFleetEnv(VectorPointNavEnv):
             return self._account(*self._discrete.run(self, act, acting=self._active))
         # Robots that are not agents any more get no command (the backend's _NO_COMMAND).
         moved, contact = self.drive(self.arrays.xp.where(self._active[..., None], act, 0.0 * act), self.state)
-        return self._account(moved, contact, None)
+        crowd = self.crowd  # it walks beside the robots present
+        touched = None if crowd is None else crowd.step(moved.x, moved.y, moved.vx, moved.vy, self.dt, self._present,
+                                                         self._active)
+        return self._account(moved, contact, None, touched)
 
     def drive(self, act: Any, state: Motion) -> tuple[Motion, Any]:
         """One control step of every world from ``state`` under commands ``act``
@@ -299,16 +309,20 @@ class VectorFleetEnv(VectorPointNavEnv):
                                     vz=xp.where(out, zero, moved.vz))
         return moved, contact & ~falling
 
-    def _account(self, moved: Motion, contact: Any, stopped: Any) -> tuple[Any, Any, Any, Any, dict[str, Any]]:
+    def _account(self, moved: Motion, contact: Any, stopped: Any,
+                 touched: Any = None) -> tuple[Any, Any, Any, Any, dict[str, Any]]:
         """Each active robot's task step (``PointNavigationTask.step``, masked by the robots
         still acting) over the moves from the committed state, then the commit and the
-        next-step autoresets. ``stopped``: the robots that called STOP (None without STOP)."""
+        next-step autoresets. ``stopped``: the robots that called STOP (None without STOP);
+        ``touched``: those that touched a pedestrian."""
         a, xp, st = self.arrays, self.arrays.xp, self.state
         acting, present = self._active, self._present
         zero = xp.zeros_like(st.x)
         t = task_step(self, moved, contact, stopped, acting)  # each acting robot's task step
         cycles = self._cycles + 1
         reward, terminated, success, fell = t.reward, t.terminated, t.success, t.fell
+        if touched is not None and self.crowd.config.end_on_collision:  # PedestrianCollision
+            terminated = terminated | (touched & acting)
         truncated = t.truncated | (acting & (cycles >= self.max_cycles)[:, None])
         r_pot, r_col, r_goal = t.r_pot, t.r_col, t.r_goal
         ended = terminated | truncated
@@ -381,7 +395,8 @@ class VectorFleetEnv(VectorPointNavEnv):
         ``_seen`` neither see nor are seen (their rows are hidden by ``_observe``)."""
         xp, st = self.arrays.xp, self.state
         yaw = xp.arctan2(s, c)  # the heading as the multi-robot env's frame gives it
-        return self.scan.readings(self.world_scene, st.x, st.y, yaw, self._seen, self.radius, st.steps)
+        return self.scan.readings(self.world_scene, st.x, st.y, yaw, self._seen, self.radius, st.steps,
+                                  None if self.crowd is None else self.crowd.discs())
 
     def _map_values(self) -> Any:
         """Every robot's local map, ``(num_envs, n_robots, cells * cells)``, with the discs of
