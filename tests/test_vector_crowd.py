@@ -76,10 +76,10 @@ def _play_alongside(venv: VectorPointNavEnv, singles: list[PointNavEnv], actions
 
 
 def _singles(venv: VectorPointNavEnv, scene: Scene, pedestrians: dict, task: dict,
-             episodes: list[PointNavEpisode]) -> list[PointNavEnv]:
+             episodes: list[PointNavEpisode], **kwargs: object) -> list[PointNavEnv]:
     singles = []
     for w, episode in enumerate(episodes):
-        env = PointNavEnv(scene=scene, flatten_obs=True, sensors=SCAN, task=task, pedestrians=pedestrians)
+        env = PointNavEnv(scene=scene, flatten_obs=True, sensors=SCAN, task=task, pedestrians=pedestrians, **kwargs)
         env.last_obs, _ = env.reset(seed=w, options={"episode": episode})
         singles.append(env)
     return singles
@@ -147,7 +147,7 @@ def test_scan_sees_a_pedestrian_at_the_hand_computed_range() -> None:
 
 @pytest.mark.parametrize(("kwargs", "names"), [
     ({"pedestrians": {"count": 2, "behaviour": "social_force"}}, "pedestrians['behaviour']"),
-    ({"pedestrians": {"count": 2}, "action_space": "discrete"}, "action_space"),
+    ({"pedestrians": {"count": 2}, "device": "cpu"}, "device='numpy'"),
     ({"pedestrians": {"count": 2}, "sensors": {"local_map": {}}}, "local_map"),
     ({"pedestrians": {"density": -1.0}}, "pedestrians['density']"),
     ({"pedestrians": {"count": 2, "behavior": "orca"}}, "unknown key 'behavior'"),
@@ -209,3 +209,66 @@ def test_several_robots_walk_beside_one_crowd_as_in_the_multi_robot_env(finished
         if not any(env.agents for env in refs):
             break
     assert seen["ends"] == n * r and seen["touches"] > 0 and seen["parked"] > 0
+
+
+@pytest.mark.parametrize("n_robots", [1, 2])
+def test_with_discrete_actions_the_crowd_walks_each_control_step(n_robots: int) -> None:
+    # Habitat's actions: a forward step or a turn lasts several control steps, and ends at a
+    # contact; STOP (3) lasts none. The crowd walks each control step the action lasts.
+    scene, n = _house(), 4
+    task = {"termination_config": {"max_steps": 40, "max_collisions": 50}}
+    kwargs = {"action_space": "discrete", "discrete_actions": {"forward_step": 0.5, "turn_angle": 0.5}}
+    pedestrians = {"count": 6, "speed": (0.8, 1.2)}
+    venv = VectorPointNavEnv(n, n_robots=n_robots, scene=scene, seed=2, sensors=SCAN, task=task,
+                             pedestrians=pedestrians, pool_size=2, **kwargs)
+    obs, _ = venv.reset(seed=2)
+    choices = np.random.default_rng(3).choice(4, size=(40, n, n_robots), p=[0.6, 0.15, 0.15, 0.1])
+    if n_robots == 1:
+        venv.reset_obs = obs
+        singles = _singles(venv, scene, pedestrians, task, [world_episode(venv, w) for w in range(n)], **kwargs)
+        seen = _play_alongside(venv, singles, choices[..., 0])
+        assert seen["ends"] == n and seen["moved"] > 0
+        return
+    refs = []
+    for w in range(n):
+        env = parallel_env(scene=scene, n_robots=n_robots, task=task, backend="kinematic", sensors=SCAN,
+                           pedestrians=pedestrians, **kwargs)
+        env.reset(seed=w, options={"episodes": [fleet_episode(venv, w, k) for k in range(n_robots)]})
+        refs.append(env)
+    agents = refs[0].possible_agents
+    for t, act in enumerate(choices):
+        obs, reward, term, trunc, info = venv.step(act)
+        for w, env in enumerate(refs):
+            if not env.agents:
+                continue
+            acting = list(env.agents)
+            sob, srew, sterm, strunc, sinfo = env.step({a: int(act[w, agents.index(a)]) for a in acting})
+            where = f"world {w}, step {t}"
+            np.testing.assert_allclose(venv.crowd.positions[w, :env.crowd.n], env.crowd.positions, atol=1e-9, rtol=0,
+                                       err_msg=where)
+            for j, a in enumerate(agents):
+                if a in acting:
+                    np.testing.assert_allclose(obs[w, j], sob[a], atol=1e-4, err_msg=f"{where}, robot {j}")
+                    assert (bool(term[w, j]), bool(trunc[w, j])) == (sterm[a], strunc[a]), f"{where}, robot {j}"
+                    assert int(info["pedestrian_collisions"][w, j]) == sinfo[a]["pedestrian_collisions"], where
+
+
+def test_a_pool_refresh_keeps_the_running_crowds_and_places_new_ones() -> None:
+    task = {"termination_config": {"max_steps": 30}}
+    venv = VectorPointNavEnv(3, scene=_house(), seed=4, task=task, pedestrians={"count": 4}, pool_size=2)
+    venv.reset(seed=4)
+    rng = np.random.default_rng(0)
+    for _ in range(5):
+        venv.step(rng.uniform(-1, 1, (3, 2)))
+    before = [venv.crowd.record(w) for w in range(3)]
+    positions = venv.crowd.positions.copy()
+    venv.refresh_pool(wait=True)
+    venv.step(np.zeros((3, 2)))  # the worlds walk on in their episodes, with their crowds
+    assert [venv.crowd.record(w) for w in range(3)] == before
+    assert np.abs(venv.crowd.positions - positions).max() > 0.0
+    starts = {ped.start for record in before for ped in record}
+    for _ in range(60):  # every world ends its episode and starts one of the new pool's
+        venv.step(rng.uniform(-1, 1, (3, 2)))
+    after = {ped.start for w in range(3) for ped in venv.crowd.record(w)}
+    assert after.isdisjoint(starts)
+    venv.close()

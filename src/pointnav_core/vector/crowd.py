@@ -23,10 +23,10 @@ definition for both engines:
   Each pedestrian's own generator is made at its first plan, where the placing left it.
 
 Several robots per world walk beside one crowd, as in the multi-robot env: it avoids every
-robot present (with ``sees_robots``), and each robot's contacts are its own. Only ORCA and
-``"static"`` crowds, on numpy with numba (the ``fast`` extra), with continuous actions; the
-rest is refused by :func:`check_vector_pedestrians` (docs/decisions.md, "Crowds in the
-batched engine").
+robot present (with ``sees_robots``), and each robot's contacts are its own. With discrete
+actions the crowd walks each control step of an action, as in the single env. Only ORCA
+and ``"static"`` crowds, on numpy with numba (the ``fast`` extra); the rest is refused by
+:func:`check_vector_pedestrians` (docs/decisions.md, "Crowds in the batched engine").
 """
 
 from __future__ import annotations
@@ -46,7 +46,7 @@ from pointnav_core.utils.compiled import kernel
 __all__ = ["VectorCrowd", "check_vector_pedestrians", "recorded_crowds"]
 
 
-def check_vector_pedestrians(config: PedestrianConfig | None, device: str, action_space: str, sensors: Any) -> None:
+def check_vector_pedestrians(config: PedestrianConfig | None, device: str, sensors: Any) -> None:
     """Refuse, naming ``pedestrians``, what the batched engine's crowds do not do yet."""
     if config is None:
         return
@@ -57,8 +57,6 @@ def check_vector_pedestrians(config: PedestrianConfig | None, device: str, actio
         )
     if device != "numpy":
         raise ArgumentError(f"pedestrians need device='numpy' in the batched engine, got device={device!r}")
-    if action_space != "continuous":
-        raise ArgumentError(f"pedestrians need action_space='continuous' in the batched engine, got {action_space!r}")
     if sensors and "local_map" in sensors:
         raise ArgumentError("pedestrians and sensors['local_map'] cannot be combined in the batched engine yet")
     if kernel(*KERNEL) is None:
@@ -121,12 +119,16 @@ class VectorCrowd:
         self._seed, self._generation = 0, 0
         self._pool: Any = None
         self._starts: list[CrowdStart] = []
+        self._stack: dict[str, NDArray[Any]] | None = None
         self._slot_of: dict[int, int] = {}
         self._recorded: dict[int, Any] = {}
         self._resize(len(self.world_scene), 0, 1)
         self.count = np.zeros(len(self.world_scene), dtype=np.int64)
         self.collisions = np.zeros((len(self.world_scene), len(self.robot_radius)), dtype=np.int64)
-        self._slot = np.zeros(len(self.world_scene), dtype=np.int64)
+        #: Whether each robot touched a pedestrian in the current env step (:meth:`begin`).
+        self.touched = np.zeros(self.collisions.shape, dtype=np.bool_)
+        self._present: NDArray[np.bool_] | None = None
+        self._start = np.empty(len(self.world_scene), dtype=object)  # each world's CrowdStart
         self._rngs: dict[tuple[int, int], np.random.Generator] = {}
 
     def _resize(self, w: int, p: int, length: int) -> None:
@@ -152,7 +154,7 @@ class VectorCrowd:
         """Start the crowds of ``worlds`` for their pool ``episodes`` (placed at their first start)."""
         if pool is not self._pool:  # a new pool (or seed): its episodes' crowds are new ones
             self._pool, self._generation = pool, self._generation + 1
-            self._starts, self._slot_of = [], {}
+            self._starts, self._slot_of, self._stack = [], {}, None
         for w, e in zip(worlds.tolist(), episodes.tolist()):
             if e not in self._slot_of:  # (an episode is of its world's scene)
                 self._slot_of[e] = self._place(pool, e, int(self.world_scene[w]))
@@ -169,26 +171,53 @@ class VectorCrowd:
         self._starts.append(self._crowds[s].start())
         return len(self._starts) - 1
 
+    def _stacked(self) -> dict[str, NDArray[Any]]:
+        """The placed crowds stacked, slot by slot (padded to the most pedestrians and the
+        longest path), made again when crowds were placed since."""
+        if self._stack is None or len(self._stack["count"]) != len(self._starts):
+            starts, n = self._starts, len(self._starts)
+            p = max(len(st.radius) for st in starts)
+            length = max(st.paths.shape[1] for st in starts)
+            t = {"count": np.array([len(st.radius) for st in starts], np.int64), "paths": np.zeros((n, p, length, 2)),
+                 "index": np.full((n, p), -1, np.int64)}
+            for name in ("positions", "goals"):
+                t[name] = np.zeros((n, p, 2))
+            for name in ("headings", "radius", "speed"):
+                t[name] = np.zeros((n, p))
+            for name in ("next", "last"):
+                t[name] = np.zeros((n, p), np.int64)
+            t["start"] = np.empty(n, dtype=object)  # each slot's CrowdStart (its walks and draws)
+            for k, st in enumerate(starts):
+                t["start"][k] = st
+                m = len(st.radius)
+                for name in ("positions", "goals", "headings", "radius", "speed", "next", "last"):
+                    t[name][k, :m] = getattr(st, name)
+                t["index"][k, :m] = st.goal_index
+                t["paths"][k, :m, : st.paths.shape[1]] = st.paths
+                t["paths"][k, :m, st.paths.shape[1]:] = st.paths[:, -1:]
+            self._stack = t
+        return self._stack
+
     def _gather(self, worlds: NDArray[np.int64], slots: NDArray[np.int64]) -> None:
         """Copy the placed crowds ``slots`` into ``worlds``, widening the arrays if needed."""
-        starts = [self._starts[k] for k in np.unique(slots).tolist()]
-        p = max([len(st.radius) for st in starts] + [self.radius.shape[1]])
-        length = max([st.paths.shape[1] for st in starts] + [self._paths.shape[1]])
+        t = self._stacked()
+        p, length = t["radius"].shape[1], t["paths"].shape[2]
         self._widen(p, length)
-        for w, k in zip(worlds.tolist(), slots.tolist()):
-            st, n = self._starts[k], len(self._starts[k].radius)
-            self.positions[w, :n], self.headings[w, :n] = st.positions, st.headings
-            self.radius[w, :n], self.speed[w, :n], self.goals[w, :n] = st.radius, st.speed, st.goals
-            self._paths[w, :n, : st.paths.shape[1]] = st.paths
-            self._paths[w, :n, st.paths.shape[1]:] = st.paths[:, -1:]
-            self._next[w, :n], self._last[w, :n], self._index[w, :n] = st.next, st.last, st.goal_index
-            self.velocities[w] = 0.0
-            self.count[w] = n
-        self._slot[worlds] = slots
+        for mine, name in ((self.positions, "positions"), (self.goals, "goals"), (self.headings, "headings"),
+                           (self.radius, "radius"), (self.speed, "speed"), (self._next, "next"), (self._last, "last"),
+                           (self._index, "index")):
+            mine[worlds, :p] = t[name][slots]
+        paths = t["paths"][slots]
+        self._paths[worlds, :p, :length] = paths
+        self._paths[worlds, :p, length:] = paths[:, :, -1:]
+        self.velocities[worlds] = 0.0
+        self.count[worlds] = t["count"][slots]
+        self._start[worlds] = t["start"][slots]  # kept past a new pool's placing
         self.collisions[worlds] = 0
-        reset = set(worlds.tolist())
-        for key in [key for key in self._rngs if key[0] in reset]:
-            del self._rngs[key]
+        if self._rngs:  # the generators of the worlds' pedestrians that planned
+            reset = set(worlds.tolist())
+            for key in [key for key in self._rngs if key[0] in reset]:
+                del self._rngs[key]
 
     def _widen(self, p: int, length: int) -> None:
         """Room for ``p`` pedestrians a world and paths of ``length`` points."""
@@ -209,17 +238,22 @@ class VectorCrowd:
         """World ``world``'s crowd as its episode placed it: the records a dataset episode
         stores (:class:`~pointnav_core.crowds.record.PedestrianRecord`), which a single
         env's reset with that episode places again exactly."""
-        return self._starts[int(self._slot[world])].record
+        return self._start[world].record
 
     # ------------------------------------------------------------------ stepping
+    def begin(self, present: NDArray[np.bool_] | None = None) -> None:
+        """Start an env step, with ``present`` ``(W, R)`` the robots in the worlds (default:
+        all): no robot has touched a pedestrian in it yet."""
+        self.touched[:] = False
+        self._present = present
+
     def step(self, x: NDArray[np.float64], y: NDArray[np.float64], vx: NDArray[np.float64], vy: NDArray[np.float64],
-             dt: float, present: NDArray[np.bool_] | None = None, acting: NDArray[np.bool_] | None = None) -> NDArray[np.bool_]:
-        """Move every world's pedestrians one control step beside its robots at ``(x, y)``
-        (m, shape ``(W,)`` or ``(W, R)``) moving at ``(vx, vy)`` (m/s), of which ``present``
-        ``(W, R)`` (default: all) are in the world; whether each robot touches a pedestrian
-        after it, in the shape of ``x`` (those ``acting``, default all, count it in
-        :attr:`collisions`)."""
-        w, r, cfg = x.shape[0], len(self.robot_radius), self.config
+             dt: float, worlds: NDArray[np.bool_] | None = None) -> None:
+        """Move the pedestrians of ``worlds`` (a ``(W,)`` mask, default all) one control step
+        beside their robots at ``(x, y)`` (m, shape ``(W,)`` or ``(W, R)``) moving at
+        ``(vx, vy)`` (m/s), of which those present (:meth:`begin`) are in the world; the
+        robots touching a pedestrian after it are added to :attr:`touched`."""
+        w, r, cfg, present = x.shape[0], len(self.robot_radius), self.config, self._present
         robots = np.stack([x.reshape(w, r), y.reshape(w, r), np.broadcast_to(self.robot_radius, (w, r))], -1)
         robot_vel = np.stack([vx.reshape(w, r), vy.reshape(w, r)], -1)
         present = np.ones((w, r), np.bool_) if present is None else np.asarray(present).reshape(w, r)
@@ -229,15 +263,21 @@ class VectorCrowd:
             robots, robot_vel = np.take_along_axis(robots, order[..., None], 1), np.take_along_axis(robot_vel, order[..., None], 1)
         seen = present.sum(1) if cfg.sees_robots else np.zeros(w, np.int64)
         contacts = np.zeros((w, r), dtype=np.bool_)
+        stepping = np.ones(w, np.bool_) if worlds is None else np.asarray(worlds).reshape(w)
         if cfg.behaviour == "static" or not self.radius.shape[1]:
             self._touching(robots, contacts)
         else:
-            self._orca(robots, robot_vel, seen.astype(np.int64), float(dt), contacts)
+            self._orca(robots, robot_vel, seen.astype(np.int64), float(dt), contacts, stepping)
         if order is not None:  # back to the robots' order
             np.put_along_axis(contacts, order, contacts.copy(), 1)
-        touched = contacts & present
-        self.collisions += touched if acting is None else touched & np.asarray(acting).reshape(w, r)
-        return touched.reshape(x.shape)
+        self.touched |= contacts & present & stepping[:, None]
+
+    def finish(self, acting: NDArray[np.bool_] | None = None) -> NDArray[np.bool_]:
+        """End an env step: the robots that touched a pedestrian in it, ``(W, R)``; those
+        ``acting`` (default all) count it in :attr:`collisions`."""
+        touched = self.touched.copy()
+        self.collisions += touched if acting is None else touched & np.asarray(acting).reshape(touched.shape)
+        return touched
 
     def _touching(self, robots: NDArray[np.float64], contacts: NDArray[np.bool_]) -> None:
         """A static crowd's contacts (it never moves): a robot's disc over a pedestrian's."""
@@ -246,12 +286,13 @@ class VectorCrowd:
         contacts[:] = ((d < robots[:, :, None, 2] + self.radius[:, None]) & present[:, None]).any(-1)
 
     def _orca(self, robots: NDArray[np.float64], robot_vel: NDArray[np.float64], seen: NDArray[np.int64], dt: float,
-              contacts: NDArray[np.bool_]) -> None:
-        """An ORCA step of every world: one compiled call per scene, then the plans."""
+              contacts: NDArray[np.bool_], stepping: NDArray[np.bool_]) -> None:
+        """An ORCA step of the ``stepping`` worlds: one compiled call per scene, then the plans."""
         cfg, fn = self.config, kernel("pointnav_core.crowds._crowd_kernel", "orca_crowd_worlds")
-        new_pos, new_vel = self.positions.copy(), np.zeros_like(self.velocities)
+        new_pos, new_vel = self.positions.copy(), self.velocities.copy()
         flags = np.zeros(self.radius.shape, np.int8)
-        for s, worlds in enumerate(self._groups):
+        for s, group in enumerate(self._groups):
+            worlds = group if stepping.all() else group[stepping[group]]
             if not len(worlds):
                 continue
             collision = self.scenes[s].floors[self.floor].collision
@@ -267,7 +308,7 @@ class VectorCrowd:
 
     def _replan(self, w: int, i: int, arrived: bool) -> None:
         """Pedestrian ``i`` of world ``w`` plans again (:func:`plan_walk`, as the single env)."""
-        st = self._starts[int(self._slot[w])]
+        st = self._start[w]
         walk = Walk(st.walks[i], st.loops[i], int(self._index[w, i]), self.goals[w, i].copy())
         rng = self._rngs.get((w, i))
         if rng is None:  # its own generator, where the placing left it

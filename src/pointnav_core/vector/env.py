@@ -132,11 +132,10 @@ class VectorPointNavEnv(PoolRefreshing, VectorEnv):
         A tqdm bar over the pool's scenes on stderr; default: from 4 scenes on, on a terminal.
     pedestrians : dict, optional
         A crowd in every world, as the single env's ``pedestrians`` (``"orca"`` or
-        ``"static"``; numpy with numba, continuous actions, one robot per world, no local
-        map): each world's crowd is the one a single env walks beside the same robot
+        ``"static"``; numpy with numba; no local map): each world's crowd is the one a
+        single env (a multi-robot env) walks beside the same robots
         (:mod:`pointnav_core.vector.crowd`); the scan sees it, and ``info`` counts
         ``pedestrian_collisions`` (with ``end_on_collision``, a touch ends the episode).
-
     Notes
     -----
     ``step`` takes actions of shape ``(num_envs, 2)`` (or ``(num_envs, 1, 2)``) in
@@ -261,7 +260,7 @@ class VectorPointNavEnv(PoolRefreshing, VectorEnv):
         scan_term = requested_scan(sensors)
         task = task_arguments(task)
         crowd = make_pedestrians(pedestrians)
-        check_vector_pedestrians(crowd, device, action_space, sensors)
+        check_vector_pedestrians(crowd, device, sensors)
         self.pool_size = validation.integer("pool_size", pool_size, minimum=1)
         self.starts_per_goal = validation.integer("starts_per_goal", starts_per_goal, minimum=1)
         self.arrays = make_arrays(device)
@@ -417,14 +416,17 @@ class VectorPointNavEnv(PoolRefreshing, VectorEnv):
         if not self._started:
             raise TaskStateError("call reset() before step()")
         act = self.check_actions(actions)
+        crowd = self.crowd  # it walks beside the moved robots, each control step
+        if crowd is not None:
+            crowd.begin()
         if self._discrete is None:
             moved, contact = self.drive(act, self.state)
             stopped = None
+            if crowd is not None:
+                crowd.step(moved.x, moved.y, moved.vx, moved.vy, self.dt)
         else:
             moved, contact, stopped = self._discrete.run(self, act)
-        crowd = self.crowd  # it walks beside the moved robots
-        touched = None if crowd is None else crowd.step(moved.x, moved.y, moved.vx, moved.vy, self.dt)
-        return self._account(moved, contact, stopped, touched)
+        return self._account(moved, contact, stopped, None if crowd is None else crowd.finish()[:, 0])
 
     def drive(self, act: Any, state: Motion) -> tuple[Motion, Any]:
         """One control step of every world from ``state`` under commands ``act``

@@ -32,10 +32,10 @@ from pointnav_core.errors import ArgumentError, TaskStateError
 from pointnav_core.utils import validation
 from pointnav_core.vector import contacts_jit
 from pointnav_core.vector.accounting import read_task, task_step
-from pointnav_core.vector.crowd import VectorCrowd, check_vector_pedestrians
 from pointnav_core.vector.arguments import as_scene_list, check_real_actions
 from pointnav_core.vector.contacts import advance
 from pointnav_core.vector.contacts_jit import advance_compiled
+from pointnav_core.vector.crowd import VectorCrowd, check_vector_pedestrians
 from pointnav_core.vector.discrete import DiscretePlan
 from pointnav_core.vector.drive import (
     arc,
@@ -131,7 +131,7 @@ class VectorFleetEnv(VectorPointNavEnv):
         self.finished = check_finished(finished)
         scan_term = requested_scan(sensors)
         crowd = make_pedestrians(pedestrians)
-        check_vector_pedestrians(crowd, device, action_space, sensors)
+        check_vector_pedestrians(crowd, device, sensors)
         if max_episode_steps is not None:
             max_episode_steps = validation.integer("max_episode_steps", max_episode_steps, minimum=1)
         task = task_arguments(task, self.n_robots, max_episode_steps)  # one dict, or one per robot
@@ -246,14 +246,18 @@ class VectorFleetEnv(VectorPointNavEnv):
         if not self._started:
             raise TaskStateError("call reset() before step()")
         act = self.check_actions(actions)
+        crowd = self.crowd  # it walks beside the robots present, each control step
+        if crowd is not None:
+            crowd.begin(self._present)
         if self._discrete is not None:
-            return self._account(*self._discrete.run(self, act, acting=self._active))
-        # Robots that are not agents any more get no command (the backend's _NO_COMMAND).
-        moved, contact = self.drive(self.arrays.xp.where(self._active[..., None], act, 0.0 * act), self.state)
-        crowd = self.crowd  # it walks beside the robots present
-        touched = None if crowd is None else crowd.step(moved.x, moved.y, moved.vx, moved.vy, self.dt, self._present,
-                                                         self._active)
-        return self._account(moved, contact, None, touched)
+            moved, contact, stopped = self._discrete.run(self, act, acting=self._active)
+        else:
+            # Robots that are not agents any more get no command (the backend's _NO_COMMAND).
+            moved, contact = self.drive(self.arrays.xp.where(self._active[..., None], act, 0.0 * act), self.state)
+            stopped = None
+            if crowd is not None:
+                crowd.step(moved.x, moved.y, moved.vx, moved.vy, self.dt)
+        return self._account(moved, contact, stopped, None if crowd is None else crowd.finish(self._active))
 
     def drive(self, act: Any, state: Motion) -> tuple[Motion, Any]:
         """One control step of every world from ``state`` under commands ``act``
