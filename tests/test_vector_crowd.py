@@ -40,15 +40,10 @@ def _house() -> Scene:
 
 
 def _play_alongside(venv: VectorPointNavEnv, singles: list[PointNavEnv], actions: np.ndarray) -> dict[str, int]:
-    """Step the engine and the single envs (each already reset to its world's episode) until
-    each world's first episode ends, checking every step; counts of what happened."""
-    n = venv.num_envs
-    obs = venv.arrays.numpy(venv.reset_obs)
-    sobs = [env.last_obs for env in singles]
-    live = [True] * n
+    """Step the engine and the single envs (each reset to its world's episode, :func:`_singles`)
+    until each world's first episode ends, checking every step; counts of what happened."""
+    live = [True] * venv.num_envs
     seen = {"touches": 0, "ends": 0, "steps": 0, "moved": 0}
-    for w in range(n):
-        np.testing.assert_allclose(obs[w], sobs[w], atol=1e-4, err_msg=f"world {w} at the reset")
     for t, act in enumerate(actions):
         before = venv.crowd.positions.copy()
         obs, reward, term, trunc, info = venv.step(act)
@@ -75,12 +70,15 @@ def _play_alongside(venv: VectorPointNavEnv, singles: list[PointNavEnv], actions
     return seen
 
 
-def _singles(venv: VectorPointNavEnv, scene: Scene, pedestrians: dict, task: dict,
-             episodes: list[PointNavEpisode], **kwargs: object) -> list[PointNavEnv]:
+def _singles(obs: np.ndarray, scene: Scene, pedestrians: dict, task: dict, episodes: list[PointNavEpisode],
+             **kwargs: object) -> list[PointNavEnv]:
+    """One single env per world, reset to the world's ``episodes`` (its crowd recorded), whose
+    first observations equal the engine's reset's ``obs``."""
     singles = []
     for w, episode in enumerate(episodes):
         env = PointNavEnv(scene=scene, flatten_obs=True, sensors=SCAN, task=task, pedestrians=pedestrians, **kwargs)
-        env.last_obs, _ = env.reset(seed=w, options={"episode": episode})
+        sob, _ = env.reset(seed=w, options={"episode": episode})
+        np.testing.assert_allclose(obs[w], sob, atol=1e-4, err_msg=f"world {w} at the reset")
         singles.append(env)
     return singles
 
@@ -96,9 +94,8 @@ def test_each_world_walks_as_a_single_env(pedestrians: dict) -> None:
     task = {"termination_config": {"max_steps": 120, "max_collisions": 50}}
     venv = VectorPointNavEnv(n, scene=scene, seed=3, sensors=SCAN, task=task, pedestrians=pedestrians, pool_size=3)
     obs, _ = venv.reset(seed=3)
-    venv.reset_obs = obs
     episodes = [world_episode(venv, w) for w in range(n)]
-    singles = _singles(venv, scene, pedestrians, task, episodes)
+    singles = _singles(obs, scene, pedestrians, task, episodes)
     actions = random_actions(np.random.default_rng(0), (140, n))
     actions[:, :, 0] = np.abs(actions[:, :, 0])  # drive ahead, into the crowd
     seen = _play_alongside(venv, singles, actions)
@@ -120,11 +117,10 @@ def test_a_dataset_crowd_is_placed_as_recorded() -> None:
     task = {"termination_config": {"max_steps": 80}}
     venv = VectorPointNavEnv(3, scene=scene, seed=0, sensors=SCAN, task=task, pedestrians=pedestrians)
     obs, _ = venv.reset(options={"episodes": episodes})
-    venv.reset_obs = obs
     for w, episode in enumerate(episodes):
         assert venv.crowd.record(w) == episode.pedestrians
         np.testing.assert_array_equal(venv.crowd.positions[w, :5], [p.start for p in episode.pedestrians])
-    singles = _singles(venv, scene, pedestrians, task, episodes)
+    singles = _singles(obs, scene, pedestrians, task, episodes)
     seen = _play_alongside(venv, singles, np.tile([[0.6, 0.0]], (80, 3, 1)))
     assert seen["ends"] == 3 and seen["moved"] > 0
 
@@ -164,27 +160,24 @@ def test_a_recorded_crowd_needs_pedestrians() -> None:
         venv.reset(options={"episodes": episodes})
 
 
-@pytest.mark.parametrize(("finished", "pedestrians"), [
-    ("park", {"count": 6}),
-    ("remove", {"count": 5, "end_on_collision": True, "speed": (0.9, 1.3)}),
-])
-def test_several_robots_walk_beside_one_crowd_as_in_the_multi_robot_env(finished: str, pedestrians: dict) -> None:
-    scene, n, r = _house(), 4, 3
-    task = {"termination_config": {"max_steps": 90, "max_collisions": 50}}
-    venv = VectorPointNavEnv(n, n_robots=r, scene=scene, seed=5, sensors=SCAN, task=task, pedestrians=pedestrians,
-                             pool_size=2, finished=finished)
-    obs, info = venv.reset(seed=5)
-    refs, agents = [], []
-    for w in range(n):
-        episodes = [fleet_episode(venv, w, k) for k in range(r)]
-        env = parallel_env(scene=scene, n_robots=r, task=task, backend="kinematic", sensors=SCAN, finished=finished,
-                           pedestrians=pedestrians)
-        sob, _ = env.reset(seed=w, options={"episodes": episodes})
-        agents = env.possible_agents
-        np.testing.assert_allclose(obs[w], [sob[a] for a in agents], atol=1e-4, err_msg=f"world {w} at the reset")
+def _fleet_refs(venv: VectorPointNavEnv, obs: np.ndarray, scene: Scene, task: dict, pedestrians: dict,
+                **kwargs: object) -> list[object]:
+    """One ``parallel_env`` per world of a fleet engine (``obs`` its reset's), reset to the
+    world's episodes and crowd."""
+    refs = []
+    for w in range(venv.num_envs):
+        env = parallel_env(scene=scene, n_robots=venv.n_robots, task=task, backend="kinematic", sensors=SCAN,
+                           pedestrians=pedestrians, **kwargs)
+        sob, _ = env.reset(seed=w, options={"episodes": [fleet_episode(venv, w, k) for k in range(venv.n_robots)]})
+        np.testing.assert_allclose(obs[w], [sob[a] for a in env.possible_agents], atol=1e-4, err_msg=f"world {w}")
         refs.append(env)
-    actions = random_actions(np.random.default_rng(1), (100, n, r))
-    actions[..., 0] = np.abs(actions[..., 0])
+    return refs
+
+
+def _play_fleet(venv: VectorPointNavEnv, refs: list, actions: np.ndarray) -> dict[str, int]:
+    """Step a fleet engine and its ``parallel_env``s until every agent is done, checking
+    each acting robot every step; counts of what happened."""
+    agents = refs[0].possible_agents
     seen = {"touches": 0, "ends": 0, "parked": 0}
     for t, act in enumerate(actions):
         obs, reward, term, trunc, info = venv.step(act)
@@ -196,7 +189,7 @@ def test_several_robots_walk_beside_one_crowd_as_in_the_multi_robot_env(finished
             where = f"world {w}, step {t}"
             k = env.crowd.n
             np.testing.assert_allclose(venv.crowd.positions[w, :k], env.crowd.positions, atol=1e-9, rtol=0, err_msg=where)
-            seen["parked"] += r - len(acting)
+            seen["parked"] += len(agents) - len(acting)
             for j, a in enumerate(agents):
                 if a not in acting:
                     continue
@@ -208,6 +201,23 @@ def test_several_robots_walk_beside_one_crowd_as_in_the_multi_robot_env(finished
                 seen["ends"] += sterm[a] or strunc[a]
         if not any(env.agents for env in refs):
             break
+    return seen
+
+
+@pytest.mark.parametrize(("finished", "pedestrians"), [
+    ("park", {"count": 6}),
+    ("remove", {"count": 5, "end_on_collision": True, "speed": (0.9, 1.3)}),
+])
+def test_several_robots_walk_beside_one_crowd_as_in_the_multi_robot_env(finished: str, pedestrians: dict) -> None:
+    scene, n, r = _house(), 4, 3
+    task = {"termination_config": {"max_steps": 90, "max_collisions": 50}}
+    venv = VectorPointNavEnv(n, n_robots=r, scene=scene, seed=5, sensors=SCAN, task=task, pedestrians=pedestrians,
+                             pool_size=2, finished=finished)
+    obs, _ = venv.reset(seed=5)
+    refs = _fleet_refs(venv, obs, scene, task, pedestrians, finished=finished)
+    actions = random_actions(np.random.default_rng(1), (100, n, r))
+    actions[..., 0] = np.abs(actions[..., 0])
+    seen = _play_fleet(venv, refs, actions)
     assert seen["ends"] == n * r and seen["touches"] > 0 and seen["parked"] > 0
 
 
@@ -224,33 +234,12 @@ def test_with_discrete_actions_the_crowd_walks_each_control_step(n_robots: int) 
     obs, _ = venv.reset(seed=2)
     choices = np.random.default_rng(3).choice(4, size=(40, n, n_robots), p=[0.6, 0.15, 0.15, 0.1])
     if n_robots == 1:
-        venv.reset_obs = obs
-        singles = _singles(venv, scene, pedestrians, task, [world_episode(venv, w) for w in range(n)], **kwargs)
+        singles = _singles(obs, scene, pedestrians, task, [world_episode(venv, w) for w in range(n)], **kwargs)
         seen = _play_alongside(venv, singles, choices[..., 0])
         assert seen["ends"] == n and seen["moved"] > 0
-        return
-    refs = []
-    for w in range(n):
-        env = parallel_env(scene=scene, n_robots=n_robots, task=task, backend="kinematic", sensors=SCAN,
-                           pedestrians=pedestrians, **kwargs)
-        env.reset(seed=w, options={"episodes": [fleet_episode(venv, w, k) for k in range(n_robots)]})
-        refs.append(env)
-    agents = refs[0].possible_agents
-    for t, act in enumerate(choices):
-        obs, reward, term, trunc, info = venv.step(act)
-        for w, env in enumerate(refs):
-            if not env.agents:
-                continue
-            acting = list(env.agents)
-            sob, srew, sterm, strunc, sinfo = env.step({a: int(act[w, agents.index(a)]) for a in acting})
-            where = f"world {w}, step {t}"
-            np.testing.assert_allclose(venv.crowd.positions[w, :env.crowd.n], env.crowd.positions, atol=1e-9, rtol=0,
-                                       err_msg=where)
-            for j, a in enumerate(agents):
-                if a in acting:
-                    np.testing.assert_allclose(obs[w, j], sob[a], atol=1e-4, err_msg=f"{where}, robot {j}")
-                    assert (bool(term[w, j]), bool(trunc[w, j])) == (sterm[a], strunc[a]), f"{where}, robot {j}"
-                    assert int(info["pedestrian_collisions"][w, j]) == sinfo[a]["pedestrian_collisions"], where
+    else:
+        seen = _play_fleet(venv, _fleet_refs(venv, obs, scene, task, pedestrians, **kwargs), choices)
+        assert seen["ends"] == n * n_robots
 
 
 def test_a_pool_refresh_keeps_the_running_crowds_and_places_new_ones() -> None:
