@@ -119,7 +119,7 @@ class VectorCrowd:
         self._seed, self._generation = 0, 0
         self._pool: Any = None
         self._starts: list[CrowdStart] = []
-        self._stack: dict[str, NDArray[Any]] | None = None
+        self._stack: dict[str, Any] | None = None  # the placed crowds as arrays (_stacked)
         self._slot_of: dict[int, int] = {}
         self._recorded: dict[int, Any] = {}
         self._resize(len(self.world_scene), 0, 1)
@@ -129,7 +129,6 @@ class VectorCrowd:
         self.touched = np.zeros(self.collisions.shape, dtype=np.bool_)
         self._present: NDArray[np.bool_] | None = None
         self._start = np.empty(len(self.world_scene), dtype=object)  # each world's CrowdStart
-        self._rngs: dict[tuple[int, int], np.random.Generator] = {}
 
     def _resize(self, w: int, p: int, length: int) -> None:
         """Zeroed state arrays for ``w`` worlds of ``p`` pedestrians, paths of ``length`` points."""
@@ -138,6 +137,7 @@ class VectorCrowd:
         self._paths = np.zeros((w, p, length, 2))
         self._next, self._last = np.zeros((w, p), np.int64), np.zeros((w, p), np.int64)
         self._index = np.full((w, p), -1, np.int64)
+        self._rngs = np.full((w, p), None, dtype=object)  # (W, P): each one's generator, once made
 
     # ------------------------------------------------------------------ placing
     def seed(self, seed: int) -> None:
@@ -171,32 +171,37 @@ class VectorCrowd:
         self._starts.append(self._crowds[s].start())
         return len(self._starts) - 1
 
-    def _stacked(self) -> dict[str, NDArray[Any]]:
-        """The placed crowds stacked, slot by slot (padded to the most pedestrians and the
-        longest path), made again when crowds were placed since."""
-        if self._stack is None or len(self._stack["count"]) != len(self._starts):
-            starts, n = self._starts, len(self._starts)
-            p = max(len(st.radius) for st in starts)
-            length = max(st.paths.shape[1] for st in starts)
-            t = {"count": np.array([len(st.radius) for st in starts], np.int64), "paths": np.zeros((n, p, length, 2)),
-                 "index": np.full((n, p), -1, np.int64)}
-            for name in ("positions", "goals"):
-                t[name] = np.zeros((n, p, 2))
-            for name in ("headings", "radius", "speed"):
-                t[name] = np.zeros((n, p))
-            for name in ("next", "last"):
-                t[name] = np.zeros((n, p), np.int64)
-            t["start"] = np.empty(n, dtype=object)  # each slot's CrowdStart (its walks and draws)
-            for k, st in enumerate(starts):
-                t["start"][k] = st
-                m = len(st.radius)
-                for name in ("positions", "goals", "headings", "radius", "speed", "next", "last"):
-                    t[name][k, :m] = getattr(st, name)
-                t["index"][k, :m] = st.goal_index
-                t["paths"][k, :m, : st.paths.shape[1]] = st.paths
-                t["paths"][k, :m, st.paths.shape[1]:] = st.paths[:, -1:]
-            self._stack = t
-        return self._stack
+    _STACKED = (("positions", 2), ("goals", 2), ("headings", 0), ("radius", 0), ("speed", 0), ("next", 0),
+                ("last", 0), ("goal_index", 0))
+
+    def _stacked(self) -> dict[str, Any]:
+        """The placed crowds stacked, slot by slot, room for all the pool's episodes (padded
+        to the most pedestrians and the longest path): the crowds placed since the last
+        call are written in, and the table widened only when one is larger."""
+        starts, t = self._starts, self._stack
+        done = 0 if t is None else t["done"]
+        if t is not None and done == len(starts):
+            return t
+        p = max([len(st.radius) for st in starts] + ([t["radius"].shape[1]] if t else []))
+        length = max([st.paths.shape[1] for st in starts[done:]] + ([t["paths"].shape[2]] if t else []))
+        rows = max(len(starts), 0 if t is None else len(t["count"]), len(self._pool) + self.world_scene.shape[0])
+        if t is None or p > t["radius"].shape[1] or length > t["paths"].shape[2] or rows > len(t["count"]):
+            new = {"done": 0, "count": np.zeros(rows, np.int64), "start": np.empty(rows, dtype=object),
+                   "paths": np.zeros((rows, p, length, 2))}
+            for name, dim in self._STACKED:
+                dtype = np.int64 if name in ("next", "last", "goal_index") else np.float64
+                new[name] = np.zeros((rows, p, dim) if dim else (rows, p), dtype)
+            self._stack = t = new  # written whole again: rare
+            done = 0
+        for k in range(done, len(starts)):
+            st, m = starts[k], len(starts[k].radius)
+            t["count"][k], t["start"][k] = m, st  # its CrowdStart: its walks and draws
+            for name, _ in self._STACKED:
+                t[name][k, :m] = getattr(st, name)
+            t["paths"][k, :m, : st.paths.shape[1]] = st.paths
+            t["paths"][k, :m, st.paths.shape[1]:] = st.paths[:, -1:]
+        t["done"] = len(starts)
+        return t
 
     def _gather(self, worlds: NDArray[np.int64], slots: NDArray[np.int64]) -> None:
         """Copy the placed crowds ``slots`` into ``worlds``, widening the arrays if needed."""
@@ -205,7 +210,7 @@ class VectorCrowd:
         self._widen(p, length)
         for mine, name in ((self.positions, "positions"), (self.goals, "goals"), (self.headings, "headings"),
                            (self.radius, "radius"), (self.speed, "speed"), (self._next, "next"), (self._last, "last"),
-                           (self._index, "index")):
+                           (self._index, "goal_index")):
             mine[worlds, :p] = t[name][slots]
         paths = t["paths"][slots]
         self._paths[worlds, :p, :length] = paths
@@ -214,10 +219,7 @@ class VectorCrowd:
         self.count[worlds] = t["count"][slots]
         self._start[worlds] = t["start"][slots]  # kept past a new pool's placing
         self.collisions[worlds] = 0
-        if self._rngs:  # the generators of the worlds' pedestrians that planned
-            reset = set(worlds.tolist())
-            for key in [key for key in self._rngs if key[0] in reset]:
-                del self._rngs[key]
+        self._rngs[worlds] = None  # each pedestrian's generator is made again at its first plan
 
     def _widen(self, p: int, length: int) -> None:
         """Room for ``p`` pedestrians a world and paths of ``length`` points."""
@@ -225,10 +227,10 @@ class VectorCrowd:
         if p <= p0 and length <= l0:
             return
         old = (self.positions, self.velocities, self.goals, self.headings, self.radius, self.speed, self._next,
-               self._last, self._index, self._paths)
+               self._last, self._index, self._rngs, self._paths)
         self._resize(w, max(p, p0), max(length, l0))
         new = (self.positions, self.velocities, self.goals, self.headings, self.radius, self.speed, self._next,
-               self._last, self._index)
+               self._last, self._index, self._rngs)
         for dst, src in zip(new, old):
             dst[:, :p0] = src
         self._paths[:, :p0, :l0] = old[-1]
@@ -310,7 +312,7 @@ class VectorCrowd:
         """Pedestrian ``i`` of world ``w`` plans again (:func:`plan_walk`, as the single env)."""
         st = self._start[w]
         walk = Walk(st.walks[i], st.loops[i], int(self._index[w, i]), self.goals[w, i].copy())
-        rng = self._rngs.get((w, i))
+        rng = self._rngs[w, i]
         if rng is None:  # its own generator, where the placing left it
             rng = self._rngs[w, i] = np.random.default_rng(0)
             rng.bit_generator.state = st.draws[i]
