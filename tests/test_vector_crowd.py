@@ -71,12 +71,12 @@ def _play_alongside(venv: VectorPointNavEnv, singles: list[PointNavEnv], actions
 
 
 def _singles(obs: np.ndarray, scene: Scene, pedestrians: dict, task: dict, episodes: list[PointNavEpisode],
-             **kwargs: object) -> list[PointNavEnv]:
+             sensors: dict = SCAN, **kwargs: object) -> list[PointNavEnv]:
     """One single env per world, reset to the world's ``episodes`` (its crowd recorded), whose
     first observations equal the engine's reset's ``obs``."""
     singles = []
     for w, episode in enumerate(episodes):
-        env = PointNavEnv(scene=scene, flatten_obs=True, sensors=SCAN, task=task, pedestrians=pedestrians, **kwargs)
+        env = PointNavEnv(scene=scene, flatten_obs=True, sensors=sensors, task=task, pedestrians=pedestrians, **kwargs)
         sob, _ = env.reset(seed=w, options={"episode": episode})
         np.testing.assert_allclose(obs[w], sob, atol=1e-4, err_msg=f"world {w} at the reset")
         singles.append(env)
@@ -144,7 +144,6 @@ def test_scan_sees_a_pedestrian_at_the_hand_computed_range() -> None:
 @pytest.mark.parametrize(("kwargs", "names"), [
     ({"pedestrians": {"count": 2, "behaviour": "social_force"}}, "pedestrians['behaviour']"),
     ({"pedestrians": {"count": 2}, "device": "cpu"}, "device='numpy'"),
-    ({"pedestrians": {"count": 2}, "sensors": {"local_map": {}}}, "local_map"),
     ({"pedestrians": {"density": -1.0}}, "pedestrians['density']"),
     ({"pedestrians": {"count": 2, "behavior": "orca"}}, "unknown key 'behavior'"),
 ])
@@ -161,12 +160,12 @@ def test_a_recorded_crowd_needs_pedestrians() -> None:
 
 
 def _fleet_refs(venv: VectorPointNavEnv, obs: np.ndarray, scene: Scene, task: dict, pedestrians: dict,
-                **kwargs: object) -> list[object]:
+                sensors: dict = SCAN, **kwargs: object) -> list[object]:
     """One ``parallel_env`` per world of a fleet engine (``obs`` its reset's), reset to the
     world's episodes and crowd."""
     refs = []
     for w in range(venv.num_envs):
-        env = parallel_env(scene=scene, n_robots=venv.n_robots, task=task, backend="kinematic", sensors=SCAN,
+        env = parallel_env(scene=scene, n_robots=venv.n_robots, task=task, backend="kinematic", sensors=sensors,
                            pedestrians=pedestrians, **kwargs)
         sob, _ = env.reset(seed=w, options={"episodes": [fleet_episode(venv, w, k) for k in range(venv.n_robots)]})
         np.testing.assert_allclose(obs[w], [sob[a] for a in env.possible_agents], atol=1e-4, err_msg=f"world {w}")
@@ -261,3 +260,26 @@ def test_a_pool_refresh_keeps_the_running_crowds_and_places_new_ones() -> None:
     after = {ped.start for w in range(3) for ped in venv.crowd.record(w)}
     assert after.isdisjoint(starts)
     venv.close()
+
+
+@pytest.mark.parametrize("n_robots", [1, 3])
+def test_the_local_map_marks_the_pedestrians_as_the_single_env(n_robots: int) -> None:
+    # Code 4 over the robots' discs (3) and the floor, with the single env's bounds.
+    scene, n = _house(), 4
+    sensors = {**SCAN, "local_map": {"size": 4.0, "cells": 20}}
+    task = {"termination_config": {"max_steps": 50, "max_collisions": 50}}
+    pedestrians = {"count": 8, "radius": (0.25, 0.35)}
+    venv = VectorPointNavEnv(n, n_robots=n_robots, scene=scene, seed=6, sensors=sensors, task=task,
+                             pedestrians=pedestrians, pool_size=2)
+    obs, _ = venv.reset(seed=6)
+    actions = random_actions(np.random.default_rng(4), (50, n, n_robots))
+    if n_robots == 1:
+        singles = _singles(obs, scene, pedestrians, task, [world_episode(venv, w) for w in range(n)], sensors)
+        assert singles[0].observation_space == venv.single_observation_space
+        _play_alongside(venv, singles, actions[..., 0, :])
+    else:
+        refs = _fleet_refs(venv, obs, scene, task, pedestrians, sensors)
+        assert refs[0].observation_space(refs[0].possible_agents[0]) == venv.single_observation_space
+        _play_fleet(venv, refs, actions)
+    cells = venv.local_map.size
+    assert (obs[..., -cells:] == 4).any(), "no pedestrian on any map at the reset"

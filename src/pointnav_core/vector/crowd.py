@@ -25,7 +25,8 @@ definition for both engines:
 Several robots per world walk beside one crowd, as in the multi-robot env: it avoids every
 robot present (with ``sees_robots``), and each robot's contacts are its own. With discrete
 actions the crowd walks each control step of an action, as in the single env. Only ORCA
-and ``"static"`` crowds, on numpy with numba (the ``fast`` extra); the rest is refused by
+and ``"static"`` crowds, on numpy with numba (the ``fast`` extra); the scan sees them and
+the local map marks them (code 4), as the single env's; the rest is refused by
 :func:`check_vector_pedestrians` (docs/decisions.md, "Crowds in the batched engine").
 """
 
@@ -43,10 +44,25 @@ from pointnav_core.crowds.walks import Walk, plan_walk
 from pointnav_core.errors import ArgumentError
 from pointnav_core.utils.compiled import kernel
 
-__all__ = ["VectorCrowd", "check_vector_pedestrians", "recorded_crowds"]
+__all__ = ["VectorCrowd", "check_vector_pedestrians", "crowd_map_high", "recorded_crowds"]
 
 
-def check_vector_pedestrians(config: PedestrianConfig | None, device: str, sensors: Any) -> None:
+def crowd_map_high(high: NDArray[np.float64], sensors: Any) -> NDArray[np.float64]:
+    """``high``, the observation's upper bounds (the last axis), with the local map's cells
+    (the observation's last ``cells * cells`` values, where ``sensors`` has one) up to a
+    pedestrian's code, 4: the single env's bounds with a crowd."""
+    from pointnav_core.sensors.local_map import LOCAL_PEDESTRIAN
+    from pointnav_core.vector.local_map import local_map_term
+
+    term = local_map_term(sensors)
+    if term is None:
+        return high
+    out = np.array(high, dtype=high.dtype)
+    out[..., -term.size:] = np.maximum(out[..., -term.size:], LOCAL_PEDESTRIAN)
+    return out
+
+
+def check_vector_pedestrians(config: PedestrianConfig | None, device: str) -> None:
     """Refuse, naming ``pedestrians``, what the batched engine's crowds do not do yet."""
     if config is None:
         return
@@ -57,8 +73,6 @@ def check_vector_pedestrians(config: PedestrianConfig | None, device: str, senso
         )
     if device != "numpy":
         raise ArgumentError(f"pedestrians need device='numpy' in the batched engine, got device={device!r}")
-    if sensors and "local_map" in sensors:
-        raise ArgumentError("pedestrians and sensors['local_map'] cannot be combined in the batched engine yet")
     if kernel(*KERNEL) is None:
         raise ArgumentError("pedestrians in the batched engine need numba (pip install 'pointnav-core[fast]')")
 

@@ -32,6 +32,7 @@ from pointnav_core.vector.arguments import (
 from pointnav_core.vector.crowd import (
     VectorCrowd,
     check_vector_pedestrians,
+    crowd_map_high,
     recorded_crowds,
 )
 from pointnav_core.vector.discrete import DiscretePlan
@@ -132,9 +133,10 @@ class VectorPointNavEnv(PoolRefreshing, VectorEnv):
         A tqdm bar over the pool's scenes on stderr; default: from 4 scenes on, on a terminal.
     pedestrians : dict, optional
         A crowd in every world, as the single env's ``pedestrians`` (``"orca"`` or
-        ``"static"``; numpy with numba; no local map): each world's crowd is the one a
+        ``"static"``; numpy with numba): each world's crowd is the one a
         single env (a multi-robot env) walks beside the same robots
-        (:mod:`pointnav_core.vector.crowd`); the scan sees it, and ``info`` counts
+        (:mod:`pointnav_core.vector.crowd`); the scan sees it, the local map marks it (code
+        4), and ``info`` counts
         ``pedestrian_collisions`` (with ``end_on_collision``, a touch ends the episode).
     Notes
     -----
@@ -210,7 +212,6 @@ class VectorPointNavEnv(PoolRefreshing, VectorEnv):
 
     metadata = {"autoreset_mode": AutoresetMode.NEXT_STEP, "render_modes": []}
     _pool_class: Any = EpisodePool  # the episodes prepared ahead (the fleet's have a robot axis)
-    crowd: Any = None  # the fleet's worlds have none
 
     def __new__(cls, *args: Any, **kwargs: Any) -> Self:
         # Several robots per world are their own engine (vector.fleet_env), built from here.
@@ -260,7 +261,7 @@ class VectorPointNavEnv(PoolRefreshing, VectorEnv):
         scan_term = requested_scan(sensors)
         task = task_arguments(task)
         crowd = make_pedestrians(pedestrians)
-        check_vector_pedestrians(crowd, device, sensors)
+        check_vector_pedestrians(crowd, device)
         self.pool_size = validation.integer("pool_size", pool_size, minimum=1)
         self.starts_per_goal = validation.integer("starts_per_goal", starts_per_goal, minimum=1)
         self.arrays = make_arrays(device)
@@ -288,6 +289,8 @@ class VectorPointNavEnv(PoolRefreshing, VectorEnv):
         self._high = a.asarray(np.stack([b[1] for b in bounds]).astype(np.float64))
         low = np.min([b[0] for b in bounds], axis=0)
         high = np.max([b[1] for b in bounds], axis=0)
+        if crowd is not None:  # the samplers have none: their local map's top code is a robot's
+            high = crowd_map_high(high, sensors)
         self.single_observation_space = gym.spaces.Box(low, high, dtype=np.float32)
         self.single_action_space = first.action_space
         self.observation_space = gym.vector.utils.batch_space(self.single_observation_space, self.num_envs)
@@ -488,7 +491,7 @@ class VectorPointNavEnv(PoolRefreshing, VectorEnv):
         st = self.state
         one = self.arrays.xp.ones_like(st.x)[:, None] > 0.0
         return self.local_map.values(self.world_scene, st.x[:, None], st.y[:, None], st.yaw[:, None], one,
-                                     self.robot.radius)[:, 0]
+                                     self.robot.radius, None if self.crowd is None else self.crowd.discs())[:, 0]
 
     def _info(self, success: Any, r_pot: Any, r_col: Any, r_goal: Any, contact: Any, resetting: Any) -> dict[str, Any]:
         info = step_info(self.arrays.xp, self.state, success, r_pot, r_col, r_goal, contact, resetting)

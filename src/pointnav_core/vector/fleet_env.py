@@ -35,7 +35,11 @@ from pointnav_core.vector.accounting import read_task, task_step
 from pointnav_core.vector.arguments import as_scene_list, check_real_actions
 from pointnav_core.vector.contacts import advance
 from pointnav_core.vector.contacts_jit import advance_compiled
-from pointnav_core.vector.crowd import VectorCrowd, check_vector_pedestrians
+from pointnav_core.vector.crowd import (
+    VectorCrowd,
+    check_vector_pedestrians,
+    crowd_map_high,
+)
 from pointnav_core.vector.discrete import DiscretePlan
 from pointnav_core.vector.drive import (
     arc,
@@ -131,7 +135,7 @@ class VectorFleetEnv(VectorPointNavEnv):
         self.finished = check_finished(finished)
         scan_term = requested_scan(sensors)
         crowd = make_pedestrians(pedestrians)
-        check_vector_pedestrians(crowd, device, sensors)
+        check_vector_pedestrians(crowd, device)
         if max_episode_steps is not None:
             max_episode_steps = validation.integer("max_episode_steps", max_episode_steps, minimum=1)
         task = task_arguments(task, self.n_robots, max_episode_steps)  # one dict, or one per robot
@@ -163,7 +167,7 @@ class VectorFleetEnv(VectorPointNavEnv):
         self.floors = FloorTables(scene_list, t.floor, spec.radius, a, shared)
         # Each robot's clearance table, of its own radius: (R, all cells).
         self._fast = a.xp.stack([self.floors.fast_for(s.radius) for s in self.robots])
-        self._make_spaces(first)
+        self._make_spaces(first, crowd, sensors)
         self._rng = np.random.default_rng(seed)
         n, r = self.num_envs, self.n_robots
         self.world_scene = a.asarray(np.arange(n) % len(scene_list), a.i64)
@@ -178,14 +182,17 @@ class VectorFleetEnv(VectorPointNavEnv):
         radii = [s.radius for s in self.robots]
         self.crowd = None if crowd is None else VectorCrowd(crowd, scene_list, t.floor, a.numpy(self.world_scene), radii)
 
-    def _make_spaces(self, first: Any) -> None:
+    def _make_spaces(self, first: Any, crowd: Any, sensors: Any) -> None:
         """The observation bounds of every (scene, robot) and the batched spaces, from the
-        multi-robot envs (``first`` gives the action space)."""
+        multi-robot envs (``first`` gives the action space), with a ``crowd``'s code in the
+        local map."""
         a = self.arrays
         bounds = [[t.observation_bounds for t in env.tasks] for env in self._samplers]  # (scene, robot)
         lows, highs = (np.array([[b[k] for b in row] for row in bounds], np.float64) for k in (0, 1))
         self._low, self._high = a.asarray(lows), a.asarray(highs)
         low, high = lows.min(axis=(0, 1)).astype(np.float32), highs.max(axis=(0, 1)).astype(np.float32)
+        if crowd is not None:  # the samplers have none: their local map's top code is a robot's
+            high = crowd_map_high(high, sensors)
         self.single_observation_space = gym.spaces.Box(low, high, dtype=np.float32)
         self.single_action_space = first.action_space(first.possible_agents[0])
         batch = gym.vector.utils.batch_space
@@ -406,7 +413,8 @@ class VectorFleetEnv(VectorPointNavEnv):
         """Every robot's local map, ``(num_envs, n_robots, cells * cells)``, with the discs of
         the robots in ``_seen`` (the scan's rule); rows outside it are hidden by ``_observe``."""
         st = self.state
-        return self.local_map.values(self.world_scene, st.x, st.y, st.yaw, self._seen, self.radius)
+        return self.local_map.values(self.world_scene, st.x, st.y, st.yaw, self._seen, self.radius,
+                                     None if self.crowd is None else self.crowd.discs())
 
     def _observe(self, shown: Any) -> Any:
         """The robots' ``low_dim`` observations, zero where ``shown`` is False."""

@@ -5,7 +5,8 @@ centres of a ``cells x cells`` grid of side ``size`` (m) turned by its heading, 
 mapped to the floor cell under it (``floor`` of the centre over the cell size, the
 backend's :meth:`~pointnav_core.vector.floors.FloorTables.cells`), whose code is looked up
 in the floors' flat code array (off the map: VOID); then the discs of the other robots of
-its world that are present (the scan's rule) are drawn over it as code 3. The arithmetic
+its world that are present (the scan's rule) are drawn over it as code 3, and its world's
+pedestrians (the batched crowds, :mod:`pointnav_core.vector.crowd`) as code 4. The arithmetic
 is the single term's, operation for operation, on the heading the single env's frame
 derives from the planar quaternion, so the codes are equal; a cell centre that falls
 within rounding of a cell edge or a disc's rim may read the neighbouring value where the
@@ -50,7 +51,13 @@ from typing import Any
 import numpy as np
 
 from pointnav_core.errors import ArgumentError
-from pointnav_core.sensors.local_map import _LUT, LOCAL_ROBOT, LOCAL_VOID, LocalMap
+from pointnav_core.sensors.local_map import (
+    _LUT,
+    LOCAL_PEDESTRIAN,
+    LOCAL_ROBOT,
+    LOCAL_VOID,
+    LocalMap,
+)
 from pointnav_core.vector.floors import FloorTables
 from pointnav_core.vector.xp import as_dtype, cat
 
@@ -133,7 +140,7 @@ class VectorLocalMap:
         """Values per robot in the flat observation, ``cells * cells``."""
         return self.term.size
 
-    def values(self, scene: Any, x: Any, y: Any, yaw: Any, present: Any, radius: Any) -> Any:
+    def values(self, scene: Any, x: Any, y: Any, yaw: Any, present: Any, radius: Any, crowd: Any = None) -> Any:
         """Every robot's local map, row by row, as float32 codes on the arrays' device.
 
         Parameters
@@ -147,25 +154,33 @@ class VectorLocalMap:
             the env hides it).
         radius : float or float array broadcasting to (W, R)
             Robot radius (m), one for all or each robot's own: the discs drawn as code 3.
+        crowd : (qx, qy, qr, qn), optional
+            Each world's pedestrians (numpy, as :func:`~pointnav_core.vector.scan.cast_batch`
+            takes them): centres and radii ``(W, Q)`` (m) and counts ``(W,)``, drawn as
+            code 4 over everything else, as the single term draws them.
 
         Returns
         -------
         float32 array, shape (W, R, cells * cells)
-            Codes 0 free, 1 blocked, 2 void or off the map, 3 another robot.
+            Codes 0 free, 1 blocked, 2 void or off the map, 3 another robot, 4 a pedestrian.
         """
         a, xp = self.arrays, self.arrays.xp
         w, n = x.shape
         radius = xp.zeros_like(x) + radius  # (W, R)
         block = max(1, CPU_BLOCK // (n * self.size))
+        if crowd is not None:
+            crowd = tuple(a.asarray(v) for v in crowd[:3]) + (a.asarray(crowd[3], a.i64),)
         if w <= block or a.on_gpu:
-            return self._values(scene, x, y, yaw, present, radius)
+            return self._values(scene, x, y, yaw, present, radius, crowd)
         # On a CPU, blocks of worlds whose temporaries stay in cache (about twice as fast
         # at 1,024 x 4 robots with 32 x 32 maps as one call); a GPU takes the whole batch.
         parts = [self._values(scene[i : i + block], x[i : i + block], y[i : i + block], yaw[i : i + block],
-                              present[i : i + block], radius[i : i + block]) for i in range(0, w, block)]
+                              present[i : i + block], radius[i : i + block],
+                              None if crowd is None else tuple(v[i : i + block] for v in crowd))
+                 for i in range(0, w, block)]
         return cat(xp, parts)
 
-    def _values(self, scene: Any, x: Any, y: Any, yaw: Any, present: Any, radius: Any) -> Any:
+    def _values(self, scene: Any, x: Any, y: Any, yaw: Any, present: Any, radius: Any, crowd: Any) -> Any:
         """:meth:`values` of one block of worlds."""
         a, xp, fl = self.arrays, self.arrays.xp, self.floors
         c0, s0 = frame_heading(xp, yaw)
@@ -184,26 +199,35 @@ class VectorLocalMap:
         code = self._codes[flat]
         out = xp.where(inside, code, xp.full_like(code, LOCAL_VOID))
         if x.shape[1] > 1:
-            out = self._draw_discs(out, x, y, c0, s0, present, radius)
+            other = a.asarray(~np.eye(x.shape[1], dtype=bool), a.boolean)
+            out = self._draw_discs(out, x, y, c0, s0, x, y, radius, other[None] & present[:, None, :], LOCAL_ROBOT)
+        if crowd is not None and crowd[0].shape[1]:
+            qx, qy, qr, qn = crowd
+            walkers = a.asarray(np.arange(qx.shape[1]))[None] < qn[:, None]  # (W, Q)
+            seen = walkers[:, None, :] & (xp.ones_like(x) > 0.0)[:, :, None]
+            out = self._draw_discs(out, x, y, c0, s0, qx, qy, qr, seen, LOCAL_PEDESTRIAN)
         return as_dtype(xp, out, xp.float32)
 
-    def _draw_discs(self, out: Any, x: Any, y: Any, c: Any, s: Any, present: Any, radius: Any) -> Any:
-        """``out`` with code 3 where another present robot's disc (of its own ``radius``,
-        (W, R), m) covers a cell centre.
+    def _draw_discs(self, out: Any, x: Any, y: Any, c: Any, s: Any, ox: Any, oy: Any, dr: Any, seen: Any,
+                    code: int) -> Any:
+        """``out`` with ``code`` where a disc covers a cell centre: disc ``m`` of each world
+        (centres ``ox``, ``oy`` and radii ``dr``, ``(W, M)``, m) on robot ``i``'s map where
+        ``seen`` ``(W, R, M)``.
 
-        Only a window of ``k x k`` cells around each other robot (where its disc can reach)
-        is tested, with the full map's expressions for the centres, so the test is the
-        single term's on the same numbers.
+        Only a window of ``k x k`` cells around each disc (where it can reach) is tested,
+        with the full map's expressions for the centres, so the test is the single term's
+        on the same numbers.
         """
         a, xp, term = self.arrays, self.arrays.xp, self.term
         w, n = x.shape
+        m_n = ox.shape[1]
         cells, cs = term.cells, term.cell_size
         # The disc spans at most floor(2 r / cs) + 1 rows; one more each side for rounding.
         # One window size for all, from the largest disc.
-        k = min(math.ceil(2.0 * float(radius.max()) / cs) + 3, cells)
-        rm = radius[:, None, :]  # (W, 1, M): robot m's radius
-        dx = x[:, None, :] - x[:, :, None]  # (W, R, M): robot m relative to robot i
-        dy = y[:, None, :] - y[:, :, None]
+        k = min(math.ceil(2.0 * float(dr.max()) / cs) + 3, cells)
+        rm = dr[:, None, :]  # (W, 1, M): disc m's radius
+        dx = ox[:, None, :] - x[:, :, None]  # (W, R, M): disc m relative to robot i
+        dy = oy[:, None, :] - y[:, :, None]
         c, s = c[..., None], s[..., None]
         fwd, left = c * dx + s * dy, c * dy - s * dx
         # Fractional row and column of robot m in robot i's map (row i's centre: u_i).
@@ -212,18 +236,16 @@ class VectorLocalMap:
         c0 = (xp.floor(half - left / cs - rm / cs) - 1.0).clip(0.0, float(cells - k))
         ks = a.asarray(np.arange(k, dtype=np.float64))
         cell = a.to_int((r0[..., None, None] + ks[:, None]) * cells + (c0[..., None, None] + ks[None, :]))
-        cell = cell.reshape(w, n, n, k * k)
+        cell = cell.reshape(w, n, m_n, k * k)
         u, v = self._u[cell], self._v[cell]
         cx, cy = c[..., None], s[..., None]
         wx = x[:, :, None, None] + cx * u - cy * v  # the centres of values(), operation for operation
         wy = y[:, :, None, None] + cy * u + cx * v
-        ex = wx - x[:, None, :, None]
-        ey = wy - y[:, None, :, None]
-        other = a.asarray(~np.eye(n, dtype=bool), a.boolean)
-        seen = (other[None] & present[:, None, :])[..., None]
-        hit = (ex * ex + ey * ey <= (rm * rm)[..., None]) & seen
+        ex = wx - ox[:, None, :, None]
+        ey = wy - oy[:, None, :, None]
+        hit = (ex * ex + ey * ey <= (rm * rm)[..., None]) & seen[..., None]
         base = a.asarray(np.arange(w * n, dtype=np.int64).reshape(w, n, 1, 1) * (cells * cells), a.i64)
         flat = out.reshape(-1)
-        # Every write is 3, so windows overlapping on a cell need no reduction.
-        flat[(base + cell)[hit]] = LOCAL_ROBOT
+        # Every write is the one code, so windows overlapping on a cell need no reduction.
+        flat[(base + cell)[hit]] = code
         return flat.reshape(out.shape)
