@@ -283,3 +283,12 @@ def test_the_local_map_marks_the_pedestrians_as_the_single_env(n_robots: int) ->
         _play_fleet(venv, refs, actions)
     cells = venv.local_map.size
     assert (obs[..., -cells:] == 4).any(), "no pedestrian on any map at the reset"
+
+
+def test_placing_many_crowds_shows_progress(capsys: pytest.CaptureFixture[str]) -> None:
+    venv = VectorPointNavEnv(4, scene=_house(), seed=0, pedestrians={"count": 2}, pool_size=4, progress=True)
+    venv.reset(seed=0)
+    assert "placing crowds" in capsys.readouterr().err
+    quiet = VectorPointNavEnv(4, scene=_house(), seed=0, pedestrians={"count": 2}, pool_size=4)
+    quiet.reset(seed=0)  # a few crowds: no bar
+    assert "placing crowds" not in capsys.readouterr().err

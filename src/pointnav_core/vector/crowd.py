@@ -44,7 +44,11 @@ from pointnav_core.crowds.walks import Walk, plan_walk
 from pointnav_core.errors import ArgumentError
 from pointnav_core.utils.compiled import kernel
 
-__all__ = ["VectorCrowd", "check_vector_pedestrians", "crowd_map_high", "recorded_crowds"]
+__all__ = ["PROGRESS_CROWDS", "VectorCrowd", "check_vector_pedestrians", "crowd_map_high", "recorded_crowds"]
+
+#: Crowds placed at once from which a progress bar shows (each takes its pedestrians' plans,
+#: about 5-10 ms for 10 pedestrians on a house).
+PROGRESS_CROWDS = 64
 
 
 def crowd_map_high(high: NDArray[np.float64], sensors: Any) -> NDArray[np.float64]:
@@ -109,6 +113,9 @@ class VectorCrowd:
         Each world's scene.
     robot_radius : ndarray, shape (R,)
         Each robot's radius (m), the same in every world.
+    progress : bool, optional
+        A tqdm bar on stderr while crowds are placed; default: from :data:`PROGRESS_CROWDS`
+        at once (a first reset over many scenes), on a terminal.
 
     Attributes
     ----------
@@ -123,8 +130,8 @@ class VectorCrowd:
     """
 
     def __init__(self, config: PedestrianConfig, scenes: Sequence[Any], floor: int, world_scene: NDArray[np.int64],
-                 robot_radius: NDArray[np.float64]) -> None:
-        self.config = config
+                 robot_radius: NDArray[np.float64], progress: bool | None = None) -> None:
+        self.config, self.progress = config, progress
         self.scenes, self.floor = list(scenes), int(floor)
         self.robot_radius = np.asarray(robot_radius, dtype=np.float64).reshape(-1)
         self._crowds = [Crowd(config, scene) for scene in scenes]  # each scene's placer
@@ -143,6 +150,16 @@ class VectorCrowd:
         self.touched = np.zeros(self.collisions.shape, dtype=np.bool_)
         self._present: NDArray[np.bool_] | None = None
         self._start = np.empty(len(self.world_scene), dtype=object)  # each world's CrowdStart
+
+    @classmethod
+    def for_engine(cls, config: PedestrianConfig | None, engine: Any, robot_radius: Any,
+                   progress: bool | None) -> VectorCrowd | None:
+        """The crowds of a batched ``engine`` (its scenes, floor and worlds) for ``config``,
+        or None without one."""
+        if config is None:
+            return None
+        world_scene = engine.arrays.numpy(engine.world_scene)
+        return cls(config, engine.scenes, engine.task.floor, world_scene, robot_radius, progress)
 
     def _resize(self, w: int, p: int, length: int) -> None:
         """Zeroed state arrays for ``w`` worlds of ``p`` pedestrians, paths of ``length`` points."""
@@ -169,9 +186,15 @@ class VectorCrowd:
         if pool is not self._pool:  # a new pool (or seed): its episodes' crowds are new ones
             self._pool, self._generation = pool, self._generation + 1
             self._starts, self._slot_of, self._stack = [], {}, None
-        for w, e in zip(worlds.tolist(), episodes.tolist()):
-            if e not in self._slot_of:  # (an episode is of its world's scene)
-                self._slot_of[e] = self._place(pool, e, int(self.world_scene[w]))
+        new = {e: w for w, e in zip(worlds.tolist(), episodes.tolist()) if e not in self._slot_of}
+        if new:
+            from tqdm.auto import tqdm
+
+            # None: tqdm's own choice (a terminal only) from PROGRESS_CROWDS crowds on.
+            show = self.progress
+            disable = (None if len(new) >= PROGRESS_CROWDS else True) if show is None else not show
+            for e, w in tqdm(new.items(), desc="placing crowds", unit="crowd", disable=disable):
+                self._slot_of[e] = self._place(pool, e, int(self.world_scene[w]))  # (of its world's scene)
         slots = np.array([self._slot_of[e] for e in episodes.tolist()], dtype=np.int64)
         self._gather(worlds, slots)
 

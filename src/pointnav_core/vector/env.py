@@ -300,7 +300,7 @@ class VectorPointNavEnv(PoolRefreshing, VectorEnv):
         self.pool: EpisodePool | None = None  # sampled at the first reset that needs it
         self._allocate((self.num_envs,), scan_term, sensors)
         #: Every world's pedestrians (:class:`~pointnav_core.vector.crowd.VectorCrowd`), or None.
-        self.crowd = None if crowd is None else VectorCrowd(crowd, scene_list, t.floor, a.numpy(self.world_scene), [spec.radius])
+        self.crowd = VectorCrowd.for_engine(crowd, self, [spec.radius], self._pool_progress)
 
     def _allocate(self, shape: tuple[int, ...], scan_term: Any, sensors: Mapping[str, Any] | None) -> None:
         """The state arrays of ``shape`` (one entry per world, or per robot), the per-world

@@ -179,8 +179,7 @@ class VectorFleetEnv(VectorPointNavEnv):
         self._present = a.zeros((n, r), a.boolean)
         self._seen = self._present  # the robots the scans see at the next observation
         self._cycles = a.zeros(n, a.i64)
-        radii = [s.radius for s in self.robots]
-        self.crowd = None if crowd is None else VectorCrowd(crowd, scene_list, t.floor, a.numpy(self.world_scene), radii)
+        self.crowd = VectorCrowd.for_engine(crowd, self, [s.radius for s in self.robots], self._pool_progress)
 
     def _make_spaces(self, first: Any, crowd: Any, sensors: Any) -> None:
         """The observation bounds of every (scene, robot) and the batched spaces, from the
