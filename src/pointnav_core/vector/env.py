@@ -133,10 +133,9 @@ class VectorPointNavEnv(PoolRefreshing, VectorEnv):
         A tqdm bar over the pool's scenes on stderr; default: from 4 scenes on, on a terminal.
     pedestrians : dict, optional
         A crowd in every world, as the single env's ``pedestrians`` (``"orca"`` or
-        ``"static"``; numpy with numba): each world's crowd is the one a
-        single env (a multi-robot env) walks beside the same robots
-        (:mod:`pointnav_core.vector.crowd`); the scan sees it, the local map marks it (code
-        4), and ``info`` counts
+        ``"static"``; numpy with numba): each world's crowd is the one a single env (a
+        multi-robot env) walks beside the same robots (:mod:`pointnav_core.vector.crowd`);
+        the scan sees it, the local map marks it (code 4), and ``info`` counts
         ``pedestrian_collisions`` (with ``end_on_collision``, a touch ends the episode).
     Notes
     -----
