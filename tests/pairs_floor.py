@@ -1,7 +1,7 @@
 """Plain and compiled paths of the floor's collision tests, its cell draws and the tangent
 graph's sight bounds: the checks of ``property_tests/test_compiled_paths.py`` for
 ``floor._collision_kernel``, ``floor._draw_kernel``, ``geodesic._sight_kernel`` and
-``geodesic._edges_kernel``.
+``geodesic._edges_kernel`` and ``floor._component_kernel``.
 
 Each check takes ``plain_paths``, the context its plain side runs in (``numpy_paths()``).
 
@@ -22,6 +22,10 @@ Each check takes ``plain_paths``, the context its plain side runs in (``numpy_pa
   tangent segments) the same answers with its kernel and with its numpy samples, and
   ``edges.build_edges`` the same edges, in the same order, with its candidate pair kernel
   and with the KD-tree.
+- :meth:`TraversableMap.component_at` gives one point off the cell centres the same label
+  with its kernel as with its arrays (which ``tests/test_reachability.py`` checks against
+  components found by hand): random grids and rooms of obstacle polygons, radii, points
+  near, on and between cell centres, on blocked cells and off the map.
 """
 
 from __future__ import annotations
@@ -272,3 +276,43 @@ def check_draw(
         assert kernel("pointnav_core.floor._draw_kernel", "row_spans") is None
         want = [draw_cell(tmap, 0.0, label, ref, reach, np.random.default_rng(s)) for s in range(8)]
     assert got == want
+
+
+@settings(max_examples=60, deadline=None)
+@given(
+    seed=st.integers(0, 2**31 - 1),
+    rows=st.integers(2, 30),
+    cols=st.integers(2, 30),
+    density=st.floats(0.0, 0.5),
+    radius=st.one_of(st.just(0.0), st.floats(0.0, 0.4)),
+    resolution=st.sampled_from([0.05, 0.1, 0.25]),
+    with_polygons=st.booleans(),
+)
+def check_point_component(seed: int, rows: int, cols: int, density: float, radius: float, resolution: float,
+                          with_polygons: bool, plain_paths: Plain) -> None:
+    """``component_at`` of one point: the same label by ``point_component`` and by the arrays."""
+    from pointnav_core.floorplans import FloorPlan
+    from pointnav_core.floor.maps import TraversableMap
+
+    rng = np.random.default_rng(seed)
+    origin = (float(rng.uniform(-2, 2)), float(rng.uniform(-2, 2)))
+    codes = (rng.random((rows, cols)) < density).astype(np.uint8)
+    size = np.array([cols, rows]) * resolution
+    geometry = None
+    if with_polygons:  # a few boxes, some turned, over the grid
+        corner = np.array(origin) + rng.uniform(0.0, 1.0, (3, 2)) * size
+        boxes = [rotate(box(*c, *(c + rng.uniform(0.5, 3.0, 2) * resolution)), float(rng.uniform(0, 90))) for c in corner]
+        geometry = FloorPlan(outline=box(*origin, *(np.array(origin) + size)), obstacles=tuple(boxes))
+    tmap = TraversableMap(codes, resolution, origin, geometry=geometry)
+    kind = rng.integers(0, 4, 40)
+    points = np.array(origin) + rng.uniform(-0.1, 1.1, (40, 2)) * size
+    centres = np.array(origin) + (np.floor((points - origin) / resolution) + 0.5) * resolution
+    points[kind == 0] = centres[kind == 0]  # on a centre (the float path, no kernel)
+    points[kind == 1] = centres[kind == 1] + rng.uniform(-0.05, 0.05, (int((kind == 1).sum()), 2)) * resolution
+    points[kind == 2] = np.array(origin) + np.round((points[kind == 2] - origin) / resolution) * resolution  # vertices
+    got = [int(tmap.component_at(p, radius)) for p in points]
+    with plain_paths():
+        assert kernel("pointnav_core.floor._component_kernel", "point_component") is None
+        want = [int(tmap.component_at(p, radius)) for p in points]
+    assert got == want
+    assert kernel("pointnav_core.floor._component_kernel", "point_component") is not None

@@ -34,6 +34,7 @@ from scipy import ndimage
 from pointnav_core.errors import ArgumentError
 from pointnav_core.floor.collision import FloorCollision
 from pointnav_core.utils import validation
+from pointnav_core.utils.compiled import kernel
 
 __all__ = ["FREE", "OBSTACLE", "VOID", "CELL_CLASSES", "TraversableMap", "BoundedCache"]
 
@@ -387,8 +388,10 @@ class TraversableMap:
         pts = _as_points(xy, "xy")
         flat = pts.reshape(-1, 2)
         labels = self.components(radius)
-        if len(flat) == 1 and (own := self._centre_label(float(flat[0, 0]), float(flat[0, 1]), labels)) > 0:
-            return np.full(pts.shape[:-1], own, dtype=np.int32)  # one sampled point, in floats
+        if len(flat) == 1:
+            own = self._point_label(float(flat[0, 0]), float(flat[0, 1]), labels, radius)
+            if own is not None:
+                return np.full(pts.shape[:-1], own, dtype=np.int32)
         out = np.zeros(len(flat), dtype=np.int32)
         # A point on a labelled cell's centre (every sampled point) is that cell's: the
         # nearest candidate, at distance 0, which the loop below would find first. The
@@ -418,6 +421,20 @@ class TraversableMap:
             if len(hit):
                 out[i] = labels[cand[hit[0], 0], cand[hit[0], 1]]
         return out.reshape(pts.shape[:-1])
+
+    def _point_label(self, x: float, y: float, labels: NDArray[np.int32], radius: float) -> int | None:
+        """One point's label, in floats where that is quicker than the general path (the
+        same answer: property tests hold both ways equal): a sampled point (a cell centre),
+        or with numba any finite point (``floor._component_kernel``); None otherwise."""
+        own = self._centre_label(x, y, labels)
+        if own > 0:
+            return own
+        fn = kernel("pointnav_core.floor._component_kernel", "point_component")
+        collision = self.collision
+        if fn is None or not collision.compiled_polygons or not (math.isfinite(x) and math.isfinite(y)):
+            return None
+        (ox, oy), res = self.origin, self.resolution
+        return int(fn(x, y, labels, float(ox), float(oy), float(res), *collision.kernel_arguments(_check_radius(radius))))
 
     def _centre_label(self, x: float, y: float, labels: NDArray[np.int32]) -> int:
         """The label of the cell whose centre is exactly ``(x, y)`` (m), else 0: the general
