@@ -48,17 +48,19 @@ from pointnav_core.utils.compiled import kernel
 Plain = Callable[[], AbstractContextManager[None]]
 
 
+#: Random grid floors: a seed for their cells, their size, blocked share, cell size, and a radius.
+GRIDS = {
+    "seed": st.integers(0, 2**31 - 1),
+    "rows": st.integers(1, 40),
+    "cols": st.integers(1, 40),
+    "density": st.floats(0.0, 0.5),
+    "radius": st.one_of(st.just(0.0), st.floats(0.0, 0.6)),
+    "resolution": st.sampled_from([0.05, 0.1, 0.5]),
+}
+
+
 @settings(max_examples=80, deadline=None)
-@given(
-    seed=st.integers(0, 2**31 - 1),
-    rows=st.integers(1, 40),
-    cols=st.integers(1, 40),
-    density=st.floats(0.0, 0.5),
-    radius=st.one_of(st.just(0.0), st.floats(0.0, 0.6)),
-    resolution=st.sampled_from([0.05, 0.1, 0.5]),
-    outside_blocked=st.booleans(),
-    n=st.integers(1, 60),
-)
+@given(**GRIDS, outside_blocked=st.booleans(), n=st.integers(1, 60))
 def check_cell_test(
     seed: int, rows: int, cols: int, density: float, radius: float, resolution: float, outside_blocked: bool, n: int,
     plain_paths: Plain,
@@ -279,15 +281,7 @@ def check_draw(
 
 
 @settings(max_examples=60, deadline=None)
-@given(
-    seed=st.integers(0, 2**31 - 1),
-    rows=st.integers(2, 30),
-    cols=st.integers(2, 30),
-    density=st.floats(0.0, 0.5),
-    radius=st.one_of(st.just(0.0), st.floats(0.0, 0.4)),
-    resolution=st.sampled_from([0.05, 0.1, 0.25]),
-    with_polygons=st.booleans(),
-)
+@given(**GRIDS, with_polygons=st.booleans())
 def check_point_component(seed: int, rows: int, cols: int, density: float, radius: float, resolution: float,
                           with_polygons: bool, plain_paths: Plain) -> None:
     """``component_at`` of one point: the same label by ``point_component`` and by the arrays."""
