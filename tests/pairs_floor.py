@@ -285,8 +285,8 @@ def check_draw(
 def check_point_component(seed: int, rows: int, cols: int, density: float, radius: float, resolution: float,
                           with_polygons: bool, plain_paths: Plain) -> None:
     """``component_at`` of one point: the same label by ``point_component`` and by the arrays."""
-    from pointnav_core.floorplans import FloorPlan
     from pointnav_core.floor.maps import TraversableMap
+    from pointnav_core.floorplans import FloorPlan
 
     rng = np.random.default_rng(seed)
     origin = (float(rng.uniform(-2, 2)), float(rng.uniform(-2, 2)))
