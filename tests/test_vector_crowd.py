@@ -24,6 +24,7 @@ from pointnav_core.envs.pointnav import PointNavEnv
 from pointnav_core.errors import ArgumentError
 from pointnav_core.scenes import Scene
 from pointnav_core.vector import VectorPointNavEnv
+from pointnav_core.vector.social import SocialTracker
 
 pytest.importorskip("numba")
 
@@ -292,3 +293,70 @@ def test_placing_many_crowds_shows_progress(capsys: pytest.CaptureFixture[str]) 
     quiet = VectorPointNavEnv(4, scene=_house(), seed=0, pedestrians={"count": 2}, pool_size=4)
     quiet.reset(seed=0)  # a few crowds: no bar
     assert "placing crowds" not in capsys.readouterr().err
+
+
+def _same_metrics(got: dict, want: dict, where: str) -> None:
+    assert got.keys() == want.keys(), where
+    for key, value in want.items():
+        if value is None:
+            assert got[key] is None, f"{where}: {key}"
+        else:
+            assert got[key] == pytest.approx(value, rel=1e-9, abs=1e-9), f"{where}: {key}"
+
+
+def test_the_social_tracker_gives_each_episode_the_single_envs_metrics() -> None:
+    scene, n = _house(), 4
+    task = {"termination_config": {"max_steps": 60, "max_collisions": 50}}
+    pedestrians = {"count": 6}
+    venv = VectorPointNavEnv(n, scene=scene, seed=8, sensors=SCAN, task=task, pedestrians=pedestrians, pool_size=2)
+    tracker = SocialTracker(venv)
+    obs, _ = venv.reset(seed=8)
+    tracker.reset()
+    singles = _singles(obs, scene, pedestrians, task, [world_episode(venv, w) for w in range(n)])
+    actions = random_actions(np.random.default_rng(5), (60, n))
+    actions[..., 0] = np.abs(actions[..., 0])
+    done = [False] * n
+    for t, act in enumerate(actions):
+        _, _, term, trunc, info = venv.step(act)
+        ended = tracker.step(term, trunc, info)
+        for w, env in enumerate(singles):
+            if done[w]:
+                continue
+            _, _, sterm, strunc, sinfo = env.step(act[w])
+            assert ((w, 0) in ended) == (sterm or strunc), f"world {w}, step {t}"
+            if sterm or strunc:
+                _same_metrics(ended[w, 0], sinfo["social"], f"world {w}")
+                done[w] = True
+    assert all(done)
+    with pytest.raises(ArgumentError, match="pedestrians"):
+        SocialTracker(VectorPointNavEnv(1, scene=scene))
+    with pytest.raises(ArgumentError, match="discrete"):
+        SocialTracker(VectorPointNavEnv(1, scene=scene, pedestrians=pedestrians, action_space="discrete"))
+
+
+def test_the_social_tracker_follows_several_robots_as_the_multi_robot_env() -> None:
+    scene, n, r = _house(), 3, 2
+    task = {"termination_config": {"max_steps": 50, "max_collisions": 50}}
+    pedestrians = {"count": 5}
+    venv = VectorPointNavEnv(n, n_robots=r, scene=scene, seed=9, sensors=SCAN, task=task, pedestrians=pedestrians,
+                             pool_size=2)
+    tracker = SocialTracker(venv)
+    obs, _ = venv.reset(seed=9)
+    tracker.reset()
+    refs = _fleet_refs(venv, obs, scene, task, pedestrians)
+    agents = refs[0].possible_agents
+    seen = 0
+    for act in random_actions(np.random.default_rng(6), (60, n, r)):
+        _, _, term, trunc, info = venv.step(act)
+        ended = tracker.step(term, trunc, info)
+        for w, env in enumerate(refs):
+            if not env.agents:
+                continue
+            _, _, sterm, strunc, sinfo = env.step({a: act[w, agents.index(a)] for a in env.agents})
+            for a in sinfo:
+                k = agents.index(a)
+                assert ((w, k) in ended) == (sterm[a] or strunc[a])
+                if sterm[a] or strunc[a]:
+                    _same_metrics(ended[w, k], sinfo[a]["social"], f"world {w}, robot {k}")
+                    seen += 1
+    assert seen == n * r
