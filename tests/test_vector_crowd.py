@@ -71,13 +71,14 @@ def _play_alongside(venv: VectorPointNavEnv, singles: list[PointNavEnv], actions
     return seen
 
 
-def _singles(obs: np.ndarray, scene: Scene, pedestrians: dict, task: dict, episodes: list[PointNavEpisode],
+def _singles(obs: np.ndarray, scene: Scene | list[Scene], pedestrians: dict, task: dict, episodes: list[PointNavEpisode],
              sensors: dict = SCAN, **kwargs: object) -> list[PointNavEnv]:
     """One single env per world, reset to the world's ``episodes`` (its crowd recorded), whose
     first observations equal the engine's reset's ``obs``."""
     singles = []
     for w, episode in enumerate(episodes):
-        env = PointNavEnv(scene=scene, flatten_obs=True, sensors=sensors, task=task, pedestrians=pedestrians, **kwargs)
+        here = scene[w % len(scene)] if isinstance(scene, list) else scene  # world w's scene
+        env = PointNavEnv(scene=here, flatten_obs=True, sensors=sensors, task=task, pedestrians=pedestrians, **kwargs)
         sob, _ = env.reset(seed=w, options={"episode": episode})
         np.testing.assert_allclose(obs[w], sob, atol=1e-4, err_msg=f"world {w} at the reset")
         singles.append(env)
@@ -108,6 +109,23 @@ def test_each_world_walks_as_a_single_env(pedestrians: dict) -> None:
         for ped in episode.pedestrians:
             gap = math.dist(ped.start, episode.start_position[:2]) - ped.radius - venv.robot.radius
             assert gap >= 0.0, f"world {w}: a pedestrian starts on the robot"
+
+
+def test_worlds_of_several_scenes_walk_crowds_of_their_own_sizes() -> None:
+    # A density gives each scene its own count: the engine's rows are the largest's.
+    grid = np.zeros((40, 50), np.uint8)
+    grid[[0, -1], :] = grid[:, [0, -1]] = 1
+    scenes = [_house(), Scene.from_array(grid, 0.1)]
+    task = {"termination_config": {"max_steps": 60, "max_collisions": 50}}
+    pedestrians = {"density": 0.2, "radius": 0.2}
+    venv = VectorPointNavEnv(4, scene=scenes, seed=1, sensors=SCAN, task=task, pedestrians=pedestrians, pool_size=2)
+    obs, _ = venv.reset(seed=1)
+    # 0.2 a m² of free floor (0.01 m² a cell), halves up.
+    assert venv.crowd.count.tolist()[:2] == [math.floor(0.2 * s.floors[0].free.sum() * 0.01 + 0.5) for s in scenes]
+    assert venv.crowd.count[0] != venv.crowd.count[1]
+    singles = _singles(obs, scenes, pedestrians, task, [world_episode(venv, w) for w in range(4)])
+    seen = _play_alongside(venv, singles, random_actions(np.random.default_rng(2), (60, 4)))
+    assert seen["ends"] == 4 and seen["moved"] > 0
 
 
 def test_a_dataset_crowd_is_placed_as_recorded() -> None:
