@@ -322,17 +322,27 @@ def _same_metrics(got: dict, want: dict, where: str) -> None:
             assert got[key] == pytest.approx(value, rel=1e-9, abs=1e-9), f"{where}: {key}"
 
 
-def test_the_social_tracker_gives_each_episode_the_single_envs_metrics() -> None:
+DISCRETE = {"action_space": "discrete", "discrete_actions": {"forward_step": 0.5, "turn_angle": 0.5}}
+
+
+@pytest.mark.parametrize("discrete", [False, True])
+def test_the_social_tracker_gives_each_episode_the_single_envs_metrics(discrete: bool) -> None:
+    # With discrete actions both sample every control step of an action (STOP: none).
     scene, n = _house(), 4
-    task = {"termination_config": {"max_steps": 60, "max_collisions": 50}}
-    pedestrians = {"count": 6}
-    venv = VectorPointNavEnv(n, scene=scene, seed=8, sensors=SCAN, task=task, pedestrians=pedestrians, pool_size=2)
+    task = {"termination_config": {"max_steps": 60 if not discrete else 25, "max_collisions": 50}}
+    pedestrians, kwargs = {"count": 6}, (DISCRETE if discrete else {})
+    venv = VectorPointNavEnv(n, scene=scene, seed=8, sensors=SCAN, task=task, pedestrians=pedestrians, pool_size=2,
+                             **kwargs)
     tracker = SocialTracker(venv)
     obs, _ = venv.reset(seed=8)
     tracker.reset()
-    singles = _singles(obs, scene, pedestrians, task, [world_episode(venv, w) for w in range(n)])
-    actions = random_actions(np.random.default_rng(5), (60, n))
-    actions[..., 0] = np.abs(actions[..., 0])
+    singles = _singles(obs, scene, pedestrians, task, [world_episode(venv, w) for w in range(n)], **kwargs)
+    rng = np.random.default_rng(5)
+    if discrete:
+        actions = rng.choice(4, size=(60, n), p=[0.6, 0.15, 0.15, 0.1])
+    else:
+        actions = random_actions(rng, (60, n))
+        actions[..., 0] = np.abs(actions[..., 0])
     done = [False] * n
     for t, act in enumerate(actions):
         _, _, term, trunc, info = venv.step(act)
@@ -348,8 +358,6 @@ def test_the_social_tracker_gives_each_episode_the_single_envs_metrics() -> None
     assert all(done)
     with pytest.raises(ArgumentError, match="pedestrians"):
         SocialTracker(VectorPointNavEnv(1, scene=scene))
-    with pytest.raises(ArgumentError, match="discrete"):
-        SocialTracker(VectorPointNavEnv(1, scene=scene, pedestrians=pedestrians, action_space="discrete"))
 
 
 def test_the_social_tracker_follows_several_robots_as_the_multi_robot_env() -> None:

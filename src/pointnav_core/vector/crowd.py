@@ -149,6 +149,9 @@ class VectorCrowd:
         #: Whether each robot touched a pedestrian in the current env step (:meth:`begin`).
         self.touched = np.zeros(self.collisions.shape, dtype=np.bool_)
         self._present: NDArray[np.bool_] | None = None
+        #: Called after each control step with the robots' motion and the worlds that stepped
+        #: (:class:`~pointnav_core.vector.social.SocialTracker` records there).
+        self.listeners: list[Any] = []
         self._start = np.empty(len(self.world_scene), dtype=object)  # each world's CrowdStart
 
     @classmethod
@@ -286,12 +289,14 @@ class VectorCrowd:
         self.touched[:] = False
         self._present = present
 
-    def step(self, x: NDArray[np.float64], y: NDArray[np.float64], vx: NDArray[np.float64], vy: NDArray[np.float64],
-             dt: float, worlds: NDArray[np.bool_] | None = None) -> None:
+    def step(self, motion: Any, dt: float, worlds: NDArray[np.bool_] | None = None) -> None:
         """Move the pedestrians of ``worlds`` (a ``(W,)`` mask, default all) one control step
-        beside their robots at ``(x, y)`` (m, shape ``(W,)`` or ``(W, R)``) moving at
-        ``(vx, vy)`` (m/s), of which those present (:meth:`begin`) are in the world; the
-        robots touching a pedestrian after it are added to :attr:`touched`."""
+        beside their robots as ``motion`` (a :class:`~pointnav_core.vector.state.Motion`,
+        ``(W,)`` or ``(W, R)``) has them after theirs, of which those present (:meth:`begin`)
+        are in the world; the robots touching a pedestrian after it are added to
+        :attr:`touched`, and each of :attr:`listeners` is called with ``motion`` and the
+        worlds that stepped."""
+        x, y, vx, vy = motion.x, motion.y, motion.vx, motion.vy
         w, r, cfg, present = x.shape[0], len(self.robot_radius), self.config, self._present
         robots = np.stack([x.reshape(w, r), y.reshape(w, r), np.broadcast_to(self.robot_radius, (w, r))], -1)
         robot_vel = np.stack([vx.reshape(w, r), vy.reshape(w, r)], -1)
@@ -310,6 +315,8 @@ class VectorCrowd:
         if order is not None:  # back to the robots' order
             np.put_along_axis(contacts, order, contacts.copy(), 1)
         self.touched |= contacts & present & stepping[:, None]
+        for listener in self.listeners:
+            listener(motion, stepping)
 
     def finish(self, acting: NDArray[np.bool_] | None = None) -> NDArray[np.bool_]:
         """End an env step: the robots that touched a pedestrian in it, ``(W, R)``; those

@@ -178,7 +178,7 @@ class DiscretePlan:
             state = motion_where(xp, active, moved, state)
             contact = contact | (active & touched)
             if env.crowd is not None:  # the crowd walks each control step of the worlds still stepping
-                env.crowd.step(state.x, state.y, state.vx, state.vy, env.dt, active.reshape(active.shape[0], -1).any(-1))
+                env.crowd.step(state, env.dt, active.reshape(active.shape[0], -1).any(-1))
         stopped = None if self.stop is None else index == self.stop
         return state, contact, stopped
 

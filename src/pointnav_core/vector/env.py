@@ -425,7 +425,7 @@ class VectorPointNavEnv(PoolRefreshing, VectorEnv):
             moved, contact = self.drive(act, self.state)
             stopped = None
             if crowd is not None:
-                crowd.step(moved.x, moved.y, moved.vx, moved.vy, self.dt)
+                crowd.step(moved, self.dt)
         else:
             moved, contact, stopped = self._discrete.run(self, act)
         return self._account(moved, contact, stopped, None if crowd is None else crowd.finish()[:, 0])

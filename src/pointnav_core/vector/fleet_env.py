@@ -262,7 +262,7 @@ class VectorFleetEnv(VectorPointNavEnv):
             moved, contact = self.drive(self.arrays.xp.where(self._active[..., None], act, 0.0 * act), self.state)
             stopped = None
             if crowd is not None:
-                crowd.step(moved.x, moved.y, moved.vx, moved.vy, self.dt)
+                crowd.step(moved, self.dt)
         return self._account(moved, contact, stopped, None if crowd is None else crowd.finish(self._active))
 
     def drive(self, act: Any, state: Motion) -> tuple[Motion, Any]:

@@ -18,9 +18,10 @@ env's own :func:`~pointnav_core.task.social_metrics`, for the robots whose episo
 >>> sorted(ended), round(ended[0, 0]["psc"], 3) <= 1.0
 ([(0, 0), (1, 0)], True)
 
-It samples the robots and the pedestrians once per env step, as the single env does with
-continuous actions (with discrete ones the single env samples every control step of an
-action: the tracker refuses them).
+It samples the robots and the pedestrians after every control step the crowd walks (the
+engine's crowd calls it: :attr:`VectorCrowd.listeners <pointnav_core.vector.crowd.VectorCrowd.listeners>`),
+as the single env's track does: once per step with continuous actions, once per control
+step of a discrete action.
 """
 
 from __future__ import annotations
@@ -28,7 +29,6 @@ from __future__ import annotations
 import math
 from typing import Any
 
-import gymnasium as gym
 import numpy as np
 
 from pointnav_core.errors import ArgumentError
@@ -42,8 +42,8 @@ class SocialTracker:
     Parameters
     ----------
     env : VectorPointNavEnv
-        An engine with ``pedestrians`` and continuous actions, on numpy (one robot a world
-        or several).
+        An engine with ``pedestrians`` (one robot a world or several, continuous or
+        discrete actions).
 
     Call :meth:`reset` after the engine's ``reset()`` and :meth:`step` after each of its
     ``step()`` calls.
@@ -52,14 +52,10 @@ class SocialTracker:
     def __init__(self, env: Any) -> None:
         if getattr(env, "crowd", None) is None:
             raise ArgumentError("env must be a batched engine built with pedestrians={...}")
-        if isinstance(env.single_action_space, gym.spaces.Discrete):
-            raise ArgumentError("env takes discrete actions: the single env samples them per control step; "
-                                "the tracker samples per env step (continuous actions only)")
         self.env = env
         shape = np.shape(env.arrays.numpy(env.state.x))
         self._w, self._r = shape[0], (shape[1] if len(shape) > 1 else 1)
-        steps = int(np.max(env.arrays.numpy(np.asarray(env.max_steps))))
-        self._t_max = min(steps, getattr(env, "max_cycles", steps)) + 1
+        self._t_max = 64  # samples kept a world, doubled when an episode needs more
         self._robot = np.zeros((self._w, self._t_max, self._r, 2))
         self._heading = np.zeros((self._w, self._t_max, self._r))
         self._peds = np.zeros((self._w, self._t_max, 0, 2))  # widened as crowds are placed
@@ -67,6 +63,7 @@ class SocialTracker:
         radii = [s.radius for s in getattr(env, "robots", [env.robot])]
         speeds = [s.max_linear_velocity for s in getattr(env, "robots", [env.robot])]
         self._radius, self._speed = radii, speeds
+        env.crowd.listeners.append(self._control_step)
 
     def reset(self) -> None:
         """Start recording every world's episode (after the engine's ``reset()``)."""
@@ -78,24 +75,34 @@ class SocialTracker:
         single env's ``info["social"]`` for the same episode."""
         a = self.env.arrays
         restarted = np.asarray(a.numpy(info["autoreset"])).reshape(self._w, -1).any(-1)
-        self._record(np.flatnonzero(restarted), start=True)
-        self._record(np.flatnonzero(~restarted), start=False)
+        self._record(np.flatnonzero(restarted), start=True)  # (their samples of this step were the old episode's)
         ended = (np.asarray(a.numpy(terminated)) | np.asarray(a.numpy(truncated))).reshape(self._w, self._r)
         out = {}
         for w, r in zip(*np.nonzero(ended)):
             out[int(w), int(r)] = self._metrics(int(w), int(r), info)
         return out
 
-    def _record(self, worlds: np.ndarray, start: bool) -> None:
-        """Sample the robots and the pedestrians of ``worlds`` now (``start``: as their first sample)."""
+    def _control_step(self, motion: Any, stepping: np.ndarray) -> None:
+        """The crowd walked a control step in the ``stepping`` worlds, beside robots as ``motion``."""
+        self._record(np.flatnonzero(stepping), start=False, motion=motion)
+
+    def _record(self, worlds: np.ndarray, start: bool, motion: Any = None) -> None:
+        """Sample the robots (``motion``, default the engine's committed state) and the
+        pedestrians of ``worlds`` now (``start``: as their first sample)."""
         if not len(worlds):
             return
-        a, st, crowd = self.env.arrays, self.env.state, self.env.crowd
+        a, crowd = self.env.arrays, self.env.crowd
+        st = self.env.state if motion is None else motion
         if start:
             self._t[worlds] = 0
         else:
-            self._t[worlds] = np.minimum(self._t[worlds] + 1, self._t_max - 1)
+            self._t[worlds] += 1
         t = self._t[worlds]
+        if t.max() >= self._t_max:  # a longer episode than any so far: twice the room
+            self._t_max *= 2
+            self._robot, self._heading, self._peds = (
+                np.concatenate([v, np.zeros_like(v)], axis=1) for v in (self._robot, self._heading, self._peds)
+            )
         p = crowd.positions.shape[1]
         if p > self._peds.shape[2]:  # the crowds were placed (or widened) since
             wider = np.zeros(self._peds.shape[:2] + (p, 2))
@@ -128,3 +135,4 @@ class SocialTracker:
             pedestrian_radii=crowd.radius[w, :k], success=bool(at("success")),
             geodesic_dist=geodesic if math.isfinite(geodesic) else math.inf, max_speed=self._speed[r], goal=goal,
         )
+
