@@ -138,15 +138,12 @@ class CrowdTrack:
 
     def metrics(self, env: Any, info: Mapping[str, Any]) -> dict[str, float | None]:
         """The episode's social metrics, from what was recorded and the task's ``info``."""
-        from pointnav_core.task import social_metrics
+        from pointnav_core.task import recorded_social_metrics
 
-        robot = np.array(self.robot)
-        if len(robot) < 2:  # an episode that ended before any control step ran
-            robot, self.heading, self.pedestrians = np.repeat(robot, 2, axis=0), self.heading * 2, self.pedestrians * 2
         spec = env.robots[self.idn]
         task = env.tasks[self.idn] if hasattr(env, "tasks") else env.task
-        return social_metrics(
-            robot, np.array(self.heading), np.array(self.pedestrians).reshape(len(robot), env.crowd.n, 2),
+        return recorded_social_metrics(
+            self.robot, self.heading, np.array(self.pedestrians).reshape(len(self.robot), env.crowd.n, 2),
             dt=1.0 / env.action_frequency, robot_radius=spec.radius, pedestrian_radii=env.crowd.radius,
             success=bool(info["success"]), geodesic_dist=float(info["geodesic_dist"]),
             max_speed=spec.max_linear_velocity, goal=task.get_goal_pos()[:2],

@@ -15,7 +15,11 @@ from pointnav_core.task.rewards import (
     PotentialReward,
     RewardFunction,
 )
-from pointnav_core.task.social import SOCIAL_METRIC_KEYS, social_metrics
+from pointnav_core.task.social import (
+    SOCIAL_METRIC_KEYS,
+    recorded_social_metrics,
+    social_metrics,
+)
 from pointnav_core.task.task import PointNavigationTask
 from pointnav_core.task.task_env import TaskEnv
 from pointnav_core.task.terminations import (
@@ -46,6 +50,7 @@ __all__ = [
     "TaskStateError",
     "TerminationCondition",
     "Timeout",
+    "recorded_social_metrics",
     "social_metrics",
     "soft_spl",
     "spl",

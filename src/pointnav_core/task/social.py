@@ -55,6 +55,7 @@ __all__ = [
     "personal_space_steps",
     "personal_space_time",
     "psc",
+    "recorded_social_metrics",
     "social_metrics",
     "stl",
     "time_to_collision",
@@ -482,3 +483,15 @@ def social_metrics(
         pedestrian_collisions(robot, peds, robot_radius=robot_radius, pedestrian_radii=pedestrian_radii)
     )
     return {key: out[key] for key in SOCIAL_METRIC_KEYS}
+
+
+def recorded_social_metrics(robot_positions: Any, headings: Any, pedestrian_positions: Any,
+                            **kwargs: Any) -> dict[str, float | None]:
+    """:func:`social_metrics` of an episode recorded from its start (``kwargs`` as there): one
+    that ended before any control step holds its start alone, which counts twice, a step of
+    standing still (the envs' and the batched engine's trackers)."""
+    robot, heading = np.asarray(robot_positions, dtype=np.float64), np.asarray(headings, dtype=np.float64)
+    peds = np.asarray(pedestrian_positions, dtype=np.float64)
+    if len(robot) < 2:
+        robot, heading, peds = (np.repeat(v, 2, axis=0) for v in (robot, heading, peds))
+    return social_metrics(robot, heading, peds, **kwargs)

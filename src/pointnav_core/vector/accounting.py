@@ -61,7 +61,8 @@ class TaskStep(NamedTuple):
     reward: Any  #: their sum, as the task adds them
 
 
-def task_step(engine: Any, moved: Motion, contact: Any, stopped: Any, acting: Any = None) -> TaskStep:
+def task_step(engine: Any, moved: Motion, contact: Any, stopped: Any, acting: Any = None,
+              pedestrian: Any = None) -> TaskStep:
     """The task's step over the robots' moves from the engine's committed state.
 
     Parameters
@@ -77,6 +78,9 @@ def task_step(engine: Any, moved: Motion, contact: Any, stopped: Any, acting: An
         Robots that called STOP (None without the STOP action).
     acting : bool array, optional
         The robots still acting (the fleet); None: every robot acts (the one-robot engine).
+    pedestrian : bool array, optional
+        The robots that touched a pedestrian this step (with a crowd): with the crowd's
+        ``end_on_collision``, their episodes end (``PedestrianCollision``).
 
     Returns
     -------
@@ -113,6 +117,8 @@ def task_step(engine: Any, moved: Motion, contact: Any, stopped: Any, acting: An
     terminated = MaxCollision.value(collisions, engine.max_collisions) | fell | success
     if stopped is not None:
         terminated = terminated | stopped
+    if pedestrian is not None and engine.crowd.config.end_on_collision:  # PedestrianCollision
+        terminated = terminated | pedestrian
     r_pot = PotentialReward.value(engine.r_potential, st.potential, pot)
     if acting is not None:
         terminated = acting & terminated

@@ -141,7 +141,7 @@ class VectorCrowd:
         self._pool: Any = None
         self._starts: list[CrowdStart] = []
         self._stack: dict[str, Any] | None = None  # the placed crowds as arrays (_stacked)
-        self._slot_of: dict[int, int] = {}
+        self._slot_of = np.zeros(0, np.int64)
         self._recorded: dict[int, Any] = {}
         self._resize(len(self.world_scene), 0, 1)
         self.count = np.zeros(len(self.world_scene), dtype=np.int64)
@@ -188,18 +188,21 @@ class VectorCrowd:
         """Start the crowds of ``worlds`` for their pool ``episodes`` (placed at their first start)."""
         if pool is not self._pool:  # a new pool (or seed): its episodes' crowds are new ones
             self._pool, self._generation = pool, self._generation + 1
-            self._starts, self._slot_of, self._stack = [], {}, None
-        new = {e: w for w, e in zip(worlds.tolist(), episodes.tolist()) if e not in self._slot_of}
-        if new:
+            self._starts, self._stack = [], None
+            self._slot_of = np.full(len(pool), -1, np.int64)  # each pool episode's slot, once placed
+        missing = self._slot_of[episodes] < 0
+        if missing.any():
             from tqdm.auto import tqdm
 
+            new, first = np.unique(episodes[missing], return_index=True)
+            owners = worlds[missing][first]  # (an episode is of its world's scene)
             # None: tqdm's own choice (a terminal only) from PROGRESS_CROWDS crowds on.
             show = self.progress
             disable = (None if len(new) >= PROGRESS_CROWDS else True) if show is None else not show
-            for e, w in tqdm(new.items(), desc="placing crowds", unit="crowd", disable=disable):
-                self._slot_of[e] = self._place(pool, e, int(self.world_scene[w]))  # (of its world's scene)
-        slots = np.array([self._slot_of[e] for e in episodes.tolist()], dtype=np.int64)
-        self._gather(worlds, slots)
+            for e, w in tqdm(zip(new.tolist(), owners.tolist()), total=len(new), desc="placing crowds", unit="crowd",
+                             disable=disable):
+                self._slot_of[e] = self._place(pool, e, int(self.world_scene[w]))
+        self._gather(worlds, self._slot_of[episodes])
 
     def _place(self, pool: Any, e: int, s: int) -> int:
         """Place episode ``e``'s crowd with scene ``s``'s single-env crowd, beside its robots'
@@ -305,13 +308,13 @@ class VectorCrowd:
         if not present.all():  # the kernel takes the robots present first (the multi-robot env's list)
             order = np.argsort(~present, axis=1, kind="stable")
             robots, robot_vel = np.take_along_axis(robots, order[..., None], 1), np.take_along_axis(robot_vel, order[..., None], 1)
-        seen = present.sum(1) if cfg.sees_robots else np.zeros(w, np.int64)
+        seen = present.sum(1, dtype=np.int64) if cfg.sees_robots else np.zeros(w, np.int64)
         contacts = np.zeros((w, r), dtype=np.bool_)
         stepping = np.ones(w, np.bool_) if worlds is None else np.asarray(worlds).reshape(w)
         if cfg.behaviour == "static" or not self.radius.shape[1]:
             self._touching(robots, contacts)
         else:
-            self._orca(robots, robot_vel, seen.astype(np.int64), float(dt), contacts, stepping)
+            self._orca(robots, robot_vel, seen, float(dt), contacts, stepping)
         if order is not None:  # back to the robots' order
             np.put_along_axis(contacts, order, contacts.copy(), 1)
         self.touched |= contacts & present & stepping[:, None]

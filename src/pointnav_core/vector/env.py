@@ -443,10 +443,8 @@ class VectorPointNavEnv(PoolRefreshing, VectorEnv):
         then the commit and the next-step autoresets. ``stopped``: the worlds that called STOP;
         ``touched``: those whose robot touched a pedestrian."""
         a, xp = self.arrays, self.arrays.xp
-        t = task_step(self, moved, contact, stopped)  # PointNavigationTask.step's accounting
+        t = task_step(self, moved, contact, stopped, pedestrian=touched)  # PointNavigationTask.step's accounting
         reward, terminated, truncated, success = t.reward, t.terminated, t.truncated, t.success
-        if touched is not None and self.crowd.config.end_on_collision:  # PedestrianCollision
-            terminated = terminated | touched
         r_pot, r_col, r_goal, r_custom = t.r_pot, t.r_col, t.r_goal, t.r_custom
         # Commit, then reset the worlds that ended on the previous step (next-step autoreset).
         self.state = self.state.moved(moved, path_length=t.path, goal_distance=t.dist, potential=t.pot, steps=t.steps,

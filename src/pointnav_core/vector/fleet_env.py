@@ -328,11 +328,9 @@ class VectorFleetEnv(VectorPointNavEnv):
         a, xp, st = self.arrays, self.arrays.xp, self.state
         acting, present = self._active, self._present
         zero = xp.zeros_like(st.x)
-        t = task_step(self, moved, contact, stopped, acting)  # each acting robot's task step
+        t = task_step(self, moved, contact, stopped, acting, touched)  # each acting robot's task step
         cycles = self._cycles + 1
         reward, terminated, success, fell = t.reward, t.terminated, t.success, t.fell
-        if touched is not None and self.crowd.config.end_on_collision:  # PedestrianCollision
-            terminated = terminated | (touched & acting)
         truncated = t.truncated | (acting & (cycles >= self.max_cycles)[:, None])
         r_pot, r_col, r_goal = t.r_pot, t.r_col, t.r_goal
         ended = terminated | truncated

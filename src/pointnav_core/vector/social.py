@@ -115,14 +115,10 @@ class SocialTracker:
 
     def _metrics(self, w: int, r: int, info: dict[str, Any]) -> dict[str, Any]:
         """Robot ``r`` of world ``w``'s social metrics, from its recording and ``info``."""
-        from pointnav_core.task import social_metrics
+        from pointnav_core.task import recorded_social_metrics
 
         a, env, crowd = self.env.arrays, self.env, self.env.crowd
         n, k = int(self._t[w]) + 1, int(crowd.count[w])
-        robot, heading = self._robot[w, :n, r], self._heading[w, :n, r]
-        peds = self._peds[w, :n, :k]
-        if n < 2:  # an episode that ended before any control step ran (the single env's rule)
-            robot, heading, peds = np.repeat(robot, 2, axis=0), np.repeat(heading, 2), np.repeat(peds, 2, axis=0)
 
         def at(key: str) -> Any:
             return np.asarray(a.numpy(info[key])).reshape(self._w, self._r)[w, r]
@@ -130,8 +126,8 @@ class SocialTracker:
         st = env.state
         goal = [float(np.asarray(a.numpy(v)).reshape(self._w, self._r)[w, r]) for v in (st.goal_x, st.goal_y)]
         geodesic = float(at("geodesic_dist"))
-        return social_metrics(
-            robot, heading, peds, dt=1.0 / env.action_frequency, robot_radius=self._radius[r],
+        return recorded_social_metrics(
+            self._robot[w, :n, r], self._heading[w, :n, r], self._peds[w, :n, :k], dt=1.0 / env.action_frequency, robot_radius=self._radius[r],
             pedestrian_radii=crowd.radius[w, :k], success=bool(at("success")),
             geodesic_dist=geodesic if math.isfinite(geodesic) else math.inf, max_speed=self._speed[r], goal=goal,
         )
