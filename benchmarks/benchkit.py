@@ -28,7 +28,7 @@ from pathlib import Path
 from typing import Any
 
 __all__ = [
-    "MOVINGAI_DIR", "Measurement", "machine", "measure", "movingai_maps", "start_children", "steps_per_second",
+    "MOVINGAI_DIR", "VMAS_LIDAR_RANGE", "Measurement", "machine", "measure", "movingai_maps", "start_children", "steps_per_second",
     "vmas_navigation",
 ]
 
@@ -263,6 +263,10 @@ def _vmas_crowd(pedestrians: int) -> Any:
             return torch.cat([agent.state.pos, agent.state.vel, agent.state.pos - agent.goal.state.pos], dim=-1)
 
     return Crowd()
+
+
+#: VMAS navigation's lidar range (m): its scenario's ``lidar_range`` default.
+VMAS_LIDAR_RANGE = 0.35
 
 
 def vmas_navigation(num_envs: int, n_agents: int, device: str, pedestrians: int = 0) -> Callable[[], None] | None:
