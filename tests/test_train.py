@@ -22,8 +22,8 @@ from map_data import PILLAR_ROOM
 
 from pointnav_core.cli import main
 from pointnav_core.envs.config import EnvConfig
-from pointnav_core.evaluation.report import read_results
 from pointnav_core.evaluation.policy_specs import make_policy
+from pointnav_core.evaluation.report import read_results
 from pointnav_core.evaluation.run import evaluate
 from pointnav_core.policies.checkpoint import load_checkpoint, save_checkpoint
 from pointnav_core.policies.network import ActorCritic, RunningNorm
@@ -304,8 +304,9 @@ def test_evaluate_plays_a_checkpoint_with_its_own_config(scan_run, room) -> None
         evaluate(episodes, best, scenes_root=str(room), max_steps=50)
 
 
-@pytest.mark.parametrize(("name", "memory"), [("train_scan.yaml", 0), ("train_scan_lstm.yaml", 128)])
-def test_the_example_config_reads_and_fits_the_shipped_validation_set(monkeypatch, name, memory) -> None:
+@pytest.mark.parametrize(("name", "memory", "scan"), [("train_scan.yaml", 0, {"n_rays": 64, "max_range": 12.0}),
+                                                      ("train_scan_lstm.yaml", 128, {"n_rays": 64})])
+def test_the_example_config_reads_and_fits_the_shipped_validation_set(monkeypatch, name, memory, scan) -> None:
     from pathlib import Path
 
     from pointnav_core.training.config import TrainConfig
@@ -314,6 +315,6 @@ def test_the_example_config_reads_and_fits_the_shipped_validation_set(monkeypatc
     root = Path(__file__).resolve().parents[1]
     monkeypatch.chdir(root)  # its paths are relative to the repository's root
     config = TrainConfig.load(root / "examples" / name)
-    assert config.policy_config().sensors == {"scan": {"n_rays": 64}} and config.path_range == (1.0, 30.0)
+    assert config.policy_config().sensors == {"scan": scan} and config.path_range == (1.0, 30.0)
     assert config.ppo.memory == memory
     assert len(heldout_episodes(config)) == 60  # every 5th of the 300, the robot radius checked

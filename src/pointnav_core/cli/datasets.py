@@ -33,6 +33,7 @@ from collections.abc import Callable
 from typing import Any
 
 from pointnav_core.errors import ArgumentError
+from pointnav_core.evaluation.policy_specs import make_policy, policy_file
 from pointnav_core.policies.checkpoint_policy import ACTIONS
 
 __all__ = ["add_commands", "reporting"]
@@ -135,8 +136,8 @@ def _run_settings(args: argparse.Namespace, scenes_dir: str) -> dict[str, Any]:
         "limit": args.limit, "stride": args.stride,
         "env_config": None if args.config is None else args.config.to_dict(),
     }
-    if args.policy.endswith((".zip", ".pt")):
-        settings["policy_sha256"] = _sha256(args.policy)
+    if (file := policy_file(args.policy)) is not None:
+        settings["policy_sha256"] = _sha256(file)
     return settings
 
 
@@ -225,7 +226,6 @@ def _eval(args: argparse.Namespace) -> int:
     from pointnav_core.evaluation.config import check_robot_radius
     from pointnav_core.evaluation.log import ResultsLog
     from pointnav_core.evaluation.report import plot_results, summary_path
-    from pointnav_core.evaluation.policy_specs import make_policy
     from pointnav_core.evaluation.run import check_scene_ids, evaluate, select_episodes
     from pointnav_core.utils.outputs import check_output
 
@@ -234,7 +234,7 @@ def _eval(args: argparse.Namespace) -> int:
     args.limit, args.stride = _count("--limit", args.limit), _count("--stride", args.stride)
     factory = make_policy(args.policy, args.sb3_algo, args.trust_policy_file, args.actions)
     _env_config(args, factory)
-    inputs = [args.dataset] + ([args.policy] if args.policy.endswith((".zip", ".pt")) else [])
+    inputs = [args.dataset] + ([file] if (file := policy_file(args.policy)) is not None else [])
     inputs += [args.env_config] if args.env_config is not None else []
     results_path = check_output("--results", args.results or _default_output(args.dataset, ".jsonl"), inputs)
     plot_path = check_output("--plot", args.plot or _default_output(args.dataset, ".png"), [*inputs, results_path])
@@ -435,8 +435,8 @@ def _add_eval(sub: Any, positive_int: Callable[[str], int]) -> None:
     ev.add_argument("--dataset", required=True, metavar="FILE")
     ev.add_argument(
         "--policy", default="oracle",
-        help="oracle, MODULE:CALLABLE, a checkpoint .pt of pointnav train (played with its own env config) "
-        "or a Stable-Baselines3 .zip"
+        help="oracle, MODULE:CALLABLE, a checkpoint .pt of pointnav train (played with its own env config), "
+        "baseline:scan-ppo (the shipped one) or a Stable-Baselines3 .zip"
     )
     ev.add_argument(
         "--sb3-algo", default="PPO", help="algorithm class of an SB3 .zip (default PPO)"

@@ -12,12 +12,12 @@ from typing import Any
 from pointnav_core.errors import ArgumentError
 from pointnav_core.policies.spaces import check_spaces
 
-__all__ = ["BUILT_IN", "POLICY_FORMS", "Policy", "PolicyFactory", "make_policy"]
+__all__ = ["BUILT_IN", "POLICY_FORMS", "Policy", "PolicyFactory", "make_policy", "policy_file"]
 
 #: The accepted forms of a policy spec, for messages.
 POLICY_FORMS = (
     "'oracle', 'orca_robot', 'dwa', MODULE:CALLABLE (a function env -> (observation -> action)), the path to "
-    "a checkpoint .pt (pointnav train's) or the path to a Stable-Baselines3 .zip"
+    "a checkpoint .pt (pointnav train's), baseline:NAME (a shipped checkpoint) or the path to a Stable-Baselines3 .zip"
 )
 #: The suffix of a checkpoint (pointnav_core.policies.checkpoint.CHECKPOINT_SUFFIX, which
 #: imports torch).
@@ -96,6 +96,17 @@ class _SB3Policy:
         return lambda obs: model.predict(obs, deterministic=True)[0]
 
 
+def policy_file(spec: str) -> str | None:
+    """The file a policy spec plays (a checkpoint ``.pt``, a shipped baseline's, an SB3
+    ``.zip``), or None for a built-in policy or ``MODULE:CALLABLE``; ValueError for an
+    unknown baseline."""
+    from pointnav_core.policies.baselines import PREFIX, baseline_path
+
+    if spec.startswith(PREFIX):
+        return baseline_path(spec[len(PREFIX):])
+    return spec if spec.endswith((CHECKPOINT_SUFFIX, ".zip")) else None
+
+
 def make_policy(
     spec: str, sb3_algo: str = "PPO", trust_policy_file: bool = False, actions: str | None = None
 ) -> PolicyFactory:
@@ -117,18 +128,19 @@ def make_policy(
     """
     if not isinstance(spec, str) or not spec:
         raise ArgumentError(f"policy must be {POLICY_FORMS}, got {spec!r}")
-    if actions is not None and not spec.endswith(CHECKPOINT_SUFFIX):
+    file = policy_file(spec)
+    if actions is not None and not (file or "").endswith(CHECKPOINT_SUFFIX):
         raise ArgumentError(f"actions ({actions!r}) sets how a checkpoint .pt acts; policy {spec!r} is not one")
     if spec in BUILT_IN:
         return BUILT_IN[spec]
-    if spec.endswith(CHECKPOINT_SUFFIX):
-        if not os.path.isfile(spec):
+    if file is not None and file.endswith(CHECKPOINT_SUFFIX):
+        if not os.path.isfile(file):
             raise ArgumentError(f"policy {spec!r}: no such checkpoint file")
         try:
             from pointnav_core.policies.checkpoint_policy import CheckpointPolicy
         except ImportError:
             raise ArgumentError(f"policy {spec!r}: a checkpoint needs torch (pip install 'pointnav-core[vector]')") from None
-        return CheckpointPolicy(spec, actions)
+        return CheckpointPolicy(file, actions)
     if spec.endswith(".zip"):
         if not os.path.isfile(spec):
             raise ArgumentError(f"policy {spec!r}: no such SB3 .zip file")

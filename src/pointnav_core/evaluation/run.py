@@ -25,6 +25,8 @@ Policies (``policy`` argument, or ``pointnav eval --policy``):
   episode's seed (:mod:`pointnav_core.policies.checkpoint_policy`; ``pointnav eval
   --actions`` overrides it), in envs built from the env config it carries, unless
   ``env_config`` is given. Loading one runs no code, so it needs no trust flag.
+- ``"baseline:NAME"``: a checkpoint shipped with the package
+  (:mod:`pointnav_core.policies.baselines`; ``baseline:scan-ppo``), played as above.
 
 ``limit`` and ``stride`` (``--limit N``, ``--stride K``) play a subset: every ``K``-th
 episode of the dataset from the first, then the first ``N`` of those
