@@ -1,9 +1,10 @@
 """The shipped baseline: ``pointnav eval --policy baseline:scan-ppo``.
 
 The checkpoint ships in the package (``pointnav_core/policies/baselines``); these tests
-hold that it loads by name, carries the env config of its recipe (``examples/train_scan.yaml``),
-stays small, and that ``pointnav eval`` plays it as the file itself and records that file. Its figures on the full validation set are
-the README's, measured by the command given there (minutes, not a unit test).
+hold that it loads by name, carries the env config of its recipe
+(``examples/train_scan.yaml``), stays small, and that ``pointnav eval`` plays it as it plays
+the file itself and records that file. Its figures on the full validation set are the
+README's, measured by the command given there (minutes, not a unit test).
 """
 
 from __future__ import annotations

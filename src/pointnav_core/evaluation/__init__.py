@@ -2,13 +2,13 @@
 plays from a saved config, per-episode results and their summary.
 """
 
+from pointnav_core.evaluation.policy_specs import make_policy
 from pointnav_core.evaluation.report import (
     EpisodeResult,
     read_results,
     summarize,
     write_results,
 )
-from pointnav_core.evaluation.policy_specs import make_policy
 from pointnav_core.evaluation.run import evaluate
 
 __all__ = [

@@ -71,7 +71,6 @@ from pointnav_core.evaluation.config import (
     episode_config,
 )
 from pointnav_core.evaluation.policy_specs import (
-    POLICY_FORMS,
     PolicyFactory,
     make_policy,
 )

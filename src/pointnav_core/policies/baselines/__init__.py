@@ -2,7 +2,7 @@
 
 Each is a checkpoint of ``pointnav train`` (a ``.pt`` of plain data, played with the env
 config it carries). Their figures, and the command and time that trained them, are in the
-README's "Baselines".
+README's "Training" section.
 
 ======================  =============================================================
 ``scan-ppo``            goal in polar form and a 64-ray scan to 12 m, Habitat's
