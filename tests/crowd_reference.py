@@ -58,30 +58,20 @@ def spawn_is_clear(grid: np.ndarray, env: PointNavEnv) -> None:
     assert ((crowd.radius >= lo) & (crowd.radius <= hi)).all()
 
 
-def world_episode(venv: Any, w: int) -> PointNavEpisode:
-    """World ``w`` of a batched engine with pedestrians: its current episode and crowd as a
-    dataset episode, which a single env's reset plays exactly."""
+def world_episode(venv: Any, w: int, k: int | None = None) -> PointNavEpisode:
+    """World ``w`` of a batched engine with pedestrians (robot ``k`` of it, with several
+    robots a world): its current episode as a dataset episode, carrying the world's crowd
+    (for the first robot only, whose recorded crowd the multi-robot env places), which a
+    single env's (a multi-robot env's) reset plays exactly."""
     st = venv.state
-    yaw = float(st.yaw[w])
+    at = (w,) if k is None else (w, k)
+    yaw = float(st.yaw[at])
     return PointNavEpisode(
-        episode_id=str(w), scene_id="here", floor=0, start_position=(float(st.x[w]), float(st.y[w]), 0.0),
+        episode_id=str(w) if k is None else f"{w}_{k}", scene_id="here", floor=0,
+        start_position=(float(st.x[at]), float(st.y[at]), 0.0),
         start_rotation=(0.0, 0.0, math.sin(yaw / 2), math.cos(yaw / 2)),
-        goal_position=(float(st.goal_x[w]), float(st.goal_y[w]), 0.0), goal_radius=None,
-        geodesic_distance=float(st.start_distance[w]), robot_radius=venv.robot.radius,
-        pedestrians=venv.crowd.record(w),
-    )
-
-
-def fleet_episode(venv: Any, w: int, k: int) -> PointNavEpisode:
-    """Robot ``k`` of world ``w`` of a batched engine with several robots a world: its
-    episode as a dataset episode, the first robot's carrying the world's crowd (the
-    multi-robot env places the first robot's recorded crowd)."""
-    st = venv.state
-    yaw = float(st.yaw[w, k])
-    return PointNavEpisode(
-        episode_id=f"{w}_{k}", scene_id="here", floor=0, start_position=(float(st.x[w, k]), float(st.y[w, k]), 0.0),
-        start_rotation=(0.0, 0.0, math.sin(yaw / 2), math.cos(yaw / 2)),
-        goal_position=(float(st.goal_x[w, k]), float(st.goal_y[w, k]), 0.0), goal_radius=None,
-        geodesic_distance=float(st.start_distance[w, k]), robot_radius=venv.robots[k].radius,
-        pedestrians=venv.crowd.record(w) if k == 0 else None,
+        goal_position=(float(st.goal_x[at]), float(st.goal_y[at]), 0.0), goal_radius=None,
+        geodesic_distance=float(st.start_distance[at]),
+        robot_radius=(venv.robot if k is None else venv.robots[k]).radius,
+        pedestrians=venv.crowd.record(w) if not k else None,
     )

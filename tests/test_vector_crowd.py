@@ -13,7 +13,7 @@ import math
 
 import numpy as np
 import pytest
-from crowd_reference import fleet_episode, world_episode
+from crowd_reference import world_episode
 from vector_reference import random_actions
 
 from pointnav_core.datasets import presets
@@ -186,7 +186,7 @@ def _fleet_refs(venv: VectorPointNavEnv, obs: np.ndarray, scene: Scene, task: di
     for w in range(venv.num_envs):
         env = parallel_env(scene=scene, n_robots=venv.n_robots, task=task, backend="kinematic", sensors=sensors,
                            pedestrians=pedestrians, **kwargs)
-        sob, _ = env.reset(seed=w, options={"episodes": [fleet_episode(venv, w, k) for k in range(venv.n_robots)]})
+        sob, _ = env.reset(seed=w, options={"episodes": [world_episode(venv, w, k) for k in range(venv.n_robots)]})
         np.testing.assert_allclose(obs[w], [sob[a] for a in env.possible_agents], atol=1e-4, err_msg=f"world {w}")
         refs.append(env)
     return refs

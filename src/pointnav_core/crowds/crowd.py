@@ -48,7 +48,7 @@ from pointnav_core.crowds.config import CrowdView, PedestrianConfig
 from pointnav_core.crowds.orca import orca_step
 from pointnav_core.crowds.record import SEED_LIMIT, PedestrianRecord
 from pointnav_core.crowds.social_force import SocialForceParams, social_force_step
-from pointnav_core.crowds.walks import Walk, plan_walk
+from pointnav_core.crowds.walks import Walk, padded, plan_walk
 from pointnav_core.errors import ArgumentError, SamplingError
 from pointnav_core.utils.compiled import kernel
 
@@ -285,11 +285,9 @@ class Crowd:
         rows = list(rows)
         longest = max([len(p) for p in paths], default=1)
         if longest > self._paths.shape[1]:
-            pad = np.repeat(self._paths[:, -1:], longest - self._paths.shape[1], axis=1)
-            self._paths = np.concatenate([self._paths, pad], axis=1)
+            self._paths = padded(self._paths, longest)
         for i, path in zip(rows, paths):
-            self._paths[i, : len(path)] = path
-            self._paths[i, len(path):] = path[-1]
+            self._paths[i] = padded(path, self._paths.shape[1])
             self._last[i] = len(path) - 1
             self._next[i] = min(1, len(path) - 1)
 

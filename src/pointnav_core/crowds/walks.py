@@ -16,10 +16,17 @@ from numpy.typing import NDArray
 
 from pointnav_core.floor.draw import nearest_usable
 
-__all__ = ["MIN_GOAL_DISTANCE", "Walk", "plan_walk"]
+__all__ = ["MIN_GOAL_DISTANCE", "Walk", "padded", "plan_walk"]
 
 #: Goals nearer than this (m) to the pedestrian are drawn again (up to 10 times).
 MIN_GOAL_DISTANCE = 1.0
+
+
+def padded(points: NDArray[np.float64], length: int) -> NDArray[np.float64]:
+    """Paths ``(..., N, 2)`` as the crowds store them, ``(..., length, 2)`` with ``length >= N``:
+    each padded with its last point, so a walker past its end stands on it."""
+    n = points.shape[-2]
+    return np.concatenate([points, np.repeat(points[..., -1:, :], length - n, axis=-2)], axis=-2)
 
 
 class Walk:

@@ -40,7 +40,7 @@ from numpy.typing import NDArray
 
 from pointnav_core.crowds.config import PedestrianConfig
 from pointnav_core.crowds.crowd import GOAL_REACHED, KERNEL, Crowd, CrowdStart
-from pointnav_core.crowds.walks import Walk, plan_walk
+from pointnav_core.crowds.walks import Walk, padded, plan_walk
 from pointnav_core.errors import ArgumentError
 from pointnav_core.utils.compiled import kernel
 
@@ -241,8 +241,7 @@ class VectorCrowd:
             t["count"][k], t["start"][k] = m, st  # its CrowdStart: its walks and draws
             for name, _ in self._STACKED:
                 t[name][k, :m] = getattr(st, name)
-            t["paths"][k, :m, : st.paths.shape[1]] = st.paths
-            t["paths"][k, :m, st.paths.shape[1]:] = st.paths[:, -1:]
+            t["paths"][k, :m] = padded(st.paths, t["paths"].shape[2])
         t["done"] = len(starts)
         return t
 
@@ -255,9 +254,7 @@ class VectorCrowd:
                            (self.radius, "radius"), (self.speed, "speed"), (self._next, "next"), (self._last, "last"),
                            (self._index, "goal_index")):
             mine[worlds, :p] = t[name][slots]
-        paths = t["paths"][slots]
-        self._paths[worlds, :p, :length] = paths
-        self._paths[worlds, :p, length:] = paths[:, :, -1:]
+        self._paths[worlds, :p] = padded(t["paths"][slots], self._paths.shape[2])
         self.velocities[worlds] = 0.0
         self.count[worlds] = t["count"][slots]
         self._start[worlds] = t["start"][slots]  # kept past a new pool's placing
@@ -276,8 +273,7 @@ class VectorCrowd:
                self._last, self._index, self._rngs)
         for dst, src in zip(new, old):
             dst[:, :p0] = src
-        self._paths[:, :p0, :l0] = old[-1]
-        self._paths[:, :p0, l0:] = old[-1][:, :, -1:]
+        self._paths[:, :p0] = padded(old[-1], self._paths.shape[2])
 
     def record(self, world: int) -> tuple[Any, ...]:
         """World ``world``'s crowd as its episode placed it: the records a dataset episode
@@ -369,8 +365,7 @@ class VectorCrowd:
         points = planned.points
         if len(points) > self._paths.shape[2]:
             self._widen(self._paths.shape[1], max(len(points), 2 * self._paths.shape[2]))
-        self._paths[w, i, : len(points)] = points
-        self._paths[w, i, len(points):] = points[-1]
+        self._paths[w, i] = padded(points, self._paths.shape[2])
         self._last[w, i], self._next[w, i] = len(points) - 1, min(1, len(points) - 1)
 
     def discs(self) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64], NDArray[np.int64]]:

@@ -137,6 +137,7 @@ class VectorPointNavEnv(PoolRefreshing, VectorEnv):
         multi-robot env) walks beside the same robots (:mod:`pointnav_core.vector.crowd`);
         the scan sees it, the local map marks it (code 4), and ``info`` counts
         ``pedestrian_collisions`` (with ``end_on_collision``, a touch ends the episode).
+
     Notes
     -----
     ``step`` takes actions of shape ``(num_envs, 2)`` (or ``(num_envs, 1, 2)``) in
@@ -218,7 +219,6 @@ class VectorPointNavEnv(PoolRefreshing, VectorEnv):
             n_robots = kwargs.get("n_robots", args[1] if len(args) > 1 else 1)
             if isinstance(n_robots, (int, np.integer)) and not isinstance(n_robots, bool) and n_robots > 1:
                 from pointnav_core.vector.fleet_env import VectorFleetEnv
-
 
                 return super().__new__(VectorFleetEnv)
             for name in ("max_cycles", "finished"):

@@ -169,7 +169,7 @@ class VectorLocalMap:
         radius = xp.zeros_like(x) + radius  # (W, R)
         block = max(1, CPU_BLOCK // (n * self.size))
         if crowd is not None:
-            crowd = tuple(a.asarray(v) for v in crowd[:3]) + (a.asarray(crowd[3], a.i64),)
+            crowd = a.discs(crowd)
         if w <= block or a.on_gpu:
             return self._values(scene, x, y, yaw, present, radius, crowd)
         # On a CPU, blocks of worlds whose temporaries stay in cache (about twice as fast

@@ -211,7 +211,7 @@ def cast_batch(
     best = _grid_ranges(tables, scene, x, y, c, s, float(max_range))
     best = a.xp.minimum(best, _disc_ranges(a, x, y, c, s, present, radius))
     if crowd is not None:
-        crowd = tuple(a.asarray(v) for v in crowd[:3]) + (a.asarray(crowd[3], a.i64),)
+        crowd = a.discs(crowd)
         best = a.xp.minimum(best, _crowd_ranges(a, x, y, c, s, crowd))
     best = _polygon_ranges(tables, scene, x, y, c, s, float(max_range), best)
     return a.xp.where(present[..., None], best, a.xp.full_like(best, float(max_range)))

@@ -26,7 +26,6 @@ step of a discrete action.
 
 from __future__ import annotations
 
-import math
 from typing import Any
 
 import numpy as np
@@ -120,15 +119,13 @@ class SocialTracker:
         a, env, crowd = self.env.arrays, self.env, self.env.crowd
         n, k = int(self._t[w]) + 1, int(crowd.count[w])
 
-        def at(key: str) -> Any:
-            return np.asarray(a.numpy(info[key])).reshape(self._w, self._r)[w, r]
+        def at(v: Any) -> Any:  # robot r of world w's entry of an engine array
+            return np.asarray(a.numpy(v)).reshape(self._w, self._r)[w, r]
 
-        st = env.state
-        goal = [float(np.asarray(a.numpy(v)).reshape(self._w, self._r)[w, r]) for v in (st.goal_x, st.goal_y)]
-        geodesic = float(at("geodesic_dist"))
+        goal = [float(at(env.state.goal_x)), float(at(env.state.goal_y))]
         return recorded_social_metrics(
-            self._robot[w, :n, r], self._heading[w, :n, r], self._peds[w, :n, :k], dt=1.0 / env.action_frequency, robot_radius=self._radius[r],
-            pedestrian_radii=crowd.radius[w, :k], success=bool(at("success")),
-            geodesic_dist=geodesic if math.isfinite(geodesic) else math.inf, max_speed=self._speed[r], goal=goal,
+            self._robot[w, :n, r], self._heading[w, :n, r], self._peds[w, :n, :k], dt=1.0 / env.action_frequency,
+            robot_radius=self._radius[r], pedestrian_radii=crowd.radius[w, :k], success=bool(at(info["success"])),
+            geodesic_dist=float(at(info["geodesic_dist"])), max_speed=self._speed[r], goal=goal,
         )
 

@@ -64,6 +64,11 @@ class Arrays:
             return self.xp.as_tensor(np.asarray(a), dtype=dtype, device=self.device)
         return np.asarray(a, dtype=dtype)
 
+    def discs(self, discs: tuple[Any, Any, Any, Any]) -> tuple[Any, Any, Any, Any]:
+        """A world's discs ``(x, y, radius, count)`` (a crowd's, as the scan and the local map
+        take them) on this device: float64 centres and radii, int64 counts."""
+        return (*(self.asarray(v) for v in discs[:3]), self.asarray(discs[3], self.i64))
+
     def zeros(self, shape: Any, dtype: Any = None) -> Any:
         dtype = self.f64 if dtype is None else dtype
         if self.is_torch:
