@@ -96,6 +96,29 @@ def test_l2_potential_reward_matches_the_formula_on_every_step(backend):
         previous = current
 
 
+def test_slack_costs_r_slack_every_step_and_is_absent_by_default(backend):
+    goal = (3.0, 1.0)
+    kw = {"initial_pos": (1.0, 1.0, 0.0), "initial_quat": quat(0.0), "goal_pos": (*goal, 0.0)}
+    env = make_env(backend, room(), reward_config={"r_slack": 0.25}, **kw)
+    env.reset(seed=0)
+    total = 0.0
+    for _ in range(12):  # 0.6 m straight ahead: potential 2.0 -> 1.4, twelve costs of 0.25
+        _, reward, _, _, info = env.step(FORWARD)
+        assert list(info["reward_breakdown"]) == ["potential", "collision", "pointgoal", "slack"]
+        assert info["reward_breakdown"]["slack"] == -0.25
+        total += reward
+    assert total == pytest.approx((2.0 - 1.4) - 12 * 0.25, abs=1e-9)
+    plain = make_env(backend, room(), **kw)  # OmniGibson's task: no slack term at all
+    plain.reset(seed=0)
+    assert list(plain.step(FORWARD)[4]["reward_breakdown"]) == ["potential", "collision", "pointgoal"]
+
+
+@pytest.mark.parametrize("bad", [-0.01, True, "0.01", float("nan")])
+def test_a_bad_r_slack_is_refused_by_name(bad):
+    with pytest.raises(ValueError, match="r_slack"):
+        PointNavigationTask(reward_config={"r_slack": bad})
+
+
 def wall_with_gap() -> np.ndarray:
     """4 m x 4 m room split by a wall at x in [2.0, 2.1] from y = 0 up to y = 3.0."""
     grid = room(40, 40)

@@ -62,6 +62,28 @@ def test_a_custom_reward_gives_equal_rewards_in_both_engines(device: str) -> Non
     assert stats["contacts"] > 0 and stats["autoresets"] > 0
 
 
+@pytest.mark.parametrize("device", DEVICES)
+def test_the_slack_term_gives_equal_rewards_in_both_engines(device: str) -> None:
+    scene = _scene()
+    rng = np.random.default_rng(4)
+    actions = rng.uniform(-1.0, 1.0, (60, 4, 2)).astype(np.float32)
+    actions[..., 0] = np.abs(actions[..., 0])
+    task = {"reward_type": "geodesic", "reward_config": {"r_slack": 0.03}, "reward_functions": [Shaped()],
+            "termination_config": {"max_steps": 30, "max_collisions": 30}}
+    stats = compare(scene, random_episodes(scene, 4, rng), actions, task=task, device=device)
+    assert stats["autoresets"] > 0
+
+
+def test_the_fleet_reports_each_robots_slack() -> None:
+    task = [{"reward_config": {"r_slack": 0.5}}, {}]  # one robot pays for time, one does not
+    env = VectorPointNavEnv(2, n_robots=2, scene=_scene(), seed=0, task=task)
+    env.reset(seed=0)
+    _, reward, _, _, info = env.step(np.tile([[1.0, 0.0]], (2, 2, 1)).astype(np.float32))
+    np.testing.assert_array_equal(info["reward_slack"], [[-0.5, 0.0], [-0.5, 0.0]])
+    parts = info["reward_potential"] + info["reward_collision"] + info["reward_pointgoal"] + info["reward_slack"]
+    np.testing.assert_allclose(reward, parts, rtol=0, atol=1e-12)
+
+
 def test_the_engine_reports_each_custom_term_and_adds_it_last() -> None:
     env = VectorPointNavEnv(3, scene=_scene(), seed=0, task={"reward_functions": [Shaped(c=0.02)]})
     env.reset(seed=0)

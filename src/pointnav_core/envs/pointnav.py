@@ -106,13 +106,15 @@ class PointNavEnv(gym.Env[Any, np.ndarray]):
 
     ## Rewards
 
-    The sum of three terms, reported in `info["reward_breakdown"]`:
+    The sum of these terms, reported in `info["reward_breakdown"]`:
 
     - `potential`: `r_potential * (previous potential - current potential)` (default 1.0
       per metre), the potential being the xy distance to the goal (`reward_type="l2"`) or
       the geodesic distance (`"geodesic"`);
     - `collision`: `-r_collision` (default 0.1) on every step the robot touches an obstacle;
-    - `pointgoal`: `r_pointgoal` (default 10.0) on the step the goal is reached.
+    - `pointgoal`: `r_pointgoal` (default 10.0) on the step the goal is reached;
+    - `slack`, only when `reward_config={"r_slack": c}` with `c > 0`: `-c` on every step,
+      Habitat's time cost (not OmniGibson's; the default 0.0 leaves no `slack` key).
 
     ## Starting State
 

@@ -14,6 +14,7 @@ from pointnav_core.task.rewards import (
     PointGoalReward,
     PotentialReward,
     RewardFunction,
+    SlackReward,
 )
 from pointnav_core.task.social import (
     SOCIAL_METRIC_KEYS,
@@ -44,6 +45,7 @@ __all__ = [
     "PointNavigationTask",
     "PotentialReward",
     "RewardFunction",
+    "SlackReward",
     "TaskConfig",
     "TaskEnv",
     "TaskState",

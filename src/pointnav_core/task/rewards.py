@@ -10,7 +10,13 @@ class              name             reward at a step
 PotentialReward    ``"potential"``  ``r_potential * (previous potential - potential)``
 CollisionReward    ``"collision"``  ``-r_collision`` if the robot touched something
 PointGoalReward    ``"pointgoal"``  ``r_pointgoal`` on the step PointGoal succeeds
+SlackReward        ``"slack"``      ``-r_slack`` on every step (only when ``r_slack > 0``)
 =================  ===============  ==================================================
+
+``SlackReward`` is not OmniGibson's: it is Habitat's ``slack_reward``, a time cost that
+makes a detour cost reward (the potential terms telescope, so on their own they pay a long
+way and the shortest one alike). Its default ``r_slack = 0`` leaves the task OmniGibson's,
+with the three terms above and no ``"slack"`` key.
 
 The potential is the task's distance to the goal (L2 or geodesic, see
 :class:`~pointnav_core.task.PointNavigationTask`), so the potential rewards of an episode
@@ -46,7 +52,7 @@ from pointnav_core.errors import ArgumentError
 from pointnav_core.task.metrics import scalar_where
 from pointnav_core.task.terminations import _check_length
 
-__all__ = ["RewardFunction", "PotentialReward", "CollisionReward", "PointGoalReward"]
+__all__ = ["RewardFunction", "PotentialReward", "CollisionReward", "PointGoalReward", "SlackReward"]
 
 
 def _check_scale(name: str, value: Any) -> float:
@@ -216,3 +222,35 @@ class PointGoalReward(RewardFunction):
 
     def __repr__(self) -> str:
         return f"PointGoalReward(r_pointgoal={self.r_pointgoal})"
+
+
+class SlackReward(RewardFunction):
+    """Time cost: ``-r_slack`` on every step, Habitat's ``slack_reward``.
+
+    Not one of OmniGibson's terms: the task adds it after them only when ``r_slack > 0``.
+    Habitat's PointNav pays ``-0.01`` a step beside a reward of 1 per metre of progress.
+
+    Parameters
+    ----------
+    r_slack : float
+        Cost of one step, >= 0 (reward units).
+    """
+
+    name = "slack"
+
+    def __init__(self, r_slack: float = 0.0) -> None:
+        super().__init__()
+        self.r_slack = _check_scale("r_slack", r_slack)
+
+    @staticmethod
+    def value(r_slack: Any, zero: Any = 0.0) -> Any:
+        """The cost of one step or a batch's: ``zero - r_slack`` (the batched engine passes a
+        float64 zero array; ``r_slack`` may be a ``(1, R)`` row of the robots' costs)."""
+        return zero - r_slack
+
+    def step(self, task: Any, env: Any, action: Any) -> float:
+        self.reward = reward = self.value(self.r_slack)
+        return reward
+
+    def __repr__(self) -> str:
+        return f"SlackReward(r_slack={self.r_slack})"

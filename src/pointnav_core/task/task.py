@@ -67,6 +67,7 @@ from pointnav_core.task.rewards import (
     PointGoalReward,
     PotentialReward,
     RewardFunction,
+    SlackReward,
 )
 from pointnav_core.task.sampling import GoalConstraint, sample_task_episode
 from pointnav_core.task.task_env import TaskEnv, check_fits, evaluate_terminations
@@ -183,7 +184,7 @@ class PointNavigationTask(OmniGibsonTaskAPI):
     )
     #: Reward defaults (read-only; pass ``reward_config`` to override).
     default_reward_config: ClassVar[Mapping[str, Any]] = FrozenMapping(
-        {"r_potential": 1.0, "r_collision": 0.1, "r_pointgoal": 10.0}
+        {"r_potential": 1.0, "r_collision": 0.1, "r_pointgoal": 10.0, "r_slack": 0.0}
     )
 
     def __init__(
@@ -286,6 +287,9 @@ class PointNavigationTask(OmniGibsonTaskAPI):
             CollisionReward(r_collision=cfg["r_collision"]),
             PointGoalReward(r_pointgoal=cfg["r_pointgoal"]),
         ]
+        slack = SlackReward(r_slack=cfg["r_slack"])  # checked even when 0
+        if slack.r_slack > 0:  # Habitat's time cost; without it the task is OmniGibson's
+            rewards.append(slack)
         return {r.name: r for r in rewards}
 
     # ------------------------------------------------------------------ lifecycle

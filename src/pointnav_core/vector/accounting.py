@@ -15,14 +15,19 @@ from __future__ import annotations
 import math
 from typing import Any, NamedTuple
 
-from pointnav_core.task.rewards import CollisionReward, PointGoalReward, PotentialReward
+from pointnav_core.task.rewards import (
+    CollisionReward,
+    PointGoalReward,
+    PotentialReward,
+    SlackReward,
+)
 from pointnav_core.task.terminations import Falling, MaxCollision, Timeout
 from pointnav_core.vector.state import Motion
 
 __all__ = ["BatchedTask", "TaskStep", "custom_rewards", "read_task", "task_step"]
 
 #: The built-in reward terms' names (the engine computes them itself, from their ``value``).
-BUILT_IN_REWARDS = ("potential", "collision", "pointgoal")
+BUILT_IN_REWARDS = ("potential", "collision", "pointgoal", "slack")
 
 
 class BatchedTask(NamedTuple):
@@ -57,7 +62,7 @@ class TaskStep(NamedTuple):
     r_pot: Any  #: the potential reward
     r_col: Any  #: the collision penalty
     r_goal: Any  #: the goal reward
-    r_custom: dict[str, Any]  #: each custom reward term's values, by name
+    r_custom: dict[str, Any]  #: the slack term's (with ``r_slack > 0``) and each custom term's values, by name
     reward: Any  #: their sum, as the task adds them
 
 
@@ -127,6 +132,10 @@ def task_step(engine: Any, moved: Motion, contact: Any, stopped: Any, acting: An
     r_goal = PointGoalReward.value(engine.r_pointgoal, success, xp.where, zero)
     reward = ((0.0 + r_pot) + r_col) + r_goal
     r_custom: dict[str, Any] = {}
+    if engine.slack:  # Habitat's time cost, after OmniGibson's terms as the task adds it
+        slack = SlackReward.value(engine.r_slack, zero)
+        r_custom["slack"] = slack = slack if acting is None else xp.where(acting, slack, zero)
+        reward = reward + slack
     if engine.custom_rewards:  # after the built-in ones, in order, as the task sums them
         view = BatchedTask(xp, zero, (x, y, z), (gx, gy), dist, pot, touched, success, steps, collisions)
         for name, term in engine.custom_rewards:
@@ -154,9 +163,10 @@ def read_task(engine: Any, t: Any, action_frequency: float) -> None:
     cfg, rcfg = t.termination_config, t.reward_config
     engine.max_steps, engine.max_collisions = int(cfg["max_steps"]), int(cfg["max_collisions"])
     engine.fall_height, engine.goal_tolerance = float(cfg["fall_height"]), t.goal_tolerance
-    engine.r_potential, engine.r_collision, engine.r_pointgoal = (
-        float(rcfg[k]) for k in ("r_potential", "r_collision", "r_pointgoal")
+    engine.r_potential, engine.r_collision, engine.r_pointgoal, engine.r_slack = (
+        float(rcfg[k]) for k in ("r_potential", "r_collision", "r_pointgoal", "r_slack")
     )
+    engine.slack = "slack" in t.reward_functions
     engine.geodesic_reward = t.reward_type == "geodesic"
     engine.custom_rewards = custom_rewards(t)
     engine.goal_in_polar = bool(t.goal_in_polar)

@@ -147,7 +147,7 @@ class VectorPointNavEnv(PoolRefreshing, VectorEnv):
     scan, plus ``cells * cells`` with the local map), rewards float64, terminated and truncated bool, and ``info``, a dict of arrays of shape
     ``(num_envs,)``: ``success``, ``spl``, ``soft_spl``, ``path_length``,
     ``geodesic_dist``, ``distance_to_goal``, ``collisions``, ``episode_length``,
-    ``in_contact``, ``reward_potential``, ``reward_collision``, ``reward_pointgoal`` and
+    ``in_contact``, ``reward_potential``, ``reward_collision``, ``reward_pointgoal`` (and ``reward_slack`` with ``r_slack > 0``) and
     ``autoreset`` (the worlds this step reset instead of stepping). Arrays are numpy with
     ``device="numpy"`` and torch tensors on the device otherwise. On the CPU (numpy, or
     torch on ``"cpu"``) with the ``fast`` extra (numba), the contacts

@@ -332,7 +332,7 @@ class VectorFleetEnv(VectorPointNavEnv):
         cycles = self._cycles + 1
         reward, terminated, success, fell = t.reward, t.terminated, t.success, t.fell
         truncated = t.truncated | (acting & (cycles >= self.max_cycles)[:, None])
-        r_pot, r_col, r_goal = t.r_pot, t.r_col, t.r_goal
+        r_pot, r_col, r_goal, r_custom = t.r_pot, t.r_col, t.r_goal, t.r_custom  # r_custom: the slack term's
         ended = terminated | truncated
         active = acting & ~ended
         # A robot that fell leaves its floor; with "remove" every finished robot leaves.
@@ -354,10 +354,13 @@ class VectorFleetEnv(VectorPointNavEnv):
                 for v in (reward, terminated, truncated, success, contact)
             )
             r_pot, r_col, r_goal = (xp.where(keep, r, zero) for r in (r_pot, r_col, r_goal))
+            r_custom = {name: xp.where(keep, r, zero) for name, r in r_custom.items()}
             shown = xp.where(keep, acting, self._active)
             self._seen = xp.where(keep, present, self._present)
         self._needs_reset = ~self._active.any(-1)
         info = self._info(success, r_pot, r_col, r_goal, contact, shown, resetting[:, None] & shown)
+        for name, r in r_custom.items():
+            info[f"reward_{name}"] = xp.where(shown, r, zero)
         return self._observe(shown), reward, terminated, truncated, info
 
 

@@ -8,7 +8,7 @@ robot axis ``(1, R)`` that the step broadcasts over its ``(num_envs, R)`` state:
 - from each task: ``goal_tolerance``, ``reward_type`` (geodesic or l2 potential),
   ``goal_in_polar``, ``termination_config`` (``max_steps``, ``max_collisions``,
   ``fall_height``) and ``reward_config`` (``r_potential``, ``r_collision``,
-  ``r_pointgoal``); ``path_range``, ``initial_pos``, ``initial_quat`` and ``goal_pos``
+  ``r_pointgoal``, ``r_slack``); ``path_range``, ``initial_pos``, ``initial_quat`` and ``goal_pos``
   only shape the episodes, which each scene's multi-robot env draws;
 - from each robot: ``max_linear_velocity`` and ``max_angular_velocity`` (the drive's
   scaling, the observations' bounds and, with discrete actions, each action's control
@@ -115,7 +115,10 @@ def read_tasks(env: Any, tasks: Sequence[Any], specs: Sequence[RobotSpec], array
     env.max_collisions = row([int(c["max_collisions"]) for c in cfg], arrays.i64)
     env.fall_height = row([float(c["fall_height"]) for c in cfg])
     env.goal_tolerance = row([float(t.goal_tolerance) for t in tasks])
-    env.r_potential, env.r_collision, env.r_pointgoal = (row([float(c[k]) for c in rcfg]) for k in ("r_potential", "r_collision", "r_pointgoal"))
+    env.r_potential, env.r_collision, env.r_pointgoal, env.r_slack = (
+        row([float(c[k]) for c in rcfg]) for k in ("r_potential", "r_collision", "r_pointgoal", "r_slack")
+    )
+    env.slack = any("slack" in t.reward_functions for t in tasks)
     env.geodesic_reward = row([t.reward_type == "geodesic" for t in tasks], arrays.boolean)
     polar = [bool(t.goal_in_polar) for t in tasks]
     env.goal_in_polar = polar[0] if len(set(polar)) == 1 else row(polar, arrays.boolean)
