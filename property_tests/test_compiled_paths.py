@@ -71,6 +71,7 @@ PAIRS: dict[Entry, tuple[Callable[..., None], ...]] = {
     ),
     ("pointnav_core.vector._scan_kernel", "cast_worlds"): (
         pairs_vector.check_batched_scan, pairs_vector.check_batched_scan_large_floor, pairs_scan.check_grazing_scans,
+        pairs_vector.check_batched_scan_wall_near_range,
     ),
     ("pointnav_core.vector._contact_kernel", "advance_worlds"): tuple(
         partial(check, device=device)

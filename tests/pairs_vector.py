@@ -156,6 +156,31 @@ def check_batched_scan(seed, n_worlds, n_robots, ratio, res, n_rays, max_range, 
     _check_scenes(plain_paths, scenes, x, y, yaw, present, scene, radius, angles, max_range, crowd)
 
 
+@settings(max_examples=10, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(seed=st.integers(0, 2**31 - 1), res=st.sampled_from([0.05, 0.1, 0.25]), max_range=st.floats(0.3, 3.0))
+def check_batched_scan_wall_near_range(seed, res, max_range, plain_paths: Plain) -> None:
+    """Robots in an open room whose nearest wall lies within a few cells of the scan's
+    range, on either side: where the compiled cast may skip a robot's walks (open space
+    beyond the range) or must walk them (a wall just within it)."""
+    rng = np.random.default_rng(seed)
+    span = 2 * (int(np.ceil(max_range / res)) + 8)  # the map's edge beyond every robot's range
+    grid = np.zeros((2 * span + 3, 2 * span + 3), np.uint8)
+    grid[:, span + 1] = OBSTACLE  # one wall down the middle
+    scene = Scene.from_array(grid, res)
+    n_worlds, n_robots = 3, 4
+    # Each robot at max_range -3 to +3 cells from the wall's face, left or right of it.
+    gap = max_range + rng.uniform(-3.0, 3.0, (n_worlds, n_robots)) * res
+    side = rng.choice([-1.0, 1.0], (n_worlds, n_robots))
+    ox, oy = scene.floors[0].origin
+    wall_lo, wall_hi = ox + (span + 1) * res, ox + (span + 2) * res
+    x = np.where(side < 0, wall_lo - gap, wall_hi + gap)
+    y = oy + rng.uniform(span - 2.0, span + 3.0, (n_worlds, n_robots)) * res
+    yaw = rng.uniform(-np.pi, np.pi, (n_worlds, n_robots))
+    angles = scan_angles(int(rng.integers(8, 48)), 2 * np.pi)
+    present = np.ones((n_worlds, n_robots), bool)
+    _check_scenes(plain_paths, [scene], x, y, yaw, present, np.zeros(n_worlds, np.int64), 0.3 * res, angles, max_range)
+
+
 @settings(max_examples=3, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(seed=st.integers(0, 2**31 - 1), ratio=st.floats(0.3, 5.0))
 def check_batched_scan_large_floor(seed, ratio, plain_paths: Plain) -> None:

@@ -8,6 +8,10 @@ at least one cell away from its near sides; no crossing inside it can meet a blo
 The compiled walks (``sensors._raycast_kernel.grid_range`` and ``vector._scan_kernel.walk``)
 jump over those crossings. A square anchored behind the ray reaches about twice as far
 ahead as a square centred on its cell (the chessboard clearance), for the same cells.
+
+:func:`open_radius` is the per-cell bound of the batched scan's early exit: a robot whose
+cell is farther than its scan's range from every blocked cell reads the range on every ray
+without walking any (``vector._scan_kernel.cast_worlds``).
 """
 
 from __future__ import annotations
@@ -17,7 +21,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from pointnav_core.errors import ArgumentError
 
-__all__ = ["QUADRANTS", "quadrant_clearance"]
+__all__ = ["QUADRANTS", "open_radius", "quadrant_clearance"]
 
 #: The quadrants' (sign of x, sign of y), in the table's order: index
 #: ``(0 if dx >= 0 else 1) + (0 if dy >= 0 else 2)``.
@@ -75,3 +79,37 @@ def quadrant_clearance(free: ArrayLike) -> NDArray[np.uint8]:
         c0, c1 = (1, wp) if sx > 0 else (0, wp - 1)
         out[r0:r1, c0:c1, q] = side[r0 - sy : r1 - sy, c0 - sx : c1 - sx]
     return np.ascontiguousarray(np.minimum(out, _MAX_SIDE).astype(np.uint8).ravel())
+
+
+def open_radius(free: ArrayLike) -> NDArray[np.float64]:
+    """Per cell, a lower bound (cells) on the distance from any point of it to any blocked cell.
+
+    Parameters
+    ----------
+    free : array_like of bool, shape (H, W)
+        The free cells (the scan's padded grid: its ring of blocked cells included).
+
+    Returns
+    -------
+    ndarray of float64, shape (H, W)
+        The Euclidean distance between the cell's centre and the nearest blocked cell's
+        centre, less the two half-diagonals (``sqrt(2)``), never below 0 (0 on a blocked cell).
+        Points of two cells are within a half-diagonal of their centres, so no point of the
+        cell is nearer a blocked cell than this.
+
+    Examples
+    --------
+    >>> free = np.ones((1, 7), bool)
+    >>> free[0, 0] = False
+    >>> open_radius(free).round(3).tolist()
+    [[0.0, 0.0, 0.586, 1.586, 2.586, 3.586, 4.586]]
+    """
+    from scipy.ndimage import distance_transform_edt
+
+    free = np.asarray(free, dtype=bool)
+    if free.ndim != 2:
+        raise ArgumentError(f"free must be a 2-D grid of cells, got shape {free.shape}")
+    if free.all():  # no blocked cell: nothing to be near
+        return np.full(free.shape, np.inf)
+    centres = distance_transform_edt(free)  # to the nearest False (blocked) centre
+    return np.maximum(centres - np.sqrt(2.0), 0.0)

@@ -46,7 +46,7 @@ from numpy.typing import ArrayLike, NDArray
 from pointnav_core.errors import ArgumentTypeError
 from pointnav_core.floor.maps import OBSTACLE, TraversableMap
 from pointnav_core.sensors import raycast_jit
-from pointnav_core.sensors.clearance import quadrant_clearance
+from pointnav_core.sensors.clearance import open_radius, quadrant_clearance
 from pointnav_core.utils.compiled import check_method, choose
 
 __all__ = ["TOUCH_EPS", "ScanGeometry", "cast_pose_compiled", "cast_rays", "inside_polygon", "polygon_hits"]
@@ -145,6 +145,7 @@ class ScanGeometry:
         ).reshape(-1, 9))
         self._jit_base = (self.resolution, *self.origin)
         self._clearance_cells: NDArray[np.uint8] | None = None
+        self._open_cells: NDArray[np.float64] | None = None
         self._jit_params_of: dict[float, NDArray[np.float64]] = {}
 
     @property
@@ -159,6 +160,17 @@ class ScanGeometry:
             free = ~self.lookup[: self.plane].reshape(self.shape)
             self._clearance_cells = quadrant_clearance(free)
         return self._clearance_cells
+
+    @property
+    def open_radius(self) -> NDArray[np.float64]:
+        """Per padded cell, a lower bound (m) on the distance from any point of it to a
+        blocked cell (:func:`~pointnav_core.sensors.clearance.open_radius`), flat; built on
+        first use. The batched scan skips the grid walks of a robot with more than its
+        range here (obstacle polygons are cast apart, so they do not count)."""
+        if self._open_cells is None:
+            free = ~self.lookup[: self.plane].reshape(self.shape)
+            self._open_cells = np.ascontiguousarray(open_radius(free).ravel() * self.resolution)
+        return self._open_cells
 
     def jit_params(self, max_range: float) -> NDArray[np.float64]:
         """The compiled path's scalars: resolution, origin, max_range, padded shape."""

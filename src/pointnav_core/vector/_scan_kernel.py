@@ -23,8 +23,8 @@ _jit = numba.njit(cache=True, nogil=True, error_model="numpy")
 
 
 @_jit
-def cast_worlds(scene, x, y, cyaw, syaw, ca, sa, present, radius, max_range, meta, lookup, clear, edges, qx, qy, qr, qn,
-                out):  # pragma: no cover
+def cast_worlds(scene, x, y, cyaw, syaw, ca, sa, present, radius, max_range, meta, lookup, clear, open_radius, edges,
+                qx, qy, qr, qn, out):  # pragma: no cover
     n_worlds, n_robots = x.shape
     n_rays = ca.shape[0]
     # radius (W, R): each robot's disc (m); qx, qy, qr (W, Q): other discs every robot sees
@@ -53,6 +53,10 @@ def cast_worlds(scene, x, y, cyaw, syaw, ca, sa, present, radius, max_range, met
         fwp = float(wp)
         look = lookup[loff : loff + 3 * plane]
         clr = clear[coff : coff + 4 * plane]  # four quadrants a cell
+        opened = open_radius[int(meta[k, 9]) : int(meta[k, 9]) + plane]
+        # Past this (m) from every blocked cell, no ray's walk meets one within max_range
+        # (a touch counts from TOUCH_EPS; the margin covers the walk's rounding).
+        open_enough = max_range + TOUCH_EPS + 1e-6
         for i in range(n_robots):
             if not present[w, i]:
                 out[w, i, :] = max_range
@@ -89,10 +93,15 @@ def cast_worlds(scene, x, y, cyaw, syaw, ca, sa, present, radius, max_range, met
                 if fx * fx + fy * fy <= reach2:
                     near[n_near] = m
                     n_near += 1
+            # In open space every ray's walk reads max_range: none is walked.
+            walk = opened[int(min(max(math.floor(gy), 0.0), hp - 1.0)) * wp
+                          + int(min(max(math.floor(gx), 0.0), wp - 1.0))] <= open_enough
             for r in range(n_rays):
                 dx = c[r]
                 dy = s[r]
-                best = min(grid_range(gx, gy, dx, dy, fhp, fwp, plane, look, clr, e, n_cross, reach) * res, max_range)
+                best = max_range
+                if walk:
+                    best = min(grid_range(gx, gy, dx, dy, fhp, fwp, plane, look, clr, e, n_cross, reach) * res, max_range)
                 for j in range(n_robot_near):
                     m = near[j]
                     best = min(best, disc_range(px - x[w, m], py - y[w, m], dx, dy, radius[w, m] * radius[w, m]))

@@ -469,8 +469,11 @@ class VectorPointNavEnv(PoolRefreshing, VectorEnv):
         obs, c, s = low_dim(xp, self.state, self.goal_in_polar)
         if self.scan is not None:
             obs = cat(xp, [obs, self._scan_ranges(c, s)], -1)
-        sc, width = self.world_scene, obs.shape[-1]
-        obs = xp.minimum(xp.maximum(obs, self._low[..., :width][sc]), self._high[..., :width][sc])
+        width = obs.shape[-1]
+        low, high = self._low[..., :width], self._high[..., :width]
+        # One scene: its bounds broadcast over the worlds (no gather); else each world its scene's.
+        low, high = (low[0], high[0]) if low.shape[0] == 1 else (low[self.world_scene], high[self.world_scene])
+        obs = xp.minimum(xp.maximum(obs, low), high)
         obs = as_dtype(xp, obs, xp.float32)
         if self.local_map is not None:  # after the scan (the single env's order); codes within their bounds
             obs = cat(xp, [obs, self._map_values()], -1)

@@ -74,29 +74,34 @@ class ScanTables:
     """
 
     def __init__(self, scenes: Sequence[Any], floor: int, arrays: Arrays) -> None:
-        lookups, clears, edges, meta = [], [], [], []
-        lo = co = eo = 0
+        lookups, clears, opens, edges, meta = [], [], [], [], []
+        lo = co = eo = oo = 0
         #: Per scene, the single scan's geometry of its floor (cells and polygon edges).
         self.geometries = [ScanGeometry(scene.floors[floor]) for scene in scenes]
         for geo in self.geometries:
             hp, wp = geo.shape
             lookups.append(geo.lookup)
             clears.append(geo.clearance)
+            opens.append(geo.open_radius)
             edges.append(geo.edge_table)
             n_edges = len(geo.edge_table)
             # lookup offset, clearance offset, padded rows, padded columns, cell size, origin,
-            # first polygon edge, number of edges
-            meta.append((lo, co, hp, wp, geo.resolution, geo.origin[0], geo.origin[1], eo, n_edges))
+            # first polygon edge, number of edges, open-radius offset
+            meta.append((lo, co, hp, wp, geo.resolution, geo.origin[0], geo.origin[1], eo, n_edges, oo))
             lo += geo.lookup.size
             co += geo.clearance.size
             eo += n_edges
+            oo += geo.open_radius.size
         #: Per scene: lookup offset, clearance offset, hp, wp, resolution, ox, oy, first
-        #: edge, edges (float64).
+        #: edge, edges, open-radius offset (float64).
         self.meta = np.ascontiguousarray(meta, dtype=np.float64)
         #: The three lookup planes of every padded grid, end to end (bool, numpy).
         self.lookup = np.ascontiguousarray(np.concatenate(lookups))
         #: Per padded cell and quadrant, the free square ahead (sensors.clearance, uint8).
         self.clearance = np.ascontiguousarray(np.concatenate(clears), dtype=np.uint8)
+        #: Per padded cell, how far (m) every point of it is from a blocked cell at least
+        #: (ScanGeometry.open_radius, float64): the compiled cast's early exit.
+        self.open_radius = np.ascontiguousarray(np.concatenate(opens), dtype=np.float64)
         #: Every floor's polygon edges (ScanGeometry.edge_table rows), end to end.
         self.edges = np.ascontiguousarray(np.concatenate(edges).reshape(-1, 9))
         #: The scenes whose floor has obstacle polygons.
@@ -240,7 +245,7 @@ def _cast_compiled(
         np.ascontiguousarray(y, dtype=np.float64), np.cos(yaw), np.sin(yaw), np.cos(angles), np.sin(angles),
         np.ascontiguousarray(view(present), dtype=np.bool_), np.ascontiguousarray(view(radius), dtype=np.float64),
         max_range,
-        tables.meta, tables.lookup, tables.clearance, tables.edges, qx, qy, qr, qn, out,
+        tables.meta, tables.lookup, tables.clearance, tables.open_radius, tables.edges, qx, qy, qr, qn, out,
     )
     _zero_inside(tables, view(scene), x, y, view(present), out)
     return a.asarray(out) if a.is_torch else out
