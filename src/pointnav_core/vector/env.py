@@ -469,12 +469,12 @@ class VectorPointNavEnv(PoolRefreshing, VectorEnv):
         obs, c, s = low_dim(xp, self.state, self.goal_in_polar)
         if self.scan is not None:
             obs = cat(xp, [obs, self._scan_ranges(c, s)], -1)
-        width = obs.shape[-1]
-        low, high = self._low[..., :width], self._high[..., :width]
+        # Cast, then clip in place: rounding is monotone, so the floats are those of clipping first.
+        obs = as_dtype(xp, obs, xp.float32)
+        low, high = (as_dtype(xp, b[..., :obs.shape[-1]], xp.float32) for b in (self._low, self._high))
         # One scene: its bounds broadcast over the worlds (no gather); else each world its scene's.
         low, high = (low[0], high[0]) if low.shape[0] == 1 else (low[self.world_scene], high[self.world_scene])
-        obs = xp.minimum(xp.maximum(obs, low), high)
-        obs = as_dtype(xp, obs, xp.float32)
+        obs = xp.minimum(xp.maximum(obs, low, out=obs), high, out=obs)
         if self.local_map is not None:  # after the scan (the single env's order); codes within their bounds
             obs = cat(xp, [obs, self._map_values()], -1)
         return obs
