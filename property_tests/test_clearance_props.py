@@ -1,7 +1,8 @@
 """The free squares ahead (``sensors.clearance``) and the compiled walks that jump over them.
 
 The table is checked against a brute-force search for the largest free square, cell by
-cell. (The walks' jumps end just before a free square's far side, so the rays that matter are
+cell; ``open_radius`` against shapely's distance from points of each cell to the blocked
+cells' squares. (The walks' jumps end just before a free square's far side, so the rays that matter are
 those that run within ``TOUCH_EPS`` of a grid line: the compiled scans equal the array path
 there too, ``check_grazing_scans`` in ``tests/pairs_scan.py``, run by
 ``property_tests/test_compiled_paths.py``.)
@@ -11,10 +12,11 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+import shapely
 from hypothesis import given
 from hypothesis import strategies as st
 
-from pointnav_core.sensors.clearance import QUADRANTS, quadrant_clearance
+from pointnav_core.sensors.clearance import QUADRANTS, open_radius, quadrant_clearance
 
 
 def _brute_side(free: np.ndarray, row: int, col: int, sx: int, sy: int) -> int:
@@ -64,3 +66,23 @@ def test_sides_beyond_a_byte_are_clipped_to_255():
 def test_a_table_of_other_than_two_dimensions_is_refused():
     with pytest.raises(ValueError, match="free"):
         quadrant_clearance(np.ones(5, bool))
+
+
+@given(free_grids(), st.integers(0, 2**32 - 1))
+def test_no_point_of_a_cell_is_nearer_a_blocked_cell_than_its_open_radius(free, seed):
+    got = open_radius(free)
+    assert got.shape == free.shape
+    blocked = [shapely.box(c, r, c + 1, r + 1) for r, c in zip(*np.nonzero(~free))]
+    if not blocked:
+        assert np.isinf(got).all()
+        return
+    walls = shapely.union_all(blocked)
+    rng = np.random.default_rng(seed)
+    for row in range(free.shape[0]):
+        for col in range(free.shape[1]):
+            # The cell's corners and random points in it (cell units, x = column).
+            pts = np.vstack([[[0, 0], [0, 1], [1, 0], [1, 1]], rng.random((6, 2))]) + [col, row]
+            nearest = shapely.distance(shapely.points(pts), walls).min()
+            assert got[row, col] <= nearest + 1e-12, (row, col)
+            # Not loose by more than a diagonal (the centre is no farther than the blocked centre).
+            assert got[row, col] >= nearest - np.sqrt(2.0) - 1e-12, (row, col)
