@@ -23,6 +23,30 @@ _jit = numba.njit(cache=True, nogil=True, error_model="numpy")
 
 
 @_jit
+def _near_discs(w, i, px, py, x, y, present, radius, qx, qy, qr, qn, max_range, near):  # pragma: no cover
+    # The discs robot i of world w can reach: the other present robots, then the world's
+    # pedestrians, whose centres lie within max_range + radius; their indices go to near,
+    # robots first. Returns (robots among them, all of them).
+    n_near = 0
+    for m in range(x.shape[1]):
+        if m != i and present[w, m]:
+            fx, fy = px - x[w, m], py - y[w, m]
+            # Farther than this (m^2, with a margin for rounding) the disc is out of every ray's reach.
+            reach2 = ((max_range + radius[w, m]) * (1.0 + 1e-9) + 1e-12) ** 2
+            if fx * fx + fy * fy <= reach2:
+                near[n_near] = m
+                n_near += 1
+    n_robot_near = n_near
+    for m in range(qn[w]):
+        fx, fy = px - qx[w, m], py - qy[w, m]
+        reach2 = ((max_range + qr[w, m]) * (1.0 + 1e-9) + 1e-12) ** 2
+        if fx * fx + fy * fy <= reach2:
+            near[n_near] = m
+            n_near += 1
+    return n_robot_near, n_near
+
+
+@_jit
 def cast_worlds(scene, x, y, cyaw, syaw, ca, sa, present, radius, max_range, meta, lookup, clear, open_radius, edges,
                 qx, qy, qr, qn, out):  # pragma: no cover
     n_worlds, n_robots = x.shape
@@ -76,23 +100,7 @@ def cast_worlds(scene, x, y, cyaw, syaw, ca, sa, present, radius, max_range, met
             for r in range(n_rays):  # the products of scan.directions, in its order
                 c[r] = cyaw[w, i] * ca[r] - syaw[w, i] * sa[r]
                 s[r] = syaw[w, i] * ca[r] + cyaw[w, i] * sa[r]
-            # The discs a ray can reach: present, not its own, centre within max_range + radius.
-            n_near = 0
-            for m in range(n_robots):
-                if m != i and present[w, m]:
-                    fx, fy = px - x[w, m], py - y[w, m]
-                    # Farther than this (m^2, with a margin for rounding) the disc is out of every ray's reach.
-                    reach2 = ((max_range + radius[w, m]) * (1.0 + 1e-9) + 1e-12) ** 2
-                    if fx * fx + fy * fy <= reach2:
-                        near[n_near] = m
-                        n_near += 1
-            n_robot_near = n_near
-            for m in range(qn[w]):
-                fx, fy = px - qx[w, m], py - qy[w, m]
-                reach2 = ((max_range + qr[w, m]) * (1.0 + 1e-9) + 1e-12) ** 2
-                if fx * fx + fy * fy <= reach2:
-                    near[n_near] = m
-                    n_near += 1
+            n_robot_near, n_near = _near_discs(w, i, px, py, x, y, present, radius, qx, qy, qr, qn, max_range, near)
             # In open space every ray's walk reads max_range: none is walked.
             walk = opened[int(min(max(math.floor(gy), 0.0), hp - 1.0)) * wp
                           + int(min(max(math.floor(gx), 0.0), wp - 1.0))] <= open_enough
