@@ -2,9 +2,9 @@
 
 The table is checked against a brute-force search for the largest free square, cell by
 cell; ``open_radius`` against shapely's distance from points of each cell to the blocked
-cells' squares. (The walks' jumps end just before a free square's far side, so the rays that matter are
-those that run within ``TOUCH_EPS`` of a grid line: the compiled scans equal the array path
-there too, ``check_grazing_scans`` in ``tests/pairs_scan.py``, run by
+cells' squares. (The walks' jumps end just before a free square's far side, so the rays
+that matter are those that run within ``TOUCH_EPS`` of a grid line: the compiled scans
+equal the array path there too, ``check_grazing_scans`` in ``tests/pairs_scan.py``, run by
 ``property_tests/test_compiled_paths.py``.)
 """
 
