@@ -284,8 +284,8 @@ class VectorPointNavEnv(PoolRefreshing, VectorEnv):
         shared = [env.backend.floor_geometry(t.floor) for env in self._samplers]  # built by their backends
         self.floors = FloorTables(scene_list, t.floor, spec.radius, a, shared)
         bounds = [env.task.observation_bounds for env in self._samplers]
-        self._low = a.asarray(np.stack([b[0] for b in bounds]).astype(np.float64))
-        self._high = a.asarray(np.stack([b[1] for b in bounds]).astype(np.float64))
+        self._low = a.asarray(np.stack([b[0] for b in bounds]).astype(np.float32))  # float32: _observe clips after its cast
+        self._high = a.asarray(np.stack([b[1] for b in bounds]).astype(np.float32))
         low = np.min([b[0] for b in bounds], axis=0)
         high = np.max([b[1] for b in bounds], axis=0)
         if crowd is not None:  # the samplers have none: their local map's top code is a robot's
@@ -469,10 +469,10 @@ class VectorPointNavEnv(PoolRefreshing, VectorEnv):
         obs, c, s = low_dim(xp, self.state, self.goal_in_polar)
         if self.scan is not None:
             obs = cat(xp, [obs, self._scan_ranges(c, s)], -1)
-        # Cast, then clip in place: rounding is monotone, so the floats are those of clipping first.
+        # Cast, then clip in place (rounding is monotone: the floats of clipping first); one
+        # scene's bounds broadcast over the worlds (no gather), else each world its scene's.
         obs = as_dtype(xp, obs, xp.float32)
-        low, high = (as_dtype(xp, b[..., :obs.shape[-1]], xp.float32) for b in (self._low, self._high))
-        # One scene: its bounds broadcast over the worlds (no gather); else each world its scene's.
+        low, high = self._low[..., :obs.shape[-1]], self._high[..., :obs.shape[-1]]
         low, high = (low[0], high[0]) if low.shape[0] == 1 else (low[self.world_scene], high[self.world_scene])
         obs = xp.minimum(xp.maximum(obs, low, out=obs), high, out=obs)
         if self.local_map is not None:  # after the scan (the single env's order); codes within their bounds

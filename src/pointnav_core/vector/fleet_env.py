@@ -188,7 +188,7 @@ class VectorFleetEnv(VectorPointNavEnv):
         a = self.arrays
         bounds = [[t.observation_bounds for t in env.tasks] for env in self._samplers]  # (scene, robot)
         lows, highs = (np.array([[b[k] for b in row] for row in bounds], np.float64) for k in (0, 1))
-        self._low, self._high = a.asarray(lows), a.asarray(highs)
+        self._low, self._high = a.asarray(lows.astype(np.float32)), a.asarray(highs.astype(np.float32))  # as the env's
         low, high = lows.min(axis=(0, 1)).astype(np.float32), highs.max(axis=(0, 1)).astype(np.float32)
         if crowd is not None:  # the samplers have none: their local map's top code is a robot's
             high = crowd_map_high(high, sensors)

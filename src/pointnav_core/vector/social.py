@@ -128,4 +128,3 @@ class SocialTracker:
             robot_radius=self._radius[r], pedestrian_radii=crowd.radius[w, :k], success=bool(at(info["success"])),
             geodesic_dist=float(at(info["geodesic_dist"])), max_speed=self._speed[r], goal=goal,
         )
-
