@@ -57,6 +57,9 @@ PAIRS: dict[Entry, tuple[Callable[..., None], ...]] = {
     ("pointnav_core.geodesic._edges_kernel", "edge_pairs"): (pairs_floor.check_edges,),
     ("pointnav_core.geodesic._search_kernel", "seeded_dijkstra"): (pairs_geodesic.check_goal_search,),
     ("pointnav_core.geodesic._search_kernel", "seeded_astar"): (pairs_geodesic.check_point_search,),
+    ("pointnav_core.geodesic._path_kernel", "point_path"): (
+        pairs_geodesic.check_point_search, pairs_geodesic.check_point_search_pinched,
+    ),
     ("pointnav_core.geodesic._roots_kernel", "arc_tables"): (pairs_geodesic.check_arc_tables,),
     ("pointnav_core.geodesic._roots_kernel", "point_links"): (pairs_geodesic.check_point_links,),
     ("pointnav_core.geodesic._roots_kernel", "best_links"): (
@@ -82,6 +85,8 @@ PAIRS: dict[Entry, tuple[Callable[..., None], ...]] = {
 }
 
 _LOADED = re.compile(r'kernel\(\s*"(pointnav_core\.[\w.]+)",\s*"(\w+)"\s*\)|KERNEL = \("(pointnav_core\.[\w.]+)", "(\w+)"\)')
+#: ``geodesic.roots.compiled(planner, name)``: a function of ``geodesic._roots_kernel``.
+_ROOTS_LOADED = re.compile(r'\bcompiled\(\s*\w+,\s*"(\w+)"\s*\)')
 
 
 def module_name(path: Path, src: Path = SRC) -> str:
@@ -117,12 +122,13 @@ def called_by_kernels(trees: Mapping[str, ast.Module]) -> set[Entry]:
 
 def entry_points(kernels: Mapping[str, str], callers: Mapping[str, str]) -> set[Entry]:
     """The kernels a caller can reach, from the kernel modules' sources (by module name) and the
-    other modules' sources: every ``kernel(module, name)`` (or ``KERNEL = (module, name)``) of
-    the callers, and every public jitted function that no other kernel calls."""
+    other modules' sources: every ``kernel(module, name)`` (or ``KERNEL = (module, name)``, or
+    ``geodesic.roots.compiled(planner, name)``) of the callers, and every public jitted
+    function that no other kernel calls."""
     trees = {module: ast.parse(text) for module, text in kernels.items()}
     loaded = {
         (m[0] or m[2], m[1] or m[3]) for text in callers.values() for m in _LOADED.findall(text)
-    }
+    } | {("pointnav_core.geodesic._roots_kernel", m) for text in callers.values() for m in _ROOTS_LOADED.findall(text)}
     inner = called_by_kernels(trees)
     public = {(m, name) for m, tree in trees.items() for name in jitted(tree) if not name.startswith("_")}
     return loaded | (public - inner)

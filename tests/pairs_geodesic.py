@@ -218,19 +218,71 @@ def check_goal_search(floor, seed, plain_paths: Plain) -> None:
 @settings(max_examples=30, deadline=None, suppress_health_check=[HealthCheck.too_slow, HealthCheck.filter_too_much])
 @given(floor=slit_floors(), seed=st.integers(0, 2**31 - 1))
 def check_point_search(floor, seed, plain_paths: Plain) -> None:
-    """A point-to-point search on the whole graph: numba's A* gives the plain A*'s lengths
-    (1e-9 m) and reachability, and its path's ends."""
+    """A point-to-point search on the whole graph: the one compiled call
+    (``_path_kernel.point_path``, with numba's A*) gives the plain path's reachability,
+    lengths (1e-9 m) and drawn points (1e-9 m; where two routes tie and the two paths draw
+    different ones, the drawn lengths agree instead)."""
     scene, radius = floor
     planner = scene.planner(0, radius)
     pts = usable_points(scene, radius, np.random.default_rng(seed), 8)
+    # Ends where the disc does not fit, and a pair that sees itself.
+    pts += [np.asarray(scene.floors[0].origin, dtype=np.float64), pts[0] if pts else np.zeros(2)]
     for a, b in zip(pts[::2], pts[1::2]):
         got_path, got = planner.shortest_path(a, b)
         with plain_paths():
             want_path, want = planner.shortest_path(a, b)
-        assert (got is None) == (want is None)
-        if got is not None:
-            assert abs(got - want) <= 1e-9
-            assert np.allclose(got_path[[0, -1]], want_path[[0, -1]])
+        same_drawn_path(got_path, got, want_path, want)
+
+
+def same_drawn_path(got_path, got, want_path, want) -> None:
+    """Two answers of a shortest-path query agree: reachability, length (1e-9 m), and the
+    drawn points (1e-9 m), or where the drawings differ (a tie), their drawn lengths."""
+    assert (got is None) == (want is None)
+    assert (got_path is None) == (want_path is None)
+    if got is None:
+        return
+    assert abs(got - want) <= 1e-9
+    assert np.allclose(got_path[[0, -1]], want_path[[0, -1]], rtol=0, atol=1e-12)
+    if got_path.shape == want_path.shape and np.allclose(got_path, want_path, rtol=0, atol=1e-9):
+        return
+    drawn = [np.hypot(*np.diff(path, axis=0).T).sum() for path in (got_path, want_path)]
+    assert abs(drawn[0] - drawn[1]) <= 1e-9, (got_path, want_path)
+
+
+@settings(max_examples=15, deadline=None, suppress_health_check=[HealthCheck.too_slow, HealthCheck.filter_too_much])
+@given(res=st.sampled_from([0.05, 0.1]), cells=st.integers(2, 5), seed=st.integers(0, 2**31 - 1))
+def check_point_search_pinched(res, cells, seed, plain_paths: Plain) -> None:
+    """Round a block's corner A whose diagonal neighbour, a wall's corner B, is a hair more
+    than one robot diameter away, the path's arc passes B's circle, and its drawn vertices
+    there may overlap B. The compiled search hands a path's arcs back to be split where
+    they pinch (``arcs.draw_arcs``) exactly when the plain path splits one, and the drawn
+    paths are equal."""
+    from unittest import mock
+
+    from pointnav_core.geodesic import arc_search, arcs
+
+    grid = np.full((40, 40), FREE, np.uint8)
+    grid[11:15, 11:15] = OBSTACLE  # A: the block's top right corner, cell (15, 15)
+    grid[15 + cells : 19 + cells, 15 + cells : 23 + cells] = OBSTACLE  # B: cells further on both axes
+    radius = cells * res / np.sqrt(2) - 1e-10  # any narrower, and the arc is blocked there
+    scene = Scene.from_array(grid, res)
+    ax, ay = np.asarray(scene.floors[0].origin) + 15 * res
+    planner = scene.planner(0, radius)
+    rng = np.random.default_rng(seed)
+    split = 0
+    for _ in range(6):
+        # From left of A, level with its circle's top, to below it, level with its right
+        # side: the path wraps A's circle by about a quarter turn, through B's direction.
+        a = (ax - rng.uniform(0.05, 0.15), ay + radius * rng.uniform(1.0, 1.2))
+        b = (ax + radius * rng.uniform(1.0, 1.2), ay - rng.uniform(0.05, 0.15))
+        with mock.patch.object(arc_search, "draw_arcs", wraps=arc_search.draw_arcs) as handed_back:
+            got_path, got = planner.shortest_path(a, b)
+        with plain_paths(), mock.patch.object(arcs, "_split_pinched", wraps=arcs._split_pinched) as pinched:
+            want_path, want = planner.shortest_path(a, b)
+        assert handed_back.called == pinched.called
+        split += pinched.called
+        same_drawn_path(got_path, got, want_path, want)
+    note(f"{split} of 6 paths split")
 
 
 @settings(max_examples=30, deadline=None, suppress_health_check=[HealthCheck.too_slow, HealthCheck.filter_too_much])

@@ -34,10 +34,10 @@ from pointnav_core.utils import compiled as _compiled
 if TYPE_CHECKING:
     from pointnav_core.geodesic.planner import Planner
 
-__all__ = ["ArcGraph", "FieldLabels", "seeded_dijkstra"]
+__all__ = ["EPS_W", "ArcGraph", "FieldLabels", "seeded_dijkstra"]
 
 #: Added to every weight: scipy reads a stored zero as no edge.
-_EPS_W = 1e-300
+EPS_W = 1e-300
 
 
 class ArcGraph:
@@ -91,11 +91,27 @@ class ArcGraph:
         wts = [p.radius * np.maximum(d, 0.0), length, np.zeros(len(tie))]
         self._rows = np.concatenate(rows)
         self._cols = np.concatenate(cols)
-        self._w = np.concatenate(wts) + _EPS_W
+        self._w = np.concatenate(wts) + EPS_W
         # The graph once, for the compiled search (which seeds the source's arrivals itself).
         csr = sparse.csr_matrix((self._w, (self._rows, self._cols)), shape=(n_v, n_v))
         self.indptr, self.indices, self.data = csr.indptr.astype(np.int64), csr.indices.astype(np.int64), csr.data
         self._vertex_xy: tuple[NDArray[np.float64], NDArray[np.float64]] | None = None
+        self._kernel_args: tuple[tuple[Any, ...], ...] | None = None
+
+    def kernel_arguments(self) -> tuple[tuple[Any, ...], ...]:
+        """What ``geodesic._path_kernel.point_path`` reads of this graph, its planner and
+        their floor, as its ``nodes, geometry, walls, arcs, graph`` arguments; made once."""
+        if getattr(self, "_kernel_args", None) is None:  # (a copy pickled before it was made has none)
+            p = self.p
+            blocked, has_blocked = p.blocked_arcs()
+            self._kernel_args = (
+                (p.cx, p.cy, p.phi0, p.span, p.sight_reach, p.sight_profile),
+                p.geo.kernel_geometry(),
+                p.geo.kernel_arguments(p.radius),
+                (self.grp_start, self.grp_end, self.pos, blocked, has_blocked, p.span),
+                (self.indptr, self.indices, self.data, self.node, self.side, *self.vertex_points()),
+            )
+        return self._kernel_args
 
     def arc_range(self, node: int, side: int) -> tuple[int, int]:
         """The vertices ``[lo, hi)`` on the arc of ``node`` winding ``side``, by position."""
@@ -145,7 +161,7 @@ class ArcGraph:
         first vertex at or after it (-1 where none is, or the arc there is blocked), and
         the arc's cost to it (m, with the graph's zero-weight offset)."""
         x_to, x_w = self._arc_steps(x_node, x_side, x_pos, forward=True)
-        x_w[x_to >= 0] += _EPS_W
+        x_w[x_to >= 0] += EPS_W
         return x_to, x_w
 
     def departure_steps(
@@ -209,13 +225,13 @@ class ArcGraph:
         if kernel is not None:
             dist = np.full(n_v + n_x, np.inf)
             pred = np.full(n_v + n_x, -9999, dtype=np.int64)
-            kernel(self.indptr, self.indices, self.data, n_v, x_len + _EPS_W, x_to, x_w, dist, pred)
+            kernel(self.indptr, self.indices, self.data, n_v, x_len + EPS_W, x_to, x_w, dist, pred)
             return FieldLabels(self, dist, pred, x_node, x_side, x_pos)
         src = n_v + n_x
         has = np.flatnonzero(x_to >= 0)
         rows = np.concatenate([self._rows, np.full(n_x, src), n_v + has])
         cols = np.concatenate([self._cols, n_v + np.arange(n_x), x_to[has]])
-        wts = np.concatenate([self._w, x_len + _EPS_W, x_w[has]])
+        wts = np.concatenate([self._w, x_len + EPS_W, x_w[has]])
         n = src + 1
         graph = sparse.csr_matrix((wts, (rows, cols)), shape=(n, n))
         dist, pred = csgraph.dijkstra(graph, directed=True, indices=src, return_predecessors=True)

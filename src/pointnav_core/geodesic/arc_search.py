@@ -16,7 +16,10 @@ one along the arc at least as cheaply, and where the arc between them is blocked
 the way to the departure), and from an arrival on the same arc before it. The search stops
 at the first finish it settles: the heuristic (straight-line distance to the target) is
 consistent, since no tangent is shorter than its chord and no arc shorter than its chord.
-Everything is in world metres and radians.
+With numba, :func:`compiled_path` does all of a query, from the two points' tangents to
+the drawn path, in one compiled call (``geodesic._path_kernel.point_path``), the same
+steps as :func:`~pointnav_core.geodesic.point_search.shortest_path` and
+:func:`arc_graph_path`. Everything is in world metres and radians.
 """
 
 from __future__ import annotations
@@ -28,16 +31,41 @@ from typing import TYPE_CHECKING
 import numpy as np
 from numpy.typing import NDArray
 
-from pointnav_core.geodesic.arcs import draw_arcs
+from pointnav_core.floor.collision import TOUCH_TOL
+from pointnav_core.geodesic.arc_graph import EPS_W
+from pointnav_core.geodesic.arcs import ARC_PIECE, draw_arcs
 from pointnav_core.geodesic.tangents import ANG_TOL
 from pointnav_core.utils import compiled as _compiled
 
 if TYPE_CHECKING:
     from pointnav_core.geodesic.arc_graph import ArcGraph
 
-__all__ = ["arc_graph_path", "seeded_astar"]
+__all__ = ["arc_graph_path", "compiled_path", "seeded_astar"]
 
 Link = tuple[int, int, float, float]
+
+_NOT_CLEAR, _NO_PATH, _STRAIGHT, _DRAWN, _PINCHED = range(5)  # _path_kernel's outcomes
+
+
+def compiled_path(
+    graph: ArcGraph, source: tuple[float, float], target: tuple[float, float]
+) -> tuple[NDArray[np.float64], float] | tuple[None, None] | None:
+    """:func:`~pointnav_core.geodesic.point_search.shortest_path` on ``graph`` in one
+    compiled call (``geodesic._path_kernel.point_path``): the drawn path (N, 2) from
+    ``source`` to ``target`` (m) and its length (m), ``(None, None)`` without one, or None
+    where the compiled path cannot run (no numba, or polygons it cannot read)."""
+    p = graph.p
+    kernel = _compiled.kernel("pointnav_core.geodesic._path_kernel", "point_path")
+    if kernel is None or not p.geo.compiled_polygons:
+        return None
+    outcome, cost, pts, *arcs = kernel(float(source[0]), float(source[1]), float(target[0]), float(target[1]),
+                                       *graph.kernel_arguments(), p.radius, ANG_TOL, TOUCH_TOL, ARC_PIECE, EPS_W)
+    if outcome in (_NOT_CLEAR, _NO_PATH):
+        return None, None
+    if outcome == _PINCHED:  # a passage as wide as the robot: its arcs split where it pinches
+        drawn = draw_arcs(p, list(zip(*(a.tolist() for a in arcs))))
+        pts = np.concatenate([[target], drawn, [source]])[::-1].copy()
+    return pts, float(cost)
 
 
 def arc_graph_path(

@@ -2,10 +2,12 @@
 
 :func:`shortest_path` (what :meth:`Planner.shortest_path
 <pointnav_core.geodesic.planner.Planner.shortest_path>` calls) joins the two points straight
-where it can; otherwise it searches the whole graph in compiled code when the planner has
-it (:mod:`pointnav_core.geodesic.arc_search`), or runs :class:`PointSearch`, a label-setting
+where it can; otherwise it searches the whole graph when the planner has it
+(:mod:`pointnav_core.geodesic.arc_search`), or runs :class:`PointSearch`, a label-setting
 search (A* towards the target) over the planner's tangent edges, built lazily tile by tile.
-Everything is in world metres and radians.
+On the whole graph, with numba, the query is one compiled call from the clearance tests to
+the drawn points (:func:`~pointnav_core.geodesic.arc_search.compiled_path`; a crowd plans
+this way at each arrival). Everything is in world metres and radians.
 """
 
 from __future__ import annotations
@@ -18,7 +20,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from pointnav_core.geodesic.arc_search import arc_graph_path
+from pointnav_core.geodesic.arc_search import arc_graph_path, compiled_path
 from pointnav_core.geodesic.arcs import draw_arcs
 from pointnav_core.geodesic.tangents import ANG_TOL, COST_TOL
 
@@ -39,6 +41,10 @@ def shortest_path(
     src = np.asarray(source, dtype=np.float64)[:2]
     tgt = np.asarray(target, dtype=np.float64)[:2]
     sx, sy, tx, ty = float(src[0]), float(src[1]), float(tgt[0]), float(tgt[1])
+    if graph is not None:
+        found = compiled_path(graph, (sx, sy), (tx, ty))
+        if found is not None:
+            return found
     if not (p.is_clear(sx, sy) and p.is_clear(tx, ty)):
         return None, None
     if p.segment_clear(src, tgt):
