@@ -142,7 +142,10 @@ class Crowd:
 
     def discs(self) -> NDArray[np.float64]:
         """``(P, 3)`` discs ``(x, y, radius)`` of the pedestrians (m)."""
-        return np.column_stack([self.positions, self.radius])
+        out = np.empty((self.n, 3))
+        out[:, :2] = self.positions
+        out[:, 2] = self.radius
+        return out
 
     # ------------------------------------------------------------------ placing
     def spawn(self, floor: int, rng: np.random.Generator, robots: NDArray[np.float64],

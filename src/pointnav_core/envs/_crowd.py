@@ -13,7 +13,7 @@ from numpy.typing import NDArray
 
 from pointnav_core.backends.protocol import float_twin
 from pointnav_core.envs.common import edit_task
-from pointnav_core.transforms import quat2yaw
+from pointnav_core.transforms.planar import heading_of
 
 __all__ = [
     "CrowdTrack", "add_pedestrian_termination", "crowd_robots", "episode_crowd", "make_crowd", "pose_twins", "robot_discs",
@@ -66,7 +66,8 @@ def crowd_robots(
     backend, floor = env.backend, env.crowd.floor
     # The float twins give the same numbers without building two arrays per robot per step.
     pose, velocity = pose_twins(backend) if twins is None else twins
-    ids, discs, velocities = [], [], []
+    ids: list[int] = []
+    discs, velocities = np.empty((len(env.robots), 3)), np.empty((len(env.robots), 2))
     for j, spec in enumerate(env.robots):
         if not backend.is_present(j) or backend.get_robot_floor(j) != floor:
             continue
@@ -75,10 +76,11 @@ def crowd_robots(
             vx, vy = velocity(j)[:2]
         else:
             (x, y), (vx, vy) = backend.get_pose(j)[0][:2].tolist(), backend.get_velocity(j)[0][:2].tolist()
+        m = len(ids)
+        discs[m] = x, y, spec.radius
+        velocities[m] = vx, vy
         ids.append(j)
-        discs.append((x, y, spec.radius))
-        velocities.append((vx, vy))
-    return ids, np.array(discs, dtype=np.float64).reshape(-1, 3), np.array(velocities, dtype=np.float64).reshape(-1, 2)
+    return ids, discs[: len(ids)], velocities[: len(ids)]
 
 
 def robot_discs(env: Any, twins: tuple[Any, Any] | None = None) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
@@ -128,12 +130,12 @@ class CrowdTrack:
         """Add the env's positions now (after a control step, or at the reset)."""
         pose = self.twins[0]
         if pose is not None:  # the same numbers as get_pose, without its arrays
-            x, y, _, *quat = pose(self.idn)
+            x, y, _, qx, qy, qz, qw = pose(self.idn)
         else:
             position, quat = env.backend.get_pose(self.idn)
-            x, y = position[:2].tolist()
+            (x, y), (qx, qy, qz, qw) = position[:2].tolist(), quat.tolist()
         self.robot.append((x, y))
-        self.heading.append(float(quat2yaw(quat)))
+        self.heading.append(heading_of(qx, qy, qz, qw))
         self.pedestrians.append(env.crowd.positions.copy())
 
     def metrics(self, env: Any, info: Mapping[str, Any]) -> dict[str, float | None]:

@@ -301,19 +301,22 @@ def cast_pose_compiled(
     heading: NDArray[np.float64],
     angles: tuple[NDArray[np.float64], NDArray[np.float64]],
     max_range: float,
+    discs: NDArray[np.float64] | None = None,
 ) -> NDArray[np.float64] | None:
     """One origin's ranges (m), ``(R,)``, by the compiled path, or None without numba.
 
-    :func:`cast_rays` for one robot and no discs, with its conversions left out: ``origin``
-    is a ``(1, 2)`` float64 array, ``heading`` a ``(2,)`` float64 array of the yaw's
-    ``np.cos`` and ``np.sin`` (one ``np.cos`` and one ``np.sin`` of a length-1 yaw array),
-    ``angles`` the bearings' ``np.cos`` and ``np.sin``, computed once. A scan calls it at
-    every step.
+    :func:`cast_rays` for one robot, with its conversions left out: ``origin`` is a
+    ``(1, 2)`` float64 array, ``heading`` a ``(2,)`` float64 array of the yaw's ``np.cos``
+    and ``np.sin`` (one ``np.cos`` and one ``np.sin`` of a length-1 yaw array), ``angles``
+    the bearings' ``np.cos`` and ``np.sin``, computed once, and ``discs`` None or a
+    C-contiguous ``(M, 3)`` float64 array of the discs it sees (other robots, pedestrians).
+    A scan calls it at every step.
     """
     if not raycast_jit.available():
         return None
     best, near = raycast_jit.cast_rays_compiled(
-        geometry, origin, heading[:1], heading[1:], angles[0], angles[1], max_range, _NO_DISCS, _no_own(1)
+        geometry, origin, heading[:1], heading[1:], angles[0], angles[1], max_range,
+        _NO_DISCS if discs is None else discs, _no_own(1)
     )
     if near:
         best[inside_polygon(geometry, origin)] = 0.0

@@ -55,6 +55,7 @@ from pointnav_core.sensors._checks import check_int, check_number
 from pointnav_core.sensors.noise import episode_key, scan_noise, seed_entropy
 from pointnav_core.sensors.raycast import ScanGeometry, cast_pose_compiled, cast_rays
 from pointnav_core.task.observations import Frame, ObservationTerm
+from pointnav_core.transforms.planar import heading_of
 
 __all__ = ["RangeScan", "ScanShare", "other_robot_discs", "pedestrian_discs", "scan_angles"]
 
@@ -234,12 +235,12 @@ class RangeScan(ObservationTerm):
         origin[0, 0] = frame.x
         origin[0, 1] = frame.y
         yaw[0] = math.atan2(frame.sin_yaw, frame.cos_yaw)
-        if discs is None or not len(discs):
-            np.cos(yaw, out=heading[:1])  # as cast_rays turns its rays
-            np.sin(yaw, out=heading[1:])
-            fast = cast_pose_compiled(self._geometry, origin, heading, self._directions, self.max_range)
-            if fast is not None:
-                return fast
+        np.cos(yaw, out=heading[:1])  # as cast_rays turns its rays
+        np.sin(yaw, out=heading[1:])
+        fast = cast_pose_compiled(self._geometry, origin, heading, self._directions, self.max_range,
+                                  None if discs is None else np.ascontiguousarray(discs, dtype=np.float64))
+        if fast is not None:
+            return fast
         return cast_rays(
             self._geometry, origin, yaw, self.angles, self.max_range,
             discs=discs if discs is not None and len(discs) else None,
@@ -270,19 +271,6 @@ class RangeScan(ObservationTerm):
             f"RangeScan(n_rays={self.n_rays}, fov={self.fov:g}, min_range={self.min_range:g}, "
             f"max_range={self.max_range:g}, noise_std={self.noise_std:g}, dropout={self.dropout:g})"
         )
-
-
-def _heading(qx: float, qy: float, qz: float, qw: float) -> float:
-    """Yaw (rad) of a quaternion, as :class:`~pointnav_core.task.observations.Frame` derives it."""
-    q2 = 2.0 / (qx * qx + qy * qy + qz * qz + qw * qw)
-    r00 = 1.0 - q2 * (qy * qy + qz * qz)
-    r10 = q2 * (qx * qy + qz * qw)
-    h = math.hypot(r00, r10)
-    if h > 1e-12:
-        return math.atan2(r10 / h, r00 / h)
-    r01 = q2 * (qx * qy - qz * qw)
-    r11 = 1.0 - q2 * (qx * qx + qz * qz)
-    return math.atan2(-r01, r11)
 
 
 class ScanShare:
@@ -339,7 +327,7 @@ class ScanShare:
             rows = cast_rays(
                 self.geometry,
                 [robots[k][1:3] for k in cast],
-                [_heading(*robots[k][3:7]) for k in cast],
+                [heading_of(*robots[k][3:7]) for k in cast],
                 self.angles,
                 self.max_range,
                 discs=[(r[1], r[2], r[7]) for r in robots],

@@ -32,6 +32,7 @@ batch shapes of two arguments do not broadcast.
 
 from pointnav_core.transforms.planar import (
     cartesian_to_polar,
+    heading_of,
     l2_distance,
     polar_to_cartesian,
     quat2yaw,
@@ -58,6 +59,7 @@ __all__ = [
     "quat_apply",
     "yaw2quat",
     "quat2yaw",
+    "heading_of",
     "cartesian_to_polar",
     "polar_to_cartesian",
     "l2_distance",

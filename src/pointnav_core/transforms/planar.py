@@ -27,6 +27,7 @@ from pointnav_core.transforms._kernels import (
 __all__ = [
     "yaw2quat",
     "quat2yaw",
+    "heading_of",
     "cartesian_to_polar",
     "polar_to_cartesian",
     "l2_distance",
@@ -137,6 +138,26 @@ def quat2yaw(quat: ArrayLike) -> np.float64 | NDArray[np.float64]:
     if locked:
         yaw = _angle(2.0 * (w * z - x * y), 1.0 - 2.0 * (x * x + z * z))
     return np.float64(yaw)
+
+
+def heading_of(qx: float, qy: float, qz: float, qw: float) -> float:
+    """:func:`quat2yaw` of one quaternion ``(qx, qy, qz, qw)`` given as four floats, with no
+    array: the form of a per-step caller (a scan, a crowd's track), as
+    :class:`~pointnav_core.task.observations.Frame` derives the heading (the same angle
+    within a few ulps; unchecked input).
+
+    >>> round(heading_of(0.0, 0.0, math.sin(0.25), math.cos(0.25)), 12)
+    0.5
+    """
+    q2 = 2.0 / (qx * qx + qy * qy + qz * qz + qw * qw)
+    r00 = 1.0 - q2 * (qy * qy + qz * qz)
+    r10 = q2 * (qx * qy + qz * qw)
+    h = math.hypot(r00, r10)
+    if h > 1e-12:
+        return math.atan2(r10 / h, r00 / h)
+    r01 = q2 * (qx * qy - qz * qw)
+    r11 = 1.0 - q2 * (qx * qx + qz * qz)
+    return math.atan2(-r01, r11)
 
 
 # -------------------------------------------------------------------------- polar form
