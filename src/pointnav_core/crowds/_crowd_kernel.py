@@ -160,8 +160,14 @@ def orca_crowd_step(pos, vel, radius, speed, goals, paths, nxt, last, robots, ro
         (speed above 1e-9 m/s).
     contacts : (M,) bool
         Filled with whether each robot's disc overlaps a pedestrian's after the step.
+
+    Returns
+    -------
+    int
+        How many pedestrians need a new plan (blocked or arrived).
     """
     n, m = pos.shape[0], seen
+    replans = 0
     pref = np.empty((n, 2))
     _preferred(pos, speed, paths, nxt, last, dt, walls, pref)
     vel32 = _orca_velocities(pos, vel, pref, radius, speed, robots, robot_vel, m, dt, neighbor_dist,
@@ -193,7 +199,9 @@ def orca_crowd_step(pos, vel, radius, speed, goals, paths, nxt, last, robots, ro
         if np.sqrt(gx * gx + gy * gy) < goal_reached:
             bit |= 2
         flags[i] = bit
+        replans += bit & 3 != 0
     _contacts(robots, new_pos, radius, contacts)
+    return replans
 
 
 @_jit

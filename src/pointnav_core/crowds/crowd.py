@@ -67,6 +67,8 @@ ROBOT_LOOKAHEAD = 10.0
 _SOCIAL_FORCE = SocialForceParams(goal_threshold=0.0, stop_distance=0.0)
 #: The compiled step of ORCA crowds (``utils.compiled.kernel``'s module and function).
 KERNEL = ("pointnav_core.crowds._crowd_kernel", "orca_crowd_step")
+_NO_ROWS = np.zeros(0, np.int64)  # no pedestrian to plan for (read only)
+_NO_ROWS.flags.writeable = False
 
 
 class CrowdStart(NamedTuple):
@@ -360,11 +362,13 @@ class Crowd:
         robot_velocities = np.ascontiguousarray(robot_velocities, dtype=np.float64).reshape(-1, 2)
         new_pos, new_vel = np.empty((n, 2)), np.empty((n, 2))
         flags, contacts = np.empty(n, np.int8), np.empty(len(robots), np.bool_)
-        fn(self.positions, self.velocities, self.radius, self.speed, self.goals, self._paths, self._next, self._last,
-           robots, robot_velocities, len(robots) if cfg.sees_robots else 0, float(dt), cfg.neighbor_dist,
-           cfg.max_neighbors, cfg.time_horizon, GOAL_REACHED, collision.kernel_arguments(cfg.radius[1]),
-           new_pos, new_vel, flags, contacts)
-        self._moved(new_pos, new_vel, flags & 4, np.flatnonzero(flags & 3), flags & 2)
+        replans = fn(self.positions, self.velocities, self.radius, self.speed, self.goals, self._paths, self._next,
+                     self._last, robots, robot_velocities, len(robots) if cfg.sees_robots else 0, float(dt),
+                     cfg.neighbor_dist, cfg.max_neighbors, cfg.time_horizon, GOAL_REACHED,
+                     collision.kernel_arguments(cfg.radius[1]), new_pos, new_vel, flags, contacts)
+        # Most steps plan nothing: the masks of who does are made only when someone does.
+        replan = np.flatnonzero(flags & 3) if replans else _NO_ROWS
+        self._moved(new_pos, new_vel, flags & 4, replan, flags & 2 if replans else None)
         return contacts
 
     def _step_arrays(self, dt: float, robots: NDArray[np.float64], robot_velocities: NDArray[np.float64]) -> None:
@@ -396,13 +400,15 @@ class Crowd:
         self._moved(new, vel, moving, np.flatnonzero(blocked | arrived), arrived)
 
     def _moved(self, positions: NDArray[np.float64], velocities: NDArray[np.float64], moving: NDArray[Any],
-               replan: NDArray[np.int64], arrived: NDArray[Any]) -> None:
+               replan: NDArray[np.int64], arrived: NDArray[Any] | None) -> None:
         """Take a step's new ``(P, 2)`` positions (m) and velocities (m/s): the headings of
         the ``moving`` (a ``(P,)`` mask, nonzero where moving), and new plans for the
-        pedestrians ``replan``: from where they stand, to a new goal where ``arrived``."""
+        pedestrians ``replan``: from where they stand, to a new goal where ``arrived``
+        (a ``(P,)`` mask; None when ``replan`` is empty)."""
         self.positions, self.velocities = positions, velocities
         self.headings = np.where(moving, np.arctan2(velocities[:, 1], velocities[:, 0]), self.headings)
         if len(replan):
+            assert arrived is not None
             paths = [self._plan(int(i), bool(arrived[i]), self._rngs[int(i)]) for i in replan]
             self._set_paths(replan, paths)
 

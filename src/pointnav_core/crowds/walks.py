@@ -56,7 +56,8 @@ def plan_walk(scene: Any, floor: int, radius: float, here: NDArray[np.float64], 
     tmap = scene.floors[floor]
     # Where to plan from: here, or the nearest cell centre within 3 cells where the paths'
     # radius fits (a neighbour's push can leave a pedestrian nearer a wall than its path runs).
-    start = here if tmap.is_usable(here, radius) else nearest_usable(tmap, here, radius)
+    x, y = float(here[0]), float(here[1])
+    start = here if tmap.collision.segment_clear(x, y, x, y, radius) else nearest_usable(tmap, here, radius)
     if start is None:
         return Planned(here[None].copy(), False)
     drawn = False
