@@ -50,9 +50,11 @@ def reach_labels(tmap: TraversableMap, radius: float) -> NDArray[np.int32]:
 
 def _labels_at(tmap: TraversableMap, labels: NDArray[np.int32], xy: Any) -> set[int]:
     """Labels of the cells whose closed square holds ``xy`` (up to four on a corner)."""
-    g = (np.asarray(xy, float) - np.asarray(tmap.origin)) / tmap.resolution  # (col, row) in cells
-    cols = {math.floor(g[0]), math.ceil(g[0]) - 1}
-    rows = {math.floor(g[1]), math.ceil(g[1]) - 1}
+    # (col, row) in cells, on floats: the numbers numpy's arrays give, without their set-up.
+    gx = (float(xy[0]) - tmap.origin[0]) / tmap.resolution
+    gy = (float(xy[1]) - tmap.origin[1]) / tmap.resolution
+    cols = {math.floor(gx), math.ceil(gx) - 1}
+    rows = {math.floor(gy), math.ceil(gy) - 1}
     h, w = labels.shape
     return {int(labels[r, c]) for r in rows for c in cols if 0 <= r < h and 0 <= c < w} - {0}
 

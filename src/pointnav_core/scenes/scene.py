@@ -366,9 +366,10 @@ class Scene:
             raise SamplingError(
                 f"floor {floor} has no usable cell{within} for a robot of radius {radius} m"
             )
-        cell = np.unravel_index(index, tmap.shape)
-        x, y = tmap.cell_to_world(np.array(cell))
-        return int(floor), np.array([x, y, tmap.height])
+        # The cell's centre as cell_to_world computes it, without its array set-up.
+        row, col = divmod(index, tmap.shape[1])
+        res, (ox, oy) = tmap.resolution, tmap.origin
+        return int(floor), np.array([ox + (col + 0.5) * res, oy + (row + 0.5) * res, tmap.height])
 
     # ---------------------------------------------------------------- geodesic
     def goal_field(self, floor: int, goal_xy: ArrayLike, robot: Any = None) -> FloorGoalField:
