@@ -6,7 +6,8 @@ machine.
 Speed (default): for generated houses on 200x200, 400x400 and 1000x1000 grids, the time to
 build the per-floor planner of :mod:`pointnav_core.geodesic.planner` (erosion, corners and
 their arcs), to build one goal field, to query a cached field (a distance lookup and a whole
-any-angle path), and, for the same start/goal pairs, one query of pyastar2d's C++ A* and of
+any-angle path), to find the same pair's path without a field (``Planner.shortest_path``,
+the point-to-point search a crowd's plans run), and, for the same start/goal pairs, one query of pyastar2d's C++ A* and of
 networkx A* on an 8-connected grid graph (how iGibson planned).
 
 Accuracy (``--accuracy``, with the speed mode): relative error of ``get_shortest_path``
@@ -148,7 +149,7 @@ def speed(args):
         scene = scenes.rooms(seed=args.seed, **kw)
         tmap = scene.floors[0]
         rng = np.random.default_rng(args.seed)
-        _, t_planner = timed(lambda: scene.planner(0, RADIUS).component_graph(1) and scene.planner(0, RADIUS).cell_graph())
+        _, t_planner = timed(lambda: scene.planner(0, RADIUS))  # built on first use, then cached
         pairs = grid_pairs(scene, args.pairs, rng)
         fields = []
         t_field = []
@@ -164,11 +165,16 @@ def speed(args):
             t_field.append(t)
         t_lookup = []
         t_path = []
+        t_point = []
+        planner = scene.planner(0, RADIUS)
         for (a, b, _, _), f in zip(pairs, fields):
             _, t = timed(lambda: f.distance(a[0], a[1]), repeat=50)
             t_lookup.append(t)
             _, t = timed(lambda: scene.get_shortest_path(0, a, b, entire_path=True, robot=RADIUS), repeat=5)
             t_path.append(t)
+            # The same pair without the goal's field: the point-to-point search a crowd's plans run.
+            _, t = timed(lambda: planner.shortest_path(a, b), repeat=5)
+            t_point.append(t)
         usable = tmap.usable(RADIUS)
         weights = np.where(usable, 1.0, np.inf).astype(np.float32)
         t_astar = []
@@ -183,17 +189,18 @@ def speed(args):
                 _, t = timed(lambda: nx.astar_path(graph, tuple(ca), tuple(cb), heuristic=heuristic, weight="weight"))
                 t_nx.append(t)
         med = statistics.median
-        rows.append((name, t_planner, med(t_field), med(t_lookup), med(t_path), med(t_astar),
+        rows.append((name, t_planner, med(t_field), med(t_lookup), med(t_path), med(t_point), med(t_astar),
                      med(t_nx) if t_nx else math.nan))
-    print(f"{'grid':26} {'planner':>9} {'field':>9} {'lookup':>9} {'path':>9} {'pyastar2d':>10} "
-          f"{'networkx':>10} {'astar/lookup':>13} {'astar/path':>11} {'nx/path':>9}")
-    for name, tp, tf, tl, tq, ta, tn in rows:
-        print(f"{name:26} {tp*1e3:8.1f}ms {tf*1e3:8.2f}ms {tl*1e6:8.2f}us {tq*1e6:8.1f}us "
-              f"{ta*1e3:9.2f}ms {tn*1e3:9.1f}ms {ta/tl:13.0f} {ta/tq:11.1f} {tn/tq:9.0f}")
+    print(f"{'grid':26} {'planner':>9} {'field':>9} {'lookup':>9} {'path':>9} {'point':>9} {'pyastar2d':>10} "
+          f"{'networkx':>10} {'astar/lookup':>13} {'astar/path':>11} {'astar/point':>12} {'nx/path':>9}")
+    for name, tp, tf, tl, tq, tpt, ta, tn in rows:
+        print(f"{name:26} {tp*1e3:8.1f}ms {tf*1e3:8.2f}ms {tl*1e6:8.2f}us {tq*1e6:8.1f}us {tpt*1e6:8.1f}us "
+              f"{ta*1e3:9.2f}ms {tn*1e3:9.1f}ms {ta/tl:13.0f} {ta/tq:11.1f} {ta/tpt:12.1f} {tn/tq:9.0f}")
     print("planner: per floor and radius (erosion, corners, arcs), cached;"
           " field: per goal (arc-vertex distances + root table), cached; lookup:"
           " FloorGoalField.distance (the per-step query); path: get_shortest_path to a cached"
-          " goal (checked, entire any-angle path); medians over pairs.")
+          " goal (checked, entire any-angle path); point: Planner.shortest_path of the same pair"
+          " without a field (A* on the whole graph, one compiled call with numba); medians over pairs.")
 
 
 def accuracy(args):
