@@ -14,27 +14,15 @@ same floats (``tests/pairs_crowds.py``); the headings (``atan2``) are left to nu
 
 from __future__ import annotations
 
-import math
-
 import numba
 import numpy as np
 
 from pointnav_core.crowds._orca_kernel import orca_worlds
-from pointnav_core.floor._collision_kernel import segment_hits
+from pointnav_core.floor._collision_kernel import segment_clear as _clear
 
 __all__ = ["orca_crowd_step", "orca_crowd_worlds"]
 
 _jit = numba.njit(cache=True, nogil=True, error_model="numpy")
-
-
-@_jit
-def _clear(ax, ay, bx, by, walls):  # pragma: no cover
-    # FloorCollision.segments_clear for one segment: False where an end is not finite.
-    if not (math.isfinite(ax) and math.isfinite(ay) and math.isfinite(bx) and math.isfinite(by)):
-        return False
-    ox, oy, inv, rho, rowcum, outside, reach, boxes, first, last, ex0, ey0, ex1, ey1, use_polygons = walls
-    return not segment_hits(ax, ay, bx, by, ox, oy, inv, rho, rowcum, outside, reach, boxes, first, last, ex0, ey0,
-                            ex1, ey1, use_polygons)
 
 
 @_jit

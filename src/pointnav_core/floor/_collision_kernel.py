@@ -12,7 +12,7 @@ import math
 
 import numba
 
-__all__ = ["cells_hit", "segment_hits", "segments_clear"]
+__all__ = ["cells_hit", "segment_clear", "segment_hits", "segments_clear"]
 
 _jit = numba.njit(cache=True, nogil=True, error_model="numpy")
 
@@ -187,6 +187,17 @@ def segment_hits(ax, ay, bx, by, ox, oy, inv, rho, rowcum, outside_blocked, reac
                           outside_blocked):
         return True
     return use_polygons and segment_hits_polygons(ax, ay, bx, by, reach, boxes, first, last, ex0, ey0, ex1, ey1)
+
+
+@_jit
+def segment_clear(ax, ay, bx, by, walls):  # pragma: no cover
+    """``FloorCollision.segment_clear`` for one segment, ``walls`` being
+    ``FloorCollision.kernel_arguments(radius)``: False where an end is not finite."""
+    if not (math.isfinite(ax) and math.isfinite(ay) and math.isfinite(bx) and math.isfinite(by)):
+        return False
+    ox, oy, inv, rho, rowcum, outside, reach, boxes, first, last, ex0, ey0, ex1, ey1, use_polygons = walls
+    return not segment_hits(ax, ay, bx, by, ox, oy, inv, rho, rowcum, outside, reach, boxes, first, last, ex0, ey0,
+                            ex1, ey1, use_polygons)
 
 
 @_jit

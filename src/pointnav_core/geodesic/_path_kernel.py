@@ -20,7 +20,7 @@ import math
 import numba
 import numpy as np
 
-from pointnav_core.floor._collision_kernel import segment_hits
+from pointnav_core.floor._collision_kernel import segment_clear as _clear
 from pointnav_core.geodesic._roots_kernel import _arc_free, point_links
 from pointnav_core.geodesic._search_kernel import seeded_astar
 
@@ -30,16 +30,6 @@ _jit = numba.njit(cache=True, nogil=True, error_model="numpy")
 
 #: :func:`point_path`'s outcomes.
 NOT_CLEAR, NO_PATH, STRAIGHT, DRAWN, PINCHED = 0, 1, 2, 3, 4
-
-
-@_jit
-def _clear(ax, ay, bx, by, walls):  # pragma: no cover
-    # FloorCollision.segment_clear for the planner's disc: False where an end is not finite.
-    if not (math.isfinite(ax) and math.isfinite(ay) and math.isfinite(bx) and math.isfinite(by)):
-        return False
-    ox, oy, inv, rho, rowcum, outside, reach, boxes, first, last, ex0, ey0, ex1, ey1, use_polygons = walls
-    return not segment_hits(ax, ay, bx, by, ox, oy, inv, rho, rowcum, outside, reach, boxes, first, last, ex0, ey0,
-                            ex1, ey1, use_polygons)
 
 
 @_jit
