@@ -117,6 +117,38 @@ def _draw(arcs_node, arcs_side, arcs_from, arcs_to, nodes, r, ang_tol, piece_max
 
 
 @_jit
+def _same_arc(x_node, x_side, x_pos, f_node, f_side, f_pos, f_len, arcs, r, ang_tol):  # pragma: no cover
+    # arc_search.arc_graph_path's xf_w: finish f entered from arrival k on its arc before it
+    # (a path that wraps one node only), at the arc's cost and the finish's tangent; inf: not.
+    _, _, _, blocked, has_blocked, span = arcs
+    xf_w = np.full((x_node.shape[0], f_node.shape[0]), np.inf)
+    for k in range(x_node.shape[0]):
+        for f in range(f_node.shape[0]):
+            if x_node[k] == f_node[f] and x_side[k] == f_side[f] and x_pos[k] <= f_pos[f] + ang_tol and _arc_free(
+                    blocked, has_blocked, span, f_node[f], f_side[f], x_pos[k], f_pos[f], ang_tol):
+                xf_w[k, f] = r * max(f_pos[f] - x_pos[k], 0.0) + f_len[f]
+    return xf_w
+
+
+@_jit
+def _drawn_path(sx, sy, tx, ty, arcs_node, arcs_side, arcs_from, arcs_to, nodes, r, ang_tol, piece_max,
+                walls):  # pragma: no cover
+    # The drawn path from the source to the target, (N, 2): the target, the arcs drawn by
+    # _draw, the source, reversed; (0, 2) where a drawn vertex is not clear.
+    size = 2
+    for a in range(arcs_node.shape[0]):
+        delta = arcs_from[a] - arcs_to[a]
+        size += 1 if delta <= ang_tol or r == 0.0 else max(1, math.ceil(delta / piece_max)) + 2
+    out = np.empty((size, 2))
+    out[0, 0], out[0, 1] = tx, ty
+    at = _draw(arcs_node, arcs_side, arcs_from, arcs_to, nodes, r, ang_tol, piece_max, walls, out, 1)
+    if at < 0:
+        return np.zeros((0, 2))
+    out[at, 0], out[at, 1] = sx, sy
+    return out[::-1].copy()
+
+
+@_jit
 def _trace(pred, first, g_node, g_side, g_pos, x_node, x_side, x_pos, dep):  # pragma: no cover
     # arc_search.arc_graph_path's trace: from the finish's predecessor ``first`` back to the
     # source, each arc as (node, side, departure, arrival), target side first.
@@ -204,14 +236,7 @@ def point_path(sx, sy, tx, ty, nodes, geometry, walls, arcs, graph, r, ang_tol, 
             x_w[k] += eps_w
     f_from, f_arc = _arc_steps(f_node, f_side, f_pos, False, arcs, r, ang_tol)
     f_w = f_arc + f_len
-    # ... and from an arrival on its arc before it (a path that wraps one node only).
-    _, _, _, blocked, has_blocked, _ = arcs
-    xf_w = np.full((n_x, n_f), np.inf)
-    for k in range(n_x):
-        for f in range(n_f):
-            if x_node[k] == f_node[f] and x_side[k] == f_side[f] and x_pos[k] <= f_pos[f] + ang_tol and _arc_free(
-                    blocked, has_blocked, span, f_node[f], f_side[f], x_pos[k], f_pos[f], ang_tol):
-                xf_w[k, f] = r * max(f_pos[f] - x_pos[k], 0.0) + f_len[f]
+    xf_w = _same_arc(x_node, x_side, x_pos, f_node, f_side, f_pos, f_len, arcs, r, ang_tol)
     indptr, indices, data, g_node, g_side, vx, vy = graph
     n_v = vx.shape[0]
     x_x, x_y = np.empty(n_x), np.empty(n_x)
@@ -227,14 +252,7 @@ def point_path(sx, sy, tx, ty, nodes, geometry, walls, arcs, graph, r, ang_tol, 
     cost = dist[n_v + n_x + best]
     arc_n, arc_s, arc_a, arc_b = _trace(pred, pred[n_v + n_x + best], g_node, g_side, arcs[2], x_node, x_side, x_pos,
                                         f_pos[best])
-    size = 2
-    for a in range(arc_n.shape[0]):
-        delta = arc_a[a] - arc_b[a]
-        size += 1 if delta <= ang_tol or r == 0.0 else max(1, math.ceil(delta / piece_max)) + 2
-    out = np.empty((size, 2))
-    out[0, 0], out[0, 1] = tx, ty
-    at = _draw(arc_n, arc_s, arc_a, arc_b, nodes, r, ang_tol, piece_max, walls, out, 1)
-    if at < 0:
+    out = _drawn_path(sx, sy, tx, ty, arc_n, arc_s, arc_a, arc_b, nodes, r, ang_tol, piece_max, walls)
+    if out.shape[0] == 0:
         return PINCHED, cost, empty, arc_n, arc_s, arc_a, arc_b
-    out[at, 0], out[at, 1] = sx, sy
-    return DRAWN, cost, out[::-1].copy(), arc_n, arc_s, arc_a, arc_b
+    return DRAWN, cost, out, arc_n, arc_s, arc_a, arc_b
