@@ -17,6 +17,7 @@ from pointnav_core.testing.strategies import (
 from pointnav_core.transforms import (
     cartesian_to_polar,
     euler2quat,
+    heading_of,
     l2_distance,
     mat2quat,
     polar_to_cartesian,
@@ -177,6 +178,26 @@ def test_quat2yaw_is_the_heading_of_the_forward_axis(q):
         expected = math.atan2(forward[1], forward[0])
         assert abs(angle_diff(yaw, expected)) <= 1e-14 / planar
     assert -math.pi < yaw <= math.pi
+
+
+@given(unit_quaternions(), st.floats(0.5, 2.0))
+def test_heading_of_is_the_heading_of_the_forward_axis(q, scale):
+    """The scalar form, on quaternions of any length, against the rotated +x axis worked out
+    by quat_apply; straight up or down it reads the heading off +y, as quat2yaw does."""
+    qx, qy, qz, qw = (float(v) * scale for v in q)
+    forward = quat_apply(q, [1.0, 0.0, 0.0])
+    planar = math.hypot(forward[0], forward[1])
+    yaw = heading_of(qx, qy, qz, qw)
+    if planar > 1e-6:
+        assert abs(angle_diff(yaw, math.atan2(forward[1], forward[0]))) <= 1e-14 / planar
+    assert -math.pi <= yaw <= math.pi
+
+
+@given(st.floats(-math.pi, math.pi), st.sampled_from([1.0, -1.0]))
+def test_heading_of_straight_up_or_down_is_quat2yaw(angle, sign):
+    # +x rotated onto +z or -z (pitch -+90 degrees) after a yaw of `angle`.
+    q = quat_multiply(yaw2quat(angle), [0.0, sign * math.sin(math.pi / 4), 0.0, math.cos(math.pi / 4)])
+    assert abs(angle_diff(heading_of(*(float(v) for v in q)), float(quat2yaw(q)))) <= 1e-9
 
 
 # ------------------------------------------------------------------------- polar form

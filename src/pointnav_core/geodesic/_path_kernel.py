@@ -23,13 +23,18 @@ import numpy as np
 from pointnav_core.floor._collision_kernel import segment_clear as _clear
 from pointnav_core.geodesic._roots_kernel import _arc_free, point_links
 from pointnav_core.geodesic._search_kernel import seeded_astar
+from pointnav_core.geodesic.arc_search import (
+    DRAWN,
+    NO_PATH,
+    NOT_CLEAR,
+    PINCHED,
+    STRAIGHT,
+)
 
 __all__ = ["point_path"]
 
 _jit = numba.njit(cache=True, nogil=True, error_model="numpy")
 
-#: :func:`point_path`'s outcomes.
-NOT_CLEAR, NO_PATH, STRAIGHT, DRAWN, PINCHED = 0, 1, 2, 3, 4
 
 
 @_jit

@@ -40,11 +40,13 @@ from pointnav_core.utils import compiled as _compiled
 if TYPE_CHECKING:
     from pointnav_core.geodesic.arc_graph import ArcGraph
 
-__all__ = ["arc_graph_path", "compiled_path", "seeded_astar"]
+__all__ = ["DRAWN", "NOT_CLEAR", "NO_PATH", "PINCHED", "STRAIGHT", "arc_graph_path", "compiled_path", "seeded_astar"]
 
 Link = tuple[int, int, float, float]
 
-_NOT_CLEAR, _NO_PATH, _STRAIGHT, _DRAWN, _PINCHED = range(5)  # _path_kernel's outcomes
+#: ``_path_kernel.point_path``'s outcomes: an end where the disc does not fit, no path, the
+#: straight segment, a drawn path, a path whose arcs Python must split (drawn, not clear).
+NOT_CLEAR, NO_PATH, STRAIGHT, DRAWN, PINCHED = range(5)
 
 
 def compiled_path(
@@ -60,9 +62,9 @@ def compiled_path(
         return None
     outcome, cost, pts, *arcs = kernel(float(source[0]), float(source[1]), float(target[0]), float(target[1]),
                                        *graph.kernel_arguments(), p.radius, ANG_TOL, TOUCH_TOL, ARC_PIECE, EPS_W)
-    if outcome in (_NOT_CLEAR, _NO_PATH):
+    if outcome in (NOT_CLEAR, NO_PATH):
         return None, None
-    if outcome == _PINCHED:  # a passage as wide as the robot: its arcs split where it pinches
+    if outcome == PINCHED:  # a passage as wide as the robot: its arcs split where it pinches
         drawn = draw_arcs(p, list(zip(*(a.tolist() for a in arcs))))
         pts = np.concatenate([[target], drawn, [source]])[::-1].copy()
     return pts, float(cost)
