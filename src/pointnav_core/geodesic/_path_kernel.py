@@ -211,8 +211,8 @@ def point_path(sx, sy, tx, ty, nodes, geometry, walls, arcs, graph, r, ang_tol, 
     Returns
     -------
     outcome : int
-        :data:`NOT_CLEAR` (an end where the disc does not fit), :data:`NO_PATH`,
-        :data:`STRAIGHT`, :data:`DRAWN` or :data:`PINCHED` (found, not drawn).
+        One of ``geodesic.arc_search``'s ``NOT_CLEAR`` (an end where the disc does not
+        fit), ``NO_PATH``, ``STRAIGHT``, ``DRAWN`` or ``PINCHED`` (found, not drawn).
     cost : float
         The length (m), inf without a path.
     points : (N, 2) float64
