@@ -10,13 +10,15 @@ percent where the raw rates do not. Printed per workload: that median and its qu
 
 The workloads are the default rows of ``bench_env.py``, ``bench_parallel.py`` and
 ``bench_vector.py``: ``PointNav-v0`` on the default house (l2 reward; and with a 64-ray scan),
-``MultiPointNav-v0`` with three robots and its default episodes (resets included), and the
-batched engine at 1,024 worlds x 4 robots (32-ray scan, none, and on torch) and 4,096 x 1.
+``MultiPointNav-v0`` with three robots and its default episodes (resets included), the
+batched engine at 1,024 worlds x 4 robots (32-ray scan, none, and on torch) and 4,096 x 1,
+and ``bench_crowd.py``'s single env with a 12-ray scan and 10 ORCA pedestrians.
 Imports fall back to the module names before the package layout of 2026-11-28, so an older
 tree can be the ``--old`` one.
 
-Run: ``python benchmarks/bench_ab.py --old PATH --new PATH [--pairs 30]`` (each PATH a
-checkout's root, for example a ``git worktree add`` of the commit before).
+Run: ``python benchmarks/bench_ab.py --old PATH --new PATH [--pairs 30] [--only TEXT ...]``
+(each PATH a checkout's root, for example a ``git worktree add`` of the commit before;
+``--only`` keeps the workloads whose names contain one of the texts).
 """
 
 from __future__ import annotations
@@ -34,6 +36,7 @@ from typing import Any
 WORKLOADS: dict[str, tuple[int, str]] = {
     "PointNav-v0": (2000, "bench_env's default row"),
     "PointNav-v0 + scan 64": (800, "bench_env's scan row"),
+    "PointNav-v0 + scan 12, 10 ORCA pedestrians": (600, "bench_crowd's single-env row, resets included"),
     "MultiPointNav-v0 (3 robots)": (600, "bench_parallel's defaults, resets included"),
     "vector 1,024 x 4, 32 rays": (5, "bench_vector, numpy"),
     "vector 1,024 x 4, no scan": (20, "bench_vector, numpy"),
@@ -113,6 +116,8 @@ def _worker() -> None:
     runs = {
         "PointNav-v0": _single(),
         "PointNav-v0 + scan 64": _single(sensors={"scan": {"n_rays": 64}}),
+        "PointNav-v0 + scan 12, 10 ORCA pedestrians": _single(sensors={"scan": {"n_rays": 12}},
+                                                             pedestrians={"count": 10}),
         "MultiPointNav-v0 (3 robots)": _multi(),
         "vector 1,024 x 4, 32 rays": _vector(1024, 4, True),
         "vector 1,024 x 4, no scan": _vector(1024, 4, False),
@@ -134,7 +139,10 @@ def main() -> None:
     parser.add_argument("--old", required=True, help="root of the checkout to compare against")
     parser.add_argument("--new", default=os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
     parser.add_argument("--pairs", type=int, default=30, help="alternated bursts per workload and tree")
+    parser.add_argument("--only", nargs="+", default=None, metavar="TEXT",
+                        help="run only the workloads whose names contain one of these")
     args = parser.parse_args()
+    chosen = [name for name in WORKLOADS if args.only is None or any(t in name for t in args.only)]
     workers = {}
     for side in ("old", "new"):
         root = os.path.abspath(getattr(args, side))
@@ -153,13 +161,14 @@ def main() -> None:
         return float(proc.stdout.readline())  # type: ignore[union-attr]
 
     print(f"new {args.new} against old {args.old}: new time / old time per burst, {args.pairs} pairs each")
-    for name, (steps, what) in WORKLOADS.items():
+    for name in chosen:
+        steps, what = WORKLOADS[name]
         ratios = []
         for pair in range(args.pairs):
             times = {side: burst(side, name) for side in (("old", "new") if pair % 2 else ("new", "old"))}
             ratios.append(times["new"] / times["old"])
         lo, mid, hi = statistics.quantiles(ratios, n=4)
-        print(f"{name:34s} median {statistics.median(ratios):.3f}  quartiles {lo:.3f}-{hi:.3f}  "
+        print(f"{name:44s} median {statistics.median(ratios):.3f}  quartiles {lo:.3f}-{hi:.3f}  "
               f"({steps} steps a burst; {what})", flush=True)
     for proc in workers.values():
         proc.stdin.close()  # type: ignore[union-attr]
