@@ -21,20 +21,13 @@ import numba
 import numpy as np
 
 from pointnav_core.floor._collision_kernel import segment_clear as _clear
+from pointnav_core.geodesic import arc_search as _outcome  # the outcomes' names
 from pointnav_core.geodesic._roots_kernel import _arc_free, point_links
 from pointnav_core.geodesic._search_kernel import seeded_astar
-from pointnav_core.geodesic.arc_search import (
-    DRAWN,
-    NO_PATH,
-    NOT_CLEAR,
-    PINCHED,
-    STRAIGHT,
-)
 
 __all__ = ["point_path"]
 
 _jit = numba.njit(cache=True, nogil=True, error_model="numpy")
-
 
 
 @_jit
@@ -223,11 +216,11 @@ def point_path(sx, sy, tx, ty, nodes, geometry, walls, arcs, graph, r, ang_tol, 
     none_i, none_f = np.zeros(0, np.int64), np.zeros(0)
     empty = np.zeros((0, 2))
     if not (_clear(sx, sy, sx, sy, walls) and _clear(tx, ty, tx, ty, walls)):
-        return NOT_CLEAR, math.inf, empty, none_i, none_i, none_f, none_f
+        return _outcome.NOT_CLEAR, math.inf, empty, none_i, none_i, none_f, none_f
     if _clear(sx, sy, tx, ty, walls):
         pts = np.empty((2, 2))
         pts[0, 0], pts[0, 1], pts[1, 0], pts[1, 1] = sx, sy, tx, ty
-        return STRAIGHT, math.hypot(tx - sx, ty - sy), pts, none_i, none_i, none_f, none_f
+        return _outcome.STRAIGHT, math.hypot(tx - sx, ty - sy), pts, none_i, none_i, none_f, none_f
     span = nodes[3]
     # Links into the target, seen from the target: reversed, they leave a node.
     f_node, f_side, f_pos, f_len = _links(tx, ty, nodes, geometry, r, ang_tol, touch_tol)
@@ -253,11 +246,11 @@ def point_path(sx, sy, tx, ty, nodes, geometry, walls, arcs, graph, r, ang_tol, 
     best = seeded_astar(indptr, indices, data, vx, vy, x_len, x_to, x_w, x_x, x_y, f_from[order], order, f_w, xf_w,
                         tx, ty, dist, pred)
     if best < 0:
-        return NO_PATH, math.inf, empty, none_i, none_i, none_f, none_f
+        return _outcome.NO_PATH, math.inf, empty, none_i, none_i, none_f, none_f
     cost = dist[n_v + n_x + best]
     arc_n, arc_s, arc_a, arc_b = _trace(pred, pred[n_v + n_x + best], g_node, g_side, arcs[2], x_node, x_side, x_pos,
                                         f_pos[best])
     out = _drawn_path(sx, sy, tx, ty, arc_n, arc_s, arc_a, arc_b, nodes, r, ang_tol, piece_max, walls)
     if out.shape[0] == 0:
-        return PINCHED, cost, empty, arc_n, arc_s, arc_a, arc_b
-    return DRAWN, cost, out, arc_n, arc_s, arc_a, arc_b
+        return _outcome.PINCHED, cost, empty, arc_n, arc_s, arc_a, arc_b
+    return _outcome.DRAWN, cost, out, arc_n, arc_s, arc_a, arc_b
