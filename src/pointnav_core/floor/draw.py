@@ -103,15 +103,11 @@ def nearest_usable(tmap: TraversableMap, xy: NDArray[np.float64], radius: float,
     """Centre (m) of the nearest cell within ``reach`` cells of ``xy`` whose centre a disc of
     ``radius`` m fits at; None if there is none."""
     usable = tmap.usable(radius)
-    res, (ox, oy) = tmap.resolution, tmap.origin
-    x, y = float(xy[0]), float(xy[1])
-    # world_to_cell's and cell_to_world's expressions, on a few cells without their checks.
-    row, col = math.floor((y - oy) / res), math.floor((x - ox) / res)
+    row, col = (int(v) for v in tmap.world_to_cell(xy))
     h, w = usable.shape
     r0, r1, c0, c1 = max(row - reach, 0), min(row + reach + 1, h), max(col - reach, 0), min(col + reach + 1, w)
-    rows, cols = np.nonzero(usable[r0:r1, c0:c1])
-    if not len(rows):
+    cells = np.argwhere(usable[r0:r1, c0:c1]) + (r0, c0)
+    if not len(cells):
         return None
-    cx, cy = ox + (cols + (c0 + 0.5)) * res, oy + (rows + (r0 + 0.5)) * res
-    k = int(np.argmin(np.hypot(cx - x, cy - y)))
-    return np.array([cx[k], cy[k]])
+    centres = tmap.cell_to_world(cells)
+    return centres[int(np.argmin(np.hypot(*(centres - xy).T)))]

@@ -366,10 +366,9 @@ class Scene:
             raise SamplingError(
                 f"floor {floor} has no usable cell{within} for a robot of radius {radius} m"
             )
-        # The cell's centre as cell_to_world computes it, without its array set-up.
-        row, col = divmod(index, tmap.shape[1])
-        res, (ox, oy) = tmap.resolution, tmap.origin
-        return int(floor), np.array([ox + (col + 0.5) * res, oy + (row + 0.5) * res, tmap.height])
+        cell = np.unravel_index(index, tmap.shape)
+        x, y = tmap.cell_to_world(np.array(cell))
+        return int(floor), np.array([x, y, tmap.height])
 
     # ---------------------------------------------------------------- geodesic
     def goal_field(self, floor: int, goal_xy: ArrayLike, robot: Any = None) -> FloorGoalField:
