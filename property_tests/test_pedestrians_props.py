@@ -1,15 +1,23 @@
-"""No pedestrian ever starts overlapping a robot, a wall or another pedestrian (issue 33).
+"""No pedestrian ever starts overlapping a robot, a wall or another pedestrian (issue 33),
+and the paths they walk keep their radius from the walls.
 
 Random walled rooms with boxes, crowds of 0 to 14 with random radius ranges, robots of
 random radii; the check (``tests/crowd_reference.py``) measures every distance to the wall
-cells by brute force over their squares.
+cells by brute force over their squares. The paths are measured with shapely.
 """
 
 from __future__ import annotations
 
-from crowd_reference import env_in, room, spawn_is_clear
+import math
+
+import numpy as np
+import shapely
+from crowd_reference import RES, env_in, room, spawn_is_clear
 from hypothesis import given, settings
 from hypothesis import strategies as st
+
+from pointnav_core.crowds.walks import WALK_PIECE, Walk, plan_walk
+from pointnav_core.scenes import Scene
 
 
 @settings(max_examples=25, deadline=None)
@@ -29,3 +37,30 @@ def test_pedestrians_start_clear_of_walls_robots_and_each_other(
     env.reset(seed=seed)
     assert env.crowd.n == count
     spawn_is_clear(grid, env)
+
+
+@settings(max_examples=25, deadline=None)
+@given(seed=st.integers(0, 2**31 - 1), boxes=st.integers(0, 16), radius=st.floats(0.1, 0.4))
+def test_a_pedestrians_path_keeps_its_radius_from_the_walls_and_turns_at_most_a_piece_at_a_time(
+    seed: int, boxes: int, radius: float
+) -> None:
+    grid = room(70, 50, boxes=boxes, seed=seed % 1000)
+    scene = Scene.from_array(grid, RES)
+    rng = np.random.default_rng(seed)
+    here = scene.get_random_point(0, robot=radius, rng=rng)[1][:2]
+    walk = Walk((), False, -1, here.copy())
+    path = plan_walk(scene, 0, radius, here, walk, True, rng).points
+    assert np.array_equal(path[0], here) and np.array_equal(path[-1], walk.goal)
+    # Independent reference: every blocked square and the map's outside, as shapely geometry.
+    h, w = grid.shape
+    squares = [shapely.box(c * RES, r * RES, (c + 1) * RES, (r + 1) * RES) for r, c in np.argwhere(~grid)]
+    outside = shapely.box(-1, -1, w * RES + 1, h * RES + 1).difference(shapely.box(0, 0, w * RES, h * RES))
+    blocked = shapely.union_all([*squares, outside])
+    pieces = shapely.linestrings(np.stack([path[:-1], path[1:]], axis=1)) if len(path) > 1 else []
+    assert all(blocked.distance(piece) >= radius - 1e-9 for piece in pieces)
+    # Drawn in pieces of at most WALK_PIECE: no bend between two steps turns more.
+    steps = np.diff(path, axis=0)
+    steps = steps[np.hypot(*steps.T) > 1e-9]
+    heading = np.arctan2(steps[:, 1], steps[:, 0])
+    turns = np.abs((np.diff(heading) + math.pi) % (2 * math.pi) - math.pi)
+    assert (turns <= WALK_PIECE + 1e-9).all(), np.degrees(turns.max())

@@ -20,6 +20,7 @@ Each check takes ``plain_paths``, the context its plain side runs in (``numpy_pa
 from __future__ import annotations
 
 import contextlib
+import math
 from collections.abc import Callable
 from contextlib import AbstractContextManager
 
@@ -215,9 +216,13 @@ def check_goal_search(floor, seed, plain_paths: Plain) -> None:
     np.testing.assert_allclose(fast.cost[ok], plain.cost[ok], rtol=1e-12, atol=1e-12)
 
 
+#: Drawn arcs' largest pieces (rad): a robot's path's (2 deg), a pedestrian's (10 deg), and coarser.
+PIECES = st.sampled_from([math.radians(2.0), math.radians(10.0), math.radians(30.0), math.pi / 2])
+
+
 @settings(max_examples=30, deadline=None, suppress_health_check=[HealthCheck.too_slow, HealthCheck.filter_too_much])
-@given(floor=slit_floors(), seed=st.integers(0, 2**31 - 1))
-def check_point_search(floor, seed, plain_paths: Plain) -> None:
+@given(floor=slit_floors(), seed=st.integers(0, 2**31 - 1), piece=PIECES)
+def check_point_search(floor, seed, piece, plain_paths: Plain) -> None:
     """A point-to-point search on the whole graph: the one compiled call
     (``_path_kernel.point_path``, with numba's A*) gives the plain path's reachability,
     lengths (1e-9 m) and drawn points (1e-9 m; where two routes tie and the two paths draw
@@ -228,9 +233,9 @@ def check_point_search(floor, seed, plain_paths: Plain) -> None:
     # Ends where the disc does not fit, and a pair that sees itself.
     pts += [np.asarray(scene.floors[0].origin, dtype=np.float64), pts[0] if pts else np.zeros(2)]
     for a, b in zip(pts[::2], pts[1::2]):
-        got_path, got = planner.shortest_path(a, b)
+        got_path, got = planner.shortest_path(a, b, piece)
         with plain_paths():
-            want_path, want = planner.shortest_path(a, b)
+            want_path, want = planner.shortest_path(a, b, piece)
         same_drawn_path(got_path, got, want_path, want)
 
 
@@ -250,8 +255,8 @@ def same_drawn_path(got_path, got, want_path, want) -> None:
 
 
 @settings(max_examples=15, deadline=None, suppress_health_check=[HealthCheck.too_slow, HealthCheck.filter_too_much])
-@given(res=st.sampled_from([0.05, 0.1]), cells=st.integers(2, 5), seed=st.integers(0, 2**31 - 1))
-def check_point_search_pinched(res, cells, seed, plain_paths: Plain) -> None:
+@given(res=st.sampled_from([0.05, 0.1]), cells=st.integers(2, 5), seed=st.integers(0, 2**31 - 1), piece=PIECES)
+def check_point_search_pinched(res, cells, seed, piece, plain_paths: Plain) -> None:
     """Round a block's corner A whose diagonal neighbour, a wall's corner B, is a hair more
     than one robot diameter away, the path's arc passes B's circle, and its drawn vertices
     there may overlap B. The compiled search hands a path's arcs back to be split where
@@ -276,9 +281,9 @@ def check_point_search_pinched(res, cells, seed, plain_paths: Plain) -> None:
         a = (ax - rng.uniform(0.05, 0.15), ay + radius * rng.uniform(1.0, 1.2))
         b = (ax + radius * rng.uniform(1.0, 1.2), ay - rng.uniform(0.05, 0.15))
         with mock.patch.object(arc_search, "draw_arcs", wraps=arc_search.draw_arcs) as handed_back:
-            got_path, got = planner.shortest_path(a, b)
+            got_path, got = planner.shortest_path(a, b, piece)
         with plain_paths(), mock.patch.object(arcs, "_split_pinched", wraps=arcs._split_pinched) as pinched:
-            want_path, want = planner.shortest_path(a, b)
+            want_path, want = planner.shortest_path(a, b, piece)
         assert handed_back.called == pinched.called
         split += pinched.called
         same_drawn_path(got_path, got, want_path, want)

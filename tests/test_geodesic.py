@@ -196,6 +196,36 @@ def test_a_drawn_arc_through_a_passage_exactly_as_wide_as_the_robot_keeps_clear_
     assert dist - 1e-9 <= path_length(path) <= dist * (1 + 1.1e-4) + 1e-9
 
 
+@pytest.mark.parametrize("degrees", [2.0, 10.0, 30.0])
+def test_a_path_round_one_corner_is_drawn_in_as_many_pieces_as_its_piece_asks(degrees):
+    # A 1 m block whose top right corner is (2, 2); a 0.3 m disc from (1.5, 2.3) to
+    # (2.3, 1.5) runs along the block's top, wraps the corner a quarter turn and runs down its
+    # right side. By hand: 0.5 + 0.5 + 0.3 * pi / 2 m, and the quarter turn drawn as
+    # ceil(90 / degrees) pieces whose inner vertices stand 0.3 / cos(piece / 2) m from the
+    # corner, between the arc's ends (2, 2.3) and (2.3, 2).
+    grid = np.zeros((40, 40), np.uint8)
+    grid[10:20, 10:20] = OBSTACLE
+    planner = Scene.from_array(grid, 0.1).planner(0, 0.3)
+    path, length = planner.shortest_path((1.5, 2.3), (2.3, 1.5), math.radians(degrees))
+    assert length == pytest.approx(1.0 + 0.3 * math.pi / 2, abs=1e-9)
+    pieces = math.ceil(90.0 / degrees - 1e-9)
+    assert len(path) == pieces + 4  # the ends, the arc's ends and its inner vertices
+    np.testing.assert_allclose(path[[0, 1, -2, -1]], [(1.5, 2.3), (2.0, 2.3), (2.3, 2.0), (2.3, 1.5)], atol=1e-9)
+    inner = path[2:-2]
+    piece = math.pi / 2 / pieces
+    np.testing.assert_allclose(np.hypot(inner[:, 0] - 2.0, inner[:, 1] - 2.0), 0.3 / math.cos(piece / 2), rtol=1e-12)
+    # Clockwise from straight up, half a piece in, then a piece apart.
+    angles = np.arctan2(inner[:, 1] - 2.0, inner[:, 0] - 2.0)
+    np.testing.assert_allclose(angles, math.pi / 2 - piece * (np.arange(pieces) + 0.5), atol=1e-12)
+
+
+@pytest.mark.parametrize("piece", [0.0, -0.1, math.pi, float("nan"), True, "0.1"])
+def test_a_drawn_piece_out_of_range_is_refused_naming_it(piece):
+    planner = Scene.from_array(np.zeros((10, 10), np.uint8), 0.1).planner(0, 0.1)
+    with pytest.raises(ValueError, match=r"piece must be a number of radians in \(0, pi / 2\]"):
+        planner.shortest_path((0.2, 0.2), (0.8, 0.8), piece)
+
+
 def test_a_floor_geometry_past_its_byte_budget_is_refused_naming_the_budget(monkeypatch):
     from pointnav_core import scenes
     from pointnav_core.geodesic import cache

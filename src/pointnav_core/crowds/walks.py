@@ -14,12 +14,21 @@ from typing import Any, NamedTuple
 import numpy as np
 from numpy.typing import NDArray
 
+from pointnav_core.floor import reachability
 from pointnav_core.floor.draw import nearest_usable
 
-__all__ = ["MIN_GOAL_DISTANCE", "Walk", "padded", "plan_walk"]
+__all__ = ["MIN_GOAL_DISTANCE", "WALK_PIECE", "Walk", "padded", "plan_walk"]
 
 #: Goals nearer than this (m) to the pedestrian are drawn again (up to 10 times).
 MIN_GOAL_DISTANCE = 1.0
+
+#: Largest angle (rad) of one piece of a pedestrian's path where it bends around a corner
+#: (``Planner.shortest_path``'s ``piece``): 10 deg, where a robot's drawn path takes 2.
+#: Every piece stays tangent to the arc, so the path keeps its radius from the corner; its
+#: vertices stand at most 0.4 % of the radius farther out (1.3 mm at 0.35 m). A fifth of the
+#: vertices is a fifth of their clearance tests in each plan, and of the waypoints a
+#: pedestrian passes (docs/decisions.md, "A pedestrian's path in 10 degree pieces").
+WALK_PIECE = math.radians(10.0)
 
 
 def padded(points: NDArray[np.float64], length: int) -> NDArray[np.float64]:
@@ -53,7 +62,7 @@ def plan_walk(scene: Any, floor: int, radius: float, here: NDArray[np.float64], 
     the next of its fixed list while there is one, else drawn from ``rng`` in ``here``'s
     part of the floor, at least :data:`MIN_GOAL_DISTANCE` away (10 tries). ``walk`` is
     updated in place; paths keep ``radius`` (m) from the walls."""
-    tmap = scene.floors[floor]
+    tmap, planner = scene.floors[floor], scene.planner(floor, radius)
     # Where to plan from: here, or the nearest cell centre within 3 cells where the paths'
     # radius fits (a neighbour's push can leave a pedestrian nearer a wall than its path runs).
     x, y = float(here[0]), float(here[1])
@@ -77,7 +86,10 @@ def plan_walk(scene: Any, floor: int, radius: float, here: NDArray[np.float64], 
                 if math.dist(goal, start) >= MIN_GOAL_DISTANCE:
                     break
             walk.goal = np.asarray(goal, dtype=np.float64)
-        points, _ = scene.get_shortest_path(floor, start, walk.goal, entire_path=True, robot=radius)
+        # Scene.get_shortest_path's search on the planner itself: its arcs in WALK_PIECE.
+        points = None
+        if not reachability.disconnected(tmap, radius, start, walk.goal):
+            points, _ = planner.shortest_path(start, walk.goal, WALK_PIECE)
         if points is not None:
             points = np.asarray(points, dtype=np.float64)
             return Planned(points if start is here else np.concatenate([here[None], points]), drawn)

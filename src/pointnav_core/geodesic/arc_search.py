@@ -50,35 +50,37 @@ NOT_CLEAR, NO_PATH, STRAIGHT, DRAWN, PINCHED = range(5)
 
 
 def compiled_path(
-    graph: ArcGraph, source: tuple[float, float], target: tuple[float, float]
+    graph: ArcGraph, source: tuple[float, float], target: tuple[float, float], piece: float = ARC_PIECE
 ) -> tuple[NDArray[np.float64], float] | tuple[None, None] | None:
     """:func:`~pointnav_core.geodesic.point_search.shortest_path` on ``graph`` in one
     compiled call (``geodesic._path_kernel.point_path``): the drawn path (N, 2) from
-    ``source`` to ``target`` (m) and its length (m), ``(None, None)`` without one, or None
-    where the compiled path cannot run (no numba, or polygons it cannot read)."""
+    ``source`` to ``target`` (m), its arcs in pieces of at most ``piece`` (rad), and its
+    length (m), ``(None, None)`` without one, or None where the compiled path cannot run
+    (no numba, or polygons it cannot read)."""
     p = graph.p
     kernel = _compiled.kernel("pointnav_core.geodesic._path_kernel", "point_path")
     if kernel is None or not p.geo.compiled_polygons:
         return None
     outcome, cost, pts, *arcs = kernel(float(source[0]), float(source[1]), float(target[0]), float(target[1]),
-                                       *graph.kernel_arguments(), p.radius, ANG_TOL, TOUCH_TOL, ARC_PIECE, EPS_W)
+                                       *graph.kernel_arguments(), p.radius, ANG_TOL, TOUCH_TOL, float(piece), EPS_W)
     if outcome in (NOT_CLEAR, NO_PATH):
         return None, None
     if outcome == PINCHED:  # a passage as wide as the robot: its arcs split where it pinches
-        drawn = draw_arcs(p, list(zip(*(a.tolist() for a in arcs))))
+        drawn = draw_arcs(p, list(zip(*(a.tolist() for a in arcs))), piece)
         pts = np.concatenate([[target], drawn, [source]])[::-1].copy()
     return pts, float(cost)
 
 
 def arc_graph_path(
-    graph: ArcGraph, source: tuple[float, float], target: tuple[float, float], starts: list[Link], finishes: list[Link]
+    graph: ArcGraph, source: tuple[float, float], target: tuple[float, float], starts: list[Link], finishes: list[Link],
+    piece: float = ARC_PIECE,
 ) -> tuple[NDArray[np.float64], float] | None:
     """The shortest path from ``source`` to ``target`` over ``graph``, or None if none.
 
     ``starts`` are the source's tangents ``(node, side, arrival, length)``; ``finishes`` the
     tangents into the target, as departures ``(node, side, departure, length)``. Returns
     the drawn points (M, 2) from the target back to the source (as the lazy search's
-    trace gives them) and the exact length (m).
+    trace gives them; arcs in pieces of at most ``piece`` rad) and the exact length (m).
     """
     p = graph.p
     n_v, n_x, n_f = graph.n_vertices, len(starts), len(finishes)
@@ -117,7 +119,7 @@ def arc_graph_path(
         label = int(pred[label])
         if label >= 0:
             dep = _vertex(graph, x_node, x_side, x_pos, label)[2]
-    pts = np.concatenate([[target], draw_arcs(p, arcs), [source]])
+    pts = np.concatenate([[target], draw_arcs(p, arcs, piece), [source]])
     return pts, float(dist[n_v + n_x + best])
 
 

@@ -27,8 +27,10 @@ __all__ = ["ARC_PIECE", "arc_points", "draw_arcs"]
 ARC_PIECE = math.radians(2.0)
 
 
-def arc_points(p: Planner, node: int, s: int, pos_from: float, pos_to: float, splits: int = 4) -> list[NDArray[np.float64]]:
-    """Drawn arc of ``node`` from position ``pos_from`` back to ``pos_to`` (both ends on it).
+def arc_points(p: Planner, node: int, s: int, pos_from: float, pos_to: float, splits: int = 4,
+               piece: float = ARC_PIECE) -> list[NDArray[np.float64]]:
+    """Drawn arc of ``node`` from position ``pos_from`` back to ``pos_to`` (both ends on it),
+    in pieces of at most ``piece`` (rad).
 
     Intermediate vertices lie outside the circle, so that every drawn piece is tangent to
     it and keeps the full radius from the corner. Where an obstacle is exactly ``2 r`` from
@@ -37,17 +39,18 @@ def arc_points(p: Planner, node: int, s: int, pos_from: float, pos_to: float, sp
     on the circle at that line (touching both sides, as the path does), so the vertices on
     either side point away from it (``splits`` bounds how often this may recur).
     """
-    out = _drawn_arc(p, node, s, pos_from, pos_to)
+    out = _drawn_arc(p, node, s, pos_from, pos_to, piece)
     if len(out) <= 2 or splits <= 0:
         return list(out)
-    return _split_pinched(p, node, s, pos_from, pos_to, out, p.geo.points_clear(out[1:-1], p.radius), splits)
+    return _split_pinched(p, node, s, pos_from, pos_to, out, p.geo.points_clear(out[1:-1], p.radius), splits, piece)
 
 
-def draw_arcs(p: Planner, arcs: list[tuple[int, int, float, float]]) -> NDArray[np.float64]:
+def draw_arcs(p: Planner, arcs: list[tuple[int, int, float, float]], piece: float = ARC_PIECE) -> NDArray[np.float64]:
     """The drawn arcs ``(node, side, pos_from, pos_to)`` one after another, shape (M, 2):
-    what :func:`arc_points` gives for each, with one clearance test for all of their
-    vertices rather than one per arc (a path's arcs are drawn together)."""
-    drawn = [_drawn_arc(p, node, s, a, b) for node, s, a, b in arcs]
+    what :func:`arc_points` gives for each (pieces of at most ``piece`` rad), with one
+    clearance test for all of their vertices rather than one per arc (a path's arcs are
+    drawn together)."""
+    drawn = [_drawn_arc(p, node, s, a, b, piece) for node, s, a, b in arcs]
     inner = [d[1:-1] for d in drawn if len(d) > 2]
     if not inner:
         return np.concatenate(drawn) if drawn else np.zeros((0, 2))
@@ -60,13 +63,14 @@ def draw_arcs(p: Planner, arcs: list[tuple[int, int, float, float]]) -> NDArray[
             ok = clear[at : at + len(d) - 2]
             at += len(d) - 2
             if not ok.all():
-                d = np.array(_split_pinched(p, node, s, a, b, d, ok, 4))
+                d = np.array(_split_pinched(p, node, s, a, b, d, ok, 4, piece))
         out.append(d)
     return np.concatenate(out)
 
 
 def _split_pinched(
-    p: Planner, node: int, s: int, pos_from: float, pos_to: float, out: NDArray[np.float64], clear: NDArray[np.bool_], splits: int
+    p: Planner, node: int, s: int, pos_from: float, pos_to: float, out: NDArray[np.float64], clear: NDArray[np.bool_],
+    splits: int, piece: float,
 ) -> list[NDArray[np.float64]]:
     """:func:`arc_points`' split at a passage as wide as the robot, given the drawn arc
     ``out`` and whether each of its inner vertices is clear."""
@@ -76,18 +80,18 @@ def _split_pinched(
     pos = _pinch_position(p, node, s, out[1:-1][bad[0]])
     if pos is None or not pos_to + ANG_TOL < pos < pos_from - ANG_TOL:
         return list(out)
-    first = arc_points(p, node, s, pos_from, pos, splits - 1)
-    return first + arc_points(p, node, s, pos, pos_to, splits - 1)[1:]
+    first = arc_points(p, node, s, pos_from, pos, splits - 1, piece)
+    return first + arc_points(p, node, s, pos, pos_to, splits - 1, piece)[1:]
 
 
-def _drawn_arc(p: Planner, node: int, s: int, pos_from: float, pos_to: float) -> NDArray[np.float64]:
+def _drawn_arc(p: Planner, node: int, s: int, pos_from: float, pos_to: float, largest: float) -> NDArray[np.float64]:
     """The arc's ends on the circle and, between them, vertices of pieces of at most
-    :data:`ARC_PIECE` tangent to it (each at ``r / cos(piece / 2)`` from the corner), (k, 2)."""
+    ``largest`` (rad) tangent to it (each at ``r / cos(piece / 2)`` from the corner), (k, 2)."""
     a = p.node_point(node, s, pos_from)
     delta = pos_from - pos_to
     if delta <= ANG_TOL or p.radius == 0.0:
         return np.array([a])
-    n = max(1, math.ceil(delta / ARC_PIECE))
+    n = max(1, math.ceil(delta / largest))
     piece = delta / n
     reach = p.radius / math.cos(piece / 2)
     pos = pos_from - piece * (np.arange(n) + 0.5)

@@ -49,6 +49,7 @@ from pointnav_core.errors import ArgumentError
 from pointnav_core.floor.collision import FloorCollision
 from pointnav_core.geodesic import cache
 from pointnav_core.geodesic.arc_graph import ArcGraph
+from pointnav_core.geodesic.arcs import ARC_PIECE
 from pointnav_core.geodesic.cache import edge_arrays
 from pointnav_core.geodesic.edge_store import EdgeStore
 from pointnav_core.geodesic.cell_links import CellLinks
@@ -61,6 +62,7 @@ from pointnav_core.geodesic.sight import NodeBalls, node_sights
 from pointnav_core.geodesic.tangents import ANG_TOL
 from pointnav_core.geodesic.usable import nearest_usable, usable_cells
 from pointnav_core.utils.frozen import ThawOnUnpickle
+from pointnav_core.utils.validation import is_real
 
 if TYPE_CHECKING:
     from pointnav_core.floor.maps import TraversableMap
@@ -446,7 +448,7 @@ class Planner(ThawOnUnpickle):
             self._field_bytes -= self._fields.pop(key).nbytes
 
     def shortest_path(
-        self, source: ArrayLike, target: ArrayLike
+        self, source: ArrayLike, target: ArrayLike, piece: float = ARC_PIECE
     ) -> tuple[NDArray[np.float64], float] | tuple[None, None]:
         """Exact shortest path between two world points by A*, without building a field.
 
@@ -454,10 +456,13 @@ class Planner(ThawOnUnpickle):
         so does this on floors of at most :data:`WHOLE_GRAPH_NODES` nodes), the search runs
         on it in compiled code (:mod:`pointnav_core.geodesic.arc_search`); before, it
         builds the edges it needs tile by tile (:mod:`.point_search`). Returns the drawn
-        path (N, 2) and its exact length in metres, or ``(None, None)``.
+        path (N, 2), its arcs in pieces of at most ``piece`` (rad, in (0, pi / 2]), and its
+        exact length in metres, or ``(None, None)``.
         """
+        if not (is_real(piece) and 0.0 < piece <= math.pi / 2):
+            raise ArgumentError(f"piece must be a number of radians in (0, pi / 2], got {piece!r}")
         whole = self.whole_graph_search and (self._arc_graph is not None or self.n_nodes <= WHOLE_GRAPH_NODES)
-        return shortest_path(self, source, target, self.arc_graph() if whole else None)
+        return shortest_path(self, source, target, self.arc_graph() if whole else None, float(piece))
 
     @property
     def usable(self) -> NDArray[np.bool_]:

@@ -21,7 +21,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from pointnav_core.geodesic.arc_search import arc_graph_path, compiled_path
-from pointnav_core.geodesic.arcs import draw_arcs
+from pointnav_core.geodesic.arcs import ARC_PIECE, draw_arcs
 from pointnav_core.geodesic.tangents import ANG_TOL, COST_TOL
 
 if TYPE_CHECKING:
@@ -32,17 +32,17 @@ __all__ = ["PointSearch", "shortest_path"]
 
 
 def shortest_path(
-    planner: Planner, source: ArrayLike, target: ArrayLike, graph: ArcGraph | None
+    planner: Planner, source: ArrayLike, target: ArrayLike, graph: ArcGraph | None, piece: float = ARC_PIECE
 ) -> tuple[NDArray[np.float64], float] | tuple[None, None]:
-    """The exact shortest path from ``source`` to ``target`` (world m): the drawn path (N, 2)
-    and its length (m), or ``(None, None)``; on ``graph`` (the planner's whole graph) if
-    given, else by the lazy :class:`PointSearch`."""
+    """The exact shortest path from ``source`` to ``target`` (world m): the drawn path (N, 2),
+    its arcs in pieces of at most ``piece`` (rad), and its length (m), or ``(None, None)``;
+    on ``graph`` (the planner's whole graph) if given, else by the lazy :class:`PointSearch`."""
     p = planner
     src = np.asarray(source, dtype=np.float64)[:2]
     tgt = np.asarray(target, dtype=np.float64)[:2]
     sx, sy, tx, ty = float(src[0]), float(src[1]), float(tgt[0]), float(tgt[1])
     if graph is not None:
-        found = compiled_path(graph, (sx, sy), (tx, ty))
+        found = compiled_path(graph, (sx, sy), (tx, ty), piece)
         if found is not None:
             return found
     if not (p.is_clear(sx, sy) and p.is_clear(tx, ty)):
@@ -55,7 +55,7 @@ def shortest_path(
         finish.setdefault((c, -s), []).append((p.span_list[c] - pos, length))
     if graph is not None:
         found = arc_graph_path(graph, (sx, sy), (tx, ty), p.point_links(sx, sy),
-                               [(c, s, pos, length) for (c, s), deps in finish.items() for pos, length in deps])
+                               [(c, s, pos, length) for (c, s), deps in finish.items() for pos, length in deps], piece)
         if found is None:
             return None, None
         pts, cost = found
@@ -67,7 +67,7 @@ def shortest_path(
     if best is None:
         return None, None
     cost, label, dep = best
-    pts = [np.array([tx, ty]), *search.trace(label, dep), np.array([sx, sy])]
+    pts = [np.array([tx, ty]), *search.trace(label, dep, piece), np.array([sx, sy])]
     return np.array(pts[::-1]), cost
 
 
@@ -151,11 +151,12 @@ class PointSearch:
                 self.push(g + r * max(d - pos, 0.0) + length[i], to[i], side[i], arr[i], lab, d)
         return None
 
-    def trace(self, label: int, dep: float) -> list[NDArray[np.float64]]:
-        """Points from the departure at ``dep`` on ``label``'s arc back to the first node."""
+    def trace(self, label: int, dep: float, piece: float = ARC_PIECE) -> list[NDArray[np.float64]]:
+        """Points from the departure at ``dep`` on ``label``'s arc back to the first node, the
+        arcs drawn in pieces of at most ``piece`` (rad)."""
         arcs = []
         while label >= 0:
             arcs.append((self.node[label], self.side[label], dep, self.pos[label]))
             dep = self.parent_dep[label]
             label = self.parent[label]
-        return list(draw_arcs(self.p, arcs))
+        return list(draw_arcs(self.p, arcs, piece))
