@@ -2,8 +2,9 @@
 
 :class:`Crowd` places pedestrians where they fit (clear of the walls, the robots and each
 other), gives each a goal in its part of the floor and the exact shortest path there
-(:meth:`Scene.get_shortest_path <pointnav_core.scenes.Scene.get_shortest_path>`, for the
-crowd's largest radius), and advances them one control step at a time:
+(:meth:`Planner.shortest_path <pointnav_core.geodesic.Planner.shortest_path>`, for the
+crowd's largest radius, its arcs drawn in pieces of
+:data:`~pointnav_core.crowds.walks.WALK_PIECE`), and advances them one control step at a time:
 
 1. each pedestrian's *preferred velocity* points at its next waypoint at its preferred speed
    (slowing to arrive on the last one); a waypoint nearer than one step is passed when the
