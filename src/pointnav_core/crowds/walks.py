@@ -15,7 +15,8 @@ import numpy as np
 from numpy.typing import NDArray
 
 from pointnav_core.floor import reachability
-from pointnav_core.floor.draw import nearest_usable
+from pointnav_core.floor.draw import draw_point, nearest_usable
+from pointnav_core.geodesic import planner_for
 
 __all__ = ["MIN_GOAL_DISTANCE", "WALK_PIECE", "Walk", "padded", "plan_walk"]
 
@@ -62,15 +63,22 @@ def plan_walk(scene: Any, floor: int, radius: float, here: NDArray[np.float64], 
     the next of its fixed list while there is one, else drawn from ``rng`` in ``here``'s
     part of the floor, at least :data:`MIN_GOAL_DISTANCE` away (10 tries). ``walk`` is
     updated in place; paths keep ``radius`` (m) from the walls."""
-    tmap, planner = scene.floors[floor], scene.planner(floor, radius)
+    tmap = scene.floors[floor]
+    planner = planner_for(tmap, radius)
     # Where to plan from: here, or the nearest cell centre within 3 cells where the paths'
     # radius fits (a neighbour's push can leave a pedestrian nearer a wall than its path runs).
+    # Here's part of the floor, which goals are drawn from, is found on the way: a point with
+    # a component fits the disc (TraversableMap.component_at).
+    label = int(tmap.component_at(here, radius))
     x, y = float(here[0]), float(here[1])
-    start = here if tmap.collision.segment_clear(x, y, x, y, radius) else nearest_usable(tmap, here, radius)
+    start = here if label or tmap.collision.segment_clear(x, y, x, y, radius) else nearest_usable(tmap, here, radius)
     if start is None:
         return Planned(here[None].copy(), False)
+    if start is not here:
+        label = int(tmap.component_at(start, radius))
     drawn = False
     for attempt in range(10):
+        fresh = False  # a goal drawn now, from start's component
         if new_goal:
             walk.index += 1
         k = walk.index
@@ -79,16 +87,18 @@ def plan_walk(scene: Any, floor: int, radius: float, here: NDArray[np.float64], 
             new_goal = True  # an unreachable fixed goal: try the next one
         elif new_goal or attempt:
             goal = start
-            drawn = True
+            drawn = fresh = True
             for _ in range(10):
-                _, goal = scene.get_random_point(floor, reference_point=start, robot=radius, rng=rng)
-                goal = goal[:2]
+                goal = draw_point(tmap, radius, label, start, None, rng) if label else None
+                if goal is None:  # Scene.get_random_point's errors where it has no draw
+                    goal = scene.get_random_point(floor, reference_point=start, robot=radius, rng=rng)[1][:2]
                 if math.dist(goal, start) >= MIN_GOAL_DISTANCE:
                     break
             walk.goal = np.asarray(goal, dtype=np.float64)
-        # Scene.get_shortest_path's search on the planner itself: its arcs in WALK_PIECE.
+        # Scene.get_shortest_path's search on the planner itself, its arcs in WALK_PIECE. A
+        # goal drawn from start's component is reachable: its O(1) proof of no path is not run.
         points = None
-        if not reachability.disconnected(tmap, radius, start, walk.goal):
+        if fresh or not reachability.disconnected(tmap, radius, start, walk.goal):
             points, _ = planner.shortest_path(start, walk.goal, WALK_PIECE)
         if points is not None:
             points = np.asarray(points, dtype=np.float64)

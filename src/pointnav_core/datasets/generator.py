@@ -40,6 +40,7 @@ from pointnav_core.crowds import Crowd, make_pedestrians
 from pointnav_core.datasets.format import EpisodeDataset, PointNavEpisode
 from pointnav_core.datasets.scene_sets import SceneSet, load_scene
 from pointnav_core.errors import ArgumentError, SamplingError
+from pointnav_core.floor.draw import cell_centre
 from pointnav_core.scenes import Scene, robot_radius
 from pointnav_core.utils import validation
 
@@ -168,8 +169,7 @@ class GeneratorConfig:
 
 def _pick_cell(tmap: Any, radius: float, rng: np.random.Generator) -> NDArray[np.float64]:
     cells = np.flatnonzero(tmap.usable(radius))
-    cell = np.unravel_index(cells[int(rng.integers(len(cells)))], tmap.shape)
-    return tmap.cell_to_world(np.array(cell))
+    return cell_centre(tmap, int(cells[int(rng.integers(len(cells)))]))
 
 
 def generate_episodes(

@@ -11,7 +11,7 @@ from numpy.typing import NDArray
 from pointnav_core.floor.maps import TraversableMap
 from pointnav_core.utils import compiled as _compiled
 
-__all__ = ["draw_cell", "nearest_usable"]
+__all__ = ["cell_centre", "draw_cell", "draw_point", "nearest_usable"]
 
 
 def draw_cell(
@@ -70,6 +70,22 @@ def draw_cell(
     ends = np.cumsum(counts)
     row = int(np.searchsorted(ends, k, side="right"))
     return int(flat[start[row] + k - (ends[row] - counts[row])])
+
+
+def draw_point(
+    tmap: TraversableMap, radius: float, label: int, ref: NDArray[np.float64], max_distance: float | None,
+    rng: np.random.Generator,
+) -> NDArray[np.float64] | None:
+    """:func:`draw_cell`'s cell as its centre ``(x, y)`` (m), the point
+    :meth:`Scene.get_random_point <pointnav_core.scenes.Scene.get_random_point>` returns;
+    None when no cell is within reach (nothing is drawn then)."""
+    index = draw_cell(tmap, radius, label, ref, max_distance, rng)
+    return None if index is None else cell_centre(tmap, index)
+
+
+def cell_centre(tmap: TraversableMap, index: int) -> NDArray[np.float64]:
+    """Centre ``(x, y)`` (m) of the cell of flat (row-major) index ``index``."""
+    return tmap.cell_to_world(np.array(np.unravel_index(index, tmap.shape)))
 
 
 def _row_spans(

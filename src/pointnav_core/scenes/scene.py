@@ -37,7 +37,7 @@ from numpy.typing import ArrayLike, NDArray
 from pointnav_core import floorplans
 from pointnav_core.errors import ArgumentError, SamplingError
 from pointnav_core.floor import loaders, reachability
-from pointnav_core.floor.draw import draw_cell
+from pointnav_core.floor.draw import cell_centre, draw_point
 from pointnav_core.floor.maps import OBSTACLE, TraversableMap
 from pointnav_core.floorplans import FloorPlan
 from pointnav_core.geodesic import Planner, planner_for
@@ -352,6 +352,7 @@ class Scene:
         if reference_point is None:
             cells = tmap.usable_indices(radius)
             index = int(cells[int(rng.integers(len(cells)))]) if len(cells) else None
+            point = None if index is None else cell_centre(tmap, index)
         else:
             ref = as_xy(reference_point, "reference_point")
             label = int(tmap.component_at(ref, radius))
@@ -360,14 +361,13 @@ class Scene:
                     f"reference_point {ref.tolist()} is not usable on floor {floor} for a robot "
                     f"of radius {radius} m (blocked, too close to an obstacle, or off the map)"
                 )
-            index = draw_cell(tmap, radius, label, ref, max_distance, rng)
-        if index is None:
+            point = draw_point(tmap, radius, label, ref, max_distance, rng)
+        if point is None:
             within = "" if max_distance is None else f" within {max_distance} m of the reference point"
             raise SamplingError(
                 f"floor {floor} has no usable cell{within} for a robot of radius {radius} m"
             )
-        cell = np.unravel_index(index, tmap.shape)
-        x, y = tmap.cell_to_world(np.array(cell))
+        x, y = point
         return int(floor), np.array([x, y, tmap.height])
 
     # ---------------------------------------------------------------- geodesic
