@@ -42,13 +42,21 @@ def test_pedestrians_start_clear_of_walls_robots_and_each_other(
     spawn_is_clear(grid, env)
 
 
+#: A walk's random room (its seed and boxes) and the radius it is planned for (m).
+WALKS = {"seed": st.integers(0, 2**31 - 1), "boxes": st.integers(0, 16), "radius": st.floats(0.1, 0.4)}
+
+
+def _room(seed: int, boxes: int) -> tuple[np.ndarray, Scene]:
+    grid = room(70, 50, boxes=boxes, seed=seed % 1000)
+    return grid, Scene.from_array(grid, RES)
+
+
 @settings(max_examples=25, deadline=None)
-@given(seed=st.integers(0, 2**31 - 1), boxes=st.integers(0, 16), radius=st.floats(0.1, 0.4))
+@given(**WALKS)
 def test_a_pedestrians_path_keeps_its_radius_from_the_walls_and_turns_at_most_a_piece_at_a_time(
     seed: int, boxes: int, radius: float
 ) -> None:
-    grid = room(70, 50, boxes=boxes, seed=seed % 1000)
-    scene = Scene.from_array(grid, RES)
+    grid, scene = _room(seed, boxes)
     rng = np.random.default_rng(seed)
     here = scene.get_random_point(0, robot=radius, rng=rng)[1][:2]
     walk = Walk((), False, -1, here.copy())
@@ -70,7 +78,7 @@ def test_a_pedestrians_path_keeps_its_radius_from_the_walls_and_turns_at_most_a_
 
 
 @settings(max_examples=40, deadline=None)
-@given(seed=st.integers(0, 2**31 - 1), boxes=st.integers(0, 16), radius=st.floats(0.1, 0.4))
+@given(**WALKS)
 def test_a_pedestrians_new_goal_is_scene_get_random_points_draw_and_its_path_the_planners(
     seed: int, boxes: int, radius: float
 ) -> None:
@@ -78,8 +86,7 @@ def test_a_pedestrians_new_goal_is_scene_get_random_points_draw_and_its_path_the
     # the reachability proof for it; by its definition the goal is Scene.get_random_point's
     # from where it plans (again while nearer than MIN_GOAL_DISTANCE, 10 tries), with the
     # same draws, and the path the planner's to it.
-    grid = room(70, 50, boxes=boxes, seed=seed % 1000)
-    scene = Scene.from_array(grid, RES)
+    _, scene = _room(seed, boxes)
     rng = np.random.default_rng(seed)
     here = rng.uniform((0.0, 0.0), (7.0, 5.0))  # anywhere: near walls, inside boxes, at corners
     ours, theirs = np.random.default_rng(seed + 1), np.random.default_rng(seed + 1)
