@@ -16,7 +16,7 @@ from pointnav_core.envs.common import edit_task
 from pointnav_core.transforms.planar import heading_of
 
 __all__ = [
-    "CrowdTrack", "add_pedestrian_termination", "crowd_robots", "episode_crowd", "make_crowd", "pose_twins", "robot_discs",
+    "CrowdRobots", "CrowdTrack", "add_pedestrian_termination", "crowd_robots", "episode_crowd", "make_crowd", "pose_twins",
     "spawn_crowd",
 ]
 
@@ -57,36 +57,49 @@ def pose_twins(backend: Any) -> tuple[Any, Any]:
     return float_twin(backend, "get_pose_floats"), float_twin(backend, "get_velocity_floats")
 
 
-def crowd_robots(
-    env: Any, twins: tuple[Any, Any] | None = None
-) -> tuple[list[int], NDArray[np.float64], NDArray[np.float64]]:
-    """The env's robots present on its crowd's floor: their indices, ``(M, 3)`` discs
-    ``(x, y, radius)`` and ``(M, 2)`` planar velocities (m, m/s), read through ``twins``
-    (:func:`pose_twins` of its backend, found here when None)."""
-    backend, floor = env.backend, env.crowd.floor
-    # The float twins give the same numbers without building two arrays per robot per step.
-    pose, velocity = pose_twins(backend) if twins is None else twins
-    ids: list[int] = []
-    discs, velocities = np.empty((len(env.robots), 3)), np.empty((len(env.robots), 2))
-    for j, spec in enumerate(env.robots):
-        if not backend.is_present(j) or backend.get_robot_floor(j) != floor:
-            continue
-        if pose is not None and velocity is not None:
-            x, y = pose(j)[:2]
-            vx, vy = velocity(j)[:2]
-        else:
-            (x, y), (vx, vy) = backend.get_pose(j)[0][:2].tolist(), backend.get_velocity(j)[0][:2].tolist()
-        m = len(ids)
-        discs[m] = x, y, spec.radius
-        velocities[m] = vx, vy
-        ids.append(j)
-    return ids, discs[: len(ids)], velocities[: len(ids)]
+class CrowdRobots:
+    """The env's robots as its crowd sees them at a control step, read once per step
+    through the backend's float twins (:func:`pose_twins`, bound for the episode): the
+    discs ``(x, y, radius)`` (m) and planar velocities (m/s) of those present on the
+    crowd's floor, in rows kept from step to step, and every robot's pose, which its
+    :class:`CrowdTrack` records (the crowd does not move the robots)."""
+
+    def __init__(self, env: Any) -> None:
+        self.twins = pose_twins(env.backend)
+        n = len(env.robots)
+        self._radius = [spec.radius for spec in env.robots]
+        self._discs, self._velocities = np.empty((n, 3)), np.empty((n, 2))
+        #: Each robot's ``(x, y, z, qx, qy, qz, qw)`` at the last :meth:`read`.
+        self.poses: list[tuple[float, ...]] = [()] * n
+
+    def read(self, env: Any) -> tuple[list[int], NDArray[np.float64], NDArray[np.float64]]:
+        """The present robots on the crowd's floor now: their indices, ``(M, 3)`` discs and
+        ``(M, 2)`` velocities (views of the kept rows, good until the next read)."""
+        backend, floor = env.backend, env.crowd.floor
+        pose, velocity = self.twins
+        ids: list[int] = []
+        discs, velocities = self._discs, self._velocities
+        for j in range(len(self.poses)):
+            if pose is not None:  # the same numbers as get_pose, without its arrays
+                p = self.poses[j] = pose(j)
+            else:
+                position, quat = backend.get_pose(j)
+                p = self.poses[j] = (*position.tolist(), *quat.tolist())
+            if not backend.is_present(j) or backend.get_robot_floor(j) != floor:
+                continue
+            vx, vy = velocity(j)[:2] if velocity is not None else backend.get_velocity(j)[0][:2].tolist()
+            m = len(ids)
+            discs[m, 0], discs[m, 1], discs[m, 2] = p[0], p[1], self._radius[j]
+            velocities[m, 0], velocities[m, 1] = vx, vy
+            ids.append(j)
+        return ids, discs[: len(ids)], velocities[: len(ids)]
 
 
-def robot_discs(env: Any, twins: tuple[Any, Any] | None = None) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-    """:func:`crowd_robots`' discs and velocities."""
-    _, discs, velocities = crowd_robots(env, twins)
-    return discs, velocities
+def crowd_robots(env: Any) -> tuple[list[int], NDArray[np.float64], NDArray[np.float64]]:
+    """The env's robots present on its crowd's floor, read once (:meth:`CrowdRobots.read`,
+    in fresh arrays): their indices, ``(M, 3)`` discs ``(x, y, radius)`` and ``(M, 2)``
+    planar velocities (m, m/s)."""
+    return CrowdRobots(env).read(env)
 
 
 def spawn_crowd(env: Any, record: Any = None) -> None:
@@ -97,7 +110,7 @@ def spawn_crowd(env: Any, record: Any = None) -> None:
     env.crowd.floor = task.floor
     # A recorded crowd draws nothing here: the env's stream is the same with or without it.
     seed = 0 if record is not None else int(env.np_random.integers(2**63))
-    robots, _ = robot_discs(env)
+    _, robots, _ = crowd_robots(env)
     env.crowd.spawn(task.floor, np.random.default_rng(seed), robots, record)
 
 
@@ -126,14 +139,18 @@ class CrowdTrack:
         self.pedestrians: list[NDArray[np.float64]] = []
         self.record(env)
 
-    def record(self, env: Any) -> None:
-        """Add the env's positions now (after a control step, or at the reset)."""
-        pose = self.twins[0]
-        if pose is not None:  # the same numbers as get_pose, without its arrays
-            x, y, _, qx, qy, qz, qw = pose(self.idn)
-        else:
-            position, quat = env.backend.get_pose(self.idn)
-            (x, y), (qx, qy, qz, qw) = position[:2].tolist(), quat.tolist()
+    def record(self, env: Any, pose: tuple[float, ...] | None = None) -> None:
+        """Add the env's positions now (after a control step, or at the reset): the robot's
+        ``pose`` ``(x, y, z, qx, qy, qz, qw)`` where it was read already
+        (:attr:`CrowdRobots.poses`), else read here."""
+        if pose is None:
+            twin = self.twins[0]
+            if twin is not None:  # the same numbers as get_pose, without its arrays
+                pose = twin(self.idn)
+            else:
+                position, quat = env.backend.get_pose(self.idn)
+                pose = (*position.tolist(), *quat.tolist())
+        x, y, _, qx, qy, qz, qw = pose
         self.robot.append((x, y))
         self.heading.append(heading_of(qx, qy, qz, qw))
         self.pedestrians.append(env.crowd.positions.copy())

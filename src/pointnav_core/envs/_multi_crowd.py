@@ -35,6 +35,7 @@ class FleetCrowd:
         self.touched = [False] * n_robots
         self.counts = [0] * n_robots
         self.tracks: list[_crowd.CrowdTrack] = []
+        self.robots: _crowd.CrowdRobots | None = None
 
     def reset(self, env: Any, infos: list[dict[str, Any]], record: Any = None) -> None:
         """Place the crowd for new episodes (after the robots' resets, whose ``infos`` get
@@ -46,6 +47,7 @@ class FleetCrowd:
         self.touched = [False] * self.n
         self.counts = [0] * self.n
         self.tracks = [_crowd.CrowdTrack(env, i) for i in range(self.n)]
+        self.robots = _crowd.CrowdRobots(env)
 
     def begin(self, env: Any) -> Callable[[], None]:
         """Start an action (no robot has touched a pedestrian yet); the call that walks the
@@ -55,12 +57,12 @@ class FleetCrowd:
 
     def step(self, env: Any) -> None:
         """Move the crowd one control step beside the robots; note who touches a pedestrian."""
-        ids, discs, velocities = _crowd.crowd_robots(env, self.tracks[0].twins)
+        ids, discs, velocities = self.robots.read(env)
         hits = self.crowd.step_contacts(1.0 / env.action_frequency, discs, velocities)
         for i, hit in zip(ids, hits.tolist()):
             self.touched[i] = self.touched[i] or hit
         for track in self.tracks:
-            track.record(env)
+            track.record(env, self.robots.poses[track.idn])
 
     def finish(self, env: Any, index: Mapping[str, int], returns: Any) -> None:
         """Add each acting robot's contact count, and its social metrics where its episode

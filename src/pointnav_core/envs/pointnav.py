@@ -274,6 +274,7 @@ class PointNavEnv(gym.Env[Any, np.ndarray]):
         self.crowd = self._own_crowd = _crowd.make_crowd(pedestrians, scene)
         self._touched, self._pedestrian_steps = False, 0
         self._track: _crowd.CrowdTrack | None = None
+        self._robots: _crowd.CrowdRobots | None = None
         task = _envcommon.add_stop(_envcommon.add_sensors(task, sensors), self.discrete_actions)
         task = _crowd.add_pedestrian_termination(task, self.crowd)
         self.task = _envcommon.make_task(task)
@@ -320,7 +321,7 @@ class PointNavEnv(gym.Env[Any, np.ndarray]):
         if self.crowd is not None:
             _crowd.spawn_crowd(self, record)
             self._touched, self._pedestrian_steps = False, 0
-            self._track = _crowd.CrowdTrack(self)
+            self._track, self._robots = _crowd.CrowdTrack(self), _crowd.CrowdRobots(self)
             info["pedestrian_collisions"] = 0
         return self._get_obs(), info
 
@@ -405,11 +406,11 @@ class PointNavEnv(gym.Env[Any, np.ndarray]):
 
     def _step_crowd(self) -> bool:
         """Move the pedestrians one control step beside the robot; whether they touch it."""
-        robots, velocities = _crowd.robot_discs(self, self._track.twins)  # type: ignore[union-attr]
+        _, robots, velocities = self._robots.read(self)  # type: ignore[union-attr]
         # One call steps the crowd and finds its contacts (one compiled call for ORCA).
         contacts = self.crowd.step_contacts(1.0 / self.action_frequency, robots, velocities)  # type: ignore[union-attr]
         self._touched = touched = bool(contacts.any())  # none when the robot left the floor
-        self._track.record(self)
+        self._track.record(self, self._robots.poses[self._idn])  # type: ignore[union-attr]
         return touched
 
     def _count_contact(self, info: dict[str, Any], touched: bool) -> dict[str, Any]:
