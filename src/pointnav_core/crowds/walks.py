@@ -67,15 +67,11 @@ def plan_walk(scene: Any, floor: int, radius: float, here: NDArray[np.float64], 
     planner = planner_for(tmap, radius)
     # Where to plan from: here, or the nearest cell centre within 3 cells where the paths'
     # radius fits (a neighbour's push can leave a pedestrian nearer a wall than its path runs).
-    # Here's part of the floor, which goals are drawn from, is found on the way: a point with
-    # a component fits the disc (TraversableMap.component_at).
-    label = int(tmap.component_at(here, radius))
     x, y = float(here[0]), float(here[1])
-    start = here if label or tmap.collision.segment_clear(x, y, x, y, radius) else nearest_usable(tmap, here, radius)
+    start = here if tmap.collision.segment_clear(x, y, x, y, radius) else nearest_usable(tmap, here, radius)
     if start is None:
         return Planned(here[None].copy(), False)
-    if start is not here:
-        label = int(tmap.component_at(start, radius))
+    label = None  # start's part of the floor, which goals are drawn from: found at the first draw
     drawn = False
     for attempt in range(10):
         fresh = False  # a goal drawn now, from start's component
@@ -88,6 +84,8 @@ def plan_walk(scene: Any, floor: int, radius: float, here: NDArray[np.float64], 
         elif new_goal or attempt:
             goal = start
             drawn = fresh = True
+            if label is None:
+                label = int(tmap.component_at(start, radius))
             for _ in range(10):
                 goal = draw_point(tmap, radius, label, start, None, rng) if label else None
                 if goal is None:  # Scene.get_random_point's errors where it has no draw
